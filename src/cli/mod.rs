@@ -1,0 +1,7 @@
+//! The native command-line tool.
+
+use std::process::ExitCode;
+
+pub fn main() -> ExitCode {
+    ExitCode::SUCCESS
+}

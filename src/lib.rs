@@ -1,0 +1,17 @@
+//! meshsmooth: visually guided smoothing of anatomical surface meshes.
+//!
+//! Data flows one way: bytes -> [`io`] (parse, weld) -> [`mesh`] (indexed mesh, CSR topology,
+//! report) -> [`smooth`] (CPU reference) -> [`metrics`] -> [`export`]. The command-line tool
+//! (native) and the web app (wasm32) sit on top and own no algorithm.
+
+pub mod export;
+pub mod io;
+pub mod mesh;
+pub mod metrics;
+pub mod smooth;
+
+#[cfg(not(target_arch = "wasm32"))]
+pub mod cli;
+
+#[cfg(target_arch = "wasm32")]
+pub mod app;

@@ -1,0 +1,150 @@
+//! The indexed triangle mesh and everything derived from its connectivity.
+//!
+//! A mesh is two flat arrays (positions, triangles) so it can be uploaded to a GPU as-is;
+//! topology (`Topology`) and the validation report (`MeshReport`) are built on demand.
+
+mod normals;
+mod report;
+mod topology;
+
+pub use normals::vertex_normals;
+pub use report::MeshReport;
+pub use topology::Topology;
+
+/// "No such index" in flat `u32` arrays.
+pub const NONE: u32 = u32::MAX;
+
+/// Indexed triangle mesh: positions in the file's units (mm for medical meshes) and
+/// counter-clockwise triangles (seen from outside).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    pub fn new(positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>) -> Self {
+        Self {
+            positions,
+            triangles,
+        }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Axis-aligned bounding box `(min, max)` of all positions; `None` for an empty mesh.
+    pub fn bounding_box(&self) -> Option<([f32; 3], [f32; 3])> {
+        bounding_box(&self.positions)
+    }
+
+    /// Length of the bounding-box diagonal (0 for an empty mesh).
+    pub fn bounding_box_diagonal(&self) -> f64 {
+        self.bounding_box().map_or(0.0, |(lo, hi)| {
+            let d: f64 = (0..3).map(|k| (hi[k] as f64 - lo[k] as f64).powi(2)).sum();
+            d.sqrt()
+        })
+    }
+
+    /// Signed volume by the divergence theorem, `V = 1/6 sum_t p_a . (p_b x p_c)`, in f64.
+    /// Meaningful only for a closed, consistently wound mesh (the report says whether it is).
+    pub fn signed_volume(&self) -> f64 {
+        signed_volume(&self.positions, &self.triangles)
+    }
+}
+
+/// Axis-aligned bounding box of a point set.
+pub fn bounding_box(positions: &[[f32; 3]]) -> Option<([f32; 3], [f32; 3])> {
+    let first = *positions.first()?;
+    Some(
+        positions
+            .iter()
+            .fold((first, first), |(mut lo, mut hi), p| {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+                (lo, hi)
+            }),
+    )
+}
+
+/// Signed volume of a triangle set over the given positions (divergence theorem, f64 sums).
+pub fn signed_volume(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> f64 {
+    use rayon::prelude::*;
+    triangles
+        .par_chunks(4096)
+        .map(|chunk| {
+            chunk
+                .iter()
+                .map(|t| {
+                    let a = to_f64(positions[t[0] as usize]);
+                    let b = to_f64(positions[t[1] as usize]);
+                    let c = to_f64(positions[t[2] as usize]);
+                    dot(a, cross(b, c))
+                })
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / 6.0
+}
+
+#[inline]
+pub(crate) fn to_f64(p: [f32; 3]) -> [f64; 3] {
+    [p[0] as f64, p[1] as f64, p[2] as f64]
+}
+
+#[inline]
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline]
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline]
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit right tetrahedron, outward winding.
+    pub(crate) fn tetrahedron() -> Mesh {
+        Mesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        )
+    }
+
+    #[test]
+    fn tetrahedron_volume_is_one_sixth() {
+        assert!((tetrahedron().signed_volume() - 1.0 / 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bounding_box_of_tetrahedron() {
+        let m = tetrahedron();
+        assert_eq!(m.bounding_box(), Some(([0.0; 3], [1.0; 3])));
+        assert!((m.bounding_box_diagonal() - 3f64.sqrt()).abs() < 1e-12);
+        assert_eq!(Mesh::default().bounding_box(), None);
+    }
+}

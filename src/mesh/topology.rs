@@ -1,0 +1,251 @@
+//! Vertex 1-rings and vertex->triangle incidence as flat CSR arrays.
+//!
+//! Built in linear time by counting sorts; every array is `u32` so the GPU engine uploads it as-is.
+//! `offsets[i]..offsets[i + 1]` indexes vertex `i`'s entries (the paper's "lookup table").
+
+use super::Mesh;
+use rayon::prelude::*;
+
+/// Connectivity of an indexed mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Topology {
+    /// CSR offsets into `neighbors`, one more than the vertex count.
+    pub neighbor_offsets: Vec<u32>,
+    /// 1-ring `N(i)`: the vertices sharing an edge with `i`, each once, ascending.
+    pub neighbors: Vec<u32>,
+    /// Parallel to `neighbors`: how many triangles use the edge `(i, neighbors[k])`.
+    /// 1 = boundary edge, 2 = manifold interior edge, 3+ = non-manifold edge.
+    pub edge_triangle_counts: Vec<u32>,
+    /// CSR offsets into `vertex_triangles`, one more than the vertex count.
+    pub triangle_offsets: Vec<u32>,
+    /// Triangles incident to each vertex, ascending, each once.
+    pub vertex_triangles: Vec<u32>,
+    /// True for vertices on a boundary edge (an edge used by exactly one triangle).
+    pub is_boundary: Vec<bool>,
+    /// The neighbourhood smoothing uses: the full 1-ring for interior vertices and only the
+    /// boundary neighbours for boundary vertices (1-D smoothing along the boundary).
+    /// `None` when the mesh has no boundary, in which case it equals the 1-ring.
+    boundary_ring: Option<(Vec<u32>, Vec<u32>)>,
+}
+
+impl Topology {
+    /// Builds the CSR arrays for `mesh`. Triangles with repeated indices contribute only their
+    /// distinct edges; indices must be in range (the parsers guarantee it).
+    pub fn build(mesh: &Mesh) -> Self {
+        let n = mesh.positions.len();
+        let tris = &mesh.triangles;
+        debug_assert!(tris.iter().flatten().all(|&v| (v as usize) < n));
+
+        // Vertex -> triangle incidence by counting sort (ascending triangle order for free).
+        let mut triangle_offsets = vec![0u32; n + 1];
+        for t in tris {
+            for (k, &v) in t.iter().enumerate() {
+                if !t[..k].contains(&v) {
+                    triangle_offsets[v as usize + 1] += 1;
+                }
+            }
+        }
+        prefix_sum(&mut triangle_offsets);
+        let mut cursor: Vec<u32> = triangle_offsets[..n].to_vec();
+        let mut vertex_triangles = vec![0u32; triangle_offsets[n] as usize];
+        for (ti, t) in tris.iter().enumerate() {
+            for (k, &v) in t.iter().enumerate() {
+                if !t[..k].contains(&v) {
+                    let c = &mut cursor[v as usize];
+                    vertex_triangles[*c as usize] = ti as u32;
+                    *c += 1;
+                }
+            }
+        }
+
+        // Raw 1-ring with multiplicity: each triangle around `i` lists its other two corners, so a
+        // neighbour appears once per triangle using that edge.
+        let mut neighbor_offsets = vec![0u32; n + 1];
+        let mut lists: Vec<(Vec<u32>, Vec<u32>)> = (0..n)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|i| {
+                let fan = &vertex_triangles
+                    [triangle_offsets[i] as usize..triangle_offsets[i + 1] as usize];
+                let mut raw: Vec<u32> = Vec::with_capacity(fan.len() * 2);
+                for &ti in fan {
+                    for &v in &tris[ti as usize] {
+                        if v as usize != i {
+                            raw.push(v);
+                        }
+                    }
+                }
+                raw.sort_unstable();
+                let mut ring = Vec::with_capacity(fan.len() + 1);
+                let mut counts = Vec::with_capacity(fan.len() + 1);
+                for v in raw {
+                    if ring.last() == Some(&v) {
+                        *counts.last_mut().expect("counts parallel to ring") += 1;
+                    } else {
+                        ring.push(v);
+                        counts.push(1u32);
+                    }
+                }
+                (ring, counts)
+            })
+            .collect();
+        for (i, (ring, _)) in lists.iter().enumerate() {
+            neighbor_offsets[i + 1] = neighbor_offsets[i] + ring.len() as u32;
+        }
+        let total = neighbor_offsets[n] as usize;
+        let mut neighbors = Vec::with_capacity(total);
+        let mut edge_triangle_counts = Vec::with_capacity(total);
+        for (ring, counts) in lists.drain(..) {
+            neighbors.extend_from_slice(&ring);
+            edge_triangle_counts.extend_from_slice(&counts);
+        }
+
+        let is_boundary: Vec<bool> = (0..n)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|i| {
+                edge_triangle_counts[neighbor_offsets[i] as usize..neighbor_offsets[i + 1] as usize]
+                    .contains(&1)
+            })
+            .collect();
+
+        let boundary_ring = is_boundary.iter().any(|&b| b).then(|| {
+            let mut offsets = vec![0u32; n + 1];
+            let mut ring = Vec::with_capacity(total);
+            for i in 0..n {
+                let range = neighbor_offsets[i] as usize..neighbor_offsets[i + 1] as usize;
+                if is_boundary[i] {
+                    ring.extend(
+                        range
+                            .filter(|&k| edge_triangle_counts[k] == 1)
+                            .map(|k| neighbors[k]),
+                    );
+                } else {
+                    ring.extend_from_slice(&neighbors[range]);
+                }
+                offsets[i + 1] = ring.len() as u32;
+            }
+            (offsets, ring)
+        });
+
+        Self {
+            neighbor_offsets,
+            neighbors,
+            edge_triangle_counts,
+            triangle_offsets,
+            vertex_triangles,
+            is_boundary,
+            boundary_ring,
+        }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.neighbor_offsets.len().saturating_sub(1)
+    }
+
+    /// The 1-ring `N(i)`.
+    #[inline]
+    pub fn neighbors_of(&self, i: usize) -> &[u32] {
+        &self.neighbors[self.neighbor_offsets[i] as usize..self.neighbor_offsets[i + 1] as usize]
+    }
+
+    /// Triangles incident to vertex `i`.
+    #[inline]
+    pub fn triangles_of(&self, i: usize) -> &[u32] {
+        &self.vertex_triangles
+            [self.triangle_offsets[i] as usize..self.triangle_offsets[i + 1] as usize]
+    }
+
+    /// True when any vertex lies on a boundary edge.
+    pub fn has_boundary(&self) -> bool {
+        self.boundary_ring.is_some()
+    }
+
+    /// The smoothing neighbourhood as CSR `(offsets, neighbors)`: the 1-ring, except that boundary
+    /// vertices see only their boundary neighbours.
+    pub fn smoothing_ring(&self) -> (&[u32], &[u32]) {
+        match &self.boundary_ring {
+            Some((offsets, ring)) => (offsets, ring),
+            None => (&self.neighbor_offsets, &self.neighbors),
+        }
+    }
+
+    /// Number of distinct undirected edges.
+    pub fn edge_count(&self) -> usize {
+        self.neighbors.len() / 2
+    }
+}
+
+fn prefix_sum(offsets: &mut [u32]) {
+    for i in 1..offsets.len() {
+        offsets[i] += offsets[i - 1];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Mesh {
+        // Two triangles sharing the diagonal 0-2: an open quad.
+        Mesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    #[test]
+    fn quad_rings_and_edge_counts() {
+        let t = Topology::build(&square());
+        assert_eq!(t.neighbors_of(0), &[1, 2, 3]);
+        assert_eq!(t.neighbors_of(1), &[0, 2]);
+        assert_eq!(t.triangles_of(0), &[0, 1]);
+        assert_eq!(t.triangles_of(3), &[1]);
+        assert_eq!(t.edge_count(), 5);
+        // The diagonal 0-2 is shared by both triangles; all others are boundary edges.
+        let k = t.neighbor_offsets[0] as usize + 1;
+        assert_eq!(t.neighbors[k], 2);
+        assert_eq!(t.edge_triangle_counts[k], 2);
+        assert!(t.is_boundary.iter().all(|&b| b));
+        // Boundary vertices smooth along the boundary only: 0 drops the diagonal to 2.
+        let (off, ring) = t.smoothing_ring();
+        assert_eq!(&ring[off[0] as usize..off[1] as usize], &[1, 3]);
+    }
+
+    #[test]
+    fn closed_mesh_has_no_boundary_and_shares_the_ring() {
+        let m = Mesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        );
+        let t = Topology::build(&m);
+        assert!(!t.has_boundary());
+        assert!(t.edge_triangle_counts.iter().all(|&c| c == 2));
+        assert_eq!(t.smoothing_ring().1, &t.neighbors[..]);
+        assert_eq!(t.edge_count(), 6);
+    }
+
+    #[test]
+    fn unreferenced_and_degenerate_index_triangles() {
+        let m = Mesh::new(
+            vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [5.0; 3]],
+            vec![[0, 1, 2], [0, 0, 1]],
+        );
+        let t = Topology::build(&m);
+        assert!(t.neighbors_of(3).is_empty());
+        assert!(t.triangles_of(3).is_empty());
+        assert_eq!(t.triangles_of(0), &[0, 1]);
+        // Edge 0-1 is used by both triangles (the second is degenerate but still names it).
+        assert_eq!(t.neighbors_of(0), &[1, 2]);
+    }
+}
