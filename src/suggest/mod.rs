@@ -42,11 +42,14 @@ impl Terms {
         volume_change: Some(0.0),
     };
 
-    /// The accuracy part of the score, `0.5 * (E/(E+1) + |V-V0|/V0)`. An open mesh has no volume
-    /// term, so only the error counts there.
+    /// The accuracy half of the score, `0.5 * (E/(E+1) + |V-V0|/V0)`. Without a volume (open
+    /// mesh) it is `E/(E+1)` alone, the mean of the terms that exist, as in [`crate::metrics`].
     pub fn accuracy(&self) -> f64 {
         let e = self.mean_error / (self.mean_error + 1.0);
-        0.5 * (e + self.volume_change.unwrap_or(0.0))
+        match self.volume_change {
+            Some(v) => 0.5 * (e + v),
+            None => e,
+        }
     }
 
     /// `S(tau) = tau * K/K0 + (1 - tau) * accuracy`. Lower is better. NaN terms give NaN, which
@@ -193,7 +196,7 @@ mod tests {
             volume_change: None,
             ..t
         };
-        assert!((open.accuracy() - 0.5 * 0.2).abs() < 1e-15);
+        assert!((open.accuracy() - 0.2).abs() < 1e-15);
         assert_eq!(Terms::UNCHANGED.score(0.0), 0.0);
         assert_eq!(Terms::UNCHANGED.score(0.7), 0.7);
     }

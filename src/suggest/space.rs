@@ -53,15 +53,17 @@ impl Param {
         }
     }
 
+    /// The value in `p`, as the decimal the f32 was written as (0.1, not 0.10000000149).
     pub fn get(self, p: &Params) -> f64 {
-        match self {
-            Param::Lambda => p.lambda as f64,
-            Param::Mu => p.mu as f64,
-            Param::Alpha => p.alpha as f64,
-            Param::Beta => p.beta as f64,
-            Param::Passband => p.passband as f64,
-            Param::Iterations => p.iterations as f64,
-        }
+        let weight = match self {
+            Param::Lambda => p.lambda,
+            Param::Mu => p.mu,
+            Param::Alpha => p.alpha,
+            Param::Beta => p.beta,
+            Param::Passband => p.passband,
+            Param::Iterations => return p.iterations as f64,
+        };
+        weight.to_string().parse().unwrap_or(weight as f64)
     }
 
     pub fn set(self, p: &mut Params, value: f64) {
@@ -264,6 +266,14 @@ impl ParamSpace {
                     self.is_valid(base, p).then_some(p)
                 })
             })
+            .collect()
+    }
+
+    /// The values of this filter's parameters in `params`, in axis order.
+    pub fn values(&self, params: &Params) -> Vec<(Param, f64)> {
+        self.axes
+            .iter()
+            .map(|a| (a.param, a.param.get(params)))
             .collect()
     }
 

@@ -217,7 +217,7 @@ mod tests {
         assert_eq!(g.curves[0].samples.len(), 21);
         assert_eq!(g.curves[0].samples[1].value, 0.05);
         assert_eq!(g.curves[2].samples.len(), 51);
-        assert_eq!(g.curves[0].current, 0.1f32 as f64);
+        assert_eq!(g.curves[0].current, 0.1);
         // 21 + 21 weight runs, one cumulative run for the 51 iteration samples.
         assert_eq!(ev.runs, 43);
         for c in &g.curves {
