@@ -53,8 +53,8 @@ fn differences(
         .zip(q.par_chunks(CHUNK).zip(original.par_chunks(CHUNK)))
         .enumerate()
         .for_each(|(c, (b, (own, orig)))| {
-            for (k, (bi, (&qi, &oi))) in b.iter_mut().zip(own.iter().zip(orig)).enumerate() {
-                let ring = rings.of(c * CHUNK + k);
+            let rows = b.iter_mut().zip(own.iter().zip(orig)).zip(rings.chunk(c));
+            for ((bi, (&qi, &oi)), ring) in rows {
                 *bi = if ring.is_empty() {
                     [0.0; 3]
                 } else {
@@ -81,9 +81,9 @@ fn correct<C: Constrain>(
         .zip(b.par_chunks(CHUNK).zip(original.par_chunks(CHUNK)))
         .enumerate()
         .for_each(|(c, (q, (own_b, orig)))| {
-            for (k, (qi, (&bi, &oi))) in q.iter_mut().zip(own_b.iter().zip(orig)).enumerate() {
+            let rows = q.iter_mut().zip(own_b.iter().zip(orig)).zip(rings.chunk(c));
+            for (k, ((qi, (&bi, &oi)), ring)) in rows.enumerate() {
                 let i = c * CHUNK + k;
-                let ring = rings.of(i);
                 if ring.is_empty() {
                     continue;
                 }

@@ -34,10 +34,16 @@ impl<'a> Rings<'a> {
         self.offsets.len() - 1
     }
 
-    /// The ring of vertex `i` (`i < vertex_count`).
+    /// The rings of the vertices of chunk `c` (`c * CHUNK ..`, at most `CHUNK` of them), in
+    /// order. Walking the chunk's offsets pairwise saves the per-vertex offset checks.
     #[inline(always)]
-    pub(crate) fn of(&self, i: usize) -> &'a [u32] {
-        &self.neighbors[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    pub(crate) fn chunk(&self, c: usize) -> impl Iterator<Item = &'a [u32]> + 'a {
+        let start = (c * CHUNK).min(self.vertex_count());
+        let end = (start + CHUNK).min(self.vertex_count());
+        let neighbors = self.neighbors;
+        self.offsets[start..=end]
+            .windows(2)
+            .map(move |w| &neighbors[w[0] as usize..w[1] as usize])
     }
 }
 

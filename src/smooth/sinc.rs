@@ -99,10 +99,9 @@ fn first_term(
         .enumerate()
         .for_each(|(c, (((t0, t1), e), orig))| {
             let rows = t0.iter_mut().zip(t1.iter_mut()).zip(e.iter_mut()).zip(orig);
-            for (k, (((t0, t1), e), &o)) in rows.enumerate() {
+            for ((((t0, t1), e), &o), ring) in rows.zip(rings.chunk(c)) {
                 let z0 = std::array::from_fn(|k| o[k] - centre[k]);
                 *t0 = z0;
-                let ring = rings.of(c * CHUNK + k);
                 if ring.is_empty() {
                     *t1 = z0;
                     *e = o;
@@ -129,8 +128,8 @@ fn next_term(
         .zip(current.par_chunks(CHUNK))
         .enumerate()
         .for_each(|(c, ((t, e), own))| {
-            for (k, ((t, e), &tk)) in t.iter_mut().zip(e.iter_mut()).zip(own).enumerate() {
-                let ring = rings.of(c * CHUNK + k);
+            let rows = t.iter_mut().zip(e.iter_mut()).zip(own).zip(rings.chunk(c));
+            for (((t, e), &tk), ring) in rows {
                 if ring.is_empty() {
                     // L = 0 there: every T_k x equals x, and the estimate stays the original.
                     *t = tk;

@@ -47,9 +47,9 @@ fn step<C: Constrain>(
         .zip(src.par_chunks(CHUNK))
         .enumerate()
         .for_each(|(c, (dst, own))| {
-            for (k, (out, &q)) in dst.iter_mut().zip(own).enumerate() {
+            let rows = dst.iter_mut().zip(own).zip(rings.chunk(c)).enumerate();
+            for (k, ((out, &q), ring)) in rows {
                 let i = c * CHUNK + k;
-                let ring = rings.of(i);
                 *out = if ring.is_empty() {
                     q
                 } else {
