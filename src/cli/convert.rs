@@ -1,0 +1,22 @@
+//! `meshsmooth convert IN OUT`.
+
+use crate::export::{self, ExportFormat, ExportOptions};
+use std::path::Path;
+
+pub(super) fn run(input: &Path, output: &Path) -> Result<(), String> {
+    let format = output_format(output)?;
+    let mesh = super::load_file(input)?;
+    let bytes = export::write(&mesh, format, &ExportOptions::default())
+        .map_err(|e| format!("{}: {e}", output.display()))?;
+    super::write_file(output, &bytes)
+}
+
+/// The output format named by the file's extension.
+pub(super) fn output_format(output: &Path) -> Result<ExportFormat, String> {
+    ExportFormat::from_name(&output.to_string_lossy()).ok_or_else(|| {
+        format!(
+            "{}: cannot tell the output format: use .ply, .stl, .obj or .glb",
+            output.display()
+        )
+    })
+}
