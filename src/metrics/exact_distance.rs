@@ -94,12 +94,8 @@ impl TriangleBvh {
                     .iter()
                     .enumerate()
                 {
-                    let d2 = point_triangle_distance2(
-                        p,
-                        to_f64(tri[0]),
-                        to_f64(tri[1]),
-                        to_f64(tri[2]),
-                    );
+                    let d2 =
+                        point_triangle_distance2(p, to_f64(tri[0]), to_f64(tri[1]), to_f64(tri[2]));
                     if d2 < best {
                         best = d2;
                         best_entry = start + k;

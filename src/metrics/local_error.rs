@@ -4,127 +4,74 @@
 //!
 //! It measures to part of the original mesh, so it is never below the exact distance to it.
 
+use super::curvature::other_corners;
 use super::exact_distance::{point_segment_distance2, SLIVER_SINE};
 use super::Original;
 use crate::mesh::{cross, dot, sub, to_f64};
 use crate::smooth::StepObserver;
 use rayon::prelude::*;
 
-/// One original triangle's prism, precomputed once. The paper solves `(a, b, c) = P^-1 (q - p_r)`
-/// with `P = [e1 e2 n]` from the reference corner `r`; `(a, b)` and `1 - a - b` are then the
-/// barycentric coordinates of `q`'s projection and `c` its height over the plane, none of which
-/// depends on which corner is the origin. So each triangle stores one frame, at its first corner:
-/// `a = g1 . (q - origin)`, `b = g2 . (q - origin)`, `c = n . (q - origin)`.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct PrismFrame {
-    /// Unit normal, in f64: the height `|c|` is the reported distance.
-    normal: [f64; 3],
-    /// The first corner, exactly as in the original positions.
-    origin: [f32; 3],
-    /// Rows of `P^-1` for the in-plane coordinates; f32 suffices to classify inside or outside.
-    g1: [f32; 3],
-    g2: [f32; 3],
-    /// False for degenerate and sliver triangles (`P` is not invertible): only their edges count.
-    valid: bool,
-}
-
-impl PrismFrame {
-    fn new(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> Self {
-        let (a64, b64, c64) = (to_f64(a), to_f64(b), to_f64(c));
-        let e1 = sub(b64, a64);
-        let e2 = sub(c64, a64);
-        let m = cross(e1, e2);
-        let len = dot(m, m).sqrt();
-        let scale = (dot(e1, e1) * dot(e2, e2)).sqrt();
-        if !(len > SLIVER_SINE * scale && len.is_finite()) {
-            return Self::default();
-        }
-        let n = [m[0] / len, m[1] / len, m[2] / len];
-        // Dual basis of (e1, e2) in the plane: g1 . e1 = 1, g1 . e2 = 0 and so on.
-        let g1 = cross(e2, n).map(|x| (x / len) as f32);
-        let g2 = cross(n, e1).map(|x| (x / len) as f32);
-        let valid = g1.iter().chain(&g2).all(|x| x.is_finite());
-        Self {
-            normal: n,
-            origin: a,
-            g1,
-            g2,
-            valid,
-        }
-    }
-
-    /// Height of `q` over the triangle's plane when `q` lies in its prism. The height is taken from
-    /// the reference corner `pr`, as in the paper, so a vertex sitting on it measures exactly 0.
-    #[inline]
-    fn height_inside(&self, q: [f64; 3], pr: [f64; 3]) -> Option<f64> {
-        if !self.valid {
-            return None;
-        }
-        let d = sub(q, to_f64(self.origin));
-        let a = dot(to_f64(self.g1), d);
-        let b = dot(to_f64(self.g2), d);
-        (a >= 0.0 && b >= 0.0 && a + b <= 1.0).then(|| dot(self.normal, sub(q, pr)).abs())
-    }
-}
-
-/// Prism frames of every triangle of the original mesh.
-pub(crate) fn prism_frames(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Vec<PrismFrame> {
-    triangles
-        .par_iter()
-        .with_min_len(4096)
-        .map(|t| {
-            PrismFrame::new(
-                positions[t[0] as usize],
-                positions[t[1] as usize],
-                positions[t[2] as usize],
-            )
-        })
-        .collect()
-}
-
 /// Local error of a smoothed vertex at `q` whose reference vertex on the original mesh is `r`:
 /// the smallest prism height over the triangles around `r`, else the distance to the fan's edges
 /// (spokes from `r` and the rim opposite it), which covers its vertices.
+///
+/// Everything is computed from the original positions on the fly: for the usual `r = i` the
+/// measure pass has just read the same triangles for the curvature, so they are in cache, while
+/// precomputed per-triangle frames would be fetched from all over memory.
 #[inline]
 pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> f64 {
-    let q = to_f64(q);
-    let topology = original.topology();
-    let fan = topology.triangles_of(r);
-    let frames = original.frames();
     let positions = &original.mesh().positions;
+    let triangles = &original.mesh().triangles;
+    let fan = original.topology().triangles_of(r);
+    let q = to_f64(q);
     let pr = to_f64(positions[r]);
+    let d = sub(q, pr);
     let mut best = f64::INFINITY;
     for &t in fan {
-        if let Some(h) = frames[t as usize].height_inside(q, pr) {
+        let (j, k) = other_corners(triangles[t as usize], r as u32);
+        let e1 = sub(to_f64(positions[j as usize]), pr);
+        let e2 = sub(to_f64(positions[k as usize]), pr);
+        if let Some(h) = prism_height(e1, e2, d) {
             best = best.min(h);
         }
     }
     if best.is_finite() {
         return best;
     }
-    let triangles = &original.mesh().triangles;
-    let d = sub(q, pr);
     // The reference vertex itself: all there is for a vertex no triangle uses.
     let mut best2 = dot(d, d);
-    for &j in topology.neighbors_of(r) {
-        best2 = best2.min(point_segment_distance2(q, pr, to_f64(positions[j as usize])));
-    }
-    for &t in fan {
-        let tri = triangles[t as usize];
-        let rim = if tri[0] as usize == r {
-            (tri[1], tri[2])
-        } else if tri[1] as usize == r {
-            (tri[2], tri[0])
-        } else {
-            (tri[0], tri[1])
-        };
+    for &j in original.topology().neighbors_of(r) {
         best2 = best2.min(point_segment_distance2(
             q,
-            to_f64(positions[rim.0 as usize]),
-            to_f64(positions[rim.1 as usize]),
+            pr,
+            to_f64(positions[j as usize]),
+        ));
+    }
+    for &t in fan {
+        let (j, k) = other_corners(triangles[t as usize], r as u32);
+        best2 = best2.min(point_segment_distance2(
+            q,
+            to_f64(positions[j as usize]),
+            to_f64(positions[k as usize]),
         ));
     }
     best2.sqrt()
+}
+
+/// The paper's prism test, `(a, b, c) = P^-1 d` with `P = [e1 e2 n]`, `e1`, `e2` the triangle's
+/// edges from the reference vertex and `d = q - p_r`. By Cramer's rule with `m = e1 x e2`
+/// (`n = m / |m|`): `a = (d x e2).m / |m|^2`, `b = (e1 x d).m / |m|^2`, `c = d.m / |m|`, so the
+/// inside test needs no division. Returns `|c|` when `a, b >= 0` and `a + b <= 1`. A degenerate or
+/// sliver triangle (`P` not safely invertible) has no prism; its edges still count.
+#[inline]
+fn prism_height(e1: [f64; 3], e2: [f64; 3], d: [f64; 3]) -> Option<f64> {
+    let m = cross(e1, e2);
+    let m2 = dot(m, m);
+    let a = dot(cross(d, e2), m);
+    let b = dot(cross(e1, d), m);
+    let inside = a >= 0.0 && b >= 0.0 && a + b <= m2;
+    (inside && m2 > SLIVER_SINE * SLIVER_SINE * dot(e1, e1) * dot(e2, e2))
+        .then(|| dot(d, m).abs() / m2.sqrt())
 }
 
 /// The drifting reference neighbourhood: after every smoothing step, each vertex's reference moves
@@ -175,10 +122,9 @@ impl<'a> DriftingReference<'a> {
                 let mut best_d2 = d2(original.positions[best as usize]);
                 for &j in topology.neighbors_of(*r as usize) {
                     let dj = d2(original.positions[j as usize]);
-                    if dj < best_d2 {
-                        best = j;
-                        best_d2 = dj;
-                    }
+                    let closer = dj < best_d2;
+                    best = if closer { j } else { best };
+                    best_d2 = if closer { dj } else { best_d2 };
                 }
                 *r = best;
             });

@@ -1,17 +1,15 @@
 //! The original mesh M as the measures see it: built once per loaded mesh, so every measure pass
 //! over a smoothed mesh only reads what stays fixed.
 
-use super::local_error::{prism_frames, PrismFrame};
 use super::report::{measure_pass, Sums};
 use crate::mesh::{Mesh, Topology};
 
-/// The original mesh with what the measures precompute from it: its prism frames, its volume
-/// V0 (closed meshes only) and its curvature K0.
+/// The original mesh with what the measures precompute from it: its volume V0 (closed meshes
+/// only) and its curvature K0.
 #[derive(Clone, Debug)]
 pub struct Original {
     mesh: Mesh,
     topology: Topology,
-    frames: Vec<PrismFrame>,
     volume: Option<f64>,
     curvature: f64,
     /// Vertices some triangle uses: the ones the local error averages over.
@@ -32,7 +30,6 @@ impl Original {
         let mut original = Self {
             mesh: mesh.clone(),
             topology: topology.clone(),
-            frames: prism_frames(&mesh.positions, &mesh.triangles),
             volume: None,
             curvature: 0.0,
             referenced,
@@ -70,9 +67,5 @@ impl Original {
     /// Number of vertices some triangle uses.
     pub fn referenced_vertices(&self) -> usize {
         self.referenced
-    }
-
-    pub(crate) fn frames(&self) -> &[PrismFrame] {
-        &self.frames
     }
 }

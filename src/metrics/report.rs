@@ -1,7 +1,7 @@
 //! One measure pass over a smoothed mesh and the report it yields: volume, curvature, local
 //! error and the score, plus per-vertex arrays for colour-coding.
 
-use super::curvature::fan_sums;
+use super::curvature::{fan_sums, triangle_areas, TriangleArea};
 use super::exact_distance::TriangleBvh;
 use super::local_error::vertex_local_error;
 use super::score::ScoreTerms;
@@ -79,7 +79,12 @@ pub struct ErrorSummary {
 /// Measures `positions` (the smoothed mesh M', one per original vertex) against the original.
 /// `reference` holds each vertex's drifted reference vertex ([`super::DriftingReference`]);
 /// `tau` weighs the score.
-pub fn measure(original: &Original, positions: &[[f32; 3]], reference: &[u32], tau: f64) -> Metrics {
+pub fn measure(
+    original: &Original,
+    positions: &[[f32; 3]],
+    reference: &[u32],
+    tau: f64,
+) -> Metrics {
     let sums = measure_pass(original, positions, Some(reference), None);
     metrics(original, &sums, tau)
 }
@@ -195,68 +200,86 @@ pub(crate) fn measure_pass(
     out: Option<(&mut [f32], &mut [f32])>,
 ) -> Sums {
     let n = original.mesh().vertex_count();
-    assert_eq!(positions.len(), n, "positions must belong to the original mesh");
+    assert_eq!(
+        positions.len(),
+        n,
+        "positions must belong to the original mesh"
+    );
     if let Some(r) = reference {
         assert_eq!(r.len(), n, "one reference vertex per vertex");
     }
+    let (areas, volume6) = triangle_areas(positions, &original.mesh().triangles);
+    let pass = Pass {
+        original,
+        positions,
+        reference,
+        areas: &areas,
+    };
     let partial: Vec<Sums> = match out {
         Some((error, curvature)) => error
             .par_chunks_mut(CHUNK)
             .zip(curvature.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(c, (e, k))| {
-                chunk_sums(original, positions, reference, c * CHUNK, Some((e, k)))
-            })
+            .map(|(c, (e, k))| pass.chunk(c * CHUNK, Some((e, k))))
             .collect(),
         None => (0..n.div_ceil(CHUNK))
             .into_par_iter()
-            .map(|c| chunk_sums(original, positions, reference, c * CHUNK, None))
+            .map(|c| pass.chunk(c * CHUNK, None))
             .collect(),
     };
-    let mut total = Sums::default();
+    let mut total = Sums {
+        volume6,
+        ..Sums::default()
+    };
     for p in &partial {
         total.add(p);
     }
     total
 }
 
-fn chunk_sums(
-    original: &Original,
-    positions: &[[f32; 3]],
-    reference: Option<&[u32]>,
-    start: usize,
-    mut out: Option<(&mut [f32], &mut [f32])>,
-) -> Sums {
-    let mesh = original.mesh();
-    let topology = original.topology();
-    let end = (start + CHUNK).min(mesh.vertex_count());
-    let mut s = Sums::default();
-    for i in start..end {
-        let fan = topology.triangles_of(i);
-        if fan.is_empty() {
-            continue;
-        }
-        let f = fan_sums(positions, &mesh.triangles, fan, i as u32);
-        s.volume6 += f.volume6;
-        let mut k_g = 0.0;
-        if !topology.is_boundary[i] && f.mixed_area > 0.0 {
-            let k = (2.0 * PI - f.angle_sum) / f.mixed_area;
-            // A fan of vanishing area has no meaningful curvature: leave it out, like no area.
-            if k.is_finite() {
-                k_g = k;
-                s.curvature_sum += k.abs();
-                s.curvature_count += 1;
+/// What every chunk of a measure pass reads.
+struct Pass<'a> {
+    original: &'a Original,
+    positions: &'a [[f32; 3]],
+    reference: Option<&'a [u32]>,
+    areas: &'a [TriangleArea],
+}
+
+impl Pass<'_> {
+    /// Curvature and local error of the vertices `start..start + CHUNK`.
+    fn chunk(&self, start: usize, mut out: Option<(&mut [f32], &mut [f32])>) -> Sums {
+        let mesh = self.original.mesh();
+        let topology = self.original.topology();
+        let end = (start + CHUNK).min(mesh.vertex_count());
+        let mut s = Sums::default();
+        for i in start..end {
+            let fan = topology.triangles_of(i);
+            if fan.is_empty() {
+                continue;
+            }
+            let f = fan_sums(self.positions, &mesh.triangles, fan, i as u32, |_, t| {
+                self.areas[t as usize]
+            });
+            let mut k_g = 0.0;
+            if !topology.is_boundary[i] && f.mixed_area > 0.0 {
+                let k = (2.0 * PI - f.angle_sum) / f.mixed_area;
+                // A fan of vanishing area has no meaningful curvature: leave it out, like no area.
+                if k.is_finite() {
+                    k_g = k;
+                    s.curvature_sum += k.abs();
+                    s.curvature_count += 1;
+                }
+            }
+            let r = self.reference.map_or(i, |r| r[i] as usize);
+            let e = vertex_local_error(self.original, self.positions[i], r);
+            s.error_sum += e;
+            s.error_max = s.error_max.max(e);
+            s.error_count += 1;
+            if let Some((error, curvature)) = out.as_mut() {
+                error[i - start] = e as f32;
+                curvature[i - start] = k_g as f32;
             }
         }
-        let r = reference.map_or(i, |r| r[i] as usize);
-        let e = vertex_local_error(original, positions[i], r);
-        s.error_sum += e;
-        s.error_max = s.error_max.max(e);
-        s.error_count += 1;
-        if let Some((error, curvature)) = out.as_mut() {
-            error[i - start] = e as f32;
-            curvature[i - start] = k_g as f32;
-        }
+        s
     }
-    s
 }

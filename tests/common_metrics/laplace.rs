@@ -4,6 +4,7 @@
 
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::smooth::StepObserver;
+use rayon::prelude::*;
 
 pub fn laplace(
     mesh: &Mesh,
@@ -16,22 +17,25 @@ pub fn laplace(
     let mut q = mesh.positions.clone();
     let mut next = q.clone();
     for it in 1..=iterations {
-        for (i, out) in next.iter_mut().enumerate() {
-            let nb = &ring[offsets[i] as usize..offsets[i + 1] as usize];
-            if nb.is_empty() {
-                *out = q[i];
-                continue;
-            }
-            let mut avg = [0.0f32; 3];
-            for &j in nb {
-                for k in 0..3 {
-                    avg[k] += q[j as usize][k];
+        next.par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, out)| {
+                let nb = &ring[offsets[i] as usize..offsets[i + 1] as usize];
+                if nb.is_empty() {
+                    *out = q[i];
+                    return;
                 }
-            }
-            for k in 0..3 {
-                out[k] = q[i][k] + lambda * (avg[k] / nb.len() as f32 - q[i][k]);
-            }
-        }
+                let mut avg = [0.0f32; 3];
+                for &j in nb {
+                    for k in 0..3 {
+                        avg[k] += q[j as usize][k];
+                    }
+                }
+                for k in 0..3 {
+                    out[k] = q[i][k] + lambda * (avg[k] / nb.len() as f32 - q[i][k]);
+                }
+            });
         std::mem::swap(&mut q, &mut next);
         observer.after_step(&q);
         observer.after_iteration(it, &q);

@@ -155,7 +155,11 @@ pub fn parse(bytes: &[u8]) -> Result<Mesh, String> {
             }
         }
     }
-    if let Some(bad) = triangles.iter().flatten().find(|&&v| v as usize >= positions.len()) {
+    if let Some(bad) = triangles
+        .iter()
+        .flatten()
+        .find(|&&v| v as usize >= positions.len())
+    {
         return Err(format!("face index {bad} out of range"));
     }
     Ok(Mesh::new(positions, triangles))

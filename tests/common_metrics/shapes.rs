@@ -131,7 +131,12 @@ pub fn grid(n: u32, z: f32) -> Mesh {
     let mut t = Vec::new();
     for y in 0..n - 1 {
         for x in 0..n - 1 {
-            let (a, b, c, d) = (y * n + x, y * n + x + 1, (y + 1) * n + x, (y + 1) * n + x + 1);
+            let (a, b, c, d) = (
+                y * n + x,
+                y * n + x + 1,
+                (y + 1) * n + x,
+                (y + 1) * n + x + 1,
+            );
             if (x + y) % 2 == 0 {
                 t.push([a, b, d]);
                 t.push([a, d, c]);
