@@ -35,7 +35,13 @@ pub fn vertex_curvature(
         .iter()
         .map(|&t| TriangleArea::new(positions, triangles[t as usize]).0)
         .collect();
-    let sums = fan_sums(positions, triangles, fan, i as u32, |k, _| areas[k]);
+    let sums = fan_sums(
+        positions,
+        fan,
+        i as u32,
+        |_, t| other_corners(triangles[t as usize], i as u32),
+        |k, _| areas[k],
+    );
     VertexCurvature {
         angle_defect: 2.0 * PI - sums.angle_sum,
         mixed_area: sums.mixed_area,
@@ -57,9 +63,13 @@ pub fn vertex_curvatures(
             if fan.is_empty() {
                 return VertexCurvature::default();
             }
-            let sums = fan_sums(positions, triangles, fan, i as u32, |_, t| {
-                areas[t as usize]
-            });
+            let sums = fan_sums(
+                positions,
+                fan,
+                i as u32,
+                |_, t| other_corners(triangles[t as usize], i as u32),
+                |_, t| areas[t as usize],
+            );
             VertexCurvature {
                 angle_defect: 2.0 * PI - sums.angle_sum,
                 mixed_area: sums.mixed_area,
@@ -129,6 +139,31 @@ pub(crate) fn triangle_areas(
         })
         .collect();
     (areas, partial.iter().sum())
+}
+
+/// For every entry of the vertex->triangle incidence, the triangle's other two corners in winding
+/// order: the passes then read them in sequence instead of looking up every triangle.
+pub(crate) fn fan_corners(triangles: &[[u32; 3]], topology: &Topology) -> Vec<[u32; 2]> {
+    let mut out = vec![[0u32; 2]; topology.vertex_triangles.len()];
+    let n = topology.vertex_count();
+    let mut rest: &mut [[u32; 2]] = &mut out;
+    let mut slices = Vec::with_capacity(n);
+    for i in 0..n {
+        let (head, tail) = rest.split_at_mut(topology.triangles_of(i).len());
+        slices.push(head);
+        rest = tail;
+    }
+    slices
+        .into_par_iter()
+        .enumerate()
+        .with_min_len(1024)
+        .for_each(|(i, s)| {
+            for (c, &t) in s.iter_mut().zip(topology.triangles_of(i)) {
+                let (j, k) = other_corners(triangles[t as usize], i as u32);
+                *c = [j, k];
+            }
+        });
+    out
 }
 
 /// The corners of `tri` other than `i`, in winding order: `(i, j, k)` is a rotation of `tri`.
@@ -223,20 +258,21 @@ fn lower(re: f64, im: f64) -> bool {
 }
 
 /// Angle sum and mixed area of vertex `i` over the triangles `fan` (all containing `i`);
-/// `area(k, t)` gives the area data of triangle `t`, the `k`-th of the fan.
+/// `corners(k, t)` gives the other two corners of triangle `t`, the `k`-th of the fan, in
+/// winding order, and `area(k, t)` its area data.
 #[inline]
 pub(crate) fn fan_sums(
     positions: &[[f32; 3]],
-    triangles: &[[u32; 3]],
     fan: &[u32],
     i: u32,
+    corners: impl Fn(usize, u32) -> (u32, u32),
     area: impl Fn(usize, u32) -> TriangleArea,
 ) -> FanSums {
     let pi = to_f64(positions[i as usize]);
     let mut sums = FanSums::default();
     let mut angles = AngleSum::new();
     for (n, &t) in fan.iter().enumerate() {
-        let (j, k) = other_corners(triangles[t as usize], i);
+        let (j, k) = corners(n, t);
         let pj = to_f64(positions[j as usize]);
         let pk = to_f64(positions[k as usize]);
         let u = sub(pj, pi);

@@ -4,7 +4,6 @@
 //!
 //! It measures to part of the original mesh, so it is never below the exact distance to it.
 
-use super::curvature::other_corners;
 use super::exact_distance::{point_segment_distance2, SLIVER_SINE};
 use super::Original;
 use crate::mesh::{cross, dot, sub, to_f64};
@@ -21,14 +20,12 @@ use rayon::prelude::*;
 #[inline]
 pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> f64 {
     let positions = &original.mesh().positions;
-    let triangles = &original.mesh().triangles;
-    let fan = original.topology().triangles_of(r);
+    let fan = original.fan_corners(r);
     let q = to_f64(q);
     let pr = to_f64(positions[r]);
     let d = sub(q, pr);
     let mut best = f64::INFINITY;
-    for &t in fan {
-        let (j, k) = other_corners(triangles[t as usize], r as u32);
+    for &[j, k] in fan {
         let e1 = sub(to_f64(positions[j as usize]), pr);
         let e2 = sub(to_f64(positions[k as usize]), pr);
         if let Some(h) = prism_height(e1, e2, d) {
@@ -47,8 +44,7 @@ pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> 
             to_f64(positions[j as usize]),
         ));
     }
-    for &t in fan {
-        let (j, k) = other_corners(triangles[t as usize], r as u32);
+    for &[j, k] in fan {
         best2 = best2.min(point_segment_distance2(
             q,
             to_f64(positions[j as usize]),

@@ -1,6 +1,7 @@
 //! The original mesh M as the measures see it: built once per loaded mesh, so every measure pass
 //! over a smoothed mesh only reads what stays fixed.
 
+use super::curvature::fan_corners;
 use super::report::{measure_pass, Sums};
 use crate::mesh::{Mesh, Topology};
 
@@ -10,6 +11,8 @@ use crate::mesh::{Mesh, Topology};
 pub struct Original {
     mesh: Mesh,
     topology: Topology,
+    /// Other two corners of each vertex->triangle incidence (parallel to `vertex_triangles`).
+    fan_corners: Vec<[u32; 2]>,
     volume: Option<f64>,
     curvature: f64,
     /// Vertices some triangle uses: the ones the local error averages over.
@@ -30,6 +33,7 @@ impl Original {
         let mut original = Self {
             mesh: mesh.clone(),
             topology: topology.clone(),
+            fan_corners: fan_corners(&mesh.triangles, topology),
             volume: None,
             curvature: 0.0,
             referenced,
@@ -62,6 +66,13 @@ impl Original {
 
     pub fn topology(&self) -> &Topology {
         &self.topology
+    }
+
+    /// The other two corners of each triangle around vertex `i`, in winding order.
+    #[inline]
+    pub(crate) fn fan_corners(&self, i: usize) -> &[[u32; 2]] {
+        let o = &self.topology.triangle_offsets;
+        &self.fan_corners[o[i] as usize..o[i + 1] as usize]
     }
 
     /// Number of vertices some triangle uses.

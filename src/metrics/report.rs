@@ -257,9 +257,14 @@ impl Pass<'_> {
             if fan.is_empty() {
                 continue;
             }
-            let f = fan_sums(self.positions, &mesh.triangles, fan, i as u32, |_, t| {
-                self.areas[t as usize]
-            });
+            let corners = self.original.fan_corners(i);
+            let f = fan_sums(
+                self.positions,
+                fan,
+                i as u32,
+                |k, _| (corners[k][0], corners[k][1]),
+                |_, t| self.areas[t as usize],
+            );
             let mut k_g = 0.0;
             if !topology.is_boundary[i] && f.mixed_area > 0.0 {
                 let k = (2.0 * PI - f.angle_sum) / f.mixed_area;
