@@ -218,16 +218,9 @@ fn build(
 #[inline]
 fn box_distance2(node: &Node, p: [f64; 3]) -> f64 {
     let mut d2 = 0.0;
-    for k in 0..3 {
-        let lo = node.min[k] as f64;
-        let hi = node.max[k] as f64;
-        let d = if p[k] < lo {
-            lo - p[k]
-        } else if p[k] > hi {
-            p[k] - hi
-        } else {
-            0.0
-        };
+    for ((&x, &lo), &hi) in p.iter().zip(&node.min).zip(&node.max) {
+        // Zero inside the slab, else the gap to its nearer side.
+        let d = (lo as f64 - x).max(x - hi as f64).max(0.0);
         d2 += d * d;
     }
     d2

@@ -91,7 +91,10 @@ impl Shape {
     fn arc_tube(&self, q: [f64; 3]) -> f64 {
         let rb = need(self.bend_radius, "bend_radius");
         let r = need(self.tube_radius, "tube_radius");
-        let (phi0, phi1) = (need(self.arc_phi0, "arc_phi0"), need(self.arc_phi1, "arc_phi1"));
+        let (phi0, phi1) = (
+            need(self.arc_phi0, "arc_phi0"),
+            need(self.arc_phi1, "arc_phi1"),
+        );
         let phi = q[1].atan2(q[0]);
         // numpy's mod takes the divisor's sign: the angle relative to phi0 in [0, 2 pi).
         let rel = (phi - phi0).rem_euclid(2.0 * PI);
