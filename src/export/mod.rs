@@ -1,6 +1,11 @@
 //! Writers: an indexed mesh out as bytes (binary PLY, binary STL, OBJ, GLB), vertex order kept.
 //! Nothing from an input file's header is ever written (STL headers often carry patient names).
 
+mod glb;
+mod obj;
+mod ply;
+mod stl;
+
 use crate::mesh::Mesh;
 
 /// Output formats.
@@ -51,6 +56,16 @@ pub enum ExportError {
         format: &'static str,
         detail: String,
     },
+    #[error("the mesh has no triangles: there is nothing to write")]
+    NoTriangles,
+    #[error("triangle {triangle} uses vertex {index} but the mesh has {count} vertices")]
+    IndexOutOfRange {
+        triangle: usize,
+        index: u32,
+        count: usize,
+    },
+    #[error("{what} of vertex {vertex} is not finite")]
+    NonFinite { what: &'static str, vertex: usize },
 }
 
 /// Serialises `mesh` in `format`.
@@ -59,6 +74,105 @@ pub fn write(
     format: ExportFormat,
     options: &ExportOptions,
 ) -> Result<Vec<u8>, ExportError> {
-    let _ = (mesh, format, options);
-    Ok(Vec::new())
+    check(mesh, options)?;
+    match format {
+        ExportFormat::Ply => ply::write(mesh, options),
+        ExportFormat::Stl => stl::write(mesh),
+        ExportFormat::Obj => Ok(obj::write(mesh, options)),
+        ExportFormat::Glb => glb::write(mesh, options),
+    }
+}
+
+/// What every format needs: triangles, valid indices, finite coordinates and per-vertex
+/// arrays as long as the vertex list.
+fn check(mesh: &Mesh, options: &ExportOptions) -> Result<(), ExportError> {
+    if mesh.triangles.is_empty() {
+        return Err(ExportError::NoTriangles);
+    }
+    let count = mesh.vertex_count();
+    for (what, got) in [
+        ("normals", options.normals.map(<[_]>::len)),
+        ("colors", options.colors.map(<[_]>::len)),
+    ] {
+        if let Some(got) = got.filter(|&g| g != count) {
+            return Err(ExportError::LengthMismatch {
+                what,
+                got,
+                expected: count,
+            });
+        }
+    }
+    for (triangle, t) in mesh.triangles.iter().enumerate() {
+        if let Some(&index) = t.iter().find(|&&i| i as usize >= count) {
+            return Err(ExportError::IndexOutOfRange {
+                triangle,
+                index,
+                count,
+            });
+        }
+    }
+    let finite = |p: &[f32; 3]| p.iter().all(|v| v.is_finite());
+    for (what, values) in [
+        ("position", Some(mesh.positions.as_slice())),
+        ("normal", options.normals),
+    ] {
+        if let Some(vertex) = values.and_then(|v| v.iter().position(|p| !finite(p))) {
+            return Err(ExportError::NonFinite { what, vertex });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle() -> Mesh {
+        Mesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        )
+    }
+
+    #[test]
+    fn refuses_meshes_it_cannot_write_faithfully() {
+        let none = ExportOptions::default();
+        for format in [
+            ExportFormat::Ply,
+            ExportFormat::Stl,
+            ExportFormat::Obj,
+            ExportFormat::Glb,
+        ] {
+            let empty = Mesh::new(vec![[0.0; 3]], vec![]);
+            assert_eq!(write(&empty, format, &none), Err(ExportError::NoTriangles));
+            let normals = [[0.0, 0.0, 1.0]; 2];
+            let short = ExportOptions {
+                normals: Some(&normals),
+                ..Default::default()
+            };
+            assert_eq!(
+                write(&triangle(), format, &short),
+                Err(ExportError::LengthMismatch {
+                    what: "normals",
+                    got: 2,
+                    expected: 3
+                })
+            );
+            let mut bad = triangle();
+            bad.triangles[0][2] = 3;
+            assert!(matches!(
+                write(&bad, format, &none),
+                Err(ExportError::IndexOutOfRange { index: 3, .. })
+            ));
+            let mut nan = triangle();
+            nan.positions[1][0] = f32::NAN;
+            assert_eq!(
+                write(&nan, format, &none),
+                Err(ExportError::NonFinite {
+                    what: "position",
+                    vertex: 1
+                })
+            );
+        }
+    }
 }

@@ -5,7 +5,10 @@ mod error;
 mod gltf;
 mod obj;
 mod ply;
+mod ply_ascii;
+mod ply_binary;
 mod stl;
+mod text;
 mod weld;
 
 pub use error::{LoadError, Location};

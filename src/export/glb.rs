@@ -1,0 +1,210 @@
+//! GLB (binary glTF 2.0): one mesh with one triangle primitive. POSITION (with the min/max the
+//! specification requires), NORMAL and COLOR_0 when given, u32 indices, one buffer in the BIN
+//! chunk. The JSON is built with serde_json; nothing from any input file is written.
+
+use serde_json::{json, Value};
+
+use super::{ExportError, ExportOptions};
+use crate::mesh::{bounding_box, Mesh};
+
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+const FLOAT: u32 = 5126;
+const UNSIGNED_BYTE: u32 = 5121;
+const UNSIGNED_INT: u32 = 5125;
+const TRIANGLES: u32 = 4;
+
+/// The BIN chunk being built, with one buffer view and accessor per array.
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    /// Appends `bytes` as a new buffer view (4-byte aligned) and returns the accessor index of
+    /// `accessor`, which gets the view filled in.
+    fn push(&mut self, bytes: &[u8], target: u32, mut accessor: Value) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let view = self.views.len();
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": self.bin.len(),
+            "byteLength": bytes.len(),
+            "target": target,
+        }));
+        self.bin.extend_from_slice(bytes);
+        accessor["bufferView"] = json!(view);
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+}
+
+fn floats(values: &[[f32; 3]]) -> Vec<u8> {
+    values
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect()
+}
+
+/// The specification requires NORMAL to be unit length. Normals within rounding of unit length
+/// are kept bit for bit; others are rescaled, and a zero normal (a vertex with no incident
+/// area) becomes +Z.
+fn unit_normal(n: [f32; 3]) -> [f32; 3] {
+    let len = n.iter().map(|&v| f64::from(v).powi(2)).sum::<f64>().sqrt();
+    if (len - 1.0).abs() <= 1e-4 {
+        n
+    } else if len > 0.0 {
+        n.map(|v| (f64::from(v) / len) as f32)
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+pub(super) fn write(mesh: &Mesh, options: &ExportOptions) -> Result<Vec<u8>, ExportError> {
+    let n = mesh.vertex_count();
+    let too_large = || ExportError::TooLarge {
+        format: "GLB",
+        detail: "the file would exceed the 4 GiB a GLB header can describe".into(),
+    };
+    // A GLB's total length is a u32: check before building anything that large.
+    let estimate = (n as u64) * (12 + 12 + 4) + mesh.triangle_count() as u64 * 12 + 4096;
+    if estimate > u64::from(u32::MAX) {
+        return Err(too_large());
+    }
+    let (min, max) = bounding_box(&mesh.positions).unwrap_or_default();
+    let mut b = Builder {
+        bin: Vec::with_capacity(estimate as usize),
+        views: Vec::new(),
+        accessors: Vec::new(),
+    };
+    // Min/max as the f64 of each f32, so a reader comparing in either precision sees them equal.
+    let bound = |v: [f32; 3]| v.map(f64::from);
+    let position = b.push(
+        &floats(&mesh.positions),
+        ARRAY_BUFFER,
+        json!({"componentType": FLOAT, "count": n, "type": "VEC3",
+               "min": bound(min), "max": bound(max)}),
+    );
+    let mut attributes = json!({ "POSITION": position });
+    if let Some(normals) = options.normals {
+        let unit: Vec<[f32; 3]> = normals.iter().map(|&v| unit_normal(v)).collect();
+        attributes["NORMAL"] = json!(b.push(
+            &floats(&unit),
+            ARRAY_BUFFER,
+            json!({"componentType": FLOAT, "count": n, "type": "VEC3"}),
+        ));
+    }
+    if let Some(colors) = options.colors {
+        attributes["COLOR_0"] = json!(b.push(
+            colors.as_flattened(),
+            ARRAY_BUFFER,
+            json!({"componentType": UNSIGNED_BYTE, "normalized": true, "count": n, "type": "VEC4"}),
+        ));
+    }
+    let index_bytes: Vec<u8> = mesh
+        .triangles
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let indices = b.push(
+        &index_bytes,
+        ELEMENT_ARRAY_BUFFER,
+        json!({"componentType": UNSIGNED_INT, "count": 3 * mesh.triangle_count(), "type": "SCALAR"}),
+    );
+
+    let mut gltf_mesh = json!({
+        "primitives": [{ "attributes": attributes, "indices": indices, "mode": TRIANGLES }],
+    });
+    if let Some(extras) = &options.extras {
+        gltf_mesh["extras"] = extras.clone();
+    }
+    let document = json!({
+        "asset": { "version": "2.0", "generator": "meshsmooth" },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0 }],
+        "meshes": [gltf_mesh],
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [{ "byteLength": b.bin.len() }],
+    });
+    let mut json = document.to_string().into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    while !b.bin.len().is_multiple_of(4) {
+        b.bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + b.bin.len();
+    let total32 = u32::try_from(total).map_err(|_| too_large())?;
+
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend(total32.to_le_bytes());
+    for (kind, data) in [(b"JSON", &json), (b"BIN\0", &b.bin)] {
+        // Each chunk is shorter than the total checked above.
+        out.extend((data.len() as u32).to_le_bytes());
+        out.extend_from_slice(kind);
+        out.extend_from_slice(data);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn container_is_aligned_and_json_describes_the_bin_chunk() {
+        let mesh = Mesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, -2.5]],
+            vec![[0, 1, 2]],
+        );
+        let colors = [[255, 0, 0, 255]; 3];
+        let options = ExportOptions {
+            colors: Some(&colors),
+            extras: Some(json!({"filter": "taubin"})),
+            ..Default::default()
+        };
+        let bytes = write(&mesh, &options).expect("writes");
+        assert_eq!(&bytes[..8], b"glTF\x02\0\0\0");
+        assert_eq!(
+            u32::from_le_bytes(bytes[8..12].try_into().expect("4")) as usize,
+            bytes.len()
+        );
+        let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("4")) as usize;
+        assert_eq!(json_len % 4, 0);
+        assert_eq!(&bytes[16..20], b"JSON");
+        let doc: Value = serde_json::from_slice(&bytes[20..20 + json_len]).expect("JSON");
+        let bin_at = 20 + json_len;
+        assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
+        let bin_len = u32::from_le_bytes(bytes[bin_at..bin_at + 4].try_into().expect("4"));
+        assert_eq!(bin_len % 4, 0);
+        assert_eq!(doc["buffers"][0]["byteLength"], json!(bin_len));
+        assert_eq!(doc["asset"]["generator"], "meshsmooth");
+        assert_eq!(doc["meshes"][0]["extras"]["filter"], "taubin");
+        assert_eq!(doc["accessors"][0]["min"], json!([0.0, 0.0, -2.5]));
+        assert_eq!(doc["accessors"][0]["max"], json!([1.0, 1.0, 0.0]));
+        let attributes = &doc["meshes"][0]["primitives"][0]["attributes"];
+        assert!(attributes.get("NORMAL").is_none());
+        let color = &doc["accessors"][attributes["COLOR_0"].as_u64().expect("index") as usize];
+        assert_eq!(color["normalized"], true);
+        for view in doc["bufferViews"].as_array().expect("views") {
+            assert_eq!(view["byteOffset"].as_u64().expect("offset") % 4, 0);
+        }
+    }
+
+    #[test]
+    fn normals_are_made_unit_only_when_they_are_not() {
+        let almost = [0.0, 0.6, 0.800_000_1];
+        assert_eq!(unit_normal(almost), almost);
+        assert_eq!(unit_normal([0.0, 0.0, 0.0]), [0.0, 0.0, 1.0]);
+        assert_eq!(unit_normal([0.0, 2.0, 0.0]), [0.0, 1.0, 0.0]);
+    }
+}

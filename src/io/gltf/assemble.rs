@@ -1,0 +1,230 @@
+//! Merging the triangle primitives of every placed mesh into one indexed mesh: vertices in
+//! traversal order then accessor order, strips and fans turned into triangles.
+
+use ::gltf::json::mesh::{Mode, Semantic};
+use ::gltf::json::validation::Checked;
+use ::gltf::json::Root;
+
+use super::super::{Format, LoadError, Location};
+use super::accessor::{layout, load_buffers, read_indices, read_vectors, Layout};
+use super::scene::{determinant3, transform_point, Instance, IDENTITY};
+use crate::mesh::Mesh;
+
+/// Caps on the merged mesh. Each accessor is backed by bytes of the file, but nodes may place
+/// one mesh many times, so the total is bounded separately; these sit far above any
+/// segmentation surface (millions of triangles) and keep a hostile file from exhausting memory.
+const MAX_VERTICES: u64 = 1 << 25;
+const MAX_TRIANGLES: u64 = 1 << 26;
+
+/// One triangle primitive of one placed mesh, with its accessors resolved.
+struct Job<'a> {
+    instance: &'a Instance,
+    mode: Mode,
+    positions: Layout,
+    indices: Option<Layout>,
+}
+
+fn triangle_mode(mode: Mode) -> bool {
+    matches!(
+        mode,
+        Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+    )
+}
+
+/// Upper bound of the triangles `n` vertex references make in `mode`.
+fn max_triangles(mode: Mode, n: usize) -> u64 {
+    match mode {
+        Mode::Triangles => (n / 3) as u64,
+        _ => n.saturating_sub(2) as u64,
+    }
+}
+
+pub(super) fn merge(
+    root: &Root,
+    instances: &[Instance],
+    bin: Option<&[u8]>,
+    format: Format,
+) -> Result<Mesh, LoadError> {
+    let jobs = plan(root, instances, format)?;
+
+    let mut vertex_total = 0u64;
+    let mut triangle_total = 0u64;
+    let mut needed = vec![false; root.buffers.len()];
+    for job in &jobs {
+        vertex_total = vertex_total.saturating_add(job.positions.count as u64);
+        let refs = job.indices.as_ref().unwrap_or(&job.positions).count;
+        triangle_total = triangle_total.saturating_add(max_triangles(job.mode, refs));
+        for l in std::iter::once(&job.positions).chain(&job.indices) {
+            if let Some(flag) = needed.get_mut(l.buffer) {
+                *flag = true;
+            }
+        }
+    }
+    for (what, claimed, possible) in [
+        ("vertices", vertex_total, MAX_VERTICES),
+        ("triangles", triangle_total, MAX_TRIANGLES),
+    ] {
+        if claimed > possible {
+            return Err(LoadError::CountTooLarge {
+                format,
+                what,
+                claimed,
+                possible,
+            });
+        }
+    }
+    let buffers = load_buffers(root, bin, &needed, format)?;
+    let data = |l: &Layout| {
+        buffers
+            .get(l.buffer)
+            .and_then(|b| b.as_deref())
+            .ok_or_else(|| LoadError::Syntax {
+                format,
+                location: Location::Item("buffer", l.buffer),
+                detail: "was not loaded".into(),
+            })
+    };
+
+    // Both totals are bounded by the caps above.
+    let mut positions: Vec<[f32; 3]> = Vec::with_capacity(vertex_total as usize);
+    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(triangle_total as usize);
+    for job in &jobs {
+        let mut points = read_vectors::<3>(&job.positions, data(&job.positions)?, format)?;
+        if let Some(v) = points.iter().flatten().find(|v| !v.is_finite()) {
+            return Err(LoadError::NonFinite {
+                format,
+                location: Location::Item("accessor", job.positions.accessor),
+                value: v.to_string(),
+            });
+        }
+        let m = &job.instance.matrix;
+        // The identity is skipped so that untransformed positions keep their exact bits (-0.0).
+        if *m != IDENTITY {
+            for p in &mut points {
+                *p = transform_point(m, *p);
+            }
+            if let Some(v) = points.iter().flatten().find(|v| !v.is_finite()) {
+                return Err(LoadError::NonFinite {
+                    format,
+                    location: Location::Item("node", job.instance.node),
+                    value: format!("{v} after the node's transform"),
+                });
+            }
+        }
+
+        let count = points.len();
+        let refs: Vec<u32> = match &job.indices {
+            Some(l) => {
+                let refs = read_indices(l, data(l)?, format)?;
+                if let Some(&bad) = refs.iter().find(|&&i| i as usize >= count) {
+                    return Err(LoadError::IndexOutOfRange {
+                        format,
+                        location: Location::Item("accessor", l.accessor),
+                        index: bad.into(),
+                        count,
+                    });
+                }
+                refs
+            }
+            // Counts are capped far below u32::MAX.
+            None => (0..count as u32).collect(),
+        };
+        if job.mode == Mode::Triangles && !refs.len().is_multiple_of(3) {
+            let accessor = job.indices.as_ref().unwrap_or(&job.positions).accessor;
+            return Err(LoadError::Syntax {
+                format,
+                location: Location::Item("accessor", accessor),
+                detail: format!(
+                    "{} vertex references do not make whole triangles",
+                    refs.len()
+                ),
+            });
+        }
+
+        let base = positions.len() as u32;
+        let mirrored = determinant3(m) < 0.0;
+        let mut push = |t: [u32; 3]| {
+            let [a, b, c] = t.map(|v| v + base);
+            // A mirroring transform turns counter-clockwise into clockwise: swap to undo it.
+            triangles.push(if mirrored { [a, c, b] } else { [a, b, c] });
+        };
+        match job.mode {
+            Mode::Triangles => refs.chunks_exact(3).for_each(|t| push([t[0], t[1], t[2]])),
+            Mode::TriangleStrip => {
+                for (i, w) in refs.windows(3).enumerate() {
+                    let t = if i % 2 == 0 {
+                        [w[0], w[1], w[2]]
+                    } else {
+                        [w[0], w[2], w[1]]
+                    };
+                    push_unless_repeated(&mut push, t);
+                }
+            }
+            _ => {
+                if let Some((&first, rest)) = refs.split_first() {
+                    for w in rest.windows(2) {
+                        push_unless_repeated(&mut push, [w[0], w[1], first]);
+                    }
+                }
+            }
+        }
+        positions.extend_from_slice(&points);
+    }
+    if triangles.is_empty() {
+        return Err(LoadError::NoTriangles { format });
+    }
+    Ok(Mesh::new(positions, triangles))
+}
+
+/// Strips and fans join runs with repeated indices; those are not triangles of the surface.
+fn push_unless_repeated(push: &mut impl FnMut([u32; 3]), t: [u32; 3]) {
+    if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+        push(t);
+    }
+}
+
+/// The triangle primitives of every instance, in order, with accessors checked.
+fn plan<'a>(
+    root: &Root,
+    instances: &'a [Instance],
+    format: Format,
+) -> Result<Vec<Job<'a>>, LoadError> {
+    let mut jobs = Vec::new();
+    for instance in instances {
+        let mesh = root
+            .meshes
+            .get(instance.mesh)
+            .ok_or_else(|| LoadError::Syntax {
+                format,
+                location: Location::Item("node", instance.node),
+                detail: format!("mesh {} does not exist", instance.mesh),
+            })?;
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let bad = |detail: String| LoadError::Syntax {
+                format,
+                location: Location::Item("mesh", instance.mesh),
+                detail: format!("primitive {p}: {detail}"),
+            };
+            let Checked::Valid(mode) = primitive.mode else {
+                return Err(bad("invalid mode".into()));
+            };
+            if !triangle_mode(mode) {
+                continue;
+            }
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(Semantic::Positions))
+                .ok_or_else(|| bad("has no POSITION attribute".into()))?;
+            jobs.push(Job {
+                instance,
+                mode,
+                positions: layout(root, position.value(), format)?,
+                indices: primitive
+                    .indices
+                    .map(|i| layout(root, i.value(), format))
+                    .transpose()?,
+            });
+        }
+    }
+    Ok(jobs)
+}

@@ -1,0 +1,169 @@
+//! Windowed sinc (Taubin 1996) as VTK's vtkWindowedSincPolyDataFilter computes it: the filtered
+//! positions are `f(K) x` with `f` the Chebyshev series of `sinc_coefficients`, evaluated by the
+//! three-term recurrence
+//!
+//! `T_0 x = x`, `T_1 x = (x + mean_N x) / 2`, `T_{k+1} x = T_k x + mean_N(T_k x) - T_{k-1} x`
+//!
+//! (from `T_{k+1} = 2 (I + L/2) T_k - T_{k-1}`), accumulating `c_k T_k x` term by term.
+//!
+//! Coordinates are normalised first, as VTK's NormalizeCoordinates does: moved so the bounding
+//! box's centre is the origin and scaled to the unit cube, then mapped back. The scale cancels
+//! exactly in a linear filter, so only the centring is done; it matters because the series'
+//! gain at frequency 0 is 1 only to within 1e-3, and it keeps f32 precision where the mesh lies
+//! far from the origin. The accumulated sum is kept in the original coordinates
+//! (`centre + sum c_k T_k (x - centre)`), so it is the running estimate as it stands.
+//!
+//! Weights and the displacement bound act on that running estimate, never inside the
+//! recurrence (which must see the unconstrained `T_k x` to stay a polynomial in `L`): after
+//! every term the reported position is `o_i + w_i (estimate_i - o_i)`, pulled back onto the
+//! ball of radius `d_max` around `o_i`; the last one is the result.
+
+use rayon::prelude::*;
+
+use super::constraint::Constrain;
+use super::rings::{ring_mean, Rings, CHUNK};
+use super::sinc_coefficients::sinc_coefficients;
+use super::StepObserver;
+use crate::mesh::bounding_box;
+
+/// Runs the windowed-sinc filter of degree `iterations` (one neighbour pass per degree).
+/// Reports the constrained running estimate after every term and, at the end, the result as
+/// iteration `iterations`.
+pub(crate) fn run<C: Constrain>(
+    rings: Rings,
+    original: &[[f32; 3]],
+    passband: f32,
+    iterations: u32,
+    constraint: &C,
+    observer: &mut dyn StepObserver,
+) -> Vec<[f32; 3]> {
+    let n = original.len();
+    let Some((lo, hi)) = bounding_box(original).filter(|_| iterations > 0) else {
+        return original.to_vec();
+    };
+    assert!(n == rings.vertex_count());
+    let centre: [f32; 3] = std::array::from_fn(|k| ((lo[k] as f64 + hi[k] as f64) * 0.5) as f32);
+    let c: Vec<f32> = sinc_coefficients(iterations, passband)
+        .into_iter()
+        .map(|x| x as f32)
+        .collect();
+
+    // T_{k-1} x and T_k x (centred), and the estimate; allocated once for the whole run.
+    let mut previous = vec![[0.0f32; 3]; n];
+    let mut current = vec![[0.0f32; 3]; n];
+    let mut estimate = vec![[0.0f32; 3]; n];
+    // What observers and the caller see when weights or a bound apply.
+    let mut constrained = if C::IS_FREE {
+        Vec::new()
+    } else {
+        vec![[0.0f32; 3]; n]
+    };
+
+    first_term(
+        rings,
+        original,
+        centre,
+        [c[0], c[1]],
+        &mut previous,
+        &mut current,
+        &mut estimate,
+    );
+    report(original, &estimate, &mut constrained, constraint, observer);
+    for &ck in &c[2..] {
+        // `previous` becomes T_{k+1} x in place, then the pair swaps roles.
+        next_term(rings, ck, &current, &mut previous, &mut estimate);
+        std::mem::swap(&mut previous, &mut current);
+        report(original, &estimate, &mut constrained, constraint, observer);
+    }
+    let result = if C::IS_FREE { estimate } else { constrained };
+    observer.after_iteration(iterations, &result);
+    result
+}
+
+/// `previous = x - centre`, `current = T_1 (x - centre)`,
+/// `estimate = centre + c0 (x - centre) + c1 T_1 (x - centre)`. Isolated vertices stay put.
+fn first_term(
+    rings: Rings,
+    original: &[[f32; 3]],
+    centre: [f32; 3],
+    [c0, c1]: [f32; 2],
+    previous: &mut [[f32; 3]],
+    current: &mut [[f32; 3]],
+    estimate: &mut [[f32; 3]],
+) {
+    previous
+        .par_chunks_mut(CHUNK)
+        .zip(current.par_chunks_mut(CHUNK))
+        .zip(estimate.par_chunks_mut(CHUNK))
+        .zip(original.par_chunks(CHUNK))
+        .enumerate()
+        .for_each(|(c, (((t0, t1), e), orig))| {
+            let rows = t0.iter_mut().zip(t1.iter_mut()).zip(e.iter_mut()).zip(orig);
+            for ((((t0, t1), e), &o), ring) in rows.zip(rings.chunk(c)) {
+                let z0 = std::array::from_fn(|k| o[k] - centre[k]);
+                *t0 = z0;
+                if ring.is_empty() {
+                    *t1 = z0;
+                    *e = o;
+                    continue;
+                }
+                let m = ring_mean(ring, original);
+                *t1 = std::array::from_fn(|k| 0.5 * (z0[k] + (m[k] - centre[k])));
+                *e = std::array::from_fn(|k| centre[k] + c0 * z0[k] + c1 * t1[k]);
+            }
+        });
+}
+
+/// Overwrites `previous` (T_{k-1} x) with T_{k+1} x and adds `ck` times it to the estimate.
+fn next_term(
+    rings: Rings,
+    ck: f32,
+    current: &[[f32; 3]],
+    previous: &mut [[f32; 3]],
+    estimate: &mut [[f32; 3]],
+) {
+    previous
+        .par_chunks_mut(CHUNK)
+        .zip(estimate.par_chunks_mut(CHUNK))
+        .zip(current.par_chunks(CHUNK))
+        .enumerate()
+        .for_each(|(c, ((t, e), own))| {
+            let rows = t.iter_mut().zip(e.iter_mut()).zip(own).zip(rings.chunk(c));
+            for (((t, e), &tk), ring) in rows {
+                if ring.is_empty() {
+                    // L = 0 there: every T_k x equals x, and the estimate stays the original.
+                    *t = tk;
+                    continue;
+                }
+                let m = ring_mean(ring, current);
+                for k in 0..3 {
+                    t[k] = tk[k] + m[k] - t[k];
+                    e[k] += ck * t[k];
+                }
+            }
+        });
+}
+
+/// Hands the running estimate to the observer, through the weights and bound when there are any.
+fn report<C: Constrain>(
+    original: &[[f32; 3]],
+    estimate: &[[f32; 3]],
+    constrained: &mut [[f32; 3]],
+    constraint: &C,
+    observer: &mut dyn StepObserver,
+) {
+    if C::IS_FREE {
+        observer.after_step(estimate);
+        return;
+    }
+    constrained
+        .par_chunks_mut(CHUNK)
+        .zip(estimate.par_chunks(CHUNK).zip(original.par_chunks(CHUNK)))
+        .enumerate()
+        .for_each(|(c, (out, (est, orig)))| {
+            for (k, (out, (&e, &o))) in out.iter_mut().zip(est.iter().zip(orig)).enumerate() {
+                *out = constraint.apply(c * CHUNK + k, o, e);
+            }
+        });
+    observer.after_step(constrained);
+}
