@@ -9,14 +9,18 @@
 //! can interleave them with frames (wasm32 is single-threaded) and the CLI can run them to the end
 //! with [`run`], reporting progress and honouring cancellation between runs.
 
+mod auto;
 mod grid;
 mod local;
+mod mesh_evaluator;
 mod points;
 mod space;
 mod sweep;
 
+pub use auto::{quality_graphs, suggest, suggest_for_mesh, SuggestError};
 pub use grid::{EvaluatedGrid, GridSearch};
 pub use local::{LocalOutcome, LocalSearch};
+pub use mesh_evaluator::{check_weights, terms_of, MeshEvaluator, WeightsError};
 pub use space::{Axis, GridPoint, Param, ParamSpace};
 pub use sweep::{Curve, QualityGraphs, QualitySweep, Sample};
 
