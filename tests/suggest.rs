@@ -91,7 +91,7 @@ impl std::fmt::Display for Comparison {
         };
         write!(
             f,
-            "{:<34} {:<7} {:.1}  {:<4}  S grid {:.5} local {:.5} (+{:.5})  evals {:>4} / {:>3} = {:>4.1}x",
+            "{:<34} {:<7} {:.1}  {:<4}  S grid {:.5} local {:.5} (+{:.1e})  evals {:>4} / {:>3} = {:>4.1}x",
             self.mesh,
             self.filter.name(),
             self.tau,
