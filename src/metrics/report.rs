@@ -6,6 +6,7 @@ use super::exact_distance::TriangleBvh;
 use super::local_error::vertex_local_error;
 use super::score::ScoreTerms;
 use super::Original;
+use crate::mesh::to_f64;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -111,10 +112,16 @@ pub fn measure_vertices(
 }
 
 /// Exact distance from each vertex of `positions` to the original mesh, summarised over the same
-/// vertices as the local error. `bvh` is `TriangleBvh::new` over the original mesh.
-pub fn exact_error(bvh: &TriangleBvh, original: &Original, positions: &[[f32; 3]]) -> ErrorSummary {
+/// vertices as the local error. `bvh` is `TriangleBvh::new` over the original mesh; `reference`
+/// the drifted reference vertices, whose local errors bound the search.
+pub fn exact_error(
+    bvh: &TriangleBvh,
+    original: &Original,
+    positions: &[[f32; 3]],
+    reference: &[u32],
+) -> ErrorSummary {
     let topology = original.topology();
-    let distances = bvh.distances(positions);
+    let distances = exact_distances(bvh, original, positions, reference);
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (i, d) in distances.iter().enumerate() {
         if !topology.triangles_of(i).is_empty() {
@@ -126,6 +133,41 @@ pub fn exact_error(bvh: &TriangleBvh, original: &Original, positions: &[[f32; 3]
         mean: mean(sum, original.referenced_vertices()),
         max,
     }
+}
+
+/// Exact distance from each vertex of `positions` to the original mesh, in parallel; 0 for
+/// vertices no triangle uses (they never move). The local error is a distance to part of the
+/// mesh, so it bounds each search from above.
+pub fn exact_distances(
+    bvh: &TriangleBvh,
+    original: &Original,
+    positions: &[[f32; 3]],
+    reference: &[u32],
+) -> Vec<f64> {
+    let n = original.mesh().vertex_count();
+    assert_eq!(
+        positions.len(),
+        n,
+        "positions must belong to the original mesh"
+    );
+    assert_eq!(reference.len(), n, "one reference vertex per vertex");
+    let topology = original.topology();
+    (0..n)
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|i| {
+            if topology.triangles_of(i).is_empty() {
+                return 0.0;
+            }
+            let q = to_f64(positions[i]);
+            // A little slack: both distances are rounded, along different formulas.
+            let bound = vertex_local_error(original, positions[i], reference[i] as usize);
+            let bound = bound * (1.0 + 1e-9) + 1e-12;
+            bvh.closest_within(q, bound)
+                .or_else(|| bvh.closest(q))
+                .map_or(0.0, |c| c.distance)
+        })
+        .collect()
 }
 
 fn metrics(original: &Original, sums: &Sums, tau: f64) -> Metrics {
