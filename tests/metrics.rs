@@ -381,7 +381,7 @@ fn json_has_exactly_the_cli_keys() {
     ];
     assert_eq!(keys(serde_json::to_value(&m).expect("json")), base);
     let bvh = TriangleBvh::new(&mesh.positions, &mesh.triangles);
-    let m = m.with_exact(exact_error(&bvh, &o, &mesh.positions, &identity(n)));
+    let m = m.with_exact(exact_error(&bvh, &o, &mesh.positions));
     let mut with_exact: Vec<&str> = base.to_vec();
     with_exact.extend(["exact_max_error", "exact_mean_error"]);
     with_exact.sort();
@@ -426,7 +426,7 @@ fn bounded_exact_search_finds_the_same_distances() {
     params.iterations = 30;
     let mut drift = DriftingReference::new(&o);
     let q = smooth::smooth(&mesh, &topology, &params, None, &mut drift);
-    let bounded = exact_distances(&bvh, &o, &q, drift.reference());
+    let bounded = exact_distances(&bvh, &o, &q);
     let full = bvh.distances(&q);
     assert_eq!(bounded, full);
     // A bound below the distance finds nothing.
@@ -446,7 +446,7 @@ fn check_local_error_against_exact(
     reference: &[u32],
 ) -> (f64, f64) {
     let (m, v) = measure_vertices(o, positions, reference, 0.5);
-    let exact = exact_distances(bvh, o, positions, reference);
+    let exact = exact_distances(bvh, o, positions);
     let mut max = 0.0f64;
     for (i, (&local, &d)) in v.local_error.iter().zip(&exact).enumerate() {
         // The local error is stored as f32 per vertex: allow its rounding on top of 1e-6.
@@ -584,7 +584,7 @@ fn timing_on_the_large_mesh() {
     let (t_measure, m) = best_of(20, || measure(&o, &q, &reference, 0.5));
     let (t_vertices, _) = best_of(10, || measure_vertices(&o, &q, &reference, 0.5));
     let (t_bvh, bvh) = best_of(2, || TriangleBvh::new(&mesh.positions, &mesh.triangles));
-    let (t_exact, exact) = best_of(2, || exact_error(&bvh, &o, &q, &reference));
+    let (t_exact, exact) = best_of(2, || exact_error(&bvh, &o, &q));
     println!(
         "{} vertices, {threads} threads, best of several runs (ms):",
         mesh.vertex_count()
