@@ -2,6 +2,8 @@
 
 #[path = "common_metrics/data.rs"]
 mod data;
+#[path = "common_metrics/observers.rs"]
+mod observers;
 #[path = "common_metrics/shapes.rs"]
 mod shapes;
 
@@ -10,7 +12,7 @@ use meshsmooth::metrics::{
     exact_distances, exact_error, identity, measure, measure_vertices, point_triangle_distance2,
     vertex_curvatures, DriftingReference, Original, TriangleBvh,
 };
-use meshsmooth::smooth::{self, Filter, NoObserver, Params, StepObserver};
+use meshsmooth::smooth::{self, Filter, NoObserver, Params};
 use std::f64::consts::PI;
 
 fn original(mesh: &Mesh) -> Original {
@@ -234,59 +236,9 @@ fn reference_drifts_one_hop_per_step() {
     assert_eq!(drift.reference(), &identity(49)[..]);
 }
 
-/// The definition, written plainly: the reference moves to the closest of itself and its 1-ring
-/// (ties keep the reference, then the first neighbour).
-struct PlainDrift<'a> {
-    mesh: &'a Mesh,
-    topology: &'a Topology,
-    reference: Vec<u32>,
-}
-
-impl PlainDrift<'_> {
-    fn update(&mut self, q: &[[f32; 3]]) {
-        for (i, r) in self.reference.iter_mut().enumerate() {
-            let d2 = |j: u32| -> f32 {
-                let p = self.mesh.positions[j as usize];
-                (0..3).map(|k| (q[i][k] - p[k]) * (q[i][k] - p[k])).sum()
-            };
-            let mut best = *r;
-            for &j in self.topology.neighbors_of(*r as usize) {
-                if d2(j) < d2(best) {
-                    best = j;
-                }
-            }
-            *r = best;
-        }
-    }
-}
-
-/// Runs the drift and the plain definition side by side and compares them after every step.
-struct BothDrifts<'a> {
-    fast: DriftingReference<'a>,
-    plain: PlainDrift<'a>,
-    steps: u32,
-    moved: usize,
-}
-
-impl StepObserver for BothDrifts<'_> {
-    fn after_step(&mut self, positions: &[[f32; 3]]) {
-        self.fast.update(positions);
-        self.plain.update(positions);
-        assert_eq!(
-            self.fast.reference(),
-            &self.plain.reference[..],
-            "step {}",
-            self.steps
-        );
-        self.steps += 1;
-        self.moved = (0..positions.len())
-            .filter(|&i| self.plain.reference[i] != i as u32)
-            .count();
-    }
-}
-
 #[test]
 fn drift_follows_its_definition() {
+    use observers::{BothDrifts, PlainDrift};
     let (mesh, topology) = data::load("synthetic/synthetic_bent_tube_r3.5.ply");
     let o = Original::new(&mesh, &topology);
     // Strong shrinking moves many references; windowed sinc's running estimate, few but some.
@@ -462,24 +414,6 @@ fn check_local_error_against_exact(
     (m.mean_error, mean)
 }
 
-/// Keeps the drifting reference going and takes a snapshot at one iteration on the way.
-struct Snapshot<'a> {
-    drift: DriftingReference<'a>,
-    at: u32,
-    taken: Option<(Vec<[f32; 3]>, Vec<u32>)>,
-}
-
-impl StepObserver for Snapshot<'_> {
-    fn after_step(&mut self, positions: &[[f32; 3]]) {
-        self.drift.after_step(positions);
-    }
-    fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
-        if iteration == self.at {
-            self.taken = Some((positions.to_vec(), self.drift.reference().to_vec()));
-        }
-    }
-}
-
 /// How far the mean local error may lie above the exact mean. The drift takes one hop per step
 /// and can stop in a local minimum where a smoothed vertex nears a fold of the surface far away
 /// along it (the paper's own caveat). That costs a few percent on the folded meshes after strong
@@ -491,6 +425,7 @@ const LOCAL_OVER_EXACT: f64 = 1.06;
 /// whose k-iteration result is met on the way; windowed sinc runs twice).
 #[test]
 fn local_error_bounds_exact_distance_for_every_filter() {
+    use observers::Snapshot;
     let mut far = Vec::new();
     for (name, _) in data::CLOSED_MESHES {
         let (mesh, topology) = data::load(name);
