@@ -5,8 +5,6 @@
 mod data;
 #[path = "common_metrics/ground_truth.rs"]
 mod ground_truth;
-#[path = "common_metrics/ply.rs"]
-mod ply;
 
 use ground_truth::{true_error, Shape, TrueError};
 use meshsmooth::metrics::{measure, DriftingReference, Metrics, Original};

@@ -81,9 +81,16 @@ impl TriangleBvh {
 
     /// Closest point of the triangle set to `p`; `None` when there are no triangles.
     pub fn closest(&self, p: [f64; 3]) -> Option<Closest> {
+        self.closest_within(p, f64::INFINITY)
+    }
+
+    /// Closest point of the triangle set to `p` if it is nearer than `bound`, else `None`.
+    /// A good bound (a distance known to be reached, such as the local error) lets the search
+    /// skip most of the tree.
+    pub fn closest_within(&self, p: [f64; 3], bound: f64) -> Option<Closest> {
         let root = self.nodes.first()?;
-        let mut best = f64::INFINITY;
-        let mut best_entry = 0usize;
+        let mut best = bound * bound;
+        let mut best_entry = usize::MAX;
         let mut stack = [0u32; STACK_DEPTH];
         let mut top = 0usize;
         let mut node = *root;
@@ -126,9 +133,9 @@ impl TriangleBvh {
             // Pop the next subtree that can still beat the best distance.
             loop {
                 if top == 0 {
-                    return Some(Closest {
+                    return self.ids.get(best_entry).map(|&triangle| Closest {
                         distance: best.sqrt(),
-                        triangle: self.ids[best_entry],
+                        triangle,
                     });
                 }
                 top -= 1;

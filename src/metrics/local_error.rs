@@ -13,10 +13,6 @@ use rayon::prelude::*;
 /// Local error of a smoothed vertex at `q` whose reference vertex on the original mesh is `r`:
 /// the smallest prism height over the triangles around `r`, else the distance to the fan's edges
 /// (spokes from `r` and the rim opposite it), which covers its vertices.
-///
-/// Everything is computed from the original positions on the fly: for the usual `r = i` the
-/// measure pass has just read the same triangles for the curvature, so they are in cache, while
-/// precomputed per-triangle frames would be fetched from all over memory.
 #[inline]
 pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> f64 {
     let positions = &original.mesh().positions;
@@ -104,6 +100,7 @@ impl<'a> DriftingReference<'a> {
         );
         let original = self.original.mesh();
         let topology = self.original.topology();
+        let stay = self.original.stay_radius2();
         self.reference
             .par_iter_mut()
             .zip(positions.par_iter())
@@ -116,6 +113,10 @@ impl<'a> DriftingReference<'a> {
                 // Ties keep the current reference, so a vertex that did not move stays put.
                 let mut best = *r;
                 let mut best_d2 = d2(original.positions[best as usize]);
+                // Within the stay radius no neighbour can be closer (see `Original`).
+                if best_d2 <= stay[best as usize] {
+                    return;
+                }
                 for &j in topology.neighbors_of(*r as usize) {
                     let dj = d2(original.positions[j as usize]);
                     let closer = dj < best_d2;

@@ -6,6 +6,7 @@ use super::exact_distance::TriangleBvh;
 use super::local_error::vertex_local_error;
 use super::score::ScoreTerms;
 use super::Original;
+use crate::mesh::to_f64;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -114,7 +115,7 @@ pub fn measure_vertices(
 /// vertices as the local error. `bvh` is `TriangleBvh::new` over the original mesh.
 pub fn exact_error(bvh: &TriangleBvh, original: &Original, positions: &[[f32; 3]]) -> ErrorSummary {
     let topology = original.topology();
-    let distances = bvh.distances(positions);
+    let distances = exact_distances(bvh, original, positions);
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (i, d) in distances.iter().enumerate() {
         if !topology.triangles_of(i).is_empty() {
@@ -126,6 +127,36 @@ pub fn exact_error(bvh: &TriangleBvh, original: &Original, positions: &[[f32; 3]
         mean: mean(sum, original.referenced_vertices()),
         max,
     }
+}
+
+/// Exact distance from each vertex of `positions` to the original mesh, in parallel; 0 for
+/// vertices no triangle uses (they never move). The distance to the vertex's own original fan
+/// (the local error with the reference at home) is a distance to part of the mesh, so it bounds
+/// each search from above and lets it skip most of the tree.
+pub fn exact_distances(bvh: &TriangleBvh, original: &Original, positions: &[[f32; 3]]) -> Vec<f64> {
+    let n = original.mesh().vertex_count();
+    assert_eq!(
+        positions.len(),
+        n,
+        "positions must belong to the original mesh"
+    );
+    let topology = original.topology();
+    (0..n)
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|i| {
+            if topology.triangles_of(i).is_empty() {
+                return 0.0;
+            }
+            let q = to_f64(positions[i]);
+            // A little slack: both distances are rounded, along different formulas.
+            let bound = vertex_local_error(original, positions[i], i);
+            let bound = bound * (1.0 + 1e-9) + 1e-12;
+            bvh.closest_within(q, bound)
+                .or_else(|| bvh.closest(q))
+                .map_or(0.0, |c| c.distance)
+        })
+        .collect()
 }
 
 fn metrics(original: &Original, sums: &Sums, tau: f64) -> Metrics {

@@ -31,9 +31,10 @@ pub fn read(relative: &str) -> Vec<u8> {
     std::fs::read(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
 }
 
-/// Loads a shared PLY mesh and builds its topology.
+/// Loads a shared mesh and builds its topology.
 pub fn load(relative: &str) -> (Mesh, Topology) {
-    let mesh = crate::ply::parse(&read(relative)).unwrap_or_else(|e| panic!("{relative}: {e}"));
+    let mesh = meshsmooth::io::load(&read(relative), relative)
+        .unwrap_or_else(|e| panic!("{relative}: {e}"));
     let topology = Topology::build(&mesh);
     (mesh, topology)
 }
