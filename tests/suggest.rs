@@ -12,8 +12,6 @@
 mod data;
 #[path = "common_metrics/ground_truth.rs"]
 mod ground_truth;
-#[path = "common_metrics/ply.rs"]
-mod ply;
 
 use meshsmooth::metrics::{DriftingReference, Original};
 use meshsmooth::smooth::{smooth, Filter, NoObserver, Params};
