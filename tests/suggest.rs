@@ -5,8 +5,8 @@
 //! compared with it at tau 0.2, 0.5, 0.8 (table printed with `--nocapture`); on the synthetic
 //! meshes the tau = 0.5 suggestion is checked against the analytic surfaces.
 //!
-//! Benchmark (printed, not asserted), in release:
-//! `cargo test --release --test suggest -- --ignored --nocapture benchmark`
+//! Benchmark (printed, not asserted): `meshsmooth suggest FILE --filter F --search grid|local`
+//! prints the seconds and the number of parameter sets evaluated.
 
 #[path = "common_metrics/data.rs"]
 mod data;
@@ -371,35 +371,4 @@ fn quality_graphs_on_a_real_mesh() {
     assert_eq!(its.samples[p.iterations as usize].terms, at_current[0]);
     // More HC iterations smooth more here.
     assert!(its.samples[50].terms.curvature_ratio < its.samples[5].terms.curvature_ratio);
-}
-
-/// Grid for Laplace and local search for HC on the 206k-vertex staircase mesh.
-#[test]
-#[ignore = "benchmark: run in release with --ignored --nocapture"]
-fn benchmark() {
-    let start = Instant::now();
-    let (mesh, topology) = data::load(data::LARGE);
-    let original = Original::new(&mesh, &topology);
-    eprintln!(
-        "{}: {} vertices, load + Original {:.2} s",
-        data::LARGE,
-        mesh.vertex_count(),
-        start.elapsed().as_secs_f64()
-    );
-    let start = Instant::now();
-    let g = grid(&original, Filter::Laplace).best(0.5).expect("grid");
-    eprintln!(
-        "grid  laplace tau 0.5: {:.2} s, {} evaluations, {:?}",
-        start.elapsed().as_secs_f64(),
-        g.evaluations,
-        (g.params.lambda, g.params.iterations)
-    );
-    let start = Instant::now();
-    let l = local(&original, Filter::Hc, 0.5);
-    eprintln!(
-        "local hc      tau 0.5: {:.2} s, {} evaluations, {:?}",
-        start.elapsed().as_secs_f64(),
-        l.evaluations,
-        (l.params.alpha, l.params.beta, l.params.iterations)
-    );
 }

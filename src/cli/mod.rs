@@ -8,6 +8,8 @@ mod info;
 mod measure;
 mod params;
 mod smooth;
+mod suggest;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -76,6 +78,10 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Model quality graphs: each parameter swept, curves of K/K0, error, volume change and S.
+    Sweep(sweep::SweepArgs),
+    /// Suggest the parameters that minimise the score S(tau) (grid or local search).
+    Suggest(suggest::SuggestArgs),
     /// Time loading a file into an indexed mesh and its topology.
     BenchLoad {
         file: PathBuf,
@@ -120,6 +126,8 @@ pub fn main() -> ExitCode {
                 "unknown backend '{other}': this build has the cpu backend"
             )),
         },
+        Command::Sweep(args) => sweep::run(&args),
+        Command::Suggest(args) => suggest::run(&args),
         Command::BenchLoad { file, repeat, json } => bench_load::run(&file, repeat.max(1), json),
     };
     match result {
