@@ -250,3 +250,47 @@ fn bench_json_has_the_contract_keys() {
     assert_eq!(v["vertices"], 2296);
     assert!(v["vertex_iterations_per_second"].as_f64().unwrap() > 0.0);
 }
+
+#[test]
+fn smooth_auto_takes_the_suggestion_and_tau_zero_leaves_the_mesh() {
+    let input = data("synthetic/synthetic_bent_tube_r3.5.ply");
+    let out = tmp("tube_auto.ply");
+    let run = |tau: &str| {
+        json(&meshsmooth(&[
+            "smooth",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--filter",
+            "hc",
+            "--auto",
+            "--search",
+            "local",
+            "--tau",
+            tau,
+            "--json",
+        ]))
+    };
+    let none = run("0");
+    assert_eq!(none["metrics"]["mean_error"], 0.0);
+    assert_eq!(none["metrics"]["volume_change"], 0.0);
+    assert_eq!(none["suggestion"]["search"], "local");
+    let smooth = run("0.5");
+    let suggested = json(&meshsmooth(&[
+        "suggest",
+        input.to_str().unwrap(),
+        "--filter",
+        "hc",
+        "--search",
+        "local",
+        "--tau",
+        "0.5",
+        "--json",
+    ]));
+    assert_eq!(smooth["params"], suggested["params"]);
+    assert!(smooth["suggestion"]["evaluations"].as_u64().unwrap() > 1);
+    assert!(
+        (smooth["metrics"]["score"].as_f64().unwrap() - suggested["score"].as_f64().unwrap()).abs()
+            < 1e-12
+    );
+}

@@ -48,6 +48,12 @@ enum Command {
         /// Weight of smoothness against accuracy in the score S, [0, 1].
         #[arg(long, default_value_t = 0.5)]
         tau: f64,
+        /// Suggest the filter's parameters for --tau first, then smooth with them.
+        #[arg(long)]
+        auto: bool,
+        /// With --auto: grid or local search.
+        #[arg(long, default_value = "grid", value_parser = suggest::parse_search)]
+        search: crate::suggest::SearchMethod,
         #[arg(long)]
         json: bool,
     },
@@ -104,8 +110,10 @@ pub fn main() -> ExitCode {
             output,
             params,
             tau,
+            auto,
+            search,
             json,
-        } => smooth::run(&file, &output, &params, tau, json),
+        } => smooth::run(&file, &output, &params, tau, auto.then_some(search), json),
         Command::Measure {
             original,
             smoothed,

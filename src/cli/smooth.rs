@@ -5,6 +5,7 @@ use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh, Topology};
 use crate::metrics::{self, DriftingReference, Metrics, Original};
 use crate::smooth::{self, Params};
+use crate::suggest::{suggest, SearchMethod};
 use std::path::Path;
 use std::time::Instant;
 
@@ -13,14 +14,26 @@ pub(super) fn run(
     output: &Path,
     args: &FilterArgs,
     tau: f64,
+    auto: Option<SearchMethod>,
     json: bool,
 ) -> Result<(), String> {
     super::check_tau(tau)?;
     let format = super::convert::output_format(output)?;
-    let params = args.params()?;
+    let mut params = args.params()?;
     let mesh = super::load_file(file)?;
     let topology = Topology::build(&mesh);
     let original = Original::new(&mesh, &topology);
+    // The fixed-pipeline mode: the suggestion's parameters replace the given ones (the given
+    // displacement bound is kept in every trial run and in the final one).
+    let suggestion = match auto {
+        Some(method) => {
+            let s = suggest(&original, None, &params, tau, method, &mut |_| true)
+                .map_err(|e| e.to_string())?;
+            params = s.params;
+            Some(s)
+        }
+        None => None,
+    };
 
     let start = Instant::now();
     let (positions, metrics) = smooth_and_measure(&original, &params, tau);
@@ -39,11 +52,24 @@ pub(super) fn run(
     super::write_file(output, &bytes)?;
 
     if json {
-        println!(
-            "{}",
-            super::to_json(&report_json(&params, &metrics, seconds))?
-        );
+        let mut report = report_json(&params, &metrics, seconds);
+        if let Some(s) = &suggestion {
+            report["suggestion"] = serde_json::json!({
+                "search": s.search.name(),
+                "tau": tau,
+                "evaluations": s.evaluations,
+            });
+        }
+        println!("{}", super::to_json(&report)?);
     } else {
+        if let Some(s) = &suggestion {
+            println!(
+                "suggested for tau {tau} by {} search ({} parameter sets): {}",
+                s.search.name(),
+                s.evaluations,
+                params_json(&params)
+            );
+        }
         println!(
             "{} -> {} ({} {} iterations, {:.1} ms)",
             file.display(),
