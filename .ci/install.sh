@@ -58,7 +58,7 @@ done
 if [ ${#missing[@]} -gt 0 ]; then
     say "apt: ${missing[*]}"
     as_root apt-get update -q
-    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -q "${missing[@]}"
 else
     say "apt packages present"
 fi
