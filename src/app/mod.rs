@@ -1,3 +1,50 @@
-//! The web app.
+//! The web app (wasm32 only): an eframe app on the page's canvas.
+//!
+//! `start` installs the logger and a panic hook that shows a crash message on the page, then
+//! starts eframe's `WebRunner`. The app itself owns no algorithm: it reads a file's bytes,
+//! hands them to [`crate::io::load`] and shows the [`crate::mesh::MeshReport`].
+//!
+//! Modules: `state` (the loaded model and the last error), `file_input` (the file picker and
+//! dropped files, both delivering bytes asynchronously), `report_view` (the report as a table),
+//! `shell` (the `eframe::App` that lays these out).
 
-pub fn start() {}
+mod file_input;
+mod page;
+mod report_view;
+mod shell;
+mod state;
+
+pub use state::{AppState, LoadedModel};
+
+/// The mesh shown when the app opens: a voxelised bent tube (a staircase vessel surface).
+pub const SAMPLE_NAME: &str = "bent_tube_staircase.ply";
+pub const SAMPLE_BYTES: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+
+/// Entry point of the wasm32 binary.
+pub fn start() {
+    // Fails only when a logger is already installed, which is then kept.
+    let _ = eframe::WebLogger::init(log::LevelFilter::Info);
+    page::install_crash_message_hook();
+    // Installs eframe's own panic hook, which logs and then calls ours.
+    let runner = eframe::WebRunner::new();
+    wasm_bindgen_futures::spawn_local(async move {
+        let result = match page::canvas() {
+            Ok(canvas) => runner
+                .start(
+                    canvas,
+                    eframe::WebOptions::default(),
+                    Box::new(|cc| Ok(Box::new(shell::Shell::new(cc)))),
+                )
+                .await
+                .map_err(|e| page::js_error_text(&e)),
+            Err(e) => Err(e),
+        };
+        match result {
+            Ok(()) => page::remove_loading_text(),
+            Err(message) => {
+                log::error!("meshsmooth failed to start: {message}");
+                page::show_crash_message(&format!("meshsmooth failed to start: {message}"));
+            }
+        }
+    });
+}

@@ -1,0 +1,62 @@
+//! The HTML page around the canvas: the loading text, the crash message, the canvas itself.
+//! Element ids match `index.html`.
+
+use wasm_bindgen::JsCast;
+
+const CANVAS_ID: &str = "meshsmooth_canvas";
+const LOADING_ID: &str = "loading_text";
+const CRASH_ID: &str = "crash_message";
+
+fn document() -> Option<web_sys::Document> {
+    web_sys::window()?.document()
+}
+
+/// The canvas eframe draws on.
+pub fn canvas() -> Result<web_sys::HtmlCanvasElement, String> {
+    let document = document().ok_or("no document")?;
+    document
+        .get_element_by_id(CANVAS_ID)
+        .ok_or_else(|| format!("the page has no element with id '{CANVAS_ID}'"))?
+        .dyn_into::<web_sys::HtmlCanvasElement>()
+        .map_err(|_| format!("the element '{CANVAS_ID}' is not a canvas"))
+}
+
+pub fn remove_loading_text() {
+    if let Some(element) = document().and_then(|d| d.get_element_by_id(LOADING_ID)) {
+        element.remove();
+    }
+}
+
+/// Replaces the page's content with a visible crash message (the canvas is hidden: after a
+/// panic eframe stops drawing and the last frame would look alive).
+pub fn show_crash_message(message: &str) {
+    let Some(document) = document() else {
+        return;
+    };
+    remove_loading_text();
+    if let Some(canvas) = document.get_element_by_id(CANVAS_ID) {
+        let _ = canvas.set_attribute("hidden", "");
+    }
+    if let Some(crash) = document.get_element_by_id(CRASH_ID) {
+        if let Some(text) = crash.query_selector("pre").ok().flatten() {
+            text.set_text_content(Some(message));
+        }
+        let _ = crash.remove_attribute("hidden");
+    }
+}
+
+/// Shows every panic on the page. Installed before eframe's hook, which logs the panic to the
+/// console and then calls this one.
+pub fn install_crash_message_hook() {
+    std::panic::set_hook(Box::new(|info| {
+        show_crash_message(&format!("meshsmooth crashed: {info}"));
+    }));
+}
+
+/// Best-effort text of a JavaScript error value.
+pub fn js_error_text(value: &wasm_bindgen::JsValue) -> String {
+    if let Some(error) = value.dyn_ref::<js_sys::Error>() {
+        return String::from(error.message());
+    }
+    value.as_string().unwrap_or_else(|| format!("{value:?}"))
+}

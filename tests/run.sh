@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# The test command: everything CI runs, in order, stopping at the first failure.
+#
+#   bash tests/run.sh
+#
+# Installs what it needs first (idempotent, see .ci/install.sh). The test meshes are read from
+# ../shared/data, beside the checkout.
+set -euo pipefail
+
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+export PATH="$PWD/web/node_modules/.bin:$HOME/.cargo/bin:$PATH"
+# GPU tests must find an adapter (lavapipe on CI machines) instead of skipping.
+export REQUIRE_GPU=1
+
+if [ ! -d ../shared/data ]; then
+    echo "tests/run.sh: the test meshes are missing: expected ../shared/data beside the checkout" >&2
+    exit 1
+fi
+
+started=$SECONDS
+passed=()
+current=""
+on_exit() {
+    local status=$?
+    if [ "$status" -ne 0 ]; then
+        echo >&2
+        echo "tests/run.sh: FAILED in stage '$current' (exit $status) after $((SECONDS - started)) s; passed: ${passed[*]:-none}" >&2
+    fi
+}
+trap on_exit EXIT
+
+stage() {
+    current="$1"
+    shift
+    echo
+    echo "=== $current: $*"
+    local t=$SECONDS
+    "$@"
+    echo "--- $current: ok ($((SECONDS - t)) s)"
+    passed+=("$current")
+}
+
+stage install bash .ci/install.sh
+stage fmt cargo fmt --check
+stage clippy-native cargo clippy --all-targets -- -D warnings
+stage clippy-wasm32 cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
+stage test-native cargo test
+# The library and tests/wasm_*.rs compiled to wasm32, run in headless Chromium (flags in webdriver.json).
+stage test-wasm32-browser wasm-pack test --headless --chrome
+stage web-build trunk build --release
+# End-to-end browser tests of the built app go here, one line:
+# stage e2e <command>
+
+echo
+echo "tests/run.sh: all ${#passed[@]} stages passed (${passed[*]}) in $((SECONDS - started)) s"
