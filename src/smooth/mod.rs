@@ -28,7 +28,8 @@ use rings::Rings;
 /// step; sweeps over iterations measure along one run instead of restarting.
 pub trait StepObserver {
     /// After every position update (Taubin: twice per iteration; HC: once per iteration).
-    /// Windowed sinc reports its running filtered estimate after each recurrence term.
+    /// Windowed sinc's running sums between terms are not meshes, so it reports its result
+    /// once per degree (one step per neighbour pass) after the last term.
     fn after_step(&mut self, _positions: &[[f32; 3]]) {}
     /// After iteration `iteration` (1-based) of a filter whose k-iteration result is the result
     /// of smoothing with k iterations (Laplace, Taubin, HC). Windowed sinc's intermediate terms

@@ -13,10 +13,15 @@
 //! far from the origin. The accumulated sum is kept in the original coordinates
 //! (`centre + sum c_k T_k (x - centre)`), so it is the running estimate as it stands.
 //!
-//! Weights and the displacement bound act on that running estimate, never inside the
-//! recurrence (which must see the unconstrained `T_k x` to stay a polynomial in `L`): after
-//! every term the reported position is `o_i + w_i (estimate_i - o_i)`, pulled back onto the
-//! ball of radius `d_max` around `o_i`; the last one is the result.
+//! Weights and the displacement bound act on the final estimate, never inside the recurrence
+//! (which must see the unconstrained `T_k x` to stay a polynomial in `L`): the result is
+//! `o_i + w_i (estimate_i - o_i)`, pulled back onto the ball of radius `d_max` around `o_i`.
+//!
+//! The running sums between terms are not meshes (the first is roughly the mesh scaled by 0.3
+//! about its centre), so observers are not shown them: a reference drifting along them walks
+//! far away and may not find its way back. Observers see the result once per degree instead,
+//! so the drifting reference of the local error takes as many hops towards it as the filter
+//! has steps.
 
 use rayon::prelude::*;
 
@@ -27,8 +32,7 @@ use super::StepObserver;
 use crate::mesh::bounding_box;
 
 /// Runs the windowed-sinc filter of degree `iterations` (one neighbour pass per degree).
-/// Reports the constrained running estimate after every term and, at the end, the result as
-/// iteration `iterations`.
+/// Reports the result `iterations` times as a step and once as iteration `iterations`.
 pub(crate) fn run<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
@@ -52,13 +56,6 @@ pub(crate) fn run<C: Constrain>(
     let mut previous = vec![[0.0f32; 3]; n];
     let mut current = vec![[0.0f32; 3]; n];
     let mut estimate = vec![[0.0f32; 3]; n];
-    // What observers and the caller see when weights or a bound apply.
-    let mut constrained = if C::IS_FREE {
-        Vec::new()
-    } else {
-        vec![[0.0f32; 3]; n]
-    };
-
     first_term(
         rings,
         original,
@@ -68,14 +65,15 @@ pub(crate) fn run<C: Constrain>(
         &mut current,
         &mut estimate,
     );
-    report(original, &estimate, &mut constrained, constraint, observer);
     for &ck in &c[2..] {
         // `previous` becomes T_{k+1} x in place, then the pair swaps roles.
         next_term(rings, ck, &current, &mut previous, &mut estimate);
         std::mem::swap(&mut previous, &mut current);
-        report(original, &estimate, &mut constrained, constraint, observer);
     }
-    let result = if C::IS_FREE { estimate } else { constrained };
+    let result = constrain(original, estimate, constraint);
+    for _ in 0..iterations {
+        observer.after_step(&result);
+    }
     observer.after_iteration(iterations, &result);
     result
 }
@@ -144,26 +142,23 @@ fn next_term(
         });
 }
 
-/// Hands the running estimate to the observer, through the weights and bound when there are any.
-fn report<C: Constrain>(
+/// The estimate through the weights and the bound, when there are any.
+fn constrain<C: Constrain>(
     original: &[[f32; 3]],
-    estimate: &[[f32; 3]],
-    constrained: &mut [[f32; 3]],
+    mut estimate: Vec<[f32; 3]>,
     constraint: &C,
-    observer: &mut dyn StepObserver,
-) {
+) -> Vec<[f32; 3]> {
     if C::IS_FREE {
-        observer.after_step(estimate);
-        return;
+        return estimate;
     }
-    constrained
+    estimate
         .par_chunks_mut(CHUNK)
-        .zip(estimate.par_chunks(CHUNK).zip(original.par_chunks(CHUNK)))
+        .zip(original.par_chunks(CHUNK))
         .enumerate()
-        .for_each(|(c, (out, (est, orig)))| {
-            for (k, (out, (&e, &o))) in out.iter_mut().zip(est.iter().zip(orig)).enumerate() {
-                *out = constraint.apply(c * CHUNK + k, o, e);
+        .for_each(|(c, (est, orig))| {
+            for (k, (e, &o)) in est.iter_mut().zip(orig).enumerate() {
+                *e = constraint.apply(c * CHUNK + k, o, *e);
             }
         });
-    observer.after_step(constrained);
+    estimate
 }
