@@ -10,6 +10,7 @@ pub mod io;
 pub mod mesh;
 pub mod metrics;
 pub mod smooth;
+pub mod suggest;
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod cli;

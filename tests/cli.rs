@@ -123,3 +123,174 @@ fn convert_keeps_vertex_order_through_every_format() {
         assert!((v0 - v1).abs() <= 1e-9 * v0.abs(), "{ext}: {v0} vs {v1}");
     }
 }
+
+const MEASURE_KEYS: [&str; 8] = [
+    "volume",
+    "volume0",
+    "volume_change",
+    "curvature",
+    "curvature0",
+    "mean_error",
+    "max_error",
+    "score",
+];
+
+#[test]
+fn smooth_writes_the_mesh_and_measure_agrees_with_it() {
+    let input = data("synthetic/synthetic_bent_tube_r3.5.ply");
+    let out = tmp("tube_hc.ply");
+    let v = json(&meshsmooth(&[
+        "smooth",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--filter",
+        "hc",
+        "--iterations",
+        "12",
+        "--json",
+    ]));
+    assert_eq!(v["filter"], "hc");
+    assert_eq!(v["params"]["iterations"], 12);
+    assert_eq!(v["params"]["alpha"], 0.1);
+    assert!(v["seconds"].as_f64().unwrap() >= 0.0);
+    for key in MEASURE_KEYS {
+        assert!(v["metrics"].get(key).is_some(), "missing metrics.{key}");
+    }
+    let m = &v["metrics"];
+    assert!(m["curvature"].as_f64().unwrap() < m["curvature0"].as_f64().unwrap());
+    assert!(m["mean_error"].as_f64().unwrap() > 0.0);
+
+    // The written file is the smoothed mesh: measuring it again gives the same volume and
+    // curvature, and a local error close to the one tracked during smoothing.
+    let again = json(&meshsmooth(&[
+        "measure",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--exact",
+        "--json",
+    ]));
+    for key in MEASURE_KEYS {
+        assert!(again.get(key).is_some(), "missing {key}");
+    }
+    let close = |a: &serde_json::Value, b: &serde_json::Value, tol: f64| {
+        let (a, b) = (a.as_f64().unwrap(), b.as_f64().unwrap());
+        (a - b).abs() <= tol * a.abs().max(b.abs())
+    };
+    assert!(close(&again["volume"], &m["volume"], 1e-9));
+    assert!(close(&again["curvature"], &m["curvature"], 1e-9));
+    assert!(close(&again["mean_error"], &m["mean_error"], 0.05));
+    let exact = again["exact_mean_error"].as_f64().unwrap();
+    assert!(again["mean_error"].as_f64().unwrap() >= exact - 1e-6);
+}
+
+#[test]
+fn measure_of_a_mesh_against_itself_is_zero_error() {
+    let input = data("real/fsaverage_head_scalp_mne.stl");
+    let p = input.to_str().unwrap();
+    let v = json(&meshsmooth(&["measure", p, p, "--json"]));
+    assert_eq!(v["mean_error"], 0.0);
+    assert_eq!(v["max_error"], 0.0);
+    assert_eq!(v["volume_change"], 0.0);
+    assert!(v.get("exact_mean_error").is_none());
+}
+
+#[test]
+fn measure_refuses_different_meshes_and_out_of_range_parameters_are_refused() {
+    let a = data("real/fsaverage_head_scalp_mne.ply");
+    let b = data("synthetic/synthetic_bent_tube_r3.5.ply");
+    let out = meshsmooth(&["measure", a.to_str().unwrap(), b.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not the same mesh"));
+
+    let o = tmp("never.ply");
+    for (flags, expect) in [
+        (vec!["--filter", "taubin", "--mu", "-0.3"], "mu < -lambda"),
+        (vec!["--filter", "laplace", "--lambda", "1.5"], "[0, 1]"),
+        (vec!["--filter", "sinc", "--iterations", "0"], "[1, 100]"),
+        (vec!["--filter", "gauss"], "laplace, taubin, hc or sinc"),
+        (vec!["--tau", "2"], "tau"),
+    ] {
+        let mut args = vec!["smooth", a.to_str().unwrap(), "-o", o.to_str().unwrap()];
+        args.extend(flags);
+        let out = meshsmooth(&args);
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expect), "{err}");
+        assert!(!o.exists(), "nothing is written on a refused run");
+    }
+}
+
+#[test]
+fn bench_json_has_the_contract_keys() {
+    let input = data("synthetic/synthetic_bent_tube_r3.5.ply");
+    let v = json(&meshsmooth(&[
+        "bench",
+        input.to_str().unwrap(),
+        "--filter",
+        "laplace",
+        "--iterations",
+        "5",
+        "--repeat",
+        "1",
+        "--json",
+    ]));
+    for key in [
+        "filter",
+        "vertices",
+        "iterations",
+        "seconds",
+        "vertex_iterations_per_second",
+        "measure_seconds",
+        "backend",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["backend"], "cpu");
+    assert_eq!(v["vertices"], 2296);
+    assert!(v["vertex_iterations_per_second"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn smooth_auto_takes_the_suggestion_and_tau_zero_leaves_the_mesh() {
+    let input = data("synthetic/synthetic_bent_tube_r3.5.ply");
+    let out = tmp("tube_auto.ply");
+    let run = |tau: &str| {
+        json(&meshsmooth(&[
+            "smooth",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--filter",
+            "hc",
+            "--auto",
+            "--search",
+            "local",
+            "--tau",
+            tau,
+            "--json",
+        ]))
+    };
+    let none = run("0");
+    assert_eq!(none["metrics"]["mean_error"], 0.0);
+    assert_eq!(none["metrics"]["volume_change"], 0.0);
+    assert_eq!(none["suggestion"]["search"], "local");
+    let smooth = run("0.5");
+    let suggested = json(&meshsmooth(&[
+        "suggest",
+        input.to_str().unwrap(),
+        "--filter",
+        "hc",
+        "--search",
+        "local",
+        "--tau",
+        "0.5",
+        "--json",
+    ]));
+    assert_eq!(smooth["params"], suggested["params"]);
+    assert!(smooth["suggestion"]["evaluations"].as_u64().unwrap() > 1);
+    assert!(
+        (smooth["metrics"]["score"].as_f64().unwrap() - suggested["score"].as_f64().unwrap()).abs()
+            < 1e-12
+    );
+}

@@ -1,9 +1,15 @@
 //! The native command-line tool: fixed pipelines (e.g. CFD preparation) on the same engine as
 //! the web app. Every error goes to stderr with a non-zero exit code.
 
+mod bench;
 mod bench_load;
 mod convert;
 mod info;
+mod measure;
+mod params;
+mod smooth;
+mod suggest;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -31,6 +37,57 @@ enum Command {
     },
     /// Convert any supported input to .ply (binary), .stl (binary), .obj or .glb, keeping vertex order.
     Convert { input: PathBuf, output: PathBuf },
+    /// Smooth from the original and write the result; prints the quality measures.
+    Smooth {
+        file: PathBuf,
+        /// Output file; the format follows the extension (.ply .stl .obj .glb).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        params: params::FilterArgs,
+        /// Weight of smoothness against accuracy in the score S, [0, 1].
+        #[arg(long, default_value_t = 0.5)]
+        tau: f64,
+        /// Suggest the filter's parameters for --tau first, then smooth with them.
+        #[arg(long)]
+        auto: bool,
+        /// With --auto: grid or local search.
+        #[arg(long, default_value = "grid", value_parser = suggest::parse_search)]
+        search: crate::suggest::SearchMethod,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Compare a smoothed mesh with its original (same vertices in the same order).
+    Measure {
+        original: PathBuf,
+        smoothed: PathBuf,
+        #[arg(long, default_value_t = 0.5)]
+        tau: f64,
+        /// Also compute the exact point-to-mesh distance (slower) to check the local error.
+        #[arg(long)]
+        exact: bool,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Smoothing throughput and measure cost, best of several runs (all filters by default).
+    Bench {
+        file: PathBuf,
+        #[arg(long)]
+        filter: Option<String>,
+        #[arg(long)]
+        iterations: Option<u32>,
+        #[arg(long, default_value_t = 5)]
+        repeat: usize,
+        /// Only `cpu` for now.
+        #[arg(long, default_value = "cpu")]
+        backend: String,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Model quality graphs: each parameter swept, curves of K/K0, error, volume change and S.
+    Sweep(sweep::SweepArgs),
+    /// Suggest the parameters that minimise the score S(tau) (grid or local search).
+    Suggest(suggest::SuggestArgs),
     /// Time loading a file into an indexed mesh and its topology.
     BenchLoad {
         file: PathBuf,
@@ -48,6 +105,37 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info { file, json } => info::run(&file, json),
         Command::Convert { input, output } => convert::run(&input, &output),
+        Command::Smooth {
+            file,
+            output,
+            params,
+            tau,
+            auto,
+            search,
+            json,
+        } => smooth::run(&file, &output, &params, tau, auto.then_some(search), json),
+        Command::Measure {
+            original,
+            smoothed,
+            tau,
+            exact,
+            json,
+        } => measure::run(&original, &smoothed, tau, exact, json),
+        Command::Bench {
+            file,
+            filter,
+            iterations,
+            repeat,
+            backend,
+            json,
+        } => match backend.as_str() {
+            "cpu" => bench::run(&file, filter.as_deref(), iterations, repeat, json),
+            other => Err(format!(
+                "unknown backend '{other}': this build has the cpu backend"
+            )),
+        },
+        Command::Sweep(args) => sweep::run(&args),
+        Command::Suggest(args) => suggest::run(&args),
         Command::BenchLoad { file, repeat, json } => bench_load::run(&file, repeat.max(1), json),
     };
     match result {
@@ -69,6 +157,15 @@ pub(crate) fn load_file(path: &Path) -> Result<crate::mesh::Mesh, String> {
 /// Writes bytes to a file; errors name the file.
 pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
     std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Refuses a score weight outside [0, 1].
+pub(crate) fn check_tau(tau: f64) -> Result<(), String> {
+    if (0.0..=1.0).contains(&tau) {
+        Ok(())
+    } else {
+        Err(format!("tau = {tau} is out of range: [0, 1]"))
+    }
 }
 
 pub(crate) fn to_json<T: serde::Serialize>(value: &T) -> Result<String, String> {

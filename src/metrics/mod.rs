@@ -1,2 +1,23 @@
 //! Quality measures comparing a smoothed mesh with its original: volume, discrete Gaussian
 //! curvature, the paper's local error with the drifting reference vertex, and the score S(tau).
+//! Definitions: ALGORITHMS.md (shared docs), section "Quality measures".
+//!
+//! Use: build an [`Original`] once per loaded mesh; smooth with a [`DriftingReference`] as the
+//! step observer; then [`measure`] the result (or [`measure_vertices`] for colour-coding).
+//! [`TriangleBvh`] and [`exact_error`] give the exact distance the local error approximates.
+
+mod curvature;
+mod exact_distance;
+mod local_error;
+mod original;
+mod report;
+mod score;
+
+pub use curvature::{vertex_curvature, vertex_curvatures, VertexCurvature};
+pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
+pub use local_error::{identity, DriftingReference};
+pub use original::Original;
+pub use report::{
+    exact_distances, exact_error, measure, measure_vertices, ErrorSummary, Metrics, VertexMeasures,
+};
+pub use score::ScoreTerms;

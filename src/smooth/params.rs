@@ -91,12 +91,14 @@ impl Params {
                 Err(ParamError { name, value, valid })
             }
         }
+        // Through the shortest decimal form, so a message says "-0.3", not "-0.30000001192".
+        let wide = |v: f32| v.to_string().parse::<f64>().unwrap_or(v as f64);
         let (l, m, a, b, p) = (
-            self.lambda as f64,
-            self.mu as f64,
-            self.alpha as f64,
-            self.beta as f64,
-            self.passband as f64,
+            wide(self.lambda),
+            wide(self.mu),
+            wide(self.alpha),
+            wide(self.beta),
+            wide(self.passband),
         );
         let it = self.iterations as f64;
         match self.filter {
@@ -126,7 +128,7 @@ impl Params {
             }
         }
         if let Some(d) = self.max_displacement {
-            check("max_displacement", d as f64, d >= 0.0, "a distance >= 0 mm")?;
+            check("max_displacement", wide(d), d >= 0.0, "a distance >= 0 mm")?;
         }
         Ok(())
     }

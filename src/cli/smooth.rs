@@ -1,0 +1,111 @@
+//! `meshsmooth smooth FILE -o OUT [filter flags] [--json]`: smooth, write, print the measures.
+
+use super::params::{params_json, FilterArgs};
+use crate::export::{self, ExportFormat, ExportOptions};
+use crate::mesh::{vertex_normals, Mesh, Topology};
+use crate::metrics::{self, DriftingReference, Metrics, Original};
+use crate::smooth::{self, Params};
+use crate::suggest::{suggest, SearchMethod};
+use std::path::Path;
+use std::time::Instant;
+
+pub(super) fn run(
+    file: &Path,
+    output: &Path,
+    args: &FilterArgs,
+    tau: f64,
+    auto: Option<SearchMethod>,
+    json: bool,
+) -> Result<(), String> {
+    super::check_tau(tau)?;
+    let format = super::convert::output_format(output)?;
+    let mut params = args.params()?;
+    let mesh = super::load_file(file)?;
+    let topology = Topology::build(&mesh);
+    let original = Original::new(&mesh, &topology);
+    // The fixed-pipeline mode: the suggestion's parameters replace the given ones (the given
+    // displacement bound is kept in every trial run and in the final one).
+    let suggestion = match auto {
+        Some(method) => {
+            let s = suggest(&original, None, &params, tau, method, &mut |_| true)
+                .map_err(|e| e.to_string())?;
+            params = s.params;
+            Some(s)
+        }
+        None => None,
+    };
+
+    let start = Instant::now();
+    let (positions, metrics) = smooth_and_measure(&original, &params, tau);
+    let seconds = start.elapsed().as_secs_f64();
+
+    let smoothed = Mesh::new(positions, mesh.triangles.clone());
+    let normals = (format == ExportFormat::Glb)
+        .then(|| vertex_normals(&smoothed.positions, &smoothed.triangles));
+    let options = ExportOptions {
+        normals: normals.as_deref(),
+        colors: None,
+        extras: Some(report_json(&params, &metrics, seconds)),
+    };
+    let bytes = export::write(&smoothed, format, &options)
+        .map_err(|e| format!("{}: {e}", output.display()))?;
+    super::write_file(output, &bytes)?;
+
+    if json {
+        let mut report = report_json(&params, &metrics, seconds);
+        if let Some(s) = &suggestion {
+            report["suggestion"] = serde_json::json!({
+                "search": s.search.name(),
+                "tau": tau,
+                "evaluations": s.evaluations,
+            });
+        }
+        println!("{}", super::to_json(&report)?);
+    } else {
+        if let Some(s) = &suggestion {
+            println!(
+                "suggested for tau {tau} by {} search ({} parameter sets): {}",
+                s.search.name(),
+                s.evaluations,
+                params_json(&params)
+            );
+        }
+        println!(
+            "{} -> {} ({} {} iterations, {:.1} ms)",
+            file.display(),
+            output.display(),
+            params.filter,
+            params.iterations,
+            seconds * 1e3
+        );
+        print!("{}", super::measure::text(&metrics));
+    }
+    Ok(())
+}
+
+/// Smooths from the original with the drifting reference watching, then measures.
+pub(crate) fn smooth_and_measure(
+    original: &Original,
+    params: &Params,
+    tau: f64,
+) -> (Vec<[f32; 3]>, Metrics) {
+    let mut drift = DriftingReference::new(original);
+    let positions = smooth::smooth(
+        original.mesh(),
+        original.topology(),
+        params,
+        None,
+        &mut drift,
+    );
+    let metrics = metrics::measure(original, &positions, drift.reference(), tau);
+    (positions, metrics)
+}
+
+fn report_json(params: &Params, metrics: &Metrics, seconds: f64) -> serde_json::Value {
+    serde_json::json!({
+        "filter": params.filter.name(),
+        "params": params_json(params),
+        "seconds": seconds,
+        "metrics": metrics,
+    })
+}

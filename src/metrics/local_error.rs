@@ -1,0 +1,149 @@
+//! The paper's local error (section 4.1): each smoothed vertex keeps a reference vertex on the
+//! original mesh that drifts with it during smoothing; at the end its distance is measured to the
+//! triangle fan around that reference only, by the prism test with an edge fallback.
+//!
+//! It measures to part of the original mesh, so it is never below the exact distance to it.
+
+use super::exact_distance::{point_segment_distance2, SLIVER_SINE};
+use super::Original;
+use crate::mesh::{cross, dot, sub, to_f64};
+use crate::smooth::StepObserver;
+use rayon::prelude::*;
+
+/// Local error of a smoothed vertex at `q` whose reference vertex on the original mesh is `r`:
+/// the smallest prism height over the triangles around `r`, else the distance to the fan's edges
+/// (spokes from `r` and the rim opposite it), which covers its vertices.
+#[inline]
+pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> f64 {
+    let positions = &original.mesh().positions;
+    let fan = original.fan_corners(r);
+    let q = to_f64(q);
+    let pr = to_f64(positions[r]);
+    let d = sub(q, pr);
+    let mut best = f64::INFINITY;
+    for &[j, k] in fan {
+        let e1 = sub(to_f64(positions[j as usize]), pr);
+        let e2 = sub(to_f64(positions[k as usize]), pr);
+        if let Some(h) = prism_height(e1, e2, d) {
+            best = best.min(h);
+        }
+    }
+    if best.is_finite() {
+        return best;
+    }
+    // The reference vertex itself: all there is for a vertex no triangle uses.
+    let mut best2 = dot(d, d);
+    for &j in original.topology().neighbors_of(r) {
+        best2 = best2.min(point_segment_distance2(
+            q,
+            pr,
+            to_f64(positions[j as usize]),
+        ));
+    }
+    for &[j, k] in fan {
+        best2 = best2.min(point_segment_distance2(
+            q,
+            to_f64(positions[j as usize]),
+            to_f64(positions[k as usize]),
+        ));
+    }
+    best2.sqrt()
+}
+
+/// The paper's prism test, `(a, b, c) = P^-1 d` with `P = [e1 e2 n]`, `e1`, `e2` the triangle's
+/// edges from the reference vertex and `d = q - p_r`. By Cramer's rule with `m = e1 x e2`
+/// (`n = m / |m|`): `a = (d x e2).m / |m|^2`, `b = (e1 x d).m / |m|^2`, `c = d.m / |m|`, so the
+/// inside test needs no division. Returns `|c|` when `a, b >= 0` and `a + b <= 1`. A degenerate or
+/// sliver triangle (`P` not safely invertible) has no prism; its edges still count.
+#[inline]
+fn prism_height(e1: [f64; 3], e2: [f64; 3], d: [f64; 3]) -> Option<f64> {
+    let m = cross(e1, e2);
+    let m2 = dot(m, m);
+    let a = dot(cross(d, e2), m);
+    let b = dot(cross(e1, d), m);
+    let inside = a >= 0.0 && b >= 0.0 && a + b <= m2;
+    (inside && m2 > SLIVER_SINE * SLIVER_SINE * dot(e1, e1) * dot(e2, e2))
+        .then(|| dot(d, m).abs() / m2.sqrt())
+}
+
+/// The drifting reference neighbourhood: after every smoothing step, each vertex's reference moves
+/// to whichever of the reference and its 1-ring on the original mesh is closest to the vertex's
+/// current position (one hop per step). Use it as the smoothing run's [`StepObserver`].
+#[derive(Clone, Debug)]
+pub struct DriftingReference<'a> {
+    original: &'a Original,
+    reference: Vec<u32>,
+}
+
+impl<'a> DriftingReference<'a> {
+    /// Every vertex starts at itself.
+    pub fn new(original: &'a Original) -> Self {
+        Self {
+            original,
+            reference: identity(original.mesh().vertex_count()),
+        }
+    }
+
+    /// Back to the start, for a new smoothing run from the original positions.
+    pub fn reset(&mut self) {
+        for (i, r) in self.reference.iter_mut().enumerate() {
+            *r = i as u32;
+        }
+    }
+
+    /// One drift step for the positions `positions` (one per vertex of the original mesh).
+    pub fn update(&mut self, positions: &[[f32; 3]]) {
+        assert_eq!(
+            positions.len(),
+            self.reference.len(),
+            "positions must belong to the original mesh"
+        );
+        let original = self.original.mesh();
+        let topology = self.original.topology();
+        let stay = self.original.stay_radius2();
+        self.reference
+            .par_iter_mut()
+            .zip(positions.par_iter())
+            .with_min_len(2048)
+            .for_each(|(r, q)| {
+                let d2 = |p: [f32; 3]| {
+                    let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+                    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+                };
+                // Ties keep the current reference, so a vertex that did not move stays put.
+                let mut best = *r;
+                let mut best_d2 = d2(original.positions[best as usize]);
+                // Within the stay radius no neighbour can be closer (see `Original`).
+                if best_d2 <= stay[best as usize] {
+                    return;
+                }
+                for &j in topology.neighbors_of(*r as usize) {
+                    let dj = d2(original.positions[j as usize]);
+                    let closer = dj < best_d2;
+                    best = if closer { j } else { best };
+                    best_d2 = if closer { dj } else { best_d2 };
+                }
+                *r = best;
+            });
+    }
+
+    /// The current reference vertex of every vertex.
+    pub fn reference(&self) -> &[u32] {
+        &self.reference
+    }
+
+    pub fn into_reference(self) -> Vec<u32> {
+        self.reference
+    }
+}
+
+impl StepObserver for DriftingReference<'_> {
+    fn after_step(&mut self, positions: &[[f32; 3]]) {
+        self.update(positions);
+    }
+}
+
+/// `0, 1, ..., n - 1`: every vertex its own reference (nothing has drifted).
+pub fn identity(n: usize) -> Vec<u32> {
+    (0..n as u32).collect()
+}

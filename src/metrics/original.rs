@@ -1,0 +1,116 @@
+//! The original mesh M as the measures see it: built once per loaded mesh, so every measure pass
+//! over a smoothed mesh only reads what stays fixed.
+
+use super::curvature::fan_corners;
+use super::report::{measure_pass, Sums};
+use crate::mesh::{Mesh, Topology};
+
+/// The original mesh with what the measures precompute from it: the triangle fans in the order
+/// the passes read them, the drift's shortcut radius, the volume V0 (closed meshes only) and the
+/// curvature K0.
+#[derive(Clone, Debug)]
+pub struct Original {
+    mesh: Mesh,
+    topology: Topology,
+    /// Other two corners of each vertex->triangle incidence (parallel to `vertex_triangles`).
+    fan_corners: Vec<[u32; 2]>,
+    /// Per vertex, the square of 0.49 times its shortest edge: a point that near the vertex is
+    /// nearer to it than to any neighbour (each is at least 0.51 edge away), so the drift can
+    /// skip the ring. The margin keeps the shortcut exact in f32.
+    stay_radius2: Vec<f32>,
+    volume: Option<f64>,
+    curvature: f64,
+    /// Vertices some triangle uses: the ones the local error averages over.
+    referenced: usize,
+}
+
+impl Original {
+    /// Precomputes the original's measures. `topology` must be `Topology::build(mesh)`.
+    pub fn new(mesh: &Mesh, topology: &Topology) -> Self {
+        assert_eq!(
+            topology.vertex_count(),
+            mesh.vertex_count(),
+            "topology must be built from this mesh"
+        );
+        let referenced = (0..mesh.vertex_count())
+            .filter(|&i| !topology.triangles_of(i).is_empty())
+            .count();
+        let mut original = Self {
+            mesh: mesh.clone(),
+            topology: topology.clone(),
+            fan_corners: fan_corners(&mesh.triangles, topology),
+            stay_radius2: stay_radius2(&mesh.positions, topology),
+            volume: None,
+            curvature: 0.0,
+            referenced,
+        };
+        let sums: Sums = measure_pass(&original, &mesh.positions, None, None);
+        original.volume = original.is_closed().then(|| sums.volume());
+        original.curvature = sums.curvature();
+        original
+    }
+
+    /// V0, by the divergence theorem; `None` for an open mesh (or one without triangles), where
+    /// an enclosed volume means nothing.
+    pub fn volume(&self) -> Option<f64> {
+        self.volume
+    }
+
+    /// K0: mean `|K_G|` over the interior vertices with a defined curvature.
+    pub fn curvature(&self) -> f64 {
+        self.curvature
+    }
+
+    /// No boundary edges and at least one triangle.
+    pub fn is_closed(&self) -> bool {
+        !self.topology.has_boundary() && !self.mesh.triangles.is_empty()
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    pub fn topology(&self) -> &Topology {
+        &self.topology
+    }
+
+    /// The other two corners of each triangle around vertex `i`, in winding order.
+    #[inline]
+    pub(crate) fn fan_corners(&self, i: usize) -> &[[u32; 2]] {
+        let o = &self.topology.triangle_offsets;
+        &self.fan_corners[o[i] as usize..o[i + 1] as usize]
+    }
+
+    pub(crate) fn stay_radius2(&self) -> &[f32] {
+        &self.stay_radius2
+    }
+
+    /// Number of vertices some triangle uses.
+    pub fn referenced_vertices(&self) -> usize {
+        self.referenced
+    }
+}
+
+fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
+    use rayon::prelude::*;
+    (0..positions.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|i| {
+            let p = positions[i];
+            let shortest2 = topology
+                .neighbors_of(i)
+                .iter()
+                .map(|&j| {
+                    let q = positions[j as usize];
+                    (0..3).map(|k| (q[k] - p[k]) * (q[k] - p[k])).sum::<f32>()
+                })
+                .fold(f32::INFINITY, f32::min);
+            if shortest2.is_finite() {
+                0.49 * 0.49 * shortest2
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,321 @@
+//! One measure pass over a smoothed mesh and the report it yields: volume, curvature, local
+//! error and the score, plus per-vertex arrays for colour-coding.
+
+use super::curvature::{fan_sums, triangle_areas, TriangleArea};
+use super::exact_distance::TriangleBvh;
+use super::local_error::vertex_local_error;
+use super::score::ScoreTerms;
+use super::Original;
+use crate::mesh::to_f64;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// Vertices per parallel work item. Partial sums are combined in chunk order, so every result
+/// is bit-for-bit the same whatever the thread count (ties in parameter searches stay ties).
+const CHUNK: usize = 2048;
+
+/// The measures of a smoothed mesh against its original. Serialises to the keys of
+/// `meshsmooth measure --json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Metrics {
+    /// Enclosed volume V (mesh units cubed); `null` for an open mesh.
+    pub volume: Option<f64>,
+    /// V0 of the original; `null` for an open mesh.
+    pub volume0: Option<f64>,
+    /// Signed relative change `(V - V0) / V0`; `null` where V0 is undefined or 0.
+    pub volume_change: Option<f64>,
+    /// K: mean `|K_G|` over interior vertices (1 / mesh units squared).
+    pub curvature: f64,
+    /// K0 of the original.
+    pub curvature0: f64,
+    /// E: mean local error over the vertices some triangle uses (mesh units).
+    pub mean_error: f64,
+    pub max_error: f64,
+    /// S(tau), lower is better.
+    pub score: f64,
+    /// Mean exact distance to the original, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exact_mean_error: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exact_max_error: Option<f64>,
+}
+
+impl Metrics {
+    /// The two halves of the score, for scoring the same result at another `tau`.
+    pub fn score_terms(&self) -> ScoreTerms {
+        ScoreTerms::new(
+            self.curvature,
+            self.curvature0,
+            self.mean_error,
+            self.volume,
+            self.volume0,
+        )
+    }
+
+    /// Adds the exact distances (see [`exact_error`]).
+    pub fn with_exact(mut self, exact: ErrorSummary) -> Self {
+        self.exact_mean_error = Some(exact.mean);
+        self.exact_max_error = Some(exact.max);
+        self
+    }
+}
+
+/// Per-vertex measures for colour-coding, one entry per vertex of the mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct VertexMeasures {
+    /// Local error (mesh units); 0 for vertices no triangle uses.
+    pub local_error: Vec<f32>,
+    /// `K_G`; 0 where it is left out of K (boundary, unreferenced, no area).
+    pub gaussian_curvature: Vec<f32>,
+}
+
+/// Mean and maximum of a per-vertex distance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ErrorSummary {
+    pub mean: f64,
+    pub max: f64,
+}
+
+/// Measures `positions` (the smoothed mesh M', one per original vertex) against the original.
+/// `reference` holds each vertex's drifted reference vertex ([`super::DriftingReference`]);
+/// `tau` weighs the score.
+pub fn measure(
+    original: &Original,
+    positions: &[[f32; 3]],
+    reference: &[u32],
+    tau: f64,
+) -> Metrics {
+    let sums = measure_pass(original, positions, Some(reference), None);
+    metrics(original, &sums, tau)
+}
+
+/// [`measure`], also filling the per-vertex arrays, in the same pass.
+pub fn measure_vertices(
+    original: &Original,
+    positions: &[[f32; 3]],
+    reference: &[u32],
+    tau: f64,
+) -> (Metrics, VertexMeasures) {
+    let n = original.mesh().vertex_count();
+    let mut vertex = VertexMeasures {
+        local_error: vec![0.0; n],
+        gaussian_curvature: vec![0.0; n],
+    };
+    let sums = measure_pass(
+        original,
+        positions,
+        Some(reference),
+        Some((&mut vertex.local_error, &mut vertex.gaussian_curvature)),
+    );
+    (metrics(original, &sums, tau), vertex)
+}
+
+/// Exact distance from each vertex of `positions` to the original mesh, summarised over the same
+/// vertices as the local error. `bvh` is `TriangleBvh::new` over the original mesh.
+pub fn exact_error(bvh: &TriangleBvh, original: &Original, positions: &[[f32; 3]]) -> ErrorSummary {
+    let topology = original.topology();
+    let distances = exact_distances(bvh, original, positions);
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for (i, d) in distances.iter().enumerate() {
+        if !topology.triangles_of(i).is_empty() {
+            sum += d;
+            max = max.max(*d);
+        }
+    }
+    ErrorSummary {
+        mean: mean(sum, original.referenced_vertices()),
+        max,
+    }
+}
+
+/// Exact distance from each vertex of `positions` to the original mesh, in parallel; 0 for
+/// vertices no triangle uses (they never move). The distance to the vertex's own original fan
+/// (the local error with the reference at home) is a distance to part of the mesh, so it bounds
+/// each search from above and lets it skip most of the tree.
+pub fn exact_distances(bvh: &TriangleBvh, original: &Original, positions: &[[f32; 3]]) -> Vec<f64> {
+    let n = original.mesh().vertex_count();
+    assert_eq!(
+        positions.len(),
+        n,
+        "positions must belong to the original mesh"
+    );
+    let topology = original.topology();
+    (0..n)
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|i| {
+            if topology.triangles_of(i).is_empty() {
+                return 0.0;
+            }
+            let q = to_f64(positions[i]);
+            // A little slack: both distances are rounded, along different formulas.
+            let bound = vertex_local_error(original, positions[i], i);
+            let bound = bound * (1.0 + 1e-9) + 1e-12;
+            bvh.closest_within(q, bound)
+                .or_else(|| bvh.closest(q))
+                .map_or(0.0, |c| c.distance)
+        })
+        .collect()
+}
+
+fn metrics(original: &Original, sums: &Sums, tau: f64) -> Metrics {
+    let volume0 = original.volume();
+    let volume = volume0.map(|_| sums.volume());
+    let volume_change = match (volume, volume0) {
+        (Some(v), Some(v0)) if v0 != 0.0 => Some((v - v0) / v0),
+        _ => None,
+    };
+    let curvature = sums.curvature();
+    let curvature0 = original.curvature();
+    let mean_error = mean(sums.error_sum, sums.error_count);
+    let score = ScoreTerms::new(curvature, curvature0, mean_error, volume, volume0).score(tau);
+    Metrics {
+        volume,
+        volume0,
+        volume_change,
+        curvature,
+        curvature0,
+        mean_error,
+        max_error: sums.error_max,
+        score,
+        exact_mean_error: None,
+        exact_max_error: None,
+    }
+}
+
+fn mean(sum: f64, count: usize) -> f64 {
+    if count > 0 {
+        sum / count as f64
+    } else {
+        0.0
+    }
+}
+
+/// Partial sums of one measure pass.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Sums {
+    volume6: f64,
+    curvature_sum: f64,
+    curvature_count: usize,
+    error_sum: f64,
+    error_max: f64,
+    error_count: usize,
+}
+
+impl Sums {
+    fn add(&mut self, o: &Sums) {
+        self.volume6 += o.volume6;
+        self.curvature_sum += o.curvature_sum;
+        self.curvature_count += o.curvature_count;
+        self.error_sum += o.error_sum;
+        self.error_max = self.error_max.max(o.error_max);
+        self.error_count += o.error_count;
+    }
+
+    pub(crate) fn volume(&self) -> f64 {
+        self.volume6 / 6.0
+    }
+
+    pub(crate) fn curvature(&self) -> f64 {
+        mean(self.curvature_sum, self.curvature_count)
+    }
+}
+
+/// Volume, curvature and local error in one pass over the vertices (`reference`: `None` = every
+/// vertex its own reference). Writes per-vertex local error and `K_G` into `out` when given.
+pub(crate) fn measure_pass(
+    original: &Original,
+    positions: &[[f32; 3]],
+    reference: Option<&[u32]>,
+    out: Option<(&mut [f32], &mut [f32])>,
+) -> Sums {
+    let n = original.mesh().vertex_count();
+    assert_eq!(
+        positions.len(),
+        n,
+        "positions must belong to the original mesh"
+    );
+    if let Some(r) = reference {
+        assert_eq!(r.len(), n, "one reference vertex per vertex");
+    }
+    let (areas, volume6) = triangle_areas(positions, &original.mesh().triangles);
+    let pass = Pass {
+        original,
+        positions,
+        reference,
+        areas: &areas,
+    };
+    let partial: Vec<Sums> = match out {
+        Some((error, curvature)) => error
+            .par_chunks_mut(CHUNK)
+            .zip(curvature.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(c, (e, k))| pass.chunk(c * CHUNK, Some((e, k))))
+            .collect(),
+        None => (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| pass.chunk(c * CHUNK, None))
+            .collect(),
+    };
+    let mut total = Sums {
+        volume6,
+        ..Sums::default()
+    };
+    for p in &partial {
+        total.add(p);
+    }
+    total
+}
+
+/// What every chunk of a measure pass reads.
+struct Pass<'a> {
+    original: &'a Original,
+    positions: &'a [[f32; 3]],
+    reference: Option<&'a [u32]>,
+    areas: &'a [TriangleArea],
+}
+
+impl Pass<'_> {
+    /// Curvature and local error of the vertices `start..start + CHUNK`.
+    fn chunk(&self, start: usize, mut out: Option<(&mut [f32], &mut [f32])>) -> Sums {
+        let mesh = self.original.mesh();
+        let topology = self.original.topology();
+        let end = (start + CHUNK).min(mesh.vertex_count());
+        let mut s = Sums::default();
+        for i in start..end {
+            let fan = topology.triangles_of(i);
+            if fan.is_empty() {
+                continue;
+            }
+            let corners = self.original.fan_corners(i);
+            let f = fan_sums(
+                self.positions,
+                fan,
+                i as u32,
+                |k, _| (corners[k][0], corners[k][1]),
+                |_, t| self.areas[t as usize],
+            );
+            let mut k_g = 0.0;
+            if !topology.is_boundary[i] && f.mixed_area > 0.0 {
+                let k = (2.0 * PI - f.angle_sum) / f.mixed_area;
+                // A fan of vanishing area has no meaningful curvature: leave it out, like no area.
+                if k.is_finite() {
+                    k_g = k;
+                    s.curvature_sum += k.abs();
+                    s.curvature_count += 1;
+                }
+            }
+            let r = self.reference.map_or(i, |r| r[i] as usize);
+            let e = vertex_local_error(self.original, self.positions[i], r);
+            s.error_sum += e;
+            s.error_max = s.error_max.max(e);
+            s.error_count += 1;
+            if let Some((error, curvature)) = out.as_mut() {
+                error[i - start] = e as f32;
+                curvature[i - start] = k_g as f32;
+            }
+        }
+        s
+    }
+}

@@ -1,0 +1,95 @@
+//! Entry points on a real mesh: quality graphs, whole-filter suggestions, and the suggested
+//! parameters for `smooth --auto`.
+
+use super::mesh_evaluator::{MeshEvaluator, WeightsError};
+use super::{
+    run, Cancelled, GridSearch, LocalSearch, Progress, QualityGraphs, QualitySweep, SearchMethod,
+    Suggestion,
+};
+use crate::mesh::{Mesh, Topology};
+use crate::metrics::Original;
+use crate::smooth::{ParamError, Params};
+
+/// Why a sweep or suggestion could not be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SuggestError {
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    #[error(transparent)]
+    Weights(#[from] WeightsError),
+    #[error("tau = {0} is out of range: [0, 1]")]
+    Tau(f64),
+    #[error("cancelled")]
+    Cancelled,
+    #[error("the mesh has no vertices")]
+    Empty,
+}
+
+impl From<Cancelled> for SuggestError {
+    fn from(_: Cancelled) -> Self {
+        SuggestError::Cancelled
+    }
+}
+
+fn check_tau(tau: f64) -> Result<(), SuggestError> {
+    if (0.0..=1.0).contains(&tau) {
+        Ok(())
+    } else {
+        Err(SuggestError::Tau(tau))
+    }
+}
+
+/// The quality graphs of `current.filter` around `current`, on the real engine.
+pub fn quality_graphs(
+    original: &Original,
+    weights: Option<&[f32]>,
+    current: &Params,
+    tau: f64,
+    on_progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<QualityGraphs, SuggestError> {
+    check_tau(tau)?;
+    let mut evaluator = MeshEvaluator::new(original, weights)?;
+    let task = QualitySweep::new(current, tau)?;
+    Ok(run(task, &mut evaluator, on_progress)?)
+}
+
+/// The suggested parameters for `base.filter` at target smoothness `tau`. `base` carries the
+/// displacement bound; `weights` (one per vertex) are passed to every run.
+pub fn suggest(
+    original: &Original,
+    weights: Option<&[f32]>,
+    base: &Params,
+    tau: f64,
+    method: SearchMethod,
+    on_progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<Suggestion, SuggestError> {
+    check_tau(tau)?;
+    if original.mesh().vertex_count() == 0 {
+        return Err(SuggestError::Empty);
+    }
+    let mut evaluator = MeshEvaluator::new(original, weights)?;
+    let suggestion = match method {
+        SearchMethod::Grid => {
+            let task = GridSearch::new(base.filter, base)?;
+            run(task, &mut evaluator, on_progress)?.best(tau)
+        }
+        SearchMethod::Local => {
+            let task = LocalSearch::new(base.filter, base, tau)?;
+            Some(run(task, &mut evaluator, on_progress)?.suggestion)
+        }
+    };
+    suggestion.ok_or(SuggestError::Empty)
+}
+
+/// `smooth --auto`: the suggestion for a freshly loaded mesh, without progress reporting.
+pub fn suggest_for_mesh(
+    mesh: &Mesh,
+    topology: &Topology,
+    weights: Option<&[f32]>,
+    base: &Params,
+    tau: f64,
+    method: SearchMethod,
+) -> Result<Suggestion, SuggestError> {
+    let original = Original::new(mesh, topology);
+    suggest(&original, weights, base, tau, method, &mut |_| true)
+}

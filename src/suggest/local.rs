@@ -1,0 +1,300 @@
+//! The paper's local search (section 5.3): n searches for n parameters, search k starting at the
+//! maximum of parameter k and the minimum of the others. Each step measures the 3^n - 1 grid
+//! neighbours of the centre and moves to the lowest S; a search stops at a local minimum; the
+//! result is the best of the n minima. Measured points are remembered, so revisits cost nothing
+//! and the evaluation count is the number of distinct parameter sets measured.
+
+use super::grid::{check_base, lowest};
+use super::points::{plan_runs, Measured, Run};
+use super::space::{GridPoint, ParamSpace};
+use super::{score_order, Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
+use crate::smooth::{Filter, ParamError, Params};
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    /// Start the next search (or finish).
+    Start,
+    /// The centre is measured: queue its neighbours.
+    AtCentre,
+    /// The neighbours are measured: move or stop.
+    Decide,
+    Done,
+}
+
+/// The local search, one smoothing run per [`Task::step`].
+pub struct LocalSearch {
+    space: ParamSpace,
+    base: Params,
+    tau: f64,
+    starts: Vec<GridPoint>,
+    measured: Measured,
+    pending: VecDeque<Run>,
+    phase: Phase,
+    centre: GridPoint,
+    paths: Vec<Vec<GridPoint>>,
+    total: usize,
+}
+
+impl LocalSearch {
+    /// `base` supplies what the grid does not vary (the displacement bound).
+    pub fn new(filter: Filter, base: &Params, tau: f64) -> Result<Self, ParamError> {
+        let base = check_base(filter, base)?;
+        let space = ParamSpace::of(filter);
+        Ok(Self {
+            starts: space.corner_starts(&base),
+            total: space.all_points(&base).len(),
+            space,
+            base,
+            tau,
+            measured: Measured::default(),
+            pending: VecDeque::new(),
+            phase: Phase::Start,
+            centre: GridPoint([0; 3]),
+            paths: Vec::new(),
+        })
+    }
+
+    fn queue(&mut self, points: &[GridPoint]) {
+        let missing = self.measured.missing(points);
+        self.pending.extend(plan_runs(&self.space, &missing));
+    }
+
+    fn score(&self, p: GridPoint) -> f64 {
+        self.measured.get(p).map_or(f64::NAN, |t| t.score(self.tau))
+    }
+
+    /// Advances the state machine until a run is due or the search is over.
+    fn advance(&mut self) {
+        while self.pending.is_empty() && self.phase != Phase::Done {
+            match self.phase {
+                Phase::Start => match self.starts.get(self.paths.len()) {
+                    Some(&start) => {
+                        self.centre = start;
+                        self.paths.push(vec![start]);
+                        self.queue(&[start]);
+                        self.phase = Phase::AtCentre;
+                    }
+                    None => self.phase = Phase::Done,
+                },
+                Phase::AtCentre => {
+                    let around = self.space.neighbours(&self.base, self.centre);
+                    self.queue(&around);
+                    self.phase = Phase::Decide;
+                }
+                Phase::Decide => {
+                    let around = self.space.neighbours(&self.base, self.centre);
+                    let best = lowest(
+                        &self.space,
+                        self.tau,
+                        around
+                            .iter()
+                            .filter_map(|&p| self.measured.get(p).map(|t| (p, t))),
+                    );
+                    let centre_score = self.score(self.centre);
+                    match best {
+                        Some((p, t)) if score_order(t.score(self.tau), centre_score).is_lt() => {
+                            self.centre = p;
+                            if let Some(path) = self.paths.last_mut() {
+                                path.push(p);
+                            }
+                            self.phase = Phase::AtCentre;
+                        }
+                        _ => self.phase = Phase::Start,
+                    }
+                }
+                Phase::Done => {}
+            }
+        }
+    }
+}
+
+impl Task for LocalSearch {
+    type Output = LocalOutcome;
+
+    fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
+        self.advance();
+        if let Some(run) = self.pending.pop_front() {
+            self.measured
+                .measure(&self.space, &self.base, evaluator, &run);
+            self.advance();
+        }
+        self.phase == Phase::Done
+    }
+
+    fn progress(&self) -> Progress {
+        Progress {
+            done: self.measured.len(),
+            total: self.total,
+        }
+    }
+
+    fn into_output(self) -> Option<LocalOutcome> {
+        if self.phase != Phase::Done {
+            return None;
+        }
+        let minima: Vec<(GridPoint, Terms)> = self
+            .paths
+            .iter()
+            .filter_map(|path| path.last())
+            .filter_map(|&p| self.measured.get(p).map(|t| (p, t)))
+            .collect();
+        let (point, terms) = lowest(&self.space, self.tau, minima.iter().copied())?;
+        let evaluations = self.measured.len();
+        let suggestion = Suggestion {
+            filter: self.space.filter,
+            params: self.space.params_at(&self.base, point),
+            tau: self.tau,
+            score: terms.score(self.tau),
+            terms,
+            evaluations,
+            search: SearchMethod::Local,
+        };
+        Some(LocalOutcome {
+            suggestion,
+            minima: minima.iter().map(|&(p, _)| p).collect(),
+            paths: self.paths,
+        })
+    }
+}
+
+/// The local search's result and how it got there.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LocalOutcome {
+    pub suggestion: Suggestion,
+    /// The local minimum each search stopped at, in start order.
+    pub minima: Vec<GridPoint>,
+    /// Each search's centres from start to minimum.
+    pub paths: Vec<Vec<GridPoint>>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::synthetic::{bowl, smoothing_model, two_basins, FnEvaluator};
+    use super::super::GridSearch;
+    use super::*;
+    use crate::suggest::run;
+
+    fn local(filter: Filter, tau: f64, ev: &mut dyn Evaluator) -> LocalOutcome {
+        let task = LocalSearch::new(filter, &Params::defaults(filter), tau).unwrap();
+        run(task, ev, &mut |_| true).unwrap()
+    }
+
+    #[test]
+    fn descends_into_a_bowl_from_every_corner() {
+        for (filter, at) in [
+            (Filter::Laplace, [3, 4, 0]),
+            (Filter::Hc, [7, 2, 9]),
+            (Filter::Taubin, [2, 5, 6]),
+            (Filter::Sinc, [6, 3, 0]),
+        ] {
+            let space = ParamSpace::of(filter);
+            let centre = GridPoint(at);
+            let mut ev = FnEvaluator::new(bowl(&space, centre));
+            let out = local(filter, 0.5, &mut ev);
+            assert_eq!(out.minima, vec![centre; space.dims()], "{filter}");
+            assert_eq!(space.point_of(&out.suggestion.params), Some(centre));
+            assert_eq!(out.suggestion.search, SearchMethod::Local);
+            // Every step moves to a strictly better neighbour.
+            for path in &out.paths {
+                for w in path.windows(2) {
+                    assert!(space
+                        .neighbours(&Params::defaults(filter), w[0])
+                        .contains(&w[1]));
+                }
+            }
+            // Revisits are not counted twice; the grid would measure every point.
+            assert_eq!(out.suggestion.evaluations, ev.seen.len());
+            assert!(out.suggestion.evaluations < space.all_points(&Params::defaults(filter)).len());
+        }
+    }
+
+    #[test]
+    fn three_parameter_search_costs_a_third_of_the_grid_or_less() {
+        let space = ParamSpace::of(Filter::Hc);
+        let mut ev = FnEvaluator::new(bowl(&space, GridPoint([4, 6, 5])));
+        let out = local(Filter::Hc, 0.5, &mut ev);
+        assert!(
+            3 * out.suggestion.evaluations <= 1331,
+            "{}",
+            out.suggestion.evaluations
+        );
+    }
+
+    #[test]
+    fn the_second_corner_finds_what_the_first_misses() {
+        // Global minimum near lambda = max, iterations = min; a shallower basin near the other
+        // corner traps the search that starts there.
+        let space = ParamSpace::of(Filter::Laplace);
+        let global = GridPoint([8, 2, 0]);
+        let trap = GridPoint([2, 8, 0]);
+        let mut ev = FnEvaluator::new(two_basins(&space, global, 0.0, trap, 0.1));
+        let out = local(Filter::Laplace, 0.5, &mut ev);
+        assert_eq!(out.minima, vec![global, trap]);
+        assert_eq!(space.point_of(&out.suggestion.params), Some(global));
+    }
+
+    #[test]
+    fn can_miss_the_global_minimum_and_says_so_honestly() {
+        // Both corners lie in the shallow basin: the local search ends there, the grid does not.
+        let space = ParamSpace::of(Filter::Laplace);
+        let global = GridPoint([9, 9, 0]);
+        let trap = GridPoint([3, 3, 0]);
+        let f = || two_basins(&space, global, 0.0, trap, 0.05);
+        let out = local(Filter::Laplace, 0.5, &mut FnEvaluator::new(f()));
+        assert_eq!(out.minima, vec![trap, trap]);
+        let g = run(
+            GridSearch::new(Filter::Laplace, &Params::defaults(Filter::Laplace)).unwrap(),
+            &mut FnEvaluator::new(f()),
+            &mut |_| true,
+        )
+        .unwrap();
+        let best = g.best(0.5).unwrap();
+        assert_eq!(space.point_of(&best.params), Some(global));
+        assert!(out.suggestion.score > best.score);
+    }
+
+    #[test]
+    fn neighbours_of_the_same_weights_share_a_run() {
+        let space = ParamSpace::of(Filter::Laplace);
+        let mut ev = FnEvaluator::new(bowl(&space, GridPoint([5, 5, 0])));
+        let out = local(Filter::Laplace, 0.5, &mut ev);
+        assert!(ev.runs < out.suggestion.evaluations);
+    }
+
+    #[test]
+    fn tau_zero_suggests_no_smoothing() {
+        for filter in Filter::ALL {
+            let mut ev = FnEvaluator::new(smoothing_model(filter));
+            let out = local(filter, 0.0, &mut ev);
+            assert!(out.suggestion.leaves_mesh_unchanged(), "{filter}");
+        }
+    }
+
+    #[test]
+    fn agrees_with_the_grid_on_a_smooth_response() {
+        for filter in Filter::ALL {
+            for tau in [0.2, 0.5, 0.8] {
+                let g = run(
+                    GridSearch::new(filter, &Params::defaults(filter)).unwrap(),
+                    &mut FnEvaluator::new(smoothing_model(filter)),
+                    &mut |_| true,
+                )
+                .unwrap()
+                .best(tau)
+                .unwrap();
+                let l = local(filter, tau, &mut FnEvaluator::new(smoothing_model(filter)));
+                // The model's optimum is a valley; local search may stop at a different point
+                // of it, but never much worse.
+                assert!(
+                    l.suggestion.score <= g.score + 0.02,
+                    "{filter} tau {tau}: {} vs {}",
+                    l.suggestion.score,
+                    g.score
+                );
+                assert!(l.suggestion.evaluations < g.evaluations);
+            }
+        }
+    }
+}

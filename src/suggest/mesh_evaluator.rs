@@ -1,0 +1,164 @@
+//! The real evaluator: smooth with the CPU engine, drift the local error's reference vertices
+//! along the run, and measure against the original.
+
+use super::{is_cumulative, Evaluator, Terms};
+use crate::metrics::{measure, DriftingReference, Metrics, Original};
+use crate::smooth::{smooth, Params, StepObserver};
+
+/// Per-vertex weights that do not fit the mesh.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum WeightsError {
+    #[error("{given} vertex weights for a mesh of {vertices} vertices")]
+    Count { given: usize, vertices: usize },
+    #[error("vertex weight {index} is {value}; weights lie in [0, 1]")]
+    Range { index: usize, value: f32 },
+}
+
+/// Checks per-vertex weights against the mesh: one per vertex, each in [0, 1].
+pub fn check_weights(weights: &[f32], vertices: usize) -> Result<(), WeightsError> {
+    if weights.len() != vertices {
+        return Err(WeightsError::Count {
+            given: weights.len(),
+            vertices,
+        });
+    }
+    match weights.iter().position(|w| !(0.0..=1.0).contains(w)) {
+        Some(index) => Err(WeightsError::Range {
+            index,
+            value: weights[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The score terms of a measured mesh.
+pub fn terms_of(metrics: &Metrics) -> Terms {
+    Terms {
+        curvature_ratio: metrics.score_terms().curvature_ratio,
+        mean_error: metrics.mean_error,
+        volume_change: metrics.volume_change.map(f64::abs),
+    }
+}
+
+/// Smooths the original mesh of an [`Original`] and measures the results.
+pub struct MeshEvaluator<'a> {
+    original: &'a Original,
+    weights: Option<&'a [f32]>,
+    /// Smoothing runs so far (for benchmarks).
+    pub runs: usize,
+}
+
+impl<'a> MeshEvaluator<'a> {
+    /// `weights`, when given, has one entry in [0, 1] per vertex and is passed to every run.
+    pub fn new(original: &'a Original, weights: Option<&'a [f32]>) -> Result<Self, WeightsError> {
+        if let Some(w) = weights {
+            check_weights(w, original.mesh().vertex_count())?;
+        }
+        Ok(Self {
+            original,
+            weights,
+            runs: 0,
+        })
+    }
+
+    /// The terms of the unchanged mesh (no volume term when it is open).
+    fn unchanged(&self) -> Terms {
+        Terms {
+            volume_change: self.original.volume().map(|_| 0.0),
+            ..Terms::UNCHANGED
+        }
+    }
+
+    fn measure_positions(&self, positions: &[[f32; 3]], reference: &[u32]) -> Terms {
+        terms_of(&measure(self.original, positions, reference, 0.5))
+    }
+}
+
+/// Drifts the reference vertices after every step and measures after the wanted iterations.
+struct Along<'o, 'e> {
+    drift: DriftingReference<'o>,
+    evaluator: &'e MeshEvaluator<'o>,
+    at: &'e [u32],
+    terms: Vec<Terms>,
+}
+
+impl StepObserver for Along<'_, '_> {
+    fn after_step(&mut self, positions: &[[f32; 3]]) {
+        self.drift.update(positions);
+    }
+
+    fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
+        if self.at.get(self.terms.len()) == Some(&iteration) {
+            let t = self
+                .evaluator
+                .measure_positions(positions, self.drift.reference());
+            self.terms.push(t);
+        }
+    }
+}
+
+impl Evaluator for MeshEvaluator<'_> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Vec<Terms> {
+        let mesh = self.original.mesh();
+        let topology = self.original.topology();
+        let mut out = Vec::with_capacity(at.len());
+        // Zero iterations is the original mesh, whose terms are known exactly.
+        let zeros = at.iter().take_while(|&&k| k == 0).count();
+        out.extend((0..zeros).map(|_| self.unchanged()));
+        let rest = &at[zeros..];
+        if rest.is_empty() {
+            return out;
+        }
+        if is_cumulative(params.filter) {
+            let mut p = *params;
+            p.iterations = rest[rest.len() - 1];
+            let mut along = Along {
+                drift: DriftingReference::new(self.original),
+                evaluator: self,
+                at: rest,
+                terms: Vec::with_capacity(rest.len()),
+            };
+            let positions = smooth(mesh, topology, &p, self.weights, &mut along);
+            // A mesh the engine cannot smooth (nothing to move) reports no iterations: its
+            // result is the same for every count.
+            while along.terms.len() < rest.len() {
+                let t = self.measure_positions(&positions, along.drift.reference());
+                along.terms.push(t);
+            }
+            out.extend(along.terms);
+            self.runs += 1;
+        } else {
+            for &k in rest {
+                let mut p = *params;
+                p.iterations = k;
+                let mut drift = DriftingReference::new(self.original);
+                let positions = smooth(mesh, topology, &p, self.weights, &mut drift);
+                out.push(self.measure_positions(&positions, drift.reference()));
+                self.runs += 1;
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_must_fit_the_mesh() {
+        assert!(check_weights(&[0.0, 0.5, 1.0], 3).is_ok());
+        assert_eq!(
+            check_weights(&[0.0, 0.5], 3),
+            Err(WeightsError::Count {
+                given: 2,
+                vertices: 3
+            })
+        );
+        assert!(matches!(
+            check_weights(&[0.0, f32::NAN, 1.0], 3),
+            Err(WeightsError::Range { index: 1, .. })
+        ));
+        assert!(check_weights(&[1.5], 1).is_err());
+    }
+}

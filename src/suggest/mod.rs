@@ -1,0 +1,223 @@
+//! Model quality graphs and parameter suggestions (paper section 5; ALGORITHMS.md, "Model
+//! quality graphs" and "Parameter suggestion").
+//!
+//! Everything here is generic over an [`Evaluator`]: something that smooths with given
+//! parameters and returns the score terms. The search logic never smooths by itself, so it is
+//! tested on synthetic evaluators with known minima, and runs unchanged on the real engine.
+//!
+//! The work is split into [`Task`]s that do one smoothing run per [`Task::step`], so the web app
+//! can interleave them with frames (wasm32 is single-threaded) and the CLI can run them to the end
+//! with [`run`], reporting progress and honouring cancellation between runs.
+
+mod auto;
+mod grid;
+mod local;
+mod mesh_evaluator;
+mod points;
+mod space;
+mod sweep;
+
+pub use auto::{quality_graphs, suggest, suggest_for_mesh, SuggestError};
+pub use grid::{EvaluatedGrid, GridSearch};
+pub use local::{LocalOutcome, LocalSearch};
+pub use mesh_evaluator::{check_weights, terms_of, MeshEvaluator, WeightsError};
+pub use space::{Axis, GridPoint, Param, ParamSpace};
+pub use sweep::{Curve, QualityGraphs, QualitySweep, Sample};
+
+use crate::smooth::{Filter, Params};
+use serde::{Deserialize, Serialize};
+
+/// The quantities the score is made of (paper eq. 4).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Terms {
+    /// K/K0: mean |Gaussian curvature| relative to the original mesh.
+    pub curvature_ratio: f64,
+    /// E: mean local error (mesh units, mm).
+    pub mean_error: f64,
+    /// |V - V0| / V0; `None` when the mesh is open and its volume means nothing.
+    pub volume_change: Option<f64>,
+}
+
+impl Terms {
+    /// The terms of the unchanged mesh.
+    pub const UNCHANGED: Terms = Terms {
+        curvature_ratio: 1.0,
+        mean_error: 0.0,
+        volume_change: Some(0.0),
+    };
+
+    /// The accuracy half of the score, `0.5 * (E/(E+1) + |V-V0|/V0)`. Without a volume (open
+    /// mesh) it is `E/(E+1)` alone, the mean of the terms that exist, as in [`crate::metrics`].
+    pub fn accuracy(&self) -> f64 {
+        let e = self.mean_error / (self.mean_error + 1.0);
+        match self.volume_change {
+            Some(v) => 0.5 * (e + v),
+            None => e,
+        }
+    }
+
+    /// `S(tau) = tau * K/K0 + (1 - tau) * accuracy`. Lower is better. NaN terms give NaN, which
+    /// every comparison here ranks last.
+    pub fn score(&self, tau: f64) -> f64 {
+        tau * self.curvature_ratio + (1.0 - tau) * self.accuracy()
+    }
+}
+
+/// Smooths and measures. Implementations: the real engine ([`crate::smooth`] plus
+/// [`crate::metrics`]) and synthetic functions in tests.
+pub trait Evaluator {
+    /// Smooths with `params` (its `iterations` field is ignored) and returns the terms after each
+    /// iteration count in `at` (ascending, distinct; 0 means the unchanged mesh), in that order.
+    ///
+    /// For filters whose k-iteration result is a prefix of a longer run (all but windowed sinc)
+    /// this is one run measured along the way; callers pass sinc one count at a time.
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Vec<Terms>;
+}
+
+/// Whether the k-iteration result of `filter` is the state after k iterations of a longer run.
+/// Windowed sinc's iteration count is the degree of its polynomial, so each count is its own run.
+pub fn is_cumulative(filter: Filter) -> bool {
+    filter != Filter::Sinc
+}
+
+/// How far a task has come, in parameter sets measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Progress {
+    pub done: usize,
+    /// Known for sweeps and the grid; for the local search an upper bound (the grid's size).
+    pub total: usize,
+}
+
+/// A piece of work done one smoothing run at a time.
+pub trait Task {
+    type Output;
+    /// Does one smoothing run (or finishes without one); returns `true` once nothing is left.
+    fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool;
+    fn progress(&self) -> Progress;
+    /// The result, once [`Task::step`] has returned `true`; `None` before.
+    fn into_output(self) -> Option<Self::Output>;
+}
+
+/// The caller asked to stop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("cancelled")]
+pub struct Cancelled;
+
+/// Runs `task` to the end. `on_progress` is called after every run; returning `false` cancels.
+pub fn run<T: Task>(
+    mut task: T,
+    evaluator: &mut dyn Evaluator,
+    on_progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<T::Output, Cancelled> {
+    loop {
+        let finished = task.step(evaluator);
+        if !on_progress(task.progress()) {
+            return Err(Cancelled);
+        }
+        if finished {
+            return task.into_output().ok_or(Cancelled);
+        }
+    }
+}
+
+/// Which whole-filter search to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SearchMethod {
+    /// Every grid point.
+    Grid,
+    /// The paper's local search from opposite corners.
+    Local,
+}
+
+impl SearchMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchMethod::Grid => "grid",
+            SearchMethod::Local => "local",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<SearchMethod> {
+        [SearchMethod::Grid, SearchMethod::Local]
+            .into_iter()
+            .find(|m| m.name() == name)
+    }
+}
+
+/// A suggested parameter set for one filter and target smoothness.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Suggestion {
+    pub filter: Filter,
+    /// The suggested parameters; weights and displacement bound are the caller's, passed through.
+    /// `iterations == 0` means "leave the mesh unchanged" for every filter, windowed sinc included.
+    pub params: Params,
+    pub tau: f64,
+    /// S(tau) of `params`.
+    pub score: f64,
+    pub terms: Terms,
+    /// Distinct parameter sets measured to find it.
+    pub evaluations: usize,
+    pub search: SearchMethod,
+}
+
+impl Suggestion {
+    /// Whether the suggestion is to leave the mesh as it is.
+    pub fn leaves_mesh_unchanged(&self) -> bool {
+        self.params.iterations == 0
+    }
+}
+
+/// Orders scores with NaN last, so a broken measurement never wins.
+pub(crate) fn score_order(a: f64, b: f64) -> std::cmp::Ordering {
+    match (a.is_nan(), b.is_nan()) {
+        (false, false) => a.total_cmp(&b),
+        (true, true) => std::cmp::Ordering::Equal,
+        (true, false) => std::cmp::Ordering::Greater,
+        (false, true) => std::cmp::Ordering::Less,
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod synthetic;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn score_follows_equation_four() {
+        let t = Terms {
+            curvature_ratio: 0.4,
+            mean_error: 0.25,
+            volume_change: Some(0.02),
+        };
+        let accuracy = 0.5 * (0.25 / 1.25 + 0.02);
+        assert!((t.accuracy() - accuracy).abs() < 1e-15);
+        assert!((t.score(0.3) - (0.3 * 0.4 + 0.7 * accuracy)).abs() < 1e-15);
+        assert_eq!(t.score(1.0), 0.4);
+        let open = Terms {
+            volume_change: None,
+            ..t
+        };
+        assert!((open.accuracy() - 0.2).abs() < 1e-15);
+        assert_eq!(Terms::UNCHANGED.score(0.0), 0.0);
+        assert_eq!(Terms::UNCHANGED.score(0.7), 0.7);
+    }
+
+    #[test]
+    fn nan_scores_rank_last() {
+        use std::cmp::Ordering::*;
+        assert_eq!(score_order(f64::NAN, 1e9), Greater);
+        assert_eq!(score_order(0.1, f64::NAN), Less);
+        assert_eq!(score_order(0.1, 0.2), Less);
+    }
+
+    #[test]
+    fn search_names_round_trip() {
+        for m in [SearchMethod::Grid, SearchMethod::Local] {
+            assert_eq!(SearchMethod::from_name(m.name()), Some(m));
+        }
+        assert_eq!(SearchMethod::from_name("random"), None);
+    }
+}

@@ -1,0 +1,304 @@
+//! Model quality graphs (paper section 5.2): for each parameter of the active filter, K/K0, E,
+//! |V-V0|/V0 and S over its range with the other parameters at their current values. The sweep
+//! over iterations is one run measured after every iteration (windowed sinc: one run per count,
+//! since its k-iteration result is not a prefix of a longer run).
+
+use super::space::{Param, ParamSpace};
+use super::{is_cumulative, score_order, Evaluator, Progress, Task, Terms};
+use crate::smooth::{ParamError, Params};
+use serde::{Deserialize, Serialize};
+
+/// One measured sample of a curve.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sample {
+    pub value: f64,
+    pub terms: Terms,
+    /// S(tau) at the sweep's tau.
+    pub score: f64,
+}
+
+/// One parameter's graph.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Curve {
+    pub param: Param,
+    /// The parameter's current value (the dashed line).
+    pub current: f64,
+    /// Ascending by value; only values valid with the others held (Taubin: mu < -lambda).
+    pub samples: Vec<Sample>,
+    /// Index of the lowest S (ties: the weaker smoothing): this parameter's suggestion given the
+    /// others. `None` for an empty curve.
+    pub best: Option<usize>,
+}
+
+impl Curve {
+    /// The suggested value of this parameter with the others held.
+    pub fn suggestion(&self) -> Option<f64> {
+        self.best.map(|i| self.samples[i].value)
+    }
+
+    fn rescore(&mut self, tau: f64, larger_is_stronger: bool) {
+        for s in &mut self.samples {
+            s.score = s.terms.score(tau);
+        }
+        let n = self.samples.len();
+        // Weaker first, so the first of equal scores is the weaker smoothing.
+        let order: Vec<usize> = if larger_is_stronger {
+            (0..n).collect()
+        } else {
+            (0..n).rev().collect()
+        };
+        self.best = order.into_iter().reduce(|a, b| {
+            if score_order(self.samples[b].score, self.samples[a].score).is_lt() {
+                b
+            } else {
+                a
+            }
+        });
+    }
+}
+
+/// The quality graphs of one filter at one parameter set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct QualityGraphs {
+    /// The current parameters the curves vary around.
+    pub current: Params,
+    pub tau: f64,
+    pub curves: Vec<Curve>,
+}
+
+impl QualityGraphs {
+    /// Recomputes S and each curve's minimum for another tau (no smoothing needed).
+    pub fn rescored(mut self, tau: f64) -> Self {
+        let space = ParamSpace::of(self.current.filter);
+        for (curve, axis) in self.curves.iter_mut().zip(&space.axes) {
+            curve.rescore(tau, axis.larger_is_stronger);
+        }
+        self.tau = tau;
+        self
+    }
+}
+
+/// One smoothing run of the sweep: parameters and the samples it fills.
+struct Job {
+    curve: usize,
+    params: Params,
+    /// (sample index, iteration count) pairs, ascending.
+    at: Vec<(usize, u32)>,
+}
+
+/// Computes the quality graphs one smoothing run per [`Task::step`].
+pub struct QualitySweep {
+    graphs: QualityGraphs,
+    jobs: Vec<Job>,
+    next: usize,
+    done: usize,
+    total: usize,
+}
+
+impl QualitySweep {
+    /// `current` must be valid; it also carries the displacement bound passed to every run.
+    pub fn new(current: &Params, tau: f64) -> Result<Self, ParamError> {
+        current.validate()?;
+        let space = ParamSpace::of(current.filter);
+        let mut jobs = Vec::new();
+        let mut curves = Vec::new();
+        for (c, axis) in space.axes.iter().enumerate() {
+            let mut values = Vec::new();
+            for &v in &axis.sweep {
+                let mut p = *current;
+                axis.param.set(&mut p, v);
+                if p.validate().is_ok() {
+                    values.push((v, p));
+                }
+            }
+            if axis.param == Param::Iterations && is_cumulative(current.filter) {
+                if let Some(&(_, p)) = values.first() {
+                    let at = values
+                        .iter()
+                        .enumerate()
+                        .map(|(i, (_, q))| (i, q.iterations))
+                        .collect();
+                    jobs.push(Job {
+                        curve: c,
+                        params: p,
+                        at,
+                    });
+                }
+            } else {
+                jobs.extend(values.iter().enumerate().map(|(i, &(_, p))| Job {
+                    curve: c,
+                    params: p,
+                    at: vec![(i, p.iterations)],
+                }));
+            }
+            curves.push(Curve {
+                param: axis.param,
+                current: axis.param.get(current),
+                samples: values
+                    .iter()
+                    .map(|&(value, _)| Sample {
+                        value,
+                        terms: Terms {
+                            curvature_ratio: f64::NAN,
+                            mean_error: f64::NAN,
+                            volume_change: None,
+                        },
+                        score: f64::NAN,
+                    })
+                    .collect(),
+                best: None,
+            });
+        }
+        let total = curves.iter().map(|c| c.samples.len()).sum();
+        Ok(Self {
+            graphs: QualityGraphs {
+                current: *current,
+                tau,
+                curves,
+            },
+            jobs,
+            next: 0,
+            done: 0,
+            total,
+        })
+    }
+}
+
+impl Task for QualitySweep {
+    type Output = QualityGraphs;
+
+    fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
+        if let Some(job) = self.jobs.get(self.next) {
+            let counts: Vec<u32> = job.at.iter().map(|&(_, k)| k).collect();
+            let terms = evaluator.measure(&job.params, &counts);
+            let curve = &mut self.graphs.curves[job.curve];
+            for (&(i, _), t) in job.at.iter().zip(terms) {
+                curve.samples[i].terms = t;
+                self.done += 1;
+            }
+            self.next += 1;
+        }
+        self.next >= self.jobs.len()
+    }
+
+    fn progress(&self) -> Progress {
+        Progress {
+            done: self.done,
+            total: self.total,
+        }
+    }
+
+    fn into_output(self) -> Option<QualityGraphs> {
+        (self.next >= self.jobs.len()).then(|| {
+            let tau = self.graphs.tau;
+            self.graphs.rescored(tau)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::synthetic::{smoothing_model, FnEvaluator};
+    use super::*;
+    use crate::smooth::Filter;
+    use crate::suggest::run;
+
+    fn sweep(p: &Params, tau: f64, ev: &mut dyn Evaluator) -> QualityGraphs {
+        run(QualitySweep::new(p, tau).unwrap(), ev, &mut |_| true).unwrap()
+    }
+
+    #[test]
+    fn one_curve_per_parameter_with_the_specified_samples() {
+        let p = Params::defaults(Filter::Hc);
+        let mut ev = FnEvaluator::new(smoothing_model(Filter::Hc));
+        let g = sweep(&p, 0.5, &mut ev);
+        let names: Vec<_> = g.curves.iter().map(|c| c.param).collect();
+        assert_eq!(names, [Param::Alpha, Param::Beta, Param::Iterations]);
+        assert_eq!(g.curves[0].samples.len(), 21);
+        assert_eq!(g.curves[0].samples[1].value, 0.05);
+        assert_eq!(g.curves[2].samples.len(), 51);
+        assert_eq!(g.curves[0].current, 0.1);
+        // 21 + 21 weight runs, one cumulative run for the 51 iteration samples.
+        assert_eq!(ev.runs, 43);
+        for c in &g.curves {
+            for s in &c.samples {
+                assert!(s.terms.curvature_ratio.is_finite());
+                assert_eq!(s.score, s.terms.score(0.5));
+            }
+        }
+    }
+
+    #[test]
+    fn the_minimum_of_each_curve_is_its_suggestion() {
+        let p = Params::defaults(Filter::Laplace);
+        let mut ev = FnEvaluator::new(|q: &Params| Terms {
+            curvature_ratio: 1.0
+                + (q.lambda as f64 - 0.35).powi(2)
+                + ((q.iterations as f64) - 17.0).powi(2) / 100.0,
+            mean_error: 0.0,
+            volume_change: Some(0.0),
+        });
+        let g = sweep(&p, 0.5, &mut ev);
+        assert_eq!(g.curves[0].suggestion(), Some(0.35));
+        assert_eq!(g.curves[1].suggestion(), Some(17.0));
+        assert_eq!(g.curves[1].current, 10.0);
+        // At tau = 0 every sample ties at S = 0; the weaker smoothing wins.
+        let g0 = g.rescored(0.0);
+        assert_eq!(g0.curves[0].suggestion(), Some(0.0));
+        assert_eq!(g0.curves[1].suggestion(), Some(0.0));
+    }
+
+    #[test]
+    fn taubin_curves_keep_mu_below_minus_lambda() {
+        let p = Params::defaults(Filter::Taubin); // lambda 0.5, mu -0.53
+        let g = sweep(
+            &p,
+            0.5,
+            &mut FnEvaluator::new(smoothing_model(Filter::Taubin)),
+        );
+        let lambdas: Vec<f64> = g.curves[0].samples.iter().map(|s| s.value).collect();
+        assert_eq!(lambdas.first(), Some(&0.05));
+        assert_eq!(lambdas.last(), Some(&0.5));
+        let mus: Vec<f64> = g.curves[1].samples.iter().map(|s| s.value).collect();
+        assert_eq!(mus.first(), Some(&-1.0));
+        assert_eq!(mus.last(), Some(&-0.55));
+    }
+
+    #[test]
+    fn sinc_restarts_for_every_iteration_count() {
+        let p = Params::defaults(Filter::Sinc);
+        let mut ev = FnEvaluator::new(smoothing_model(Filter::Sinc));
+        let g = sweep(&p, 0.5, &mut ev);
+        assert_eq!(g.curves[0].samples.len(), 10);
+        assert_eq!(g.curves[1].samples.len(), 100);
+        assert_eq!(ev.runs, 110);
+        assert_eq!(ev.iterations_run, 10 * 20 + (1..=100).sum::<u64>());
+    }
+
+    #[test]
+    fn progress_counts_samples_and_cancel_stops() {
+        let p = Params::defaults(Filter::Laplace);
+        let mut ev = FnEvaluator::new(smoothing_model(Filter::Laplace));
+        let mut seen = Vec::new();
+        sweep_with(&p, &mut ev, &mut |pr| {
+            seen.push(pr);
+            true
+        });
+        assert_eq!(seen.last().map(|p| (p.done, p.total)), Some((72, 72)));
+        let mut ev = FnEvaluator::new(smoothing_model(Filter::Laplace));
+        let r = run(QualitySweep::new(&p, 0.5).unwrap(), &mut ev, &mut |pr| {
+            pr.done < 5
+        });
+        assert!(r.is_err());
+        assert_eq!(ev.runs, 5);
+        assert!(QualitySweep::new(&Params { lambda: 2.0, ..p }, 0.5).is_err());
+    }
+
+    fn sweep_with(
+        p: &Params,
+        ev: &mut dyn Evaluator,
+        f: &mut dyn FnMut(Progress) -> bool,
+    ) -> QualityGraphs {
+        run(QualitySweep::new(p, 0.5).unwrap(), ev, f).unwrap()
+    }
+}
