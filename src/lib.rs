@@ -5,6 +5,7 @@
 //! (native) and the web app (wasm32) sit on top and own no algorithm.
 
 pub mod export;
+pub mod gpu;
 pub mod io;
 pub mod mesh;
 pub mod metrics;

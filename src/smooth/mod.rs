@@ -19,6 +19,8 @@ mod sinc_coefficients;
 mod umbrella;
 
 pub use params::{Filter, ParamError, Params};
+// The GPU engine evaluates the same windowed-sinc series.
+pub(crate) use sinc_coefficients::sinc_coefficients;
 
 use crate::mesh::{Mesh, Topology};
 use constraint::{Constrain, Free, Limits};

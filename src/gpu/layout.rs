@@ -1,0 +1,87 @@
+//! What the Rust side and the WGSL side must agree on: the step-parameter record, its slots in
+//! the uniform buffer, and the workgroup grid.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Threads per workgroup; must equal `WORKGROUP_SIZE` in shaders/mesh.wgsl (checked by a test).
+pub const WORKGROUP_SIZE: u32 = 64;
+
+/// Flags of [`StepParams::flags`], as in shaders/mesh.wgsl.
+pub(crate) const HAS_WEIGHTS: u32 = 1;
+pub(crate) const HAS_BOUND: u32 = 2;
+
+/// One step's parameters, `StepParams` in shaders/mesh.wgsl: std140-compatible (the vec4
+/// starts at byte 32, a multiple of 16), 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct StepParams {
+    pub vertex_count: u32,
+    pub flags: u32,
+    pub bound: f32,
+    pub factor: f32,
+    pub alpha: f32,
+    pub beta: f32,
+    pub c0: f32,
+    pub c1: f32,
+    pub centre: [f32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<StepParams>() == 48);
+const _: () = assert!(std::mem::offset_of!(StepParams, centre) == 32);
+
+/// Step records a run may need at once: windowed sinc's one per term after the first, up to its
+/// largest valid iteration count (100); the other filters use one or two.
+pub(crate) const MAX_STEP_SLOTS: usize = 100;
+
+/// Distance between step records in the uniform buffer: each is bound at a dynamic offset,
+/// which must be a multiple of the device's `min_uniform_buffer_offset_alignment`.
+pub(crate) fn step_stride(min_uniform_buffer_offset_alignment: u32) -> u64 {
+    let align = u64::from(min_uniform_buffer_offset_alignment.max(1));
+    (std::mem::size_of::<StepParams>() as u64).div_ceil(align) * align
+}
+
+/// Workgroups `(x, y)` covering `vertex_count` vertices: one row while it fits in
+/// `max_per_dimension`, then rows of `max_per_dimension` (the kernels index
+/// `x + y * groups.x * WORKGROUP_SIZE` and skip indices past the vertex count). `None` when
+/// even a square grid is too small.
+pub(crate) fn dispatch_size(vertex_count: u32, max_per_dimension: u32) -> Option<(u32, u32)> {
+    let groups = vertex_count.div_ceil(WORKGROUP_SIZE);
+    let max = max_per_dimension.max(1);
+    if groups <= max {
+        return Some((groups, 1));
+    }
+    let rows = groups.div_ceil(max);
+    (rows <= max).then_some((max, rows))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_covers_every_vertex_once_within_the_limit() {
+        assert_eq!(dispatch_size(0, 65_535), Some((0, 1)));
+        assert_eq!(dispatch_size(1, 65_535), Some((1, 1)));
+        assert_eq!(dispatch_size(64 * 65_535, 65_535), Some((65_535, 1)));
+        assert_eq!(dispatch_size(64 * 65_535 + 1, 65_535), Some((65_535, 2)));
+        for (n, max) in [(1000u32, 4u32), (64 * 16, 4), (64 * 16 + 1, 4), (300, 1)] {
+            match dispatch_size(n, max) {
+                Some((x, y)) => {
+                    assert!(x <= max && y <= max);
+                    assert!(u64::from(x) * u64::from(y) * 64 >= u64::from(n));
+                    // Not a whole row more than needed.
+                    assert!(u64::from(x) * u64::from(y - 1) * 64 < u64::from(n.max(1)));
+                }
+                None => assert!(u64::from(n) > u64::from(max * max) * 64, "n {n} max {max}"),
+            }
+        }
+        assert_eq!(dispatch_size(64 * 16 + 1, 4), None);
+    }
+
+    #[test]
+    fn stride_respects_the_alignment() {
+        assert_eq!(step_stride(256), 256);
+        assert_eq!(step_stride(16), 48);
+        assert_eq!(step_stride(32), 64);
+    }
+}

@@ -1,0 +1,294 @@
+//! A mesh on the GPU: every buffer and bind group a smoothing run needs, created once at upload.
+//!
+//! Positions are vec4<f32> (w = 0). Runs ping-pong between `a` and `b`; HC keeps its
+//! differences and windowed sinc its running estimate in `aux`. The original positions, the
+//! smoothing ring and the weights stay as uploaded, so further kernels (measures) can bind
+//! them next to a run's result.
+
+use wgpu::util::DeviceExt;
+
+use super::layout::{step_stride, StepParams, MAX_STEP_SLOTS};
+use super::limits::{check_mesh_fits, POSITION_BYTES};
+use super::pipelines::Layouts;
+use super::GpuError;
+use crate::mesh::{bounding_box, Mesh, Topology};
+
+/// Which buffer holds the latest run's positions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Slot {
+    Original,
+    A,
+    B,
+    Aux,
+}
+
+/// Group-1 bind groups, one per role assignment a run uses.
+pub(crate) struct PositionGroups {
+    /// Umbrella steps `a -> b` and `b -> a`.
+    pub a_to_b: wgpu::BindGroup,
+    pub b_to_a: wgpu::BindGroup,
+    /// HC: differences `a -> aux`, correction `aux -> a`.
+    pub a_to_aux: wgpu::BindGroup,
+    pub aux_to_a: wgpu::BindGroup,
+    /// Windowed sinc: first term (T_0 in `b`, T_1 in `a`), then terms gathering `a` or `b`.
+    pub sinc_first: wgpu::BindGroup,
+    pub sinc_from_a: wgpu::BindGroup,
+    pub sinc_from_b: wgpu::BindGroup,
+}
+
+/// A mesh uploaded by [`super::GpuSmoother::upload`].
+pub struct GpuMesh {
+    pub(crate) vertex_count: u32,
+    /// Windowed sinc's centring: the original bounding box's centre, as the CPU computes it.
+    pub(crate) centre: [f32; 3],
+    pub(crate) has_weights: bool,
+    pub(crate) result: Slot,
+    pub(crate) step_stride: u64,
+    pub(crate) steps: wgpu::Buffer,
+    pub(crate) offsets: wgpu::Buffer,
+    pub(crate) neighbors: wgpu::Buffer,
+    pub(crate) original: wgpu::Buffer,
+    pub(crate) weights: wgpu::Buffer,
+    pub(crate) a: wgpu::Buffer,
+    pub(crate) b: wgpu::Buffer,
+    pub(crate) aux: wgpu::Buffer,
+    pub(crate) mesh_group: wgpu::BindGroup,
+    pub(crate) groups: PositionGroups,
+}
+
+/// Checks the smoothing ring against the vertex count as the CPU engine does, so no kernel
+/// reads past an array.
+fn checked_ring(topology: &Topology, vertex_count: usize) -> Result<(&[u32], &[u32]), GpuError> {
+    let (offsets, neighbors) = topology.smoothing_ring();
+    let mismatch = |what: String| Err(GpuError::TopologyMismatch(what));
+    if offsets.len() != vertex_count + 1 {
+        return mismatch(format!(
+            "{} ring offsets for {vertex_count} vertices",
+            offsets.len()
+        ));
+    }
+    let consistent = offsets.first() == Some(&0)
+        && offsets.windows(2).all(|w| w[0] <= w[1])
+        && offsets.last().map(|&e| e as usize) == Some(neighbors.len());
+    if !consistent {
+        return mismatch("ring offsets are not a CSR index of the neighbour list".into());
+    }
+    if let Some(&j) = neighbors.iter().find(|&&j| j as usize >= vertex_count) {
+        return mismatch(format!(
+            "neighbour {j} of a mesh of {vertex_count} vertices"
+        ));
+    }
+    Ok((offsets, neighbors))
+}
+
+/// Bytes of a storage buffer holding `data`; never empty (WebGPU refuses empty bindings).
+fn storage_init(device: &wgpu::Device, label: &str, data: &[u8]) -> wgpu::Buffer {
+    let padded;
+    let contents = if data.is_empty() {
+        padded = [0u8; 16];
+        &padded[..]
+    } else {
+        data
+    };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
+fn to_vec4(positions: &[[f32; 3]]) -> Vec<[f32; 4]> {
+    positions.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect()
+}
+
+fn bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = (0u32..)
+        .zip(buffers)
+        .map(|(binding, buffer)| wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout,
+        entries: &entries,
+    })
+}
+
+impl GpuMesh {
+    pub(crate) fn upload(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        mesh: &Mesh,
+        topology: &Topology,
+    ) -> Result<Self, GpuError> {
+        let n = mesh.positions.len();
+        let (offsets, neighbors) = checked_ring(topology, n)?;
+        // Before any buffer exists: a mesh over the limits gets an error naming the limit.
+        check_mesh_fits(&device.limits(), n, neighbors.len())?;
+
+        let stride = step_stride(device.limits().min_uniform_buffer_offset_alignment);
+        let steps = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("meshsmooth step parameters"),
+            size: stride * MAX_STEP_SLOTS as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let original_data = to_vec4(&mesh.positions);
+        let offsets = storage_init(
+            device,
+            "meshsmooth ring offsets",
+            bytemuck::cast_slice(offsets),
+        );
+        let neighbors = storage_init(device, "meshsmooth ring", bytemuck::cast_slice(neighbors));
+        let original = storage_init(
+            device,
+            "meshsmooth original positions",
+            bytemuck::cast_slice(&original_data),
+        );
+        let weights = storage_init(
+            device,
+            "meshsmooth weights",
+            bytemuck::cast_slice(&vec![1.0f32; n]),
+        );
+        let positions = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: (n.max(1) as u64) * POSITION_BYTES,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let (a, b, aux) = (
+            positions("meshsmooth positions a"),
+            positions("meshsmooth positions b"),
+            positions("meshsmooth positions aux"),
+        );
+
+        let mesh_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("meshsmooth mesh"),
+            layout: &layouts.mesh,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &steps,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<StepParams>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: offsets.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: neighbors.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: original.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: weights.as_entire_binding(),
+                },
+            ],
+        });
+        let pair = |from, to| bind_group(device, &layouts.pair, &[from, to]);
+        let groups = PositionGroups {
+            a_to_b: pair(&a, &b),
+            b_to_a: pair(&b, &a),
+            a_to_aux: pair(&a, &aux),
+            aux_to_a: pair(&aux, &a),
+            sinc_first: bind_group(device, &layouts.sinc_first, &[&original, &b, &aux, &a]),
+            sinc_from_a: bind_group(device, &layouts.sinc_term, &[&a, &b, &aux]),
+            sinc_from_b: bind_group(device, &layouts.sinc_term, &[&b, &a, &aux]),
+        };
+        let centre = bounding_box(&mesh.positions).map_or([0.0; 3], |(lo, hi)| {
+            std::array::from_fn(|k| ((f64::from(lo[k]) + f64::from(hi[k])) * 0.5) as f32)
+        });
+        Ok(Self {
+            vertex_count: n as u32,
+            centre,
+            has_weights: false,
+            result: Slot::Original,
+            step_stride: stride,
+            steps,
+            offsets,
+            neighbors,
+            original,
+            weights,
+            a,
+            b,
+            aux,
+            mesh_group,
+            groups,
+        })
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count as usize
+    }
+
+    /// Sets the per-vertex weights in [0, 1] (0 locks a vertex) used by the next runs, or clears
+    /// them (`None`: every vertex moves freely). Values are clamped to [0, 1], NaN counts as 0,
+    /// as the CPU engine reads them.
+    pub fn set_weights(
+        &mut self,
+        queue: &wgpu::Queue,
+        weights: Option<&[f32]>,
+    ) -> Result<(), GpuError> {
+        let n = self.vertex_count();
+        match weights {
+            None => self.has_weights = false,
+            Some(w) if w.len() != n => {
+                return Err(GpuError::WeightCount {
+                    given: w.len(),
+                    vertices: n,
+                })
+            }
+            Some(w) => {
+                let clean: Vec<f32> = w
+                    .iter()
+                    .map(|&x| if x > 0.0 { x.min(1.0) } else { 0.0 })
+                    .collect();
+                if n > 0 {
+                    queue.write_buffer(&self.weights, 0, bytemuck::cast_slice(&clean));
+                }
+                self.has_weights = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// The buffer holding the latest run's positions (vec4<f32> per vertex, w = 0), or the
+    /// original positions before any run. For rendering and for kernels that measure a result.
+    pub fn positions_buffer(&self) -> &wgpu::Buffer {
+        match self.result {
+            Slot::Original => &self.original,
+            Slot::A => &self.a,
+            Slot::B => &self.b,
+            Slot::Aux => &self.aux,
+        }
+    }
+
+    /// The original positions, the smoothing ring's CSR offsets and neighbour indices, as
+    /// uploaded (for further kernels on the same mesh).
+    pub fn original_buffer(&self) -> &wgpu::Buffer {
+        &self.original
+    }
+
+    pub fn ring_buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
+        (&self.offsets, &self.neighbors)
+    }
+}

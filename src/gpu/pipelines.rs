@@ -1,0 +1,125 @@
+//! Bind group layouts and compute pipelines, created once per device and shared by every mesh.
+//!
+//! Group 0 (the mesh) is the same for every kernel: the step parameters at a dynamic offset, the
+//! ring CSR, the original positions and the weights. Group 1 holds the positions a kernel reads
+//! around each vertex and the ones it writes; its shape depends on the kernel.
+
+use std::num::NonZeroU64;
+
+use super::layout::StepParams;
+use super::shaders::{Kernel, HC, SINC, UMBRELLA};
+
+pub(crate) struct Layouts {
+    /// Group 0: step parameters (uniform, dynamic offset), offsets, neighbours, original, weights.
+    pub mesh: wgpu::BindGroupLayout,
+    /// Group 1 of the umbrella and HC kernels: gathered (read), written (read-write).
+    pub pair: wgpu::BindGroupLayout,
+    /// Group 1 of `sinc_first`: gathered (the original), previous, estimate, first_current.
+    pub sinc_first: wgpu::BindGroupLayout,
+    /// Group 1 of `sinc_term` and `sinc_finish`: gathered (T_k), previous, estimate.
+    pub sinc_term: wgpu::BindGroupLayout,
+}
+
+pub(crate) struct Pipelines {
+    pub umbrella_step: wgpu::ComputePipeline,
+    pub hc_differences: wgpu::ComputePipeline,
+    pub hc_correct: wgpu::ComputePipeline,
+    pub sinc_first: wgpu::ComputePipeline,
+    pub sinc_term: wgpu::ComputePipeline,
+    pub sinc_finish: wgpu::ComputePipeline,
+}
+
+fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A group-1 layout: binding 0 read-only, the next ones read-write.
+fn positions_layout(device: &wgpu::Device, label: &str, written: u32) -> wgpu::BindGroupLayout {
+    let entries: Vec<_> = std::iter::once(storage(0, true))
+        .chain((1..=written).map(|b| storage(b, false)))
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+impl Layouts {
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
+        let step = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: NonZeroU64::new(std::mem::size_of::<StepParams>() as u64),
+            },
+            count: None,
+        };
+        let mesh = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("meshsmooth mesh"),
+            entries: &[
+                step,
+                storage(1, true),
+                storage(2, true),
+                storage(3, true),
+                storage(4, true),
+            ],
+        });
+        Self {
+            mesh,
+            pair: positions_layout(device, "meshsmooth gathered/written", 1),
+            sinc_first: positions_layout(device, "meshsmooth sinc first term", 3),
+            sinc_term: positions_layout(device, "meshsmooth sinc term", 2),
+        }
+    }
+}
+
+impl Pipelines {
+    pub(crate) fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
+        let layout = |group1: &wgpu::BindGroupLayout| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: &[Some(&layouts.mesh), Some(group1)],
+                immediate_size: 0,
+            })
+        };
+        let pair = layout(&layouts.pair);
+        let sinc_first = layout(&layouts.sinc_first);
+        let sinc_term = layout(&layouts.sinc_term);
+        let umbrella = UMBRELLA.create_module(device);
+        let hc = HC.create_module(device);
+        let sinc = SINC.create_module(device);
+        let pipeline = |layout: &wgpu::PipelineLayout,
+                        module: &wgpu::ShaderModule,
+                        kernel: Kernel,
+                        entry: &str| {
+            debug_assert!(kernel.entry_points.contains(&entry));
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(layout),
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Self {
+            umbrella_step: pipeline(&pair, &umbrella, UMBRELLA, "umbrella_step"),
+            hc_differences: pipeline(&pair, &hc, HC, "hc_differences"),
+            hc_correct: pipeline(&pair, &hc, HC, "hc_correct"),
+            sinc_first: pipeline(&sinc_first, &sinc, SINC, "sinc_first"),
+            sinc_term: pipeline(&sinc_term, &sinc, SINC, "sinc_term"),
+            sinc_finish: pipeline(&sinc_term, &sinc, SINC, "sinc_finish"),
+        }
+    }
+}
