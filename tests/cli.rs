@@ -294,3 +294,31 @@ fn smooth_auto_takes_the_suggestion_and_tau_zero_leaves_the_mesh() {
             < 1e-12
     );
 }
+
+#[test]
+fn bench_runs_on_the_gpu_backend() {
+    let input = data("synthetic/synthetic_bent_tube_r3.5.ply");
+    let out = meshsmooth(&[
+        "bench",
+        input.to_str().unwrap(),
+        "--filter",
+        "sinc",
+        "--repeat",
+        "1",
+        "--backend",
+        "gpu",
+        "--json",
+    ]);
+    if !out.status.success() && std::env::var_os("REQUIRE_GPU").is_none() {
+        eprintln!(
+            "NOTICE: no GPU adapter, bench --backend gpu not run: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        return;
+    }
+    let v = json(&out);
+    assert_eq!(v["backend"], "gpu");
+    assert_eq!(v["iterations"], 20);
+    assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()));
+    assert!(v["vertex_iterations_per_second"].as_f64().unwrap() > 0.0);
+}

@@ -3,6 +3,7 @@
 //! Speed is reported, never asserted: machines are shared and noisy.
 
 use super::params::filter;
+use crate::gpu;
 use crate::mesh::Topology;
 use crate::metrics::{self, DriftingReference, Original};
 use crate::smooth::{self, Filter, NoObserver, Params};
@@ -20,12 +21,30 @@ struct BenchResult {
     vertex_iterations_per_second: f64,
     /// Best time of one measure pass (volume, curvature, local error, score).
     measure_seconds: f64,
-    /// Extra time the drifting reference adds to the smoothing run (one update per step).
+    /// Extra time the drifting reference adds to a CPU smoothing run (one update per step).
     drift_seconds: f64,
     /// Best time of 10 Laplace iterations on the same mesh, the yardstick for the measures.
     laplace10_seconds: f64,
     backend: &'static str,
     threads: usize,
+    /// The GPU adapter, for `--backend gpu`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    adapter: Option<String>,
+}
+
+/// Which engine smooths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Backend {
+    Cpu,
+    Gpu,
+}
+
+pub(super) fn parse_backend(name: &str) -> Result<Backend, String> {
+    match name {
+        "cpu" => Ok(Backend::Cpu),
+        "gpu" => Ok(Backend::Gpu),
+        other => Err(format!("unknown backend '{other}': use cpu or gpu")),
+    }
 }
 
 pub(super) fn run(
@@ -33,6 +52,7 @@ pub(super) fn run(
     filter_name: Option<&str>,
     iterations: Option<u32>,
     repeat: usize,
+    backend: Backend,
     json: bool,
 ) -> Result<(), String> {
     let filters = match filter_name {
@@ -50,6 +70,10 @@ pub(super) fn run(
         };
         smooth::smooth(&mesh, &topology, &p, None, &mut NoObserver);
     });
+    let mut gpu = match backend {
+        Backend::Cpu => None,
+        Backend::Gpu => Some(GpuBench::new(&mesh, &topology)?),
+    };
     let mut results = Vec::new();
     for f in filters {
         let mut params = Params::defaults(f);
@@ -57,9 +81,13 @@ pub(super) fn run(
             params.iterations = n;
         }
         params.validate().map_err(|e| e.to_string())?;
-        let seconds = best_of(repeat, || {
+        let cpu_seconds = best_of(repeat, || {
             smooth::smooth(&mesh, &topology, &params, None, &mut NoObserver);
         });
+        let seconds = match gpu.as_mut() {
+            None => cpu_seconds,
+            Some(g) => g.best_of(repeat, &params)?,
+        };
         let mut positions = Vec::new();
         let mut reference = Vec::new();
         let with_drift = best_of(repeat, || {
@@ -78,10 +106,11 @@ pub(super) fn run(
             seconds,
             vertex_iterations_per_second: vertex_iterations / seconds.max(1e-12),
             measure_seconds,
-            drift_seconds: (with_drift - seconds).max(0.0),
+            drift_seconds: (with_drift - cpu_seconds).max(0.0),
             laplace10_seconds: laplace10,
-            backend: "cpu",
+            backend: if gpu.is_some() { "gpu" } else { "cpu" },
             threads: rayon::current_num_threads(),
+            adapter: gpu.as_ref().map(|g| g.adapter.clone()),
         });
     }
     if json {
@@ -92,8 +121,12 @@ pub(super) fn run(
         };
         println!("{text}");
     } else {
+        let engine = match &gpu {
+            Some(g) => format!("gpu backend on {} (measures on the cpu)", g.adapter),
+            None => "cpu backend".to_string(),
+        };
         println!(
-            "{}: {} vertices, cpu backend, {} threads, best of {repeat}",
+            "{}: {} vertices, {engine}, {} threads, best of {repeat}",
             file.display(),
             mesh.vertex_count(),
             rayon::current_num_threads()
@@ -123,4 +156,46 @@ fn best_of(repeat: usize, mut f: impl FnMut()) -> f64 {
             t.elapsed().as_secs_f64()
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// The GPU engine with the mesh uploaded once; each timing is submission to completion.
+struct GpuBench {
+    context: gpu::GpuContext,
+    smoother: gpu::GpuSmoother,
+    mesh: gpu::GpuMesh,
+    adapter: String,
+}
+
+impl GpuBench {
+    fn new(mesh: &crate::mesh::Mesh, topology: &Topology) -> Result<Self, String> {
+        let context = gpu::request_native_device().map_err(|e| e.to_string())?;
+        let smoother = gpu::GpuSmoother::new(&context.device);
+        let uploaded = smoother
+            .upload(&context.device, mesh, topology)
+            .map_err(|e| e.to_string())?;
+        let info = &context.adapter_info;
+        let adapter = format!("{} ({:?}, {:?})", info.name, info.device_type, info.backend);
+        Ok(Self {
+            context,
+            smoother,
+            mesh: uploaded,
+            adapter,
+        })
+    }
+
+    fn best_of(&mut self, repeat: usize, params: &Params) -> Result<f64, String> {
+        let mut best = f64::INFINITY;
+        for _ in 0..repeat {
+            let t = gpu::time_smoothing(
+                &self.smoother,
+                &self.context.device,
+                &self.context.queue,
+                &mut self.mesh,
+                params,
+            )
+            .map_err(|e| e.to_string())?;
+            best = best.min(t);
+        }
+        Ok(best)
+    }
 }

@@ -78,9 +78,9 @@ enum Command {
         iterations: Option<u32>,
         #[arg(long, default_value_t = 5)]
         repeat: usize,
-        /// Only `cpu` for now.
-        #[arg(long, default_value = "cpu")]
-        backend: String,
+        /// cpu, or gpu (the native wgpu engine; measures stay on the cpu).
+        #[arg(long, default_value = "cpu", value_parser = bench::parse_backend)]
+        backend: bench::Backend,
         #[arg(long)]
         json: bool,
     },
@@ -128,12 +128,7 @@ pub fn main() -> ExitCode {
             repeat,
             backend,
             json,
-        } => match backend.as_str() {
-            "cpu" => bench::run(&file, filter.as_deref(), iterations, repeat, json),
-            other => Err(format!(
-                "unknown backend '{other}': this build has the cpu backend"
-            )),
-        },
+        } => bench::run(&file, filter.as_deref(), iterations, repeat, backend, json),
         Command::Sweep(args) => sweep::run(&args),
         Command::Suggest(args) => suggest::run(&args),
         Command::BenchLoad { file, repeat, json } => bench_load::run(&file, repeat.max(1), json),
