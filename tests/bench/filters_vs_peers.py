@@ -144,7 +144,7 @@ def ours(command, mesh, filt, its, repeats):
     best = None
     for _ in range(repeats):
         out = subprocess.run(cmd, capture_output=True, text=True, check=True, cwd=ROOT).stdout
-        result = json.loads(out.strip().splitlines()[-1])
+        result = json.loads(out)
         if best is None or result["seconds"] < best["seconds"]:
             best = result
     return best
