@@ -4,6 +4,8 @@
 //! of the bounding-box diagonal.
 //!
 //! Without an adapter these tests print a notice and pass, unless REQUIRE_GPU=1, where they fail.
+//! Native only: the browser's device comes from the page, not from these helpers.
+#![cfg(not(target_arch = "wasm32"))]
 
 use std::sync::OnceLock;
 
