@@ -73,22 +73,13 @@ mod tests {
 
     wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
 
-    fn tetrahedron() -> Mesh {
-        Mesh::new(
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-            ],
-            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        )
-    }
-
     #[wasm_bindgen_test]
     fn a_bad_file_keeps_the_previous_model_and_reports_why() {
         let mut state = AppState {
-            model: Some(LoadedModel::from_mesh("tet.ply", tetrahedron())),
+            model: Some(LoadedModel::from_mesh(
+                "tet.ply",
+                crate::mesh::fixtures::tetrahedron(),
+            )),
             error: None,
         };
         state.open("notes.txt", b"not a mesh");

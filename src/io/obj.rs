@@ -61,23 +61,7 @@ fn read_vertex<'a>(
             detail: "more than 4294967294 vertices".into(),
         });
     }
-    let mut p = [0f32; 3];
-    for c in &mut p {
-        let token = tokens
-            .next()
-            .ok_or_else(|| syntax(line, "'v' needs 3 coordinates".into()))?;
-        let value = text::parse_f32(token)
-            .ok_or_else(|| syntax(line, format!("'{}' is not a number", text::show(token))))?;
-        if !value.is_finite() {
-            return Err(LoadError::NonFinite {
-                format: FORMAT,
-                location: Location::Line(line),
-                value: text::show(token),
-            });
-        }
-        *c = value;
-    }
-    Ok(p)
+    text::read_xyz(tokens, FORMAT, line, "v")
 }
 
 /// `f a b c ...` with each corner `v`, `v/t`, `v//n` or `v/t/n`; negative `v` counts back from

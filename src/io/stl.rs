@@ -243,28 +243,7 @@ fn read_xyz<'a>(
     tokens: &mut impl Iterator<Item = &'a [u8]>,
     line: usize,
 ) -> Result<[f32; 3], LoadError> {
-    let mut p = [0f32; 3];
-    for c in &mut p {
-        let token = tokens.next().ok_or_else(|| LoadError::Syntax {
-            format: FORMAT,
-            location: Location::Line(line),
-            detail: "'vertex' needs 3 coordinates".into(),
-        })?;
-        let value = text::parse_f32(token).ok_or_else(|| LoadError::Syntax {
-            format: FORMAT,
-            location: Location::Line(line),
-            detail: format!("'{}' is not a number", text::show(token)),
-        })?;
-        if !value.is_finite() {
-            return Err(LoadError::NonFinite {
-                format: FORMAT,
-                location: Location::Line(line),
-                value: text::show(token),
-            });
-        }
-        *c = value;
-    }
-    Ok(p)
+    text::read_xyz(tokens, FORMAT, line, "vertex")
 }
 
 fn too_many_vertices() -> LoadError {

@@ -110,6 +110,39 @@ pub(super) fn is_keyword(token: &[u8], keyword: &str) -> bool {
     token.eq_ignore_ascii_case(keyword.as_bytes())
 }
 
+/// Three finite coordinates from a text line's remaining tokens (OBJ `v`, ASCII STL `vertex`).
+/// `record` names the statement in the error when a coordinate is missing.
+pub(super) fn read_xyz<'a>(
+    tokens: &mut impl Iterator<Item = &'a [u8]>,
+    format: super::Format,
+    line: usize,
+    record: &str,
+) -> Result<[f32; 3], super::LoadError> {
+    use super::{LoadError, Location};
+    let syntax = |detail: String| LoadError::Syntax {
+        format,
+        location: Location::Line(line),
+        detail,
+    };
+    let mut p = [0f32; 3];
+    for c in &mut p {
+        let token = tokens
+            .next()
+            .ok_or_else(|| syntax(format!("'{record}' needs 3 coordinates")))?;
+        let value =
+            parse_f32(token).ok_or_else(|| syntax(format!("'{}' is not a number", show(token))))?;
+        if !value.is_finite() {
+            return Err(LoadError::NonFinite {
+                format,
+                location: Location::Line(line),
+                value: show(token),
+            });
+        }
+        *c = value;
+    }
+    Ok(p)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -118,11 +118,12 @@ pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+/// Meshes the unit tests of several modules share.
 #[cfg(test)]
-mod tests {
-    use super::*;
+pub(crate) mod fixtures {
+    use super::Mesh;
 
-    /// Unit right tetrahedron, outward winding.
+    /// Unit right tetrahedron, outward winding: closed, genus 0, volume 1/6.
     pub(crate) fn tetrahedron() -> Mesh {
         Mesh::new(
             vec![
@@ -134,6 +135,12 @@ mod tests {
             vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
         )
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixtures::tetrahedron;
+    use super::*;
 
     #[test]
     fn tetrahedron_volume_is_one_sixth() {

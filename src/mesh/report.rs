@@ -219,15 +219,8 @@ mod tests {
     }
 
     fn tetra() -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
-        (
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-            ],
-            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        )
+        let m = crate::mesh::fixtures::tetrahedron();
+        (m.positions, m.triangles)
     }
 
     #[test]

@@ -282,15 +282,7 @@ mod tests {
 
     #[test]
     fn closed_mesh_has_no_boundary_and_shares_the_ring() {
-        let m = Mesh::new(
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-            ],
-            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        );
+        let m = crate::mesh::fixtures::tetrahedron();
         let t = Topology::build(&m);
         assert!(!t.has_boundary());
         assert!(t.edge_triangle_counts.iter().all(|&c| c == 2));
