@@ -64,34 +64,3 @@ impl FilterArgs {
         Ok(p)
     }
 }
-
-/// The parameters a filter reads, as JSON (the others are left out so a report is not misread).
-pub(super) fn params_json(p: &Params) -> serde_json::Value {
-    let mut m = serde_json::Map::new();
-    let mut put = |k: &str, v: f32| {
-        m.insert(k.to_string(), serde_json::json!(shortest(v)));
-    };
-    match p.filter {
-        Filter::Laplace => put("lambda", p.lambda),
-        Filter::Taubin => {
-            put("lambda", p.lambda);
-            put("mu", p.mu);
-        }
-        Filter::Hc => {
-            put("alpha", p.alpha);
-            put("beta", p.beta);
-        }
-        Filter::Sinc => put("passband", p.passband),
-    }
-    m.insert("iterations".into(), serde_json::json!(p.iterations));
-    m.insert(
-        "max_displacement".into(),
-        serde_json::json!(p.max_displacement.map(shortest)),
-    );
-    serde_json::Value::Object(m)
-}
-
-/// An f32 as the f64 with the same shortest decimal form (0.1f32 prints as 0.1, not 0.10000000149).
-pub(super) fn shortest(v: f32) -> f64 {
-    v.to_string().parse().unwrap_or(v as f64)
-}

@@ -1,10 +1,10 @@
 //! `meshsmooth smooth FILE -o OUT [filter flags] [--json]`: smooth, write, print the measures.
 
-use super::params::{params_json, FilterArgs};
+use super::params::FilterArgs;
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh, Topology};
-use crate::metrics::{self, DriftingReference, Metrics, Original};
-use crate::smooth::{self, Params};
+use crate::metrics::{self, Metrics, Original};
+use crate::smooth::Params;
 use crate::suggest::{suggest, SearchMethod};
 use std::path::Path;
 use std::time::Instant;
@@ -67,7 +67,7 @@ pub(super) fn run(
                 "suggested for tau {tau} by {} search ({} parameter sets): {}",
                 s.search.name(),
                 s.evaluations,
-                params_json(&params)
+                params.to_json()
             );
         }
         println!(
@@ -89,23 +89,13 @@ pub(crate) fn smooth_and_measure(
     params: &Params,
     tau: f64,
 ) -> (Vec<[f32; 3]>, Metrics) {
-    let mut drift = DriftingReference::new(original);
-    let positions = smooth::smooth(
-        original.mesh(),
-        original.topology(),
-        params,
-        None,
-        &mut drift,
-    );
-    let metrics = metrics::measure(original, &positions, drift.reference(), tau);
+    let (positions, reference) = metrics::smooth_drifting(original, params, None);
+    let metrics = metrics::measure(original, &positions, &reference, tau);
     (positions, metrics)
 }
 
 fn report_json(params: &Params, metrics: &Metrics, seconds: f64) -> serde_json::Value {
-    serde_json::json!({
-        "filter": params.filter.name(),
-        "params": params_json(params),
-        "seconds": seconds,
-        "metrics": metrics,
-    })
+    let mut report = export::smoothing_extras(params, metrics);
+    report["seconds"] = serde_json::json!(seconds);
+    report
 }

@@ -1,7 +1,7 @@
 //! `meshsmooth suggest FILE --filter F [--tau T] [--search grid|local] [--json]`: the suggested
 //! parameters for one filter at a target smoothness.
 
-use super::params::{filter as parse_filter, params_json};
+use super::params::filter as parse_filter;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::{Filter, Params};
@@ -63,7 +63,7 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
     if args.json {
         let out = SuggestJson {
             filter: s.filter,
-            params: params_json(&s.params),
+            params: s.params.to_json(),
             score: s.score,
             terms: s.terms,
             evaluations: s.evaluations,
@@ -77,7 +77,7 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
 }
 
 fn text(s: &Suggestion, seconds: f64) -> String {
-    let params: Vec<String> = match params_json(&s.params) {
+    let params: Vec<String> = match s.params.to_json() {
         serde_json::Value::Object(m) => m
             .into_iter()
             .filter(|(_, v)| !v.is_null())

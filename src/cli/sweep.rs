@@ -3,7 +3,7 @@
 
 mod plot;
 
-use super::params::{params_json, FilterArgs};
+use super::params::FilterArgs;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::Filter;
@@ -76,7 +76,7 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
         let out = SweepJson {
             filter: current.filter,
             tau: args.tau,
-            current: params_json(&current),
+            current: current.to_json(),
             curves: &graphs.curves,
             seconds,
         };

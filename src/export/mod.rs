@@ -7,6 +7,8 @@ mod ply;
 mod stl;
 
 use crate::mesh::Mesh;
+use crate::metrics::Metrics;
+use crate::smooth::Params;
 
 /// Output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -66,6 +68,17 @@ pub enum ExportError {
     },
     #[error("{what} of vertex {vertex} is not finite")]
     NonFinite { what: &'static str, vertex: usize },
+}
+
+/// The GLB `extras` of a smoothed mesh: which filter made it, with which parameters, and its
+/// measures (the same object the CLI's `smooth --json` prints, less the timing).
+pub fn smoothing_extras(params: &Params, metrics: &Metrics) -> serde_json::Value {
+    serde_json::json!({
+        "generator": "meshsmooth",
+        "filter": params.filter.name(),
+        "params": params.to_json(),
+        "metrics": metrics,
+    })
 }
 
 /// Serialises `mesh` in `format`.

@@ -7,7 +7,7 @@
 use super::exact_distance::{point_segment_distance2, SLIVER_SINE};
 use super::Original;
 use crate::mesh::{cross, dot, sub, to_f64};
-use crate::smooth::StepObserver;
+use crate::smooth::{smooth, Params, StepObserver};
 use rayon::prelude::*;
 
 /// Local error of a smoothed vertex at `q` whose reference vertex on the original mesh is `r`:
@@ -141,6 +141,26 @@ impl StepObserver for DriftingReference<'_> {
     fn after_step(&mut self, positions: &[[f32; 3]]) {
         self.update(positions);
     }
+}
+
+/// Smooths the original mesh with `params` (and `weights`, one per vertex, when given) with the
+/// drifting reference watching every step: the smoothed positions and each vertex's reference,
+/// ready for [`super::measure`]. The one way every caller (CLI, app, suggestions) smooths
+/// before measuring, so all report the same numbers.
+pub fn smooth_drifting(
+    original: &Original,
+    params: &Params,
+    weights: Option<&[f32]>,
+) -> (Vec<[f32; 3]>, Vec<u32>) {
+    let mut drift = DriftingReference::new(original);
+    let positions = smooth(
+        original.mesh(),
+        original.topology(),
+        params,
+        weights,
+        &mut drift,
+    );
+    (positions, drift.into_reference())
 }
 
 /// `0, 1, ..., n - 1`: every vertex its own reference (nothing has drifted).

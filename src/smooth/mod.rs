@@ -18,7 +18,7 @@ mod sinc;
 mod sinc_coefficients;
 mod umbrella;
 
-pub use params::{Filter, ParamError, Params};
+pub use params::{shortest, Filter, ParamError, Params};
 // The GPU engine evaluates the same windowed-sinc series.
 pub(crate) use sinc_coefficients::sinc_coefficients;
 

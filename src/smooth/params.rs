@@ -92,7 +92,7 @@ impl Params {
             }
         }
         // Through the shortest decimal form, so a message says "-0.3", not "-0.30000001192".
-        let wide = |v: f32| v.to_string().parse::<f64>().unwrap_or(v as f64);
+        let wide = shortest;
         let (l, m, a, b, p) = (
             wide(self.lambda),
             wide(self.mu),
@@ -134,6 +134,89 @@ impl Params {
     }
 }
 
+impl Params {
+    /// The parameters this filter reads, as JSON (the others are left out so a report is not
+    /// misread): the `params` object of the CLI's reports and of the embedding API.
+    pub fn to_json(&self) -> serde_json::Value {
+        let mut m = serde_json::Map::new();
+        let mut put = |k: &str, v: f32| {
+            m.insert(k.to_string(), serde_json::json!(shortest(v)));
+        };
+        match self.filter {
+            Filter::Laplace => put("lambda", self.lambda),
+            Filter::Taubin => {
+                put("lambda", self.lambda);
+                put("mu", self.mu);
+            }
+            Filter::Hc => {
+                put("alpha", self.alpha);
+                put("beta", self.beta);
+            }
+            Filter::Sinc => put("passband", self.passband),
+        }
+        m.insert("iterations".into(), serde_json::json!(self.iterations));
+        m.insert(
+            "max_displacement".into(),
+            serde_json::json!(self.max_displacement.map(shortest)),
+        );
+        serde_json::Value::Object(m)
+    }
+
+    /// These parameters with the values of a JSON object applied: any of the keys
+    /// `lambda mu alpha beta passband iterations max_displacement` (`max_displacement: null`
+    /// removes the bound). All or nothing: an unknown key, a value of the wrong type or a
+    /// result out of range is refused with a message naming it, and `self` is left as it was.
+    pub fn with_json(&self, values: &serde_json::Value) -> Result<Params, String> {
+        let object = values
+            .as_object()
+            .ok_or_else(|| format!("parameters must be an object, not {values}"))?;
+        let mut p = *self;
+        for (key, value) in object {
+            let number = || {
+                value
+                    .as_f64()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| format!("{key} must be a finite number, not {value}"))
+            };
+            match key.as_str() {
+                "lambda" => p.lambda = number()? as f32,
+                "mu" => p.mu = number()? as f32,
+                "alpha" => p.alpha = number()? as f32,
+                "beta" => p.beta = number()? as f32,
+                "passband" => p.passband = number()? as f32,
+                "iterations" => {
+                    p.iterations = value
+                        .as_u64()
+                        .and_then(|v| u32::try_from(v).ok())
+                        .ok_or_else(|| {
+                            format!("iterations must be a whole number >= 0, not {value}")
+                        })?
+                }
+                "max_displacement" => {
+                    p.max_displacement = match value {
+                        serde_json::Value::Null => None,
+                        _ => Some(number()? as f32),
+                    }
+                }
+                other => {
+                    return Err(format!(
+                        "unknown parameter '{other}': use lambda, mu, alpha, beta, passband, \
+                         iterations or max_displacement"
+                    ))
+                }
+            }
+        }
+        p.validate().map_err(|e| e.to_string())?;
+        Ok(p)
+    }
+}
+
+/// An f32 as the f64 with the same shortest decimal form (0.1f32 prints as 0.1, not
+/// 0.10000000149).
+pub fn shortest(v: f32) -> f64 {
+    v.to_string().parse().unwrap_or(v as f64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -159,5 +242,42 @@ mod tests {
         let mut p = Params::defaults(Filter::Laplace);
         p.lambda = f32::NAN;
         assert!(p.validate().is_err());
+    }
+
+    #[test]
+    fn json_values_apply_all_or_nothing() {
+        let hc = Params::defaults(Filter::Hc);
+        let p = hc
+            .with_json(
+                &serde_json::json!({"alpha": 0.2, "iterations": 30, "max_displacement": 0.5}),
+            )
+            .unwrap();
+        assert_eq!(
+            (p.alpha, p.iterations, p.max_displacement),
+            (0.2, 30, Some(0.5))
+        );
+        assert_eq!(
+            p.to_json(),
+            serde_json::json!({"alpha": 0.2, "beta": 0.5, "iterations": 30, "max_displacement": 0.5})
+        );
+        let cleared = p
+            .with_json(&serde_json::json!({"max_displacement": null}))
+            .unwrap();
+        assert_eq!(cleared.max_displacement, None);
+
+        let refused = |v: serde_json::Value, needle: &str| {
+            let e = hc.with_json(&v).unwrap_err();
+            assert!(e.contains(needle), "{v}: {e}");
+        };
+        refused(serde_json::json!({"iterations": 1000}), "[0, 50]");
+        refused(serde_json::json!({"iterations": 2.5}), "whole number");
+        refused(serde_json::json!({"alpha": "x"}), "finite number");
+        refused(serde_json::json!({"gamma": 1}), "unknown parameter 'gamma'");
+        refused(serde_json::json!([1]), "must be an object");
+        // A valid key beside a refused one changes nothing.
+        assert!(hc
+            .with_json(&serde_json::json!({"beta": 0.1, "alpha": 7}))
+            .is_err());
+        assert_eq!(hc, Params::defaults(Filter::Hc));
     }
 }

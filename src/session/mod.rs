@@ -1,0 +1,397 @@
+//! The document the app and its embedding API edit: the open model, the active filter with each
+//! filter's parameters, and the latest smoothing result with its measures. Free of any UI, so
+//! the browser app, its JavaScript API and the native tests drive the same state the same way.
+//!
+//! Every change (a new model, filter or parameter) bumps `revision`; a result belongs to the
+//! revision it was computed for, so a result that arrives late (from the GPU) for an older
+//! revision is refused and the measures shown always match the parameters shown.
+
+mod colors;
+
+pub use colors::{ColorField, Legend, LegendTick};
+
+use crate::export::{self, ExportFormat, ExportOptions};
+use crate::io;
+use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
+use crate::metrics::{self, Metrics, Original, VertexMeasures};
+use crate::smooth::{Filter, Params};
+
+/// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
+pub const DEFAULT_TAU: f64 = 0.5;
+
+/// A mesh the session opened, with what the measures precompute from it.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub original: Original,
+    pub report: MeshReport,
+    pub warnings: Vec<String>,
+    /// Each edge once (`i < j`), for the wireframe overlay.
+    pub edges: Vec<[u32; 2]>,
+}
+
+impl Model {
+    /// Parses `bytes` (the format chosen by `name`'s extension), builds topology, report and
+    /// the original's measures.
+    pub fn load(name: &str, bytes: &[u8]) -> Result<Self, io::LoadError> {
+        Ok(Self::from_mesh(name, io::load(bytes, name)?))
+    }
+
+    pub fn from_mesh(name: &str, mesh: Mesh) -> Self {
+        let topology = Topology::build(&mesh);
+        let report = MeshReport::new(&mesh, &topology);
+        let warnings = report.warnings();
+        let edges = unique_edges(&topology);
+        Self {
+            name: name.to_string(),
+            original: Original::new(&mesh, &topology),
+            report,
+            warnings,
+            edges,
+        }
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        self.original.mesh()
+    }
+
+    pub fn topology(&self) -> &Topology {
+        self.original.topology()
+    }
+}
+
+/// Each undirected edge of the 1-ring CSR once, as `[i, j]` with `i < j`.
+fn unique_edges(topology: &Topology) -> Vec<[u32; 2]> {
+    (0..topology.vertex_count())
+        .flat_map(|i| {
+            topology
+                .neighbors_of(i)
+                .iter()
+                .filter(move |&&j| (i as u32) < j)
+                .map(move |&j| [i as u32, j])
+        })
+        .collect()
+}
+
+/// A smoothing run's result and its measures.
+#[derive(Clone, Debug)]
+pub struct Smoothed {
+    /// The session revision these positions were computed for.
+    pub revision: u64,
+    pub params: Params,
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    pub metrics: Metrics,
+    pub vertex: VertexMeasures,
+}
+
+/// The open model, the filter settings and the latest result.
+pub struct Session {
+    model: Option<Model>,
+    filter: Filter,
+    /// Each filter keeps its own values while another is active.
+    params: [Params; 4],
+    tau: f64,
+    /// Edge length of a voxel of the segmentation the mesh came from (mm), when the user gave
+    /// it: error legends then also read in voxel diagonals.
+    voxel_size: Option<[f64; 3]>,
+    revision: u64,
+    result: Option<Smoothed>,
+    /// Why the last file could not be opened; cleared by the next successful open.
+    error: Option<String>,
+}
+
+impl Default for Session {
+    fn default() -> Self {
+        Self {
+            model: None,
+            filter: Filter::Hc,
+            params: Filter::ALL.map(Params::defaults),
+            tau: DEFAULT_TAU,
+            voxel_size: None,
+            revision: 0,
+            result: None,
+            error: None,
+        }
+    }
+}
+
+fn slot(filter: Filter) -> usize {
+    Filter::ALL
+        .iter()
+        .position(|&f| f == filter)
+        .unwrap_or_default()
+}
+
+impl Session {
+    pub fn model(&self) -> Option<&Model> {
+        self.model.as_ref()
+    }
+
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    pub fn filter(&self) -> Filter {
+        self.filter
+    }
+
+    /// The active filter's parameters.
+    pub fn params(&self) -> &Params {
+        &self.params[slot(self.filter)]
+    }
+
+    pub fn tau(&self) -> f64 {
+        self.tau
+    }
+
+    pub fn revision(&self) -> u64 {
+        self.revision
+    }
+
+    pub fn voxel_size(&self) -> Option<[f64; 3]> {
+        self.voxel_size
+    }
+
+    /// The voxel diagonal (mm) when the voxel size is known.
+    pub fn voxel_diagonal(&self) -> Option<f64> {
+        self.voxel_size
+            .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
+    }
+
+    /// The latest result, if it matches the current model and parameters.
+    pub fn result(&self) -> Option<&Smoothed> {
+        self.result.as_ref().filter(|r| r.revision == self.revision)
+    }
+
+    /// The latest result even if the parameters changed since (shown until the new one lands).
+    pub fn last_result(&self) -> Option<&Smoothed> {
+        self.result.as_ref()
+    }
+
+    /// Whether a model is open whose result for the current parameters is still to compute.
+    pub fn needs_smoothing(&self) -> bool {
+        self.model.is_some() && self.result().is_none()
+    }
+
+    fn changed(&mut self) {
+        self.revision += 1;
+    }
+
+    /// Opens a file's bytes. On failure the current model stays, the error is recorded (and
+    /// returned) as "Cannot open NAME: reason".
+    pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<&Model, String> {
+        match Model::load(name, bytes) {
+            Ok(model) => Ok(self.set_model(model)),
+            Err(e) => Err(self.fail(name, &e.to_string())),
+        }
+    }
+
+    /// Makes `model` the open model (the previous result is dropped).
+    pub fn set_model(&mut self, model: Model) -> &Model {
+        self.error = None;
+        self.result = None;
+        self.changed();
+        self.model.insert(model)
+    }
+
+    /// Records that `name` could not be opened because of `reason`; returns the message.
+    pub fn fail(&mut self, name: &str, reason: &str) -> String {
+        let message = format!("Cannot open {name}: {reason}");
+        self.error = Some(message.clone());
+        message
+    }
+
+    /// Makes `filter` active (with the values it had when last active).
+    pub fn set_filter(&mut self, filter: Filter) {
+        if filter != self.filter {
+            self.filter = filter;
+            self.changed();
+        }
+    }
+
+    /// [`Self::set_filter`] by name (`laplace taubin hc sinc`).
+    pub fn set_filter_name(&mut self, name: &str) -> Result<(), String> {
+        let filter = Filter::from_name(name)
+            .ok_or_else(|| format!("unknown filter '{name}': use laplace, taubin, hc or sinc"))?;
+        self.set_filter(filter);
+        Ok(())
+    }
+
+    /// Sets the parameters of `params.filter` (and makes it active), if they are valid.
+    pub fn set_params(&mut self, params: Params) -> Result<(), String> {
+        params.validate().map_err(|e| e.to_string())?;
+        let changed = params != *self.params() || params.filter != self.filter;
+        self.params[slot(params.filter)] = params;
+        self.filter = params.filter;
+        if changed {
+            self.changed();
+        }
+        Ok(())
+    }
+
+    /// Applies a JSON object of parameter values to the active filter (see
+    /// [`Params::with_json`]); all or nothing.
+    pub fn set_params_json(&mut self, values: &serde_json::Value) -> Result<(), String> {
+        let params = self.params().with_json(values)?;
+        self.set_params(params)
+    }
+
+    /// The score's weight `tau` in [0, 1].
+    pub fn set_tau(&mut self, tau: f64) -> Result<(), String> {
+        if !(0.0..=1.0).contains(&tau) {
+            return Err(format!("tau = {tau} is out of range: [0, 1]"));
+        }
+        if tau != self.tau {
+            self.tau = tau;
+            self.changed();
+        }
+        Ok(())
+    }
+
+    /// The voxel size (mm per voxel along x, y, z), or `None` when unknown.
+    pub fn set_voxel_size(&mut self, size: Option<[f64; 3]>) -> Result<(), String> {
+        if let Some(v) = size {
+            if !v.iter().all(|s| s.is_finite() && *s > 0.0) {
+                return Err(format!("voxel size {v:?} must be three lengths > 0 mm"));
+            }
+        }
+        self.voxel_size = size;
+        Ok(())
+    }
+
+    /// Smooths and measures the current revision on the CPU engine (the reference), unless
+    /// its result is already there.
+    pub fn smooth_cpu(&mut self) {
+        if !self.needs_smoothing() {
+            return;
+        }
+        let Some(model) = &self.model else { return };
+        let params = *self.params();
+        let (positions, reference) = metrics::smooth_drifting(&model.original, &params, None);
+        let result = measured(
+            model,
+            self.revision,
+            params,
+            self.tau,
+            positions,
+            &reference,
+        );
+        self.result = Some(result);
+    }
+
+    /// Accepts positions and drifted references computed elsewhere (the GPU engine) for
+    /// `revision` and measures them. Returns false, and keeps nothing, when the session moved
+    /// on since or the arrays do not fit the model.
+    pub fn accept(&mut self, revision: u64, positions: Vec<[f32; 3]>, reference: &[u32]) -> bool {
+        let Some(model) = &self.model else {
+            return false;
+        };
+        let n = model.mesh().vertex_count();
+        let fits = positions.len() == n
+            && reference.len() == n
+            && reference.iter().all(|&r| (r as usize) < n);
+        if revision != self.revision || !fits {
+            return false;
+        }
+        let params = *self.params();
+        self.result = Some(measured(
+            model, revision, params, self.tau, positions, reference,
+        ));
+        true
+    }
+
+    /// The mesh report of the open model as the CLI's `info --json` prints it.
+    pub fn info_json(&self) -> Option<serde_json::Value> {
+        self.model
+            .as_ref()
+            .and_then(|m| serde_json::to_value(&m.report).ok())
+    }
+
+    /// The current result's measures as the CLI's `measure --json` prints them.
+    pub fn metrics_json(&self) -> Option<serde_json::Value> {
+        self.result()
+            .and_then(|r| serde_json::to_value(&r.metrics).ok())
+    }
+
+    /// Per-vertex colours of `field` on the latest result, with the legend that explains them.
+    pub fn colors(&self, field: ColorField) -> Option<(Vec<[u8; 4]>, Legend)> {
+        let model = self.model.as_ref()?;
+        let result = self.last_result()?;
+        Some(colors::colorize(
+            field,
+            &model.mesh().positions,
+            result,
+            self.voxel_diagonal(),
+        ))
+    }
+
+    /// The smoothed mesh (the original while nothing is smoothed) in `format`: normals, the
+    /// given colours and, in GLB `extras`, the filter, parameters and measures. Nothing of the
+    /// input file's header is written.
+    pub fn export(
+        &self,
+        format: ExportFormat,
+        colors: Option<&[[u8; 4]]>,
+    ) -> Result<Vec<u8>, String> {
+        let model = self.model.as_ref().ok_or("no mesh is open")?;
+        let triangles = model.mesh().triangles.clone();
+        let (mesh, normals, extras) = match self.last_result() {
+            Some(r) => (
+                Mesh::new(r.positions.clone(), triangles),
+                r.normals.clone(),
+                Some(export::smoothing_extras(&r.params, &r.metrics)),
+            ),
+            None => {
+                let mesh = model.mesh().clone();
+                let normals = vertex_normals(&mesh.positions, &mesh.triangles);
+                (mesh, normals, None)
+            }
+        };
+        let options = ExportOptions {
+            normals: Some(&normals),
+            colors,
+            extras,
+        };
+        export::write(&mesh, format, &options).map_err(|e| e.to_string())
+    }
+
+    /// What the embedding API's `state()` reports.
+    pub fn state_json(&self, busy: bool) -> serde_json::Value {
+        let model = self.model.as_ref();
+        serde_json::json!({
+            "model": model.map(|m| m.name.as_str()),
+            "vertices": model.map(|m| m.report.vertices),
+            "faces": model.map(|m| m.report.faces),
+            "error": self.error,
+            "filter": self.filter.name(),
+            "params": self.params().to_json(),
+            "tau": self.tau,
+            "busy": busy,
+        })
+    }
+}
+
+/// Measures `positions` (with their drifted references) against the model's original.
+fn measured(
+    model: &Model,
+    revision: u64,
+    params: Params,
+    tau: f64,
+    positions: Vec<[f32; 3]>,
+    reference: &[u32],
+) -> Smoothed {
+    let (metrics, vertex) = metrics::measure_vertices(&model.original, &positions, reference, tau);
+    let normals = vertex_normals(&positions, &model.mesh().triangles);
+    Smoothed {
+        revision,
+        params,
+        positions,
+        normals,
+        metrics,
+        vertex,
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,180 @@
+use super::*;
+use crate::metrics::DriftingReference;
+
+const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+
+fn sample_session() -> Session {
+    let mut s = Session::default();
+    s.open("bent_tube_staircase.ply", SAMPLE)
+        .expect("the sample opens");
+    s
+}
+
+#[test]
+fn a_bad_file_keeps_the_model_and_names_the_problem() {
+    let mut s = sample_session();
+    let before = s.revision();
+    let e = s.open("notes.txt", b"not a mesh").unwrap_err();
+    assert!(e.starts_with("Cannot open notes.txt: "), "{e}");
+    assert_eq!(s.error(), Some(e.as_str()));
+    assert_eq!(
+        s.model().map(|m| m.name.as_str()),
+        Some("bent_tube_staircase.ply")
+    );
+    assert_eq!(s.revision(), before, "a failed open changes nothing");
+    s.open("again.ply", SAMPLE).unwrap();
+    assert_eq!(s.error(), None);
+}
+
+#[test]
+fn cpu_result_equals_smoothing_then_measuring_directly() {
+    let mut s = sample_session();
+    s.set_filter_name("taubin").unwrap();
+    s.set_params_json(&serde_json::json!({"lambda": 0.6, "mu": -0.65, "iterations": 12}))
+        .unwrap();
+    assert!(s.needs_smoothing());
+    s.smooth_cpu();
+    let r = s.result().expect("a result for the current revision");
+
+    let model = s.model().unwrap();
+    let params = *s.params();
+    let mut drift = DriftingReference::new(&model.original);
+    let positions =
+        crate::smooth::smooth(model.mesh(), model.topology(), &params, None, &mut drift);
+    let direct = metrics::measure(&model.original, &positions, drift.reference(), DEFAULT_TAU);
+    assert_eq!(r.positions, positions);
+    assert_eq!(r.metrics, direct);
+    assert_eq!(
+        s.metrics_json().unwrap(),
+        serde_json::to_value(&direct).unwrap()
+    );
+    assert!(
+        r.metrics.curvature < r.metrics.curvature0,
+        "smoothing lowers K"
+    );
+}
+
+#[test]
+fn every_change_makes_the_result_stale_and_late_results_are_refused() {
+    let mut s = sample_session();
+    s.smooth_cpu();
+    assert!(!s.needs_smoothing());
+    let old = s.revision();
+    let positions = s.result().unwrap().positions.clone();
+    let n = positions.len();
+
+    s.set_params_json(&serde_json::json!({"iterations": 3}))
+        .unwrap();
+    assert!(s.needs_smoothing());
+    assert!(
+        s.last_result().is_some(),
+        "the old result is shown meanwhile"
+    );
+    assert!(!s.accept(old, positions.clone(), &metrics::identity(n)));
+    assert!(!s.accept(s.revision(), positions[1..].to_vec(), &metrics::identity(n)));
+    let mut bad_reference = metrics::identity(n);
+    bad_reference[0] = n as u32;
+    assert!(!s.accept(s.revision(), positions.clone(), &bad_reference));
+    assert!(s.accept(s.revision(), positions, &metrics::identity(n)));
+    assert!(!s.needs_smoothing());
+
+    // Setting the same values again is not a change.
+    let r = s.revision();
+    s.set_params_json(&serde_json::json!({"iterations": 3}))
+        .unwrap();
+    s.set_filter_name("hc").unwrap();
+    assert_eq!(s.revision(), r);
+}
+
+#[test]
+fn refused_parameters_change_nothing_and_each_filter_keeps_its_values() {
+    let mut s = sample_session();
+    let e = s
+        .set_params_json(&serde_json::json!({"iterations": 1000}))
+        .unwrap_err();
+    assert!(e.contains("iterations") && e.contains("[0, 50]"), "{e}");
+    assert!(s
+        .set_filter_name("gaussian")
+        .unwrap_err()
+        .contains("unknown filter"));
+    assert_eq!(*s.params(), Params::defaults(Filter::Hc));
+
+    s.set_filter_name("laplace").unwrap();
+    s.set_params_json(&serde_json::json!({"lambda": 0.3}))
+        .unwrap();
+    s.set_filter_name("sinc").unwrap();
+    assert_eq!(s.params().iterations, 20);
+    s.set_filter_name("laplace").unwrap();
+    assert_eq!(s.params().lambda, 0.3);
+    assert!(s.set_tau(1.5).is_err());
+    assert!(s.set_voxel_size(Some([1.0, 0.0, 1.0])).is_err());
+}
+
+#[test]
+fn exports_carry_the_smoothing_and_read_back() {
+    let mut s = sample_session();
+    s.set_params_json(&serde_json::json!({"iterations": 5}))
+        .unwrap();
+    s.smooth_cpu();
+    let r = s.result().unwrap().clone();
+    for format in [
+        ExportFormat::Ply,
+        ExportFormat::Stl,
+        ExportFormat::Obj,
+        ExportFormat::Glb,
+    ] {
+        let name = format!("out.{}", format!("{format:?}").to_lowercase());
+        let bytes = s.export(format, None).unwrap();
+        let back = io::load(&bytes, &name).unwrap();
+        assert_eq!(back.vertex_count(), r.positions.len(), "{name}");
+        assert_eq!(
+            back.triangle_count(),
+            s.model().unwrap().mesh().triangle_count()
+        );
+        if format != ExportFormat::Stl {
+            assert_eq!(back.positions, r.positions, "{name}");
+        }
+    }
+    let glb = s.export(ExportFormat::Glb, None).unwrap();
+    let text = String::from_utf8_lossy(&glb);
+    assert!(text.contains("\"filter\":\"hc\""), "extras name the filter");
+    assert!(text.contains("\"mean_error\""), "extras carry the measures");
+}
+
+#[test]
+fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
+    let mut s = sample_session();
+    s.set_params_json(&serde_json::json!({"iterations": 0}))
+        .unwrap();
+    s.smooth_cpu();
+    let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
+    assert_eq!(colors.len(), s.model().unwrap().mesh().vertex_count());
+    assert!(
+        colors.iter().all(|c| *c == legend.bar[0]),
+        "no error: all at the bottom"
+    );
+
+    s.set_voxel_size(Some([1.0, 1.0, 1.0])).unwrap();
+    s.set_params_json(&serde_json::json!({"iterations": 10}))
+        .unwrap();
+    s.smooth_cpu();
+    let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
+    assert!(colors.iter().any(|c| *c != legend.bar[0]));
+    assert_eq!(legend.min, 0.0);
+    let max = s.result().unwrap().metrics.max_error;
+    assert!(
+        legend.max > 0.0 && legend.max <= 2.5 * max.max(1e-9),
+        "{legend:?} max {max}"
+    );
+    assert!(
+        legend.ticks.last().unwrap().label.contains("vd"),
+        "{:?}",
+        legend.ticks
+    );
+
+    let (_, k) = s.colors(ColorField::Curvature).unwrap();
+    assert_eq!(k.min, -k.max);
+    assert!(!k.ticks[0].label.contains("vd"));
+    let (d, _) = s.colors(ColorField::Displacement).unwrap();
+    assert_eq!(d.len(), colors.len());
+}
