@@ -99,6 +99,17 @@ impl FileInput {
         });
     }
 
+    /// Starts fetching `url` (same origin, see `query`) into the inbox as `name`.
+    pub fn fetch(&self, url: String, name: String, ctx: &egui::Context) {
+        let inbox = self.inbox.clone();
+        let ctx = ctx.clone();
+        inbox.begin();
+        wasm_bindgen_futures::spawn_local(async move {
+            let bytes = super::query::fetch(&url).await;
+            inbox.deliver(ArrivedFile { name, bytes }, &ctx);
+        });
+    }
+
     /// Files whose reading finished since the last call, oldest first.
     pub fn take_arrived(&self) -> Vec<ArrivedFile> {
         std::mem::take(&mut *self.inbox.arrived.borrow_mut())

@@ -1,20 +1,27 @@
 //! The web app (wasm32 only): an eframe app on the page's canvas.
 //!
 //! `start` installs the logger and a panic hook that shows a crash message on the page, then
-//! starts eframe's `WebRunner`. The app itself owns no algorithm: it reads a file's bytes,
-//! hands them to [`crate::io::load`] and shows the [`crate::mesh::MeshReport`].
+//! starts eframe's `WebRunner`. The app owns no algorithm: it edits a
+//! [`crate::session::Session`] and shows what the engine computed.
 //!
-//! Modules: `state` (the loaded model and the last error), `file_input` (the file picker and
-//! dropped files, both delivering bytes asynchronously), `report_view` (the report as a table),
+//! Modules: `document` (the session shared by the UI and the API, waiting API calls, timings),
+//! `api` (`window.meshsmooth`), `file_input` and `query` (bytes in: picker, drops, `?model=`),
+//! `download` (bytes out), `controls`, `legend`, `report_view`, `shortcuts` (the panels),
 //! `shell` (the `eframe::App` that lays these out).
 
+mod api;
+mod controls;
+mod document;
+mod download;
 mod file_input;
+mod legend;
 mod page;
+mod query;
 mod report_view;
 mod shell;
-mod state;
+mod shortcuts;
 
-pub use state::{AppState, LoadedModel};
+pub use document::{Backend, Document};
 
 /// The mesh shown when the app opens: a voxelised bent tube (a staircase vessel surface).
 pub const SAMPLE_NAME: &str = "bent_tube_staircase.ply";

@@ -1,10 +1,10 @@
 //! The validation report as a table, with the warnings under it.
 
-use super::LoadedModel;
 use crate::mesh::MeshReport;
+use crate::session::Model;
 use eframe::egui;
 
-pub fn show(ui: &mut egui::Ui, model: &LoadedModel) {
+pub fn show(ui: &mut egui::Ui, model: &Model) {
     let r = &model.report;
     ui.heading(&model.name);
     ui.add_space(4.0);

@@ -117,6 +117,16 @@ fn round_up(v: f64) -> f64 {
         .unwrap_or(10.0 * p)
 }
 
+/// Tick intervals for a span [`round_up`] gave, so every tick is a round number too.
+fn divisions(span: f64) -> usize {
+    let mantissa = span / 10f64.powf(span.log10().floor());
+    match mantissa {
+        m if (m - 2.0).abs() < 1e-9 => 4,
+        m if (m - 4.0).abs() < 1e-9 => 4,
+        _ => 5,
+    }
+}
+
 /// The `q` quantile (0..1) of `values`' magnitudes.
 fn quantile_abs(values: &[f32], q: f64) -> f64 {
     let mut m: Vec<f32> = values
@@ -176,9 +186,10 @@ pub fn colorize(
     let t = |v: f64| (v - min) / (max - min);
     let colors = values.iter().map(|&v| sample(stops, t(v as f64))).collect();
 
-    let ticks = (0..=4)
+    let divisions = divisions(max - min);
+    let ticks = (0..=divisions)
         .map(|k| {
-            let at = k as f64 / 4.0;
+            let at = k as f64 / divisions as f64;
             let value = min + at * (max - min);
             let mut label = format!("{} {}", format_value(value), field.unit());
             if let (Some(d), false) = (voxel_diagonal, field.diverging()) {
@@ -215,6 +226,24 @@ mod tests {
         assert_eq!(round_up(3.0), 5.0);
         assert_eq!(round_up(0.031), 0.05);
         assert_eq!(round_up(0.0), 1.0);
+    }
+
+    #[test]
+    fn ticks_fall_on_round_numbers() {
+        for (span, n) in [
+            (1.0, 5),
+            (2.0, 4),
+            (2.5, 5),
+            (5.0, 5),
+            (0.25, 5),
+            (4.0, 4),
+            (10.0, 5),
+        ] {
+            assert_eq!(divisions(span), n, "{span}");
+            let step = span / n as f64;
+            let digits = (step * 1e4).round() / 1e4;
+            assert!((step - digits).abs() < 1e-12, "{span}: step {step}");
+        }
     }
 
     #[test]

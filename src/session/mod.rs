@@ -85,6 +85,15 @@ pub struct Smoothed {
     pub vertex: VertexMeasures,
 }
 
+/// How long a result took, in milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Smoothing, with the drifting reference's updates.
+    pub smooth_ms: f64,
+    /// The measure pass, per-vertex measures and normals.
+    pub measure_ms: f64,
+}
+
 /// The open model, the filter settings and the latest result.
 pub struct Session {
     model: Option<Model>,
@@ -261,14 +270,17 @@ impl Session {
     }
 
     /// Smooths and measures the current revision on the CPU engine (the reference), unless
-    /// its result is already there.
-    pub fn smooth_cpu(&mut self) {
+    /// its result is already there. `clock` gives milliseconds (the caller's timer: wasm32 has
+    /// no `Instant`); the time each half took comes back.
+    pub fn smooth_cpu(&mut self, clock: &dyn Fn() -> f64) -> Option<Timings> {
         if !self.needs_smoothing() {
-            return;
+            return None;
         }
-        let Some(model) = &self.model else { return };
+        let model = self.model.as_ref()?;
         let params = *self.params();
+        let start = clock();
         let (positions, reference) = metrics::smooth_drifting(&model.original, &params, None);
+        let smoothed = clock();
         let result = measured(
             model,
             self.revision,
@@ -277,7 +289,12 @@ impl Session {
             positions,
             &reference,
         );
+        let timings = Timings {
+            smooth_ms: smoothed - start,
+            measure_ms: clock() - smoothed,
+        };
         self.result = Some(result);
+        Some(timings)
     }
 
     /// Accepts positions and drifted references computed elsewhere (the GPU engine) for

@@ -33,7 +33,7 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
     s.set_params_json(&serde_json::json!({"lambda": 0.6, "mu": -0.65, "iterations": 12}))
         .unwrap();
     assert!(s.needs_smoothing());
-    s.smooth_cpu();
+    s.smooth_cpu(&|| 0.0);
     let r = s.result().expect("a result for the current revision");
 
     let model = s.model().unwrap();
@@ -57,7 +57,7 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
 #[test]
 fn every_change_makes_the_result_stale_and_late_results_are_refused() {
     let mut s = sample_session();
-    s.smooth_cpu();
+    s.smooth_cpu(&|| 0.0);
     assert!(!s.needs_smoothing());
     let old = s.revision();
     let positions = s.result().unwrap().positions.clone();
@@ -115,7 +115,7 @@ fn exports_carry_the_smoothing_and_read_back() {
     let mut s = sample_session();
     s.set_params_json(&serde_json::json!({"iterations": 5}))
         .unwrap();
-    s.smooth_cpu();
+    s.smooth_cpu(&|| 0.0);
     let r = s.result().unwrap().clone();
     for format in [
         ExportFormat::Ply,
@@ -146,7 +146,7 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     let mut s = sample_session();
     s.set_params_json(&serde_json::json!({"iterations": 0}))
         .unwrap();
-    s.smooth_cpu();
+    s.smooth_cpu(&|| 0.0);
     let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
     assert_eq!(colors.len(), s.model().unwrap().mesh().vertex_count());
     assert!(
@@ -157,7 +157,7 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     s.set_voxel_size(Some([1.0, 1.0, 1.0])).unwrap();
     s.set_params_json(&serde_json::json!({"iterations": 10}))
         .unwrap();
-    s.smooth_cpu();
+    s.smooth_cpu(&|| 0.0);
     let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
     assert!(colors.iter().any(|c| *c != legend.bar[0]));
     assert_eq!(legend.min, 0.0);

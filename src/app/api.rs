@@ -1,0 +1,200 @@
+//! The embedding API, `window.meshsmooth`, for the authoring page and for tests. Installed when
+//! the app has started, announced by a `meshsmooth-ready` event on `window`.
+//!
+//! - `loadMesh(bytes: Uint8Array, name): Promise<info>` (the CLI's `info --json` keys)
+//! - `setFilter(name)`, `setParams(object)` (keys `lambda mu alpha beta passband iterations
+//!   max_displacement`); both throw with the engine's message on a bad name or value
+//! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
+//!   parameters' result is computed
+//! - `exportMesh(format): Promise<Uint8Array>` for `glb stl ply obj`
+//! - `backend()`: `"webgpu"` or `"cpu"`
+//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, backend}`
+//!
+//! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
+//! what the API did and the numbers equal the CLI's for the same mesh and parameters.
+
+use super::document::SharedDocument;
+use crate::export::ExportFormat;
+use eframe::egui;
+use js_sys::{Function, Promise, Uint8Array};
+use wasm_bindgen::closure::Closure;
+use wasm_bindgen::{JsCast, JsValue};
+
+const READY_EVENT: &str = "meshsmooth-ready";
+
+fn to_js(value: &serde_json::Value) -> JsValue {
+    js_sys::JSON::parse(&value.to_string()).unwrap_or(JsValue::NULL)
+}
+
+fn from_js(value: &JsValue) -> Result<serde_json::Value, String> {
+    let text = js_sys::JSON::stringify(value)
+        .map_err(|e| super::page::js_error_text(&e))?
+        .as_string()
+        .ok_or("the value cannot be written as JSON")?;
+    serde_json::from_str(&text).map_err(|e| e.to_string())
+}
+
+fn error(message: &str) -> JsValue {
+    js_sys::Error::new(message).into()
+}
+
+/// A promise settled with `result`.
+fn settled(result: Result<JsValue, String>) -> Promise {
+    match result {
+        Ok(v) => Promise::resolve(&v),
+        Err(e) => Promise::reject(&error(&e)),
+    }
+}
+
+/// A promise resolved by the document once the current result is there, with `answer` applied
+/// to the session.
+fn when_current(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+    answer: impl Fn(&crate::session::Session) -> Result<JsValue, String> + 'static,
+) -> Promise {
+    if doc.borrow().session.model().is_none() {
+        return Promise::reject(&error("no mesh is open: call loadMesh first"));
+    }
+    let doc = doc.clone();
+    let ctx = ctx.clone();
+    let mut answer = Some(answer);
+    Promise::new(&mut |resolve: Function, reject: Function| {
+        let Some(answer) = answer.take() else { return };
+        doc.borrow_mut().when_current(Box::new(move |session| {
+            let _ = match answer(session) {
+                Ok(v) => resolve.call1(&JsValue::NULL, &v),
+                Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
+            };
+        }));
+        ctx.request_repaint();
+    })
+}
+
+/// Sets `f` as `object[name]` for the page's lifetime.
+fn define<F: ?Sized + wasm_bindgen::closure::WasmClosure>(
+    object: &js_sys::Object,
+    name: &str,
+    f: Closure<F>,
+) -> Result<(), String> {
+    js_sys::Reflect::set(object, &name.into(), f.as_ref().unchecked_ref())
+        .map_err(|e| super::page::js_error_text(&e))?;
+    // The API lives as long as the page.
+    f.forget();
+    Ok(())
+}
+
+/// Creates `window.meshsmooth` and fires `meshsmooth-ready`.
+pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
+    let window = web_sys::window().ok_or("no window")?;
+    let api = js_sys::Object::new();
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "loadMesh",
+        Closure::<dyn FnMut(JsValue, JsValue) -> Promise>::new(
+            move |bytes: JsValue, name: JsValue| {
+                let Some(bytes) = bytes.dyn_ref::<Uint8Array>() else {
+                    return settled(Err(
+                        "loadMesh(bytes, name): bytes must be a Uint8Array".into()
+                    ));
+                };
+                let name = name.as_string().unwrap_or_else(|| "mesh.ply".into());
+                let result = d.borrow_mut().open(&name, &bytes.to_vec());
+                c.request_repaint();
+                settled(result.and_then(|()| {
+                    d.borrow()
+                        .session
+                        .info_json()
+                        .map(|v| to_js(&v))
+                        .ok_or_else(|| "no report".to_string())
+                }))
+            },
+        ),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "setFilter",
+        Closure::<dyn FnMut(JsValue) -> Result<(), JsValue>>::new(move |name: JsValue| {
+            let name = name.as_string().unwrap_or_default();
+            d.borrow_mut()
+                .session
+                .set_filter_name(&name)
+                .map_err(|e| error(&e))?;
+            c.request_repaint();
+            Ok(())
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "setParams",
+        Closure::<dyn FnMut(JsValue) -> Result<(), JsValue>>::new(move |values: JsValue| {
+            let values = from_js(&values).map_err(|e| error(&e))?;
+            d.borrow_mut()
+                .session
+                .set_params_json(&values)
+                .map_err(|e| error(&e))?;
+            c.request_repaint();
+            Ok(())
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "metrics",
+        Closure::<dyn FnMut() -> Promise>::new(move || {
+            when_current(&d, &c, |session| {
+                session
+                    .metrics_json()
+                    .map(|v| to_js(&v))
+                    .ok_or_else(|| "no measures".to_string())
+            })
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "exportMesh",
+        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
+            let name = format.as_string().unwrap_or_default();
+            let Some(format) = ExportFormat::from_name(&format!("x.{name}")) else {
+                return settled(Err(format!(
+                    "unknown export format '{name}': use glb, stl, ply or obj"
+                )));
+            };
+            when_current(&d, &c, move |session| {
+                let bytes = session.export(format, None)?;
+                Ok(Uint8Array::from(bytes.as_slice()).into())
+            })
+        }),
+    )?;
+
+    let d = doc.clone();
+    define(
+        &api,
+        "backend",
+        Closure::<dyn FnMut() -> JsValue>::new(move || d.borrow().backend.name().into()),
+    )?;
+
+    let d = doc.clone();
+    define(
+        &api,
+        "state",
+        Closure::<dyn FnMut() -> JsValue>::new(move || to_js(&d.borrow().state_json())),
+    )?;
+
+    js_sys::Reflect::set(&window, &"meshsmooth".into(), &api)
+        .map_err(|e| super::page::js_error_text(&e))?;
+    let event = web_sys::Event::new(READY_EVENT).map_err(|e| super::page::js_error_text(&e))?;
+    window
+        .dispatch_event(&event)
+        .map_err(|e| super::page::js_error_text(&e))?;
+    Ok(())
+}

@@ -1,0 +1,249 @@
+//! The side panel's controls: the filter with a slider and a number field per parameter, the
+//! displacement bound, the measures of the current result, and what the colours show.
+//!
+//! Every edit goes to the session as a whole parameter set; the session refuses invalid sets
+//! (e.g. Taubin's mu >= -lambda) and the message shows under the controls until fixed.
+
+use crate::session::{ColorField, Session, Timings};
+use crate::smooth::{Filter, Params};
+use eframe::egui;
+
+/// What the controls keep between frames.
+#[derive(Default)]
+pub struct Controls {
+    /// Why the last edit was refused.
+    refused: Option<String>,
+}
+
+/// A user-facing name for each filter.
+pub fn filter_label(f: Filter) -> &'static str {
+    match f {
+        Filter::Laplace => "Laplace",
+        Filter::Taubin => "Taubin λ/μ",
+        Filter::Hc => "Laplace + HC",
+        Filter::Sinc => "Windowed sinc",
+    }
+}
+
+fn slider(
+    ui: &mut egui::Ui,
+    label: &str,
+    help: &str,
+    value: &mut f32,
+    range: std::ops::RangeInclusive<f32>,
+) {
+    ui.horizontal(|ui| {
+        ui.label(label).on_hover_text(help);
+        ui.add(
+            egui::Slider::new(value, range)
+                .max_decimals(3)
+                .clamping(egui::SliderClamping::Always),
+        )
+        .on_hover_text(help);
+    });
+}
+
+impl Controls {
+    /// The filter and its parameters.
+    pub fn filter(&mut self, ui: &mut egui::Ui, session: &mut Session) {
+        let mut p: Params = *session.params();
+        ui.horizontal_wrapped(|ui| {
+            for f in Filter::ALL {
+                if ui
+                    .selectable_label(session.filter() == f, filter_label(f))
+                    .clicked()
+                {
+                    session.set_filter(f);
+                    p = *session.params();
+                }
+            }
+        });
+        ui.add_space(4.0);
+        match p.filter {
+            Filter::Laplace => slider(
+                ui,
+                "λ",
+                "Step towards the neighbours' mean per iteration",
+                &mut p.lambda,
+                0.0..=1.0,
+            ),
+            Filter::Taubin => {
+                slider(
+                    ui,
+                    "λ",
+                    "Shrinking step per iteration",
+                    &mut p.lambda,
+                    0.01..=1.0,
+                );
+                slider(
+                    ui,
+                    "μ",
+                    "Inflating step per iteration; needs μ < −λ",
+                    &mut p.mu,
+                    -1.0..=-0.01,
+                );
+            }
+            Filter::Hc => {
+                slider(
+                    ui,
+                    "α",
+                    "Pull back towards the original positions",
+                    &mut p.alpha,
+                    0.0..=1.0,
+                );
+                slider(
+                    ui,
+                    "β",
+                    "Pull back towards the previous iteration",
+                    &mut p.beta,
+                    0.0..=1.0,
+                );
+            }
+            Filter::Sinc => {
+                ui.horizontal(|ui| {
+                    let help = "Pass band: lower removes more detail";
+                    ui.label("pass band").on_hover_text(help);
+                    ui.add(
+                        egui::Slider::new(&mut p.passband, 0.001..=1.999)
+                            .logarithmic(true)
+                            .max_decimals(4),
+                    )
+                    .on_hover_text(help);
+                });
+            }
+        }
+        let max_it = if p.filter == Filter::Sinc { 100 } else { 50 };
+        let min_it = if p.filter == Filter::Sinc { 1 } else { 0 };
+        ui.horizontal(|ui| {
+            ui.label("iterations");
+            ui.add(egui::Slider::new(&mut p.iterations, min_it..=max_it));
+        });
+        ui.horizontal(|ui| {
+            let mut bounded = p.max_displacement.is_some();
+            ui.checkbox(&mut bounded, "max displacement")
+                .on_hover_text("No vertex moves further than this from its original position");
+            match (bounded, p.max_displacement) {
+                (true, None) => p.max_displacement = Some(1.0),
+                (false, Some(_)) => p.max_displacement = None,
+                _ => {}
+            }
+            if let Some(d) = &mut p.max_displacement {
+                ui.add(
+                    egui::DragValue::new(d)
+                        .speed(0.01)
+                        .range(0.0..=1000.0)
+                        .suffix(" mm"),
+                );
+            }
+        });
+        if ui.small_button("Defaults").clicked() {
+            p = Params::defaults(p.filter);
+        }
+        if p != *session.params() {
+            self.refused = session.set_params(p).err();
+        }
+        if let Some(why) = &self.refused {
+            ui.colored_label(ui.visuals().warn_fg_color, why);
+        }
+    }
+}
+
+fn percent(v: f64) -> String {
+    format!("{:+.2} %", v * 100.0)
+}
+
+/// The measures of the latest result, as a table.
+pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<Timings>) {
+    let Some(result) = session.last_result() else {
+        ui.label("Not smoothed yet.");
+        return;
+    };
+    let m = &result.metrics;
+    let vd = session.voxel_diagonal();
+    let mm = |v: f64| match vd {
+        Some(d) => format!("{v:.3} mm ({:.2} vd)", v / d),
+        None => format!("{v:.3} mm"),
+    };
+    egui::Grid::new("measures")
+        .num_columns(2)
+        .striped(true)
+        .show(ui, |ui| {
+            let mut row = |label: &str, help: &str, value: String| {
+                ui.label(label).on_hover_text(help);
+                ui.monospace(value);
+                ui.end_row();
+            };
+            row(
+                "Volume change",
+                "Change of the enclosed volume against the original",
+                m.volume_change
+                    .map_or("undefined (open mesh)".into(), percent),
+            );
+            let ratio = if m.curvature0 > 0.0 {
+                m.curvature / m.curvature0
+            } else {
+                f64::NAN
+            };
+            row(
+                "Curvature K/K0",
+                "Mean |Gaussian curvature| against the original's: lower is smoother",
+                format!("{ratio:.4}"),
+            );
+            row(
+                "Mean error",
+                "Mean local distance of the vertices from the original surface",
+                mm(m.mean_error),
+            );
+            row(
+                "Max error",
+                "Largest local distance from the original surface",
+                mm(m.max_error),
+            );
+            row(
+                "Score S",
+                "Paper's quality score for tau = 0.5: lower is better",
+                format!("{:.4}", m.score),
+            );
+        });
+    if session.result().is_none() {
+        ui.small("Updating…");
+    } else if let Some(t) = timings {
+        ui.small(format!(
+            "smoothing {:.1} ms, measures {:.1} ms",
+            t.smooth_ms, t.measure_ms
+        ));
+    }
+}
+
+/// What the colours show (None: plain shading), and the voxel size for voxel-diagonal units.
+pub fn coloring(ui: &mut egui::Ui, field: &mut Option<ColorField>, session: &mut Session) {
+    ui.horizontal_wrapped(|ui| {
+        ui.selectable_value(field, None, "Shading");
+        for f in ColorField::ALL {
+            ui.selectable_value(field, Some(f), f.name());
+        }
+    });
+    let mut known = session.voxel_size().is_some();
+    let mut size = session.voxel_size().unwrap_or([1.0; 3]);
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut known, "voxel size").on_hover_text(
+            "The segmentation's voxel spacing: distances then also read in voxel diagonals (vd)",
+        );
+        if known {
+            for s in &mut size {
+                ui.add(
+                    egui::DragValue::new(s)
+                        .speed(0.01)
+                        .range(0.01..=100.0)
+                        .max_decimals(3),
+                );
+            }
+            ui.label("mm");
+        }
+    });
+    let wanted = known.then_some(size);
+    if wanted != session.voxel_size() {
+        // The drag values' range keeps the sizes valid.
+        let _ = session.set_voxel_size(wanted);
+    }
+}

@@ -1,0 +1,173 @@
+//! What the page has open, shared by the UI and the JavaScript embedding API: the session, the
+//! API calls waiting for a result, and the timings the status bar shows.
+//!
+//! Both sides only change the session; the shell computes what a change needs once per frame
+//! (so an API call never blocks the page inside a frame), then answers the waiting calls.
+
+use crate::session::{Session, Timings};
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// A call waiting for the result of the current parameters (the API's `metrics()` and
+/// `exportMesh()`); it receives the session once that result is there.
+pub type Waiter = Box<dyn FnOnce(&Session)>;
+
+/// Which engine smooths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// WGSL compute on the page's WebGPU device.
+    WebGpu,
+    /// The CPU engine in WebAssembly (where WebGPU is missing).
+    Cpu,
+}
+
+impl Backend {
+    /// The name the embedding API's `backend()` returns.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::WebGpu => "webgpu",
+            Backend::Cpu => "cpu",
+        }
+    }
+}
+
+pub struct Document {
+    pub session: Session,
+    pub backend: Backend,
+    /// Timings of the last result.
+    pub timings: Option<Timings>,
+    /// Bumped when a new model is opened, so views re-upload it.
+    pub model_generation: u64,
+    waiting: Vec<Waiter>,
+}
+
+/// The handle the shell and the API hold.
+pub type SharedDocument = Rc<RefCell<Document>>;
+
+impl Document {
+    pub fn new(backend: Backend) -> Self {
+        Self {
+            session: Session::default(),
+            backend,
+            timings: None,
+            model_generation: 0,
+            waiting: Vec::new(),
+        }
+    }
+
+    /// Opens a file's bytes; on failure the current model stays and the error is kept.
+    pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
+        match self.session.open(name, bytes) {
+            Ok(model) => {
+                log::info!(
+                    "opened {name}: {} vertices, {} faces",
+                    model.report.vertices,
+                    model.report.faces
+                );
+                self.model_generation += 1;
+                self.timings = None;
+                Ok(())
+            }
+            Err(message) => {
+                log::warn!("{message}");
+                Err(message)
+            }
+        }
+    }
+
+    /// Whether work for the current parameters is still to do.
+    pub fn busy(&self) -> bool {
+        self.session.needs_smoothing()
+    }
+
+    /// Runs `waiter` once the current parameters' result is there (at once if it is).
+    pub fn when_current(&mut self, waiter: Waiter) {
+        if self.busy() {
+            self.waiting.push(waiter);
+        } else {
+            waiter(&self.session);
+        }
+    }
+
+    /// Answers the waiting calls if the current result is there.
+    pub fn answer_waiting(&mut self) {
+        if self.busy() || self.waiting.is_empty() {
+            return;
+        }
+        for waiter in std::mem::take(&mut self.waiting) {
+            waiter(&self.session);
+        }
+    }
+
+    /// The CPU engine's step for this frame: smooth and measure the current parameters.
+    pub fn compute_on_cpu(&mut self) {
+        if let Some(t) = self.session.smooth_cpu(&now_ms) {
+            self.timings = Some(t);
+        }
+    }
+
+    /// What the API's `state()` returns.
+    pub fn state_json(&self) -> serde_json::Value {
+        let mut state = self.session.state_json(self.busy());
+        state["backend"] = serde_json::json!(self.backend.name());
+        state
+    }
+}
+
+/// Milliseconds from the page's high-resolution clock.
+pub fn now_ms() -> f64 {
+    web_sys::window()
+        .and_then(|w| w.performance())
+        .map_or_else(js_sys::Date::now, |p| p.now())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::Cell;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+
+    #[wasm_bindgen_test]
+    fn a_bad_file_keeps_the_previous_model_and_reports_why() {
+        let mut doc = Document::new(Backend::Cpu);
+        doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
+            .unwrap();
+        let generation = doc.model_generation;
+        let error = doc.open("notes.txt", b"not a mesh").unwrap_err();
+        assert!(error.starts_with("Cannot open notes.txt: "), "{error}");
+        assert!(error.contains(".stl .obj .ply"), "{error}");
+        assert_eq!(doc.model_generation, generation);
+        let state = doc.state_json();
+        assert_eq!(state["model"], crate::app::SAMPLE_NAME);
+        assert_eq!(state["error"], error.as_str());
+        assert!(doc.open("empty.stl", b"").unwrap_err().contains("empty"));
+    }
+
+    #[wasm_bindgen_test]
+    fn waiting_calls_are_answered_once_the_result_is_computed() {
+        let mut doc = Document::new(Backend::Cpu);
+        doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
+            .unwrap();
+        let answered = Rc::new(Cell::new(0));
+        let seen = answered.clone();
+        doc.when_current(Box::new(move |s| {
+            assert!(s.result().is_some());
+            seen.set(seen.get() + 1);
+        }));
+        doc.answer_waiting();
+        assert_eq!(answered.get(), 0, "nothing computed yet");
+        doc.compute_on_cpu();
+        doc.answer_waiting();
+        assert_eq!(answered.get(), 1);
+        assert!(doc.timings.is_some());
+        assert_eq!(doc.state_json()["busy"], false);
+        let model = doc.session.model().unwrap();
+        assert_eq!(
+            (model.report.vertices, model.report.faces),
+            (2296, 4588),
+            "the bundled sample"
+        );
+    }
+}

@@ -1,0 +1,87 @@
+//! `?model=URL`: open a mesh from the page's own origin at start. Any other origin is refused,
+//! so the page never sends a request beyond loading itself (patient data stays here).
+
+use wasm_bindgen::JsCast;
+
+/// A model named in the page's query: its absolute URL and a file name for the format.
+#[derive(Debug)]
+pub struct ModelUrl {
+    pub url: String,
+    pub name: String,
+}
+
+fn text(e: wasm_bindgen::JsValue) -> String {
+    super::page::js_error_text(&e)
+}
+
+/// The `model` query parameter, if there is one; an error when it names another origin.
+pub fn model_url() -> Option<Result<ModelUrl, String>> {
+    let location = web_sys::window()?.location();
+    let search = location.search().ok()?;
+    let wanted = web_sys::UrlSearchParams::new_with_str(&search)
+        .ok()?
+        .get("model")?;
+    Some(resolve(
+        &wanted,
+        &location.href().ok()?,
+        &location.origin().ok()?,
+    ))
+}
+
+fn resolve(wanted: &str, page: &str, origin: &str) -> Result<ModelUrl, String> {
+    let url = web_sys::Url::new_with_base(wanted, page)
+        .map_err(|_| format!("?model={wanted} is not a URL"))?;
+    if url.origin() != origin {
+        return Err(format!(
+            "?model={wanted} is on another site ({}); only files from this page's own \
+             origin ({origin}) are opened, so nothing is requested from elsewhere",
+            url.origin()
+        ));
+    }
+    let name = url
+        .pathname()
+        .rsplit('/')
+        .next()
+        .filter(|n| !n.is_empty())
+        .unwrap_or("model")
+        .to_string();
+    Ok(ModelUrl {
+        url: url.href(),
+        name,
+    })
+}
+
+/// Fetches `url`'s bytes (same origin, checked by [`model_url`]).
+pub async fn fetch(url: &str) -> Result<Vec<u8>, String> {
+    let window = web_sys::window().ok_or("no window")?;
+    let response = wasm_bindgen_futures::JsFuture::from(window.fetch_with_str(url))
+        .await
+        .map_err(|e| format!("cannot fetch it: {}", text(e)))?
+        .dyn_into::<web_sys::Response>()
+        .map_err(|_| "the fetch did not give a response")?;
+    if !response.ok() {
+        return Err(format!("the server answered {}", response.status()));
+    }
+    let buffer = wasm_bindgen_futures::JsFuture::from(response.array_buffer().map_err(text)?)
+        .await
+        .map_err(|e| format!("cannot read it: {}", text(e)))?;
+    Ok(js_sys::Uint8Array::new(&buffer).to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test]
+    fn only_the_pages_own_origin_is_opened() {
+        let page = "http://localhost:8080/app/index.html?model=x";
+        let origin = "http://localhost:8080";
+        let ok = resolve("models/liver.stl", page, origin).unwrap();
+        assert_eq!(ok.url, "http://localhost:8080/app/models/liver.stl");
+        assert_eq!(ok.name, "liver.stl");
+        let e = resolve("https://example.org/liver.stl", page, origin).unwrap_err();
+        assert!(e.contains("another site"), "{e}");
+        assert!(resolve("//evil.test/a.ply", page, origin).is_err());
+    }
+}
