@@ -84,6 +84,20 @@ impl<'a> DriftingReference<'a> {
         }
     }
 
+    /// Continues a drift from `reference` (an earlier state of one, one entry per vertex): a
+    /// run spread over several calls keeps its references between them.
+    pub fn resume(original: &'a Original, reference: Vec<u32>) -> Self {
+        assert_eq!(
+            reference.len(),
+            original.mesh().vertex_count(),
+            "one reference per vertex"
+        );
+        Self {
+            original,
+            reference,
+        }
+    }
+
     /// Back to the start, for a new smoothing run from the original positions.
     pub fn reset(&mut self) {
         for (i, r) in self.reference.iter_mut().enumerate() {

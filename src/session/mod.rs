@@ -13,8 +13,8 @@ pub use colors::{ColorField, Legend, LegendTick};
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::io;
 use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
-use crate::metrics::{self, Metrics, Original, VertexMeasures};
-use crate::smooth::{Filter, Params};
+use crate::metrics::{self, DriftingReference, Metrics, Original, VertexMeasures};
+use crate::smooth::{self, Filter, Params};
 
 /// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
 pub const DEFAULT_TAU: f64 = 0.5;
@@ -94,6 +94,15 @@ pub struct Timings {
     pub measure_ms: f64,
 }
 
+/// A CPU run in progress, kept between frames.
+struct CpuJob {
+    revision: u64,
+    positions: Vec<[f32; 3]>,
+    reference: Vec<u32>,
+    done: u32,
+    smooth_ms: f64,
+}
+
 /// The open model, the filter settings and the latest result.
 pub struct Session {
     model: Option<Model>,
@@ -106,6 +115,7 @@ pub struct Session {
     voxel_size: Option<[f64; 3]>,
     revision: u64,
     result: Option<Smoothed>,
+    job: Option<CpuJob>,
     /// Why the last file could not be opened; cleared by the next successful open.
     error: Option<String>,
 }
@@ -120,6 +130,7 @@ impl Default for Session {
             voxel_size: None,
             revision: 0,
             result: None,
+            job: None,
             error: None,
         }
     }
@@ -269,32 +280,89 @@ impl Session {
         Ok(())
     }
 
-    /// Smooths and measures the current revision on the CPU engine (the reference), unless
-    /// its result is already there. `clock` gives milliseconds (the caller's timer: wasm32 has
-    /// no `Instant`); the time each half took comes back.
+    /// Smooths and measures the current revision on the CPU engine (the reference) in one go,
+    /// unless its result is already there. `clock` gives milliseconds (the caller's timer:
+    /// wasm32 has no `Instant`); the time each half took comes back.
     pub fn smooth_cpu(&mut self, clock: &dyn Fn() -> f64) -> Option<Timings> {
+        self.step_cpu(clock, f64::INFINITY)
+    }
+
+    /// Works on the current revision's result for about `budget_ms` (at least one iteration),
+    /// continuing where the last call stopped: a page without threads spreads a long run over
+    /// frames this way. Returns the timings once the result is there (then
+    /// [`Self::result`] has it); [`Self::progress`] tells how far it got meanwhile.
+    pub fn step_cpu(&mut self, clock: &dyn Fn() -> f64, budget_ms: f64) -> Option<Timings> {
         if !self.needs_smoothing() {
             return None;
         }
         let model = self.model.as_ref()?;
         let params = *self.params();
         let start = clock();
-        let (positions, reference) = metrics::smooth_drifting(&model.original, &params, None);
+        let mut job = match self.job.take() {
+            Some(job) if job.revision == self.revision => job,
+            _ => CpuJob {
+                revision: self.revision,
+                positions: model.mesh().positions.clone(),
+                reference: metrics::identity(model.mesh().vertex_count()),
+                done: 0,
+                smooth_ms: 0.0,
+            },
+        };
+        while job.done < params.iterations || params.filter == Filter::Sinc {
+            if params.filter == Filter::Sinc {
+                // Its terms are not shorter filters' results: one piece.
+                (job.positions, job.reference) =
+                    metrics::smooth_drifting(&model.original, &params, None);
+                job.done = params.iterations;
+                break;
+            }
+            let mut drift = DriftingReference::resume(&model.original, job.reference);
+            let positions = std::mem::take(&mut job.positions);
+            job.positions = smooth::resume(
+                model.mesh(),
+                model.topology(),
+                &params,
+                None,
+                positions,
+                job.done,
+                1,
+                &mut drift,
+            )
+            .unwrap_or_default();
+            job.reference = drift.into_reference();
+            job.done += 1;
+            if clock() - start >= budget_ms {
+                break;
+            }
+        }
         let smoothed = clock();
+        job.smooth_ms += smoothed - start;
+        if job.done < params.iterations {
+            self.job = Some(job);
+            return None;
+        }
         let result = measured(
             model,
             self.revision,
             params,
             self.tau,
-            positions,
-            &reference,
+            job.positions,
+            &job.reference,
         );
-        let timings = Timings {
-            smooth_ms: smoothed - start,
-            measure_ms: clock() - smoothed,
-        };
         self.result = Some(result);
-        Some(timings)
+        Some(Timings {
+            smooth_ms: job.smooth_ms,
+            measure_ms: clock() - smoothed,
+        })
+    }
+
+    /// How far the CPU engine got with the current revision: `(iterations done, iterations)`,
+    /// while a run is under way.
+    pub fn progress(&self) -> Option<(u32, u32)> {
+        self.job
+            .as_ref()
+            .filter(|j| j.revision == self.revision && self.needs_smoothing())
+            .map(|j| (j.done, self.params().iterations))
     }
 
     /// Accepts positions and drifted references computed elsewhere (the GPU engine) for

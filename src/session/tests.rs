@@ -178,3 +178,54 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     let (d, _) = s.colors(ColorField::Displacement).unwrap();
     assert_eq!(d.len(), colors.len());
 }
+
+#[test]
+fn a_run_spread_over_steps_equals_the_run_in_one_go() {
+    for filter in ["laplace", "taubin", "hc", "sinc"] {
+        let mut whole = sample_session();
+        whole.set_filter_name(filter).unwrap();
+        whole.smooth_cpu(&|| 0.0);
+
+        let mut steps = sample_session();
+        steps.set_filter_name(filter).unwrap();
+        // A clock that runs 1 ms per reading: a budget of 0 ms means one iteration per call.
+        let t = std::cell::Cell::new(0.0);
+        let clock = || {
+            t.set(t.get() + 1.0);
+            t.get()
+        };
+        let mut calls = 0;
+        while steps.step_cpu(&clock, 0.0).is_none() {
+            calls += 1;
+            let (done, total) = steps.progress().expect("under way");
+            assert_eq!(
+                (done, total),
+                (calls, steps.params().iterations),
+                "{filter}"
+            );
+        }
+        let expected = if filter == "sinc" {
+            0
+        } else {
+            steps.params().iterations - 1
+        };
+        assert_eq!(calls, expected, "{filter}");
+        assert_eq!(steps.progress(), None);
+        let (a, b) = (whole.result().unwrap(), steps.result().unwrap());
+        assert_eq!(a.positions, b.positions, "{filter}");
+        assert_eq!(a.metrics, b.metrics, "{filter}");
+    }
+}
+
+#[test]
+fn a_change_mid_run_starts_over() {
+    let mut s = sample_session();
+    let clock = || 0.0;
+    assert!(s.step_cpu(&clock, -1.0).is_none());
+    assert_eq!(s.progress(), Some((1, 10)));
+    s.set_params_json(&serde_json::json!({"iterations": 4}))
+        .unwrap();
+    assert_eq!(s.progress(), None, "the old run is for other parameters");
+    assert!(s.step_cpu(&clock, -1.0).is_none());
+    assert_eq!(s.progress(), Some((1, 4)));
+}

@@ -13,24 +13,27 @@ use super::constraint::Constrain;
 use super::rings::{ring_mean, Rings, CHUNK};
 use super::StepObserver;
 
-/// Runs `iterations` HC iterations from `original`; one step (and report) per iteration.
+/// Runs HC iterations `done + 1 ..= done + more` from `start` (the original positions, or the
+/// result of `done` iterations); one step (and report) per iteration.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn run<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
+    start: Vec<[f32; 3]>,
     alpha: f32,
     beta: f32,
-    iterations: u32,
+    (done, more): (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
-    let mut q = original.to_vec();
-    if iterations == 0 {
+    let mut q = start;
+    if more == 0 {
         return q;
     }
     let n = q.len();
     assert!(n == rings.vertex_count());
     let mut b = vec![[0.0f32; 3]; n];
-    for iteration in 1..=iterations {
+    for iteration in done + 1..=done + more {
         differences(rings, original, &q, &mut b, alpha);
         correct(rings, original, &b, &mut q, alpha, beta, constraint);
         observer.after_step(&q);

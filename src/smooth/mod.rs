@@ -65,30 +65,166 @@ pub fn smooth(
     weights: Option<&[f32]>,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
+    run(mesh, topology, params, weights, None, observer)
+}
+
+/// Continues a run of Laplace, Taubin or HC: `current` is the result of `done` iterations of
+/// `params` from `mesh`'s positions; returns the result of `done + more` iterations (the
+/// observer sees iterations `done + 1 ..= done + more`), equal to [`smooth`] with that many
+/// iterations. Lets a caller without threads spread a run over several frames. `None` for
+/// windowed sinc, whose terms are not shorter filters' results (and for a `current` of the
+/// wrong length).
+#[allow(clippy::too_many_arguments)]
+pub fn resume(
+    mesh: &Mesh,
+    topology: &Topology,
+    params: &Params,
+    weights: Option<&[f32]>,
+    current: Vec<[f32; 3]>,
+    done: u32,
+    more: u32,
+    observer: &mut dyn StepObserver,
+) -> Option<Vec<[f32; 3]>> {
+    if params.filter == Filter::Sinc || current.len() != mesh.vertex_count() {
+        return None;
+    }
+    Some(run(
+        mesh,
+        topology,
+        params,
+        weights,
+        Some((current, done, more)),
+        observer,
+    ))
+}
+
+/// A run from the original positions (`resume` None) or from a partial result.
+fn run(
+    mesh: &Mesh,
+    topology: &Topology,
+    params: &Params,
+    weights: Option<&[f32]>,
+    resume: Option<(Vec<[f32; 3]>, u32, u32)>,
+    observer: &mut dyn StepObserver,
+) -> Vec<[f32; 3]> {
     let original = &mesh.positions;
     let Some(rings) = Rings::new(topology, original.len()) else {
-        return original.clone();
+        return resume.map_or_else(|| original.clone(), |r| r.0);
+    };
+    let (start, span) = match resume {
+        Some((current, done, more)) => (current, (done, more)),
+        None => (original.clone(), (0, params.iterations)),
     };
     match Limits::new(weights, params.max_displacement, original) {
-        None => run(rings, original, params, &Free, observer),
-        Some(limits) => run(rings, original, params, &limits, observer),
+        None => run_filter(rings, original, start, span, params, &Free, observer),
+        Some(limits) => run_filter(rings, original, start, span, params, &limits, observer),
     }
 }
 
-fn run<C: Constrain>(
+fn run_filter<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
+    start: Vec<[f32; 3]>,
+    span: (u32, u32),
     p: &Params,
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
-    let it = p.iterations;
     match p.filter {
-        Filter::Laplace => umbrella::run(rings, original, &[p.lambda], it, constraint, observer),
+        Filter::Laplace => umbrella::run(rings, start, &[p.lambda], span, constraint, observer),
         Filter::Taubin => {
-            umbrella::run(rings, original, &[p.lambda, p.mu], it, constraint, observer)
+            umbrella::run(rings, start, &[p.lambda, p.mu], span, constraint, observer)
         }
-        Filter::Hc => hc::run(rings, original, p.alpha, p.beta, it, constraint, observer),
-        Filter::Sinc => sinc::run(rings, original, p.passband, it, constraint, observer),
+        Filter::Hc => hc::run(
+            rings, original, start, p.alpha, p.beta, span, constraint, observer,
+        ),
+        Filter::Sinc => sinc::run(
+            rings,
+            original,
+            p.passband,
+            p.iterations,
+            constraint,
+            observer,
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Records every step it sees.
+    #[derive(Default)]
+    struct Steps(Vec<Vec<[f32; 3]>>, Vec<u32>);
+    impl StepObserver for Steps {
+        fn after_step(&mut self, p: &[[f32; 3]]) {
+            self.0.push(p.to_vec());
+        }
+        fn after_iteration(&mut self, k: u32, _: &[[f32; 3]]) {
+            self.1.push(k);
+        }
+    }
+
+    #[test]
+    fn a_resumed_run_equals_the_whole_run() {
+        let mesh = crate::io::load(
+            include_bytes!("../../web/sample/bent_tube_staircase.ply"),
+            "tube.ply",
+        )
+        .unwrap();
+        let topology = Topology::build(&mesh);
+        let weights: Vec<f32> = (0..mesh.vertex_count())
+            .map(|i| (i % 3) as f32 / 2.0)
+            .collect();
+        for filter in [Filter::Laplace, Filter::Taubin, Filter::Hc] {
+            let mut p = Params::defaults(filter);
+            p.iterations = 7;
+            p.max_displacement = Some(0.4);
+            let mut whole = Steps::default();
+            let expected = smooth(&mesh, &topology, &p, Some(&weights), &mut whole);
+
+            let mut parts = Steps::default();
+            let mut current = mesh.positions.clone();
+            for (done, more) in [(0, 1), (1, 4), (5, 0), (5, 2)] {
+                current = resume(
+                    &mesh,
+                    &topology,
+                    &p,
+                    Some(&weights),
+                    current,
+                    done,
+                    more,
+                    &mut parts,
+                )
+                .expect("resumable");
+            }
+            assert_eq!(current, expected, "{filter}");
+            assert_eq!(parts.0, whole.0, "{filter}: the same steps");
+            assert_eq!(parts.1, (1..=7).collect::<Vec<_>>(), "{filter}");
+        }
+        let sinc = Params::defaults(Filter::Sinc);
+        assert!(resume(
+            &mesh,
+            &topology,
+            &sinc,
+            None,
+            mesh.positions.clone(),
+            0,
+            1,
+            &mut NoObserver
+        )
+        .is_none());
+        let p = Params::defaults(Filter::Hc);
+        assert!(resume(
+            &mesh,
+            &topology,
+            &p,
+            None,
+            vec![[0.0; 3]; 3],
+            0,
+            1,
+            &mut NoObserver
+        )
+        .is_none());
     }
 }

@@ -6,23 +6,24 @@ use super::constraint::Constrain;
 use super::rings::{ring_mean, Rings, CHUNK};
 use super::StepObserver;
 
-/// Runs `iterations` iterations of the umbrella steps `factors` (Laplace: `[lambda]`; Taubin:
-/// `[lambda, mu]`) from `original`, reporting after every step and every iteration.
+/// Runs iterations `done + 1 ..= done + more` of the umbrella steps `factors` (Laplace:
+/// `[lambda]`; Taubin: `[lambda, mu]`) from `start` (the original positions, or the result of
+/// `done` iterations), reporting after every step and every iteration.
 pub(crate) fn run<C: Constrain>(
     rings: Rings,
-    original: &[[f32; 3]],
+    start: Vec<[f32; 3]>,
     factors: &[f32],
-    iterations: u32,
+    (done, more): (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
-    let mut q = original.to_vec();
-    if iterations == 0 || factors.is_empty() {
+    let mut q = start;
+    if more == 0 || factors.is_empty() {
         return q;
     }
     // The second buffer of the ping-pong pair; the only allocation of the run besides `q`.
     let mut next = vec![[0.0f32; 3]; q.len()];
-    for iteration in 1..=iterations {
+    for iteration in done + 1..=done + more {
         for &factor in factors {
             step(rings, factor, &q, &mut next, constraint);
             std::mem::swap(&mut q, &mut next);
