@@ -627,3 +627,55 @@ fn smoothing_only_meshes_are_unchanged() {
         .fold(0.0, f64::max);
     assert!(worst <= 1e-4 * m.bounding_box_diagonal());
 }
+
+/// Rows of 16 workgroups (a 2-D dispatch on a small mesh): the drift, the normals and the
+/// per-workgroup sums index the same vertices and give the same numbers as one row.
+#[test]
+fn a_2d_grid_gives_the_same_drift_normals_and_measures() {
+    let Some(gpu) = gpu() else { return };
+    let limits = wgpu::Limits {
+        max_compute_workgroups_per_dimension: 16,
+        ..wgpu::Limits::default()
+    };
+    let Some(small) = device::gpu_with(Some(limits)) else {
+        return;
+    };
+    let original = original(SCALP);
+    let n = original.mesh().vertex_count() as u32;
+    let groups = n.div_ceil(meshsmooth::gpu::WORKGROUP_SIZE);
+    assert!(groups > 16 && groups <= 256, "{groups} workgroups");
+    let p = params(Filter::Laplace, 50);
+    let mut results = Vec::new();
+    for g in [gpu, &small] {
+        let (device, queue) = (&g.ctx.device, &g.ctx.queue);
+        let mut mesh = g
+            .smoother
+            .upload_with_measures(device, &original)
+            .expect("fits");
+        let result = run(g, &mut mesh, &p);
+        g.smoother
+            .compute_normals(device, queue, &mesh)
+            .expect("has measures");
+        let normals = read_normals(device, queue, &mesh).expect("readback");
+        let measured = g
+            .smoother
+            .measure(device, queue, &mesh, true)
+            .expect("has measures")
+            .wait(device, &original, 0.5)
+            .expect("readback");
+        results.push((result, normals, measured));
+    }
+    let (one_row, two_d) = (&results[0], &results[1]);
+    assert!(
+        one_row.0.reference != identity(n as usize),
+        "the run drifts"
+    );
+    assert_eq!(one_row.0, two_d.0);
+    assert_eq!(one_row.1, two_d.1);
+    assert_eq!(one_row.2.vertex, two_d.2.vertex);
+    let (a, b) = (&one_row.2.metrics, &two_d.2.metrics);
+    assert_eq!(a.max_error, b.max_error);
+    assert!(relative(a.mean_error, b.mean_error) < 1e-6);
+    assert!(relative(a.curvature, b.curvature) < 1e-6);
+    assert!(relative(a.volume.expect("closed"), b.volume.expect("closed")) < 1e-6);
+}

@@ -48,7 +48,7 @@ pub use readback::{PositionReadback, ResultReadback, SmoothResult};
 pub use smoother::GpuSmoother;
 
 #[cfg(not(target_arch = "wasm32"))]
-pub use bench::time_smoothing;
+pub use bench::{time_measures, time_smoothing};
 #[cfg(not(target_arch = "wasm32"))]
 pub use device::{request_native_device, request_native_device_with_limits, GpuContext};
 #[cfg(not(target_arch = "wasm32"))]
