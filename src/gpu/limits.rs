@@ -5,7 +5,7 @@
 use super::layout::{dispatch_size, MeasurePartial, WORKGROUP_SIZE};
 use super::GpuError;
 
-/// Bytes per vertex position on the GPU (vec4<f32>: WGSL's vec3 arrays are padded to 16 anyway).
+/// Bytes per vertex position on the GPU (`vec4<f32>`: WGSL's vec3 arrays are padded to 16 anyway).
 pub(crate) const POSITION_BYTES: u64 = 16;
 
 /// Checks that `vertex_count` vertices with `ring_entries` smoothing-ring entries fit `limits`.
@@ -66,7 +66,7 @@ pub(crate) fn check_mesh_fits(
     Ok(())
 }
 
-/// Bytes per entry of the per-vertex measures (local error, K_G as vec2<f32>).
+/// Bytes per entry of the per-vertex measures (local error, K_G as `vec2<f32>`).
 pub(crate) const VERTEX_MEASURE_BYTES: u64 = 8;
 
 /// Checks that what the drift, normals and measures add to a mesh fits `limits`: the full

@@ -1,6 +1,6 @@
 //! A mesh on the GPU: every buffer and bind group a smoothing run needs, created once at upload.
 //!
-//! Positions are vec4<f32> (w = 0), in buffers a renderer may bind as vertex buffers. Runs
+//! Positions are `vec4<f32>` (w = 0), in buffers a renderer may bind as vertex buffers. Runs
 //! ping-pong between `a` and `b`; HC keeps its differences and windowed sinc its running
 //! estimate in `aux`. The original positions, the smoothing ring and the weights stay as
 //! uploaded, so further kernels can bind them next to a run's result; a mesh uploaded with its
@@ -314,7 +314,7 @@ impl GpuMesh {
         Ok(())
     }
 
-    /// The buffer holding the latest run's positions (vec4<f32> per vertex, w = 0: stride 16),
+    /// The buffer holding the latest run's positions (`vec4<f32>` per vertex, w = 0: stride 16),
     /// or the original positions before any run. Usages STORAGE | VERTEX | COPY_SRC | COPY_DST:
     /// a renderer may bind it as a vertex buffer. Which buffer it is changes with the filter and
     /// the iteration count, so take it again after every run.
@@ -363,14 +363,14 @@ impl GpuMesh {
         self.surface.as_ref().map(|s| &s.reference)
     }
 
-    /// Unit vertex normals from the latest [`super::GpuSmoother::compute_normals`] (vec4<f32>
+    /// Unit vertex normals from the latest [`super::GpuSmoother::compute_normals`] (`vec4<f32>`
     /// per vertex, w = 0: stride 16; usages STORAGE | VERTEX | COPY_SRC | COPY_DST). The
     /// buffer stays the same for the mesh's lifetime. `None` without measures.
     pub fn normals_buffer(&self) -> Option<&wgpu::Buffer> {
         self.surface.as_ref().map(|s| &s.normals)
     }
 
-    /// Per-vertex measures from the latest [`super::GpuSmoother::measure`]: vec2<f32> per
+    /// Per-vertex measures from the latest [`super::GpuSmoother::measure`]: `vec2<f32>` per
     /// vertex, (local error in mesh units, K_G), with the zeros the CPU's
     /// [`crate::metrics::VertexMeasures`] has (unreferenced vertices; K_G on the boundary or
     /// without area). For colour-coding on the GPU, or read back with the measures. `None`

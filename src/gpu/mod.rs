@@ -2,7 +2,7 @@
 //! imports wgpu but not egui, so the app, the CLI and the tests share it; each hands in its own
 //! `wgpu::Device` and `wgpu::Queue`.
 //!
-//! A mesh is uploaded once ([`GpuSmoother::upload`] -> [`GpuMesh`]: positions as vec4<f32>, the
+//! A mesh is uploaded once ([`GpuSmoother::upload`] -> [`GpuMesh`]: positions as `vec4<f32>`, the
 //! smoothing ring as CSR, the original positions, the weights); a run records every iteration
 //! into one submission and never reads back in between; [`read_positions`] (native) or
 //! [`PositionReadback`] (anywhere) bring the result back. The kernels in shaders/*.wgsl mirror

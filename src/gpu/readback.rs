@@ -127,7 +127,7 @@ fn encoder(device: &wgpu::Device) -> wgpu::CommandEncoder {
     })
 }
 
-/// xyz of `n` vec4<f32> (copied out, so the mapping's alignment does not matter).
+/// xyz of `n` `vec4<f32>` (copied out, so the mapping's alignment does not matter).
 fn vec3s(bytes: &[u8], n: usize) -> Vec<[f32; 3]> {
     let vec4: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(bytes);
     vec4.iter().take(n).map(|p| [p[0], p[1], p[2]]).collect()

@@ -17,9 +17,9 @@ use crate::metrics::Original;
 pub(crate) struct SurfaceBuffers {
     /// Each vertex's reference vertex on the original mesh (u32), the identity at upload.
     pub reference: wgpu::Buffer,
-    /// Unit vertex normals of the latest [`super::GpuSmoother::compute_normals`] (vec4<f32>).
+    /// Unit vertex normals of the latest [`super::GpuSmoother::compute_normals`] (`vec4<f32>`).
     pub normals: wgpu::Buffer,
-    /// Per vertex (local error, K_G) of the latest measure pass (vec2<f32>).
+    /// Per vertex (local error, K_G) of the latest measure pass (`vec2<f32>`).
     pub vertex_measures: wgpu::Buffer,
     /// One [`MeasurePartial`] per workgroup of the latest measure pass.
     pub partials: wgpu::Buffer,
