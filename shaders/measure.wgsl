@@ -51,7 +51,8 @@ const TAN_EIGHTH_PI: f32 = 0.41421357;
 // metrics::curvature's NEGLIGIBLE_ANGLE and metrics::exact_distance's SLIVER_SINE squared.
 const NEGLIGIBLE_ANGLE: f32 = 1e-12;
 const SLIVER_SINE2: f32 = 1e-16;
-const F32_MAX: f32 = 3.4028235e38;
+// The largest f32, written exactly (a decimal literal rounds past it, which Tint refuses).
+const F32_MAX: f32 = 0x1.fffffep+127f;
 
 // atan(s) for |s| <= tan(pi/8), by its Taylor series to s^19: the first term left out is below
 // 5e-10 there, under half an f32 ulp of the result.

@@ -30,7 +30,8 @@ fn vertex_normals(
     // Scaled by the largest component first, so the length neither overflows nor underflows.
     let largest = max(abs(sum.x), max(abs(sum.y), abs(sum.z)));
     var n = vec3<f32>(0.0);
-    if largest > 0.0 && largest <= 3.4028235e38 {
+    // Finite: at most the largest f32 (written exactly; a decimal literal rounds past it).
+    if largest > 0.0 && largest <= 0x1.fffffep+127f {
         let s = sum / largest;
         n = s / sqrt(dot(s, s));
     }

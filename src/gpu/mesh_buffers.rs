@@ -39,7 +39,9 @@ pub(crate) struct PositionGroups {
     pub sinc_from_b: wgpu::BindGroup,
 }
 
-/// A mesh uploaded by [`super::GpuSmoother::upload`].
+/// A mesh on the GPU: uploaded by [`super::GpuSmoother::upload`] for smoothing, or by
+/// [`super::GpuSmoother::upload_with_measures`] for smoothing with the drifting reference,
+/// normals and measures.
 pub struct GpuMesh {
     pub(crate) vertex_count: u32,
     /// Windowed sinc's centring: the original bounding box's centre, as the CPU computes it.

@@ -13,7 +13,9 @@ use crate::smooth::{sinc_coefficients, Filter, Params};
 
 /// Smooths meshes on a device handed in by the caller (the app's, the CLI's, a test's), so
 /// every caller shares one engine. Matches [`crate::smooth::smooth`] (the CPU reference) up to
-/// float rounding.
+/// float rounding; on a mesh uploaded with its measures, also the CPU's drifting reference,
+/// vertex normals and measure pass. Needs WebGPU's default limits (8 storage buffers per
+/// shader stage), which eframe requests on WebGPU.
 pub struct GpuSmoother {
     layouts: Layouts,
     pipelines: Pipelines,
