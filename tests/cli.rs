@@ -321,4 +321,6 @@ fn bench_runs_on_the_gpu_backend() {
     assert_eq!(v["iterations"], 20);
     assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()));
     assert!(v["vertex_iterations_per_second"].as_f64().unwrap() > 0.0);
+    assert!(v["gpu_measure_seconds"].as_f64().unwrap() > 0.0);
+    assert!(v["gpu_drift_seconds"].as_f64().unwrap() >= 0.0);
 }

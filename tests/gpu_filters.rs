@@ -7,60 +7,13 @@
 //! Native only: the browser's device comes from the page, not from these helpers.
 #![cfg(not(target_arch = "wasm32"))]
 
-use std::sync::OnceLock;
+#[path = "common_gpu/device.rs"]
+mod device;
 
-use meshsmooth::gpu::{
-    read_positions, request_native_device, request_native_device_with_limits, GpuContext, GpuError,
-    GpuSmoother,
-};
+use device::{gpu, gpu_with, Gpu};
+use meshsmooth::gpu::{read_positions, GpuError};
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::smooth::{smooth, Filter, NoObserver, Params};
-
-struct Gpu {
-    ctx: GpuContext,
-    smoother: GpuSmoother,
-}
-
-fn require_gpu() -> bool {
-    std::env::var("REQUIRE_GPU").is_ok_and(|v| v == "1")
-}
-
-fn no_adapter(e: GpuError) -> Option<Gpu> {
-    assert!(!require_gpu(), "REQUIRE_GPU=1 but no GPU device: {e}");
-    eprintln!("NOTICE: skipping GPU test, no adapter ({e}); set REQUIRE_GPU=1 to fail instead");
-    None
-}
-
-fn gpu_with(limits: Option<wgpu::Limits>) -> Option<Gpu> {
-    let ctx = match limits {
-        None => request_native_device(),
-        Some(l) => request_native_device_with_limits(l),
-    };
-    match ctx {
-        Ok(ctx) => {
-            let smoother = GpuSmoother::new(&ctx.device);
-            Some(Gpu { ctx, smoother })
-        }
-        Err(e) => no_adapter(e),
-    }
-}
-
-/// One device for the whole test binary (creating one on lavapipe takes a while).
-fn gpu() -> Option<&'static Gpu> {
-    static GPU: OnceLock<Option<Gpu>> = OnceLock::new();
-    GPU.get_or_init(|| {
-        let gpu = gpu_with(None);
-        if let Some(g) = &gpu {
-            let info = &g.ctx.adapter_info;
-            eprintln!(
-                "GPU tests on {} ({:?}, {:?})",
-                info.name, info.backend, info.device_type
-            );
-        }
-        gpu
-    })
-    .as_ref()
-}
 
 fn load(relative: &str) -> Mesh {
     let path = format!("{}/../shared/data/{relative}", env!("CARGO_MANIFEST_DIR"));

@@ -1,7 +1,7 @@
 //! Every WGSL file under shaders/ validated with naga, as the runtime assembles and loads it
 //! (no GPU needed).
 
-use meshsmooth::gpu::shaders::{KERNELS, PRELUDE_FILE};
+use meshsmooth::gpu::shaders::{KERNELS, PRELUDE_FILES};
 use meshsmooth::gpu::WORKGROUP_SIZE;
 
 fn validate(name: &str, source: &str) -> naga::Module {
@@ -58,8 +58,9 @@ fn every_wgsl_file_is_loaded_by_the_runtime() {
         .collect();
     files.sort();
     let mut loaded: Vec<String> = KERNELS.iter().map(|k| k.file.to_string()).collect();
-    loaded.push(PRELUDE_FILE.to_string());
+    loaded.extend(PRELUDE_FILES.iter().map(|f| f.to_string()));
     loaded.sort();
+    loaded.dedup();
     assert_eq!(files, loaded);
 }
 

@@ -45,10 +45,11 @@ stage fmt cargo fmt --check
 stage clippy-native cargo clippy --all-targets -- -D warnings
 stage clippy-wasm32 cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
 stage test-native cargo test
-# The library's tests and tests/wasm_io.rs compiled to wasm32, run in headless Chromium (flags in
-# webdriver.json). The other integration tests read files and start processes: native only, so
-# they are not built for the browser.
-stage test-wasm32-browser wasm-pack test --headless --chrome -- --lib --test wasm_io
+# The library's tests, tests/wasm_io.rs and tests/wasm_gpu.rs (the GPU engine on the browser's
+# WebGPU) compiled to wasm32, run in headless Chromium (flags in webdriver.json). The other
+# integration tests read files and start processes: native only, so they are not built for the
+# browser.
+stage test-wasm32-browser wasm-pack test --headless --chrome -- --lib --test wasm_io --test wasm_gpu
 stage web-build trunk build --release
 # End-to-end browser tests of the built app go here, one line:
 # stage e2e <command>

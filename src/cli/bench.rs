@@ -1,5 +1,7 @@
 //! `meshsmooth bench FILE [--filter F] [--iterations N] [--json]`: smoothing throughput in
-//! vertex-iterations per second and the cost of one measure pass, best of several runs.
+//! vertex-iterations per second and the cost of one measure pass, best of several runs. With
+//! `--backend gpu` the smoothing runs on the wgpu engine, and the GPU's own measure pass and
+//! drifting reference are timed too (the CPU's columns stay for comparison).
 //! Speed is reported, never asserted: machines are shared and noisy.
 
 use super::params::filter;
@@ -30,6 +32,12 @@ struct BenchResult {
     /// The GPU adapter, for `--backend gpu`.
     #[serde(skip_serializing_if = "Option::is_none")]
     adapter: Option<String>,
+    /// `--backend gpu`: best time of one measure pass on the GPU, its sums read back.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gpu_measure_seconds: Option<f64>,
+    /// `--backend gpu`: extra time the drifting reference adds to a GPU smoothing run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gpu_drift_seconds: Option<f64>,
 }
 
 /// Which engine smooths.
@@ -72,7 +80,7 @@ pub(super) fn run(
     });
     let mut gpu = match backend {
         Backend::Cpu => None,
-        Backend::Gpu => Some(GpuBench::new(&mesh, &topology)?),
+        Backend::Gpu => Some(GpuBench::new(&original)?),
     };
     let mut results = Vec::new();
     for f in filters {
@@ -84,9 +92,14 @@ pub(super) fn run(
         let cpu_seconds = best_of(repeat, || {
             smooth::smooth(&mesh, &topology, &params, None, &mut NoObserver);
         });
-        let seconds = match gpu.as_mut() {
-            None => cpu_seconds,
-            Some(g) => g.best_of(repeat, &params)?,
+        let (seconds, gpu_figures) = match gpu.as_mut() {
+            None => (cpu_seconds, None),
+            Some(g) => {
+                let seconds = g.best_of(repeat, &params, false)?;
+                let with_drift = g.best_of(repeat, &params, true)?;
+                let measure = g.measure_best_of(repeat, &original)?;
+                (seconds, Some((measure, (with_drift - seconds).max(0.0))))
+            }
         };
         let mut positions = Vec::new();
         let mut reference = Vec::new();
@@ -111,6 +124,8 @@ pub(super) fn run(
             backend: if gpu.is_some() { "gpu" } else { "cpu" },
             threads: rayon::current_num_threads(),
             adapter: gpu.as_ref().map(|g| g.adapter.clone()),
+            gpu_measure_seconds: gpu_figures.map(|(m, _)| m),
+            gpu_drift_seconds: gpu_figures.map(|(_, d)| d),
         });
     }
     if json {
@@ -122,7 +137,10 @@ pub(super) fn run(
         println!("{text}");
     } else {
         let engine = match &gpu {
-            Some(g) => format!("gpu backend on {} (measures on the cpu)", g.adapter),
+            Some(g) => format!(
+                "gpu backend on {} (measure and drift columns: the cpu's; gpu's below)",
+                g.adapter
+            ),
             None => "cpu backend".to_string(),
         };
         println!(
@@ -144,6 +162,17 @@ pub(super) fn run(
                 r.measure_seconds / r.laplace10_seconds.max(1e-12)
             );
         }
+        if gpu.is_some() {
+            println!("filter   gpu measure ms   gpu drift ms");
+            for r in &results {
+                println!(
+                    "{:<8} {:>15.2} {:>14.2}",
+                    r.filter,
+                    r.gpu_measure_seconds.unwrap_or(0.0) * 1e3,
+                    r.gpu_drift_seconds.unwrap_or(0.0) * 1e3
+                );
+            }
+        }
     }
     Ok(())
 }
@@ -158,7 +187,8 @@ fn best_of(repeat: usize, mut f: impl FnMut()) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The GPU engine with the mesh uploaded once; each timing is submission to completion.
+/// The GPU engine with the mesh (and its measures) uploaded once; each timing is submission to
+/// completion.
 struct GpuBench {
     context: gpu::GpuContext,
     smoother: gpu::GpuSmoother,
@@ -167,11 +197,11 @@ struct GpuBench {
 }
 
 impl GpuBench {
-    fn new(mesh: &crate::mesh::Mesh, topology: &Topology) -> Result<Self, String> {
+    fn new(original: &Original) -> Result<Self, String> {
         let context = gpu::request_native_device().map_err(|e| e.to_string())?;
         let smoother = gpu::GpuSmoother::new(&context.device);
         let uploaded = smoother
-            .upload(&context.device, mesh, topology)
+            .upload_with_measures(&context.device, original)
             .map_err(|e| e.to_string())?;
         let info = &context.adapter_info;
         let adapter = format!("{} ({:?}, {:?})", info.name, info.device_type, info.backend);
@@ -183,7 +213,11 @@ impl GpuBench {
         })
     }
 
-    fn best_of(&mut self, repeat: usize, params: &Params) -> Result<f64, String> {
+    /// Best smoothing time, with or without the drifting reference.
+    fn best_of(&mut self, repeat: usize, params: &Params, drift: bool) -> Result<f64, String> {
+        self.mesh
+            .set_track_reference(drift)
+            .map_err(|e| e.to_string())?;
         let mut best = f64::INFINITY;
         for _ in 0..repeat {
             let t = gpu::time_smoothing(
@@ -192,6 +226,23 @@ impl GpuBench {
                 &self.context.queue,
                 &mut self.mesh,
                 params,
+            )
+            .map_err(|e| e.to_string())?;
+            best = best.min(t);
+        }
+        Ok(best)
+    }
+
+    /// Best time of a measure pass over the latest run's result.
+    fn measure_best_of(&self, repeat: usize, original: &Original) -> Result<f64, String> {
+        let mut best = f64::INFINITY;
+        for _ in 0..repeat {
+            let t = gpu::time_measures(
+                &self.smoother,
+                &self.context.device,
+                &self.context.queue,
+                &self.mesh,
+                original,
             )
             .map_err(|e| e.to_string())?;
             best = best.min(t);

@@ -30,6 +30,10 @@ pub enum GpuError {
     WeightCount { given: usize, vertices: usize },
     #[error(transparent)]
     Params(#[from] ParamError),
+    /// The drift, normals and measures need the buffers of
+    /// [`super::GpuSmoother::upload_with_measures`].
+    #[error("the mesh was uploaded without its measures (use upload_with_measures)")]
+    NoMeasures,
     /// Reading positions back failed (device lost, mapping refused).
     #[error("reading positions back from the GPU failed: {0}")]
     Readback(String),

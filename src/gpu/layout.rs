@@ -29,6 +29,36 @@ pub(crate) struct StepParams {
 const _: () = assert!(std::mem::size_of::<StepParams>() == 48);
 const _: () = assert!(std::mem::offset_of!(StepParams, centre) == 32);
 
+/// Per-mesh constants of the surface kernels (drift, normals, measures), `SurfaceParams` in
+/// shaders/surface.wgsl: 32 bytes, the vec4 at byte 16.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct SurfaceParams {
+    pub vertex_count: u32,
+    pub pad: [u32; 3],
+    /// The original bounding box's centre (w = 0): the measures sum the volume about it.
+    pub centre: [f32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<SurfaceParams>() == 32);
+const _: () = assert!(std::mem::offset_of!(SurfaceParams, centre) == 16);
+
+/// One workgroup's sums of a measure pass, `Partial` in shaders/measure.wgsl: 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct MeasurePartial {
+    pub error_sum: f32,
+    pub error_max: f32,
+    pub curvature_sum: f32,
+    /// Six times the volume of the triangles whose smallest corner is in the workgroup.
+    pub volume6: f32,
+    pub error_count: u32,
+    pub curvature_count: u32,
+    pub pad: [u32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<MeasurePartial>() == 32);
+
 /// Step records a run may need at once: windowed sinc's one per term after the first, up to its
 /// largest valid iteration count (100); the other filters use one or two.
 pub(crate) const MAX_STEP_SLOTS: usize = 100;

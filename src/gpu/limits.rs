@@ -2,10 +2,10 @@
 //! 256 MiB per buffer, 65,535 workgroups per dimension), checked before anything is uploaded
 //! so that a too-large mesh gets an error naming the limit instead of a device error.
 
-use super::layout::{dispatch_size, WORKGROUP_SIZE};
+use super::layout::{dispatch_size, MeasurePartial, WORKGROUP_SIZE};
 use super::GpuError;
 
-/// Bytes per vertex position on the GPU (vec4<f32>: WGSL's vec3 arrays are padded to 16 anyway).
+/// Bytes per vertex position on the GPU (`vec4<f32>`: WGSL's vec3 arrays are padded to 16 anyway).
 pub(crate) const POSITION_BYTES: u64 = 16;
 
 /// Checks that `vertex_count` vertices with `ring_entries` smoothing-ring entries fit `limits`.
@@ -52,24 +52,7 @@ pub(crate) fn check_mesh_fits(
             (vertex_count as u64 + 1) * 4,
         ),
     ];
-    for (what, bytes) in arrays {
-        if bytes > limits.max_storage_buffer_binding_size {
-            return Err(too_large(
-                what,
-                "max_storage_buffer_binding_size",
-                bytes,
-                limits.max_storage_buffer_binding_size,
-            ));
-        }
-        if bytes > limits.max_buffer_size {
-            return Err(too_large(
-                what,
-                "max_buffer_size",
-                bytes,
-                limits.max_buffer_size,
-            ));
-        }
-    }
+    check_arrays(limits, arrays)?;
     let max = limits.max_compute_workgroups_per_dimension;
     if dispatch_size(vertex_count as u32, max).is_none() {
         let groups = (vertex_count as u64).div_ceil(u64::from(WORKGROUP_SIZE));
@@ -79,6 +62,95 @@ pub(crate) fn check_mesh_fits(
             groups,
             u64::from(max) * u64::from(max),
         ));
+    }
+    Ok(())
+}
+
+/// Bytes per entry of the per-vertex measures (local error, K_G as `vec2<f32>`).
+pub(crate) const VERTEX_MEASURE_BYTES: u64 = 8;
+
+/// Checks that what the drift, normals and measures add to a mesh fits `limits`: the full
+/// 1-ring of `ring_entries` entries, `fan_entries` vertex->triangle incidences (two corners
+/// each), per-vertex arrays and `partials` workgroup sums; and that a readback of positions and
+/// references together fits one buffer.
+pub(crate) fn check_surface_fits(
+    limits: &wgpu::Limits,
+    vertex_count: usize,
+    ring_entries: usize,
+    fan_entries: usize,
+    partials: usize,
+) -> Result<(), GpuError> {
+    let n = vertex_count as u64;
+    if fan_entries as u64 > u64::from(u32::MAX) - 1 {
+        return Err(GpuError::TooLarge {
+            what: format!("{fan_entries} vertex-triangle incidences"),
+            limit: "u32 index range (incidences)",
+            needed: fan_entries as u64,
+            allowed: u64::from(u32::MAX) - 1,
+        });
+    }
+    check_arrays(
+        limits,
+        [
+            (
+                format!("the 1-ring's {ring_entries} neighbour indices (bytes)"),
+                ring_entries as u64 * 4,
+            ),
+            (
+                format!("the triangle corners of {fan_entries} vertex-triangle incidences (bytes)"),
+                fan_entries as u64 * 8,
+            ),
+            (
+                format!("the normals of {vertex_count} vertices (bytes)"),
+                n * POSITION_BYTES,
+            ),
+            (
+                format!("the measures of {vertex_count} vertices (bytes)"),
+                n * VERTEX_MEASURE_BYTES,
+            ),
+            (
+                format!("the sums of {partials} workgroups (bytes)"),
+                partials as u64 * std::mem::size_of::<MeasurePartial>() as u64,
+            ),
+        ],
+    )?;
+    // One staging buffer for positions and references (not a binding: only the buffer limit).
+    let readback = n * (POSITION_BYTES + 4);
+    if readback > limits.max_buffer_size {
+        return Err(GpuError::TooLarge {
+            what: format!(
+                "a readback of the positions and references of {vertex_count} vertices (bytes)"
+            ),
+            limit: "max_buffer_size",
+            needed: readback,
+            allowed: limits.max_buffer_size,
+        });
+    }
+    Ok(())
+}
+
+/// Each array must fit one storage binding and one buffer.
+fn check_arrays<const N: usize>(
+    limits: &wgpu::Limits,
+    arrays: [(String, u64); N],
+) -> Result<(), GpuError> {
+    for (what, bytes) in arrays {
+        for (limit, allowed) in [
+            (
+                "max_storage_buffer_binding_size",
+                limits.max_storage_buffer_binding_size,
+            ),
+            ("max_buffer_size", limits.max_buffer_size),
+        ] {
+            if bytes > allowed {
+                return Err(GpuError::TooLarge {
+                    what,
+                    limit,
+                    needed: bytes,
+                    allowed,
+                });
+            }
+        }
     }
     Ok(())
 }
@@ -128,5 +200,21 @@ mod tests {
         };
         let e = check_mesh_fits(&limits, 100, 0).expect_err("1600 bytes of positions");
         assert!(e.to_string().contains("max_buffer_size"), "{e}");
+    }
+
+    #[test]
+    fn the_measures_have_limits_of_their_own() {
+        let limits = wgpu::Limits::default();
+        // 2 million vertices of valence 6: 12 million incidences, 96 MB of corners.
+        check_surface_fits(&limits, 2_000_000, 12_000_000, 12_000_000, 31_250).expect("fits");
+        // 5 million vertices fit the smoothing but not the fans' 240 MB of corners.
+        check_mesh_fits(&limits, 5_000_000, 30_000_000).expect("smoothing fits");
+        let e = check_surface_fits(&limits, 5_000_000, 30_000_000, 30_000_000, 78_125)
+            .expect_err("fans too large");
+        assert!(e.to_string().contains("incidences"), "{e}");
+        assert!(
+            e.to_string().contains("max_storage_buffer_binding_size"),
+            "{e}"
+        );
     }
 }

@@ -1,17 +1,20 @@
 //! A mesh on the GPU: every buffer and bind group a smoothing run needs, created once at upload.
 //!
-//! Positions are vec4<f32> (w = 0). Runs ping-pong between `a` and `b`; HC keeps its
-//! differences and windowed sinc its running estimate in `aux`. The original positions, the
-//! smoothing ring and the weights stay as uploaded, so further kernels (measures) can bind
-//! them next to a run's result.
+//! Positions are `vec4<f32>` (w = 0), in buffers a renderer may bind as vertex buffers. Runs
+//! ping-pong between `a` and `b`; HC keeps its differences and windowed sinc its running
+//! estimate in `aux`. The original positions, the smoothing ring and the weights stay as
+//! uploaded, so further kernels can bind them next to a run's result; a mesh uploaded with its
+//! measures also holds [`SurfaceBuffers`] (reference vertices, normals, measures).
 
 use wgpu::util::DeviceExt;
 
 use super::layout::{step_stride, StepParams, MAX_STEP_SLOTS};
 use super::limits::{check_mesh_fits, POSITION_BYTES};
 use super::pipelines::Layouts;
+use super::surface::{SlotBuffers, SurfaceBuffers};
 use super::GpuError;
 use crate::mesh::{bounding_box, Mesh, Topology};
+use crate::metrics::Original;
 
 /// Which buffer holds the latest run's positions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +39,9 @@ pub(crate) struct PositionGroups {
     pub sinc_from_b: wgpu::BindGroup,
 }
 
-/// A mesh uploaded by [`super::GpuSmoother::upload`].
+/// A mesh on the GPU: uploaded by [`super::GpuSmoother::upload`] for smoothing, or by
+/// [`super::GpuSmoother::upload_with_measures`] for smoothing with the drifting reference,
+/// normals and measures.
 pub struct GpuMesh {
     pub(crate) vertex_count: u32,
     /// Windowed sinc's centring: the original bounding box's centre, as the CPU computes it.
@@ -54,6 +59,8 @@ pub struct GpuMesh {
     pub(crate) aux: wgpu::Buffer,
     pub(crate) mesh_group: wgpu::BindGroup,
     pub(crate) groups: PositionGroups,
+    /// Present when uploaded with its measures.
+    pub(crate) surface: Option<SurfaceBuffers>,
 }
 
 /// Checks the smoothing ring against the vertex count as the CPU engine does, so no kernel
@@ -82,7 +89,17 @@ fn checked_ring(topology: &Topology, vertex_count: usize) -> Result<(&[u32], &[u
 }
 
 /// Bytes of a storage buffer holding `data`; never empty (WebGPU refuses empty bindings).
-fn storage_init(device: &wgpu::Device, label: &str, data: &[u8]) -> wgpu::Buffer {
+pub(crate) fn storage_init(device: &wgpu::Device, label: &str, data: &[u8]) -> wgpu::Buffer {
+    storage_init_with(device, label, data, wgpu::BufferUsages::empty())
+}
+
+/// [`storage_init`] with further usages.
+fn storage_init_with(
+    device: &wgpu::Device,
+    label: &str,
+    data: &[u8],
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
     let padded;
     let contents = if data.is_empty() {
         padded = [0u8; 16];
@@ -95,7 +112,8 @@ fn storage_init(device: &wgpu::Device, label: &str, data: &[u8]) -> wgpu::Buffer
         contents,
         usage: wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST,
+            | wgpu::BufferUsages::COPY_DST
+            | extra,
     })
 }
 
@@ -103,7 +121,7 @@ fn to_vec4(positions: &[[f32; 3]]) -> Vec<[f32; 4]> {
     positions.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect()
 }
 
-fn bind_group(
+pub(crate) fn bind_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     buffers: &[&wgpu::Buffer],
@@ -148,10 +166,11 @@ impl GpuMesh {
             bytemuck::cast_slice(offsets),
         );
         let neighbors = storage_init(device, "meshsmooth ring", bytemuck::cast_slice(neighbors));
-        let original = storage_init(
+        let original = storage_init_with(
             device,
             "meshsmooth original positions",
             bytemuck::cast_slice(&original_data),
+            wgpu::BufferUsages::VERTEX,
         );
         let weights = storage_init(
             device,
@@ -164,7 +183,8 @@ impl GpuMesh {
                 size: (n.max(1) as u64) * POSITION_BYTES,
                 usage: wgpu::BufferUsages::STORAGE
                     | wgpu::BufferUsages::COPY_SRC
-                    | wgpu::BufferUsages::COPY_DST,
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::VERTEX,
                 mapped_at_creation: false,
             })
         };
@@ -233,7 +253,32 @@ impl GpuMesh {
             aux,
             mesh_group,
             groups,
+            surface: None,
         })
+    }
+
+    /// [`Self::upload`] of `original`'s mesh, plus the surface buffers the drift, the normals
+    /// and the measures need (checked against the limits first, like the rest).
+    pub(crate) fn upload_with_measures(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        original: &Original,
+    ) -> Result<Self, GpuError> {
+        let mut mesh = Self::upload(device, layouts, original.mesh(), original.topology())?;
+        let slots = SlotBuffers {
+            original: &mesh.original,
+            a: &mesh.a,
+            b: &mesh.b,
+            aux: &mesh.aux,
+        };
+        mesh.surface = Some(SurfaceBuffers::upload(
+            device,
+            &layouts.surface,
+            original,
+            slots,
+            mesh.centre,
+        )?);
+        Ok(mesh)
     }
 
     pub fn vertex_count(&self) -> usize {
@@ -271,8 +316,10 @@ impl GpuMesh {
         Ok(())
     }
 
-    /// The buffer holding the latest run's positions (vec4<f32> per vertex, w = 0), or the
-    /// original positions before any run. For rendering and for kernels that measure a result.
+    /// The buffer holding the latest run's positions (`vec4<f32>` per vertex, w = 0: stride 16),
+    /// or the original positions before any run. Usages STORAGE | VERTEX | COPY_SRC | COPY_DST:
+    /// a renderer may bind it as a vertex buffer. Which buffer it is changes with the filter and
+    /// the iteration count, so take it again after every run.
     pub fn positions_buffer(&self) -> &wgpu::Buffer {
         match self.result {
             Slot::Original => &self.original,
@@ -290,5 +337,55 @@ impl GpuMesh {
 
     pub fn ring_buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
         (&self.offsets, &self.neighbors)
+    }
+
+    /// True when uploaded with [`super::GpuSmoother::upload_with_measures`]: runs can drift the
+    /// reference, and normals and measures can be computed.
+    pub fn has_measures(&self) -> bool {
+        self.surface.is_some()
+    }
+
+    /// Whether the next runs drift the reference vertices after every step (the default for a
+    /// mesh with measures) or leave every vertex its own reference (faster; the local error
+    /// then measures against each vertex's own fan). Refused without measures.
+    pub fn set_track_reference(&mut self, track: bool) -> Result<(), GpuError> {
+        self.surface_mut()?.track_reference = track;
+        Ok(())
+    }
+
+    /// Whether runs drift the reference vertices (false without measures).
+    pub fn tracks_reference(&self) -> bool {
+        self.surface.as_ref().is_some_and(|s| s.track_reference)
+    }
+
+    /// Each vertex's reference vertex on the original mesh after the latest run (`u32` per
+    /// vertex; the identity before any run, after a run of zero steps and when not tracking).
+    /// `None` without measures.
+    pub fn reference_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.surface.as_ref().map(|s| &s.reference)
+    }
+
+    /// Unit vertex normals from the latest [`super::GpuSmoother::compute_normals`] (`vec4<f32>`
+    /// per vertex, w = 0: stride 16; usages STORAGE | VERTEX | COPY_SRC | COPY_DST). The
+    /// buffer stays the same for the mesh's lifetime. `None` without measures.
+    pub fn normals_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.surface.as_ref().map(|s| &s.normals)
+    }
+
+    /// Per-vertex measures from the latest [`super::GpuSmoother::measure`]: `vec2<f32>` per
+    /// vertex, (local error in mesh units, K_G), with the zeros the CPU's
+    /// [`crate::metrics::VertexMeasures`] has (unreferenced vertices; K_G on the boundary or
+    /// without area). For colour-coding on the GPU, or read back with the measures. `None`
+    /// without measures.
+    pub fn vertex_measures_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.surface.as_ref().map(|s| &s.vertex_measures)
+    }
+
+    pub(crate) fn surface(&self) -> Result<&SurfaceBuffers, GpuError> {
+        self.surface.as_ref().ok_or(GpuError::NoMeasures)
+    }
+
+    fn surface_mut(&mut self) -> Result<&mut SurfaceBuffers, GpuError> {
+        self.surface.as_mut().ok_or(GpuError::NoMeasures)
     }
 }

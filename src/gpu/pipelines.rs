@@ -3,11 +3,15 @@
 //! Group 0 (the mesh) is the same for every kernel: the step parameters at a dynamic offset, the
 //! ring CSR, the original positions and the weights. Group 1 holds the positions a kernel reads
 //! around each vertex and the ones it writes; its shape depends on the kernel.
+//!
+//! The surface kernels (drift, normals, measures) have their own group 0: the per-mesh constants
+//! (uniform), then the mesh arrays they read, then what they write. Their group 1 is the one
+//! position buffer they look at.
 
 use std::num::NonZeroU64;
 
-use super::layout::StepParams;
-use super::shaders::{Kernel, HC, SINC, UMBRELLA};
+use super::layout::{StepParams, SurfaceParams};
+use super::shaders::{Kernel, DRIFT, HC, MEASURE, NORMALS, SINC, UMBRELLA};
 
 pub(crate) struct Layouts {
     /// Group 0: step parameters (uniform, dynamic offset), offsets, neighbours, original, weights.
@@ -18,6 +22,7 @@ pub(crate) struct Layouts {
     pub sinc_first: wgpu::BindGroupLayout,
     /// Group 1 of `sinc_term` and `sinc_finish`: gathered (T_k), previous, estimate.
     pub sinc_term: wgpu::BindGroupLayout,
+    pub surface: SurfaceLayouts,
 }
 
 pub(crate) struct Pipelines {
@@ -27,6 +32,24 @@ pub(crate) struct Pipelines {
     pub sinc_first: wgpu::ComputePipeline,
     pub sinc_term: wgpu::ComputePipeline,
     pub sinc_finish: wgpu::ComputePipeline,
+    pub reference_reset: wgpu::ComputePipeline,
+    pub reference_drift: wgpu::ComputePipeline,
+    pub vertex_normals: wgpu::ComputePipeline,
+    pub measure_vertices: wgpu::ComputePipeline,
+}
+
+/// Layouts of the surface kernels.
+pub(crate) struct SurfaceLayouts {
+    /// Group 0 of the drift: constants, original, full ring offsets and entries, stay radii
+    /// (read); the reference (written).
+    pub drift: wgpu::BindGroupLayout,
+    /// Group 0 of the normals: constants, fan offsets and corners (read); normals (written).
+    pub normals: wgpu::BindGroupLayout,
+    /// Group 0 of the measures: constants, original, fan offsets and corners, boundary flags,
+    /// reference (read); per-vertex measures and workgroup partials (written).
+    pub measure: wgpu::BindGroupLayout,
+    /// Group 1 of every surface kernel: the positions looked at (read).
+    pub looked_at: wgpu::BindGroupLayout,
 }
 
 fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -51,6 +74,45 @@ fn positions_layout(device: &wgpu::Device, label: &str, written: u32) -> wgpu::B
         label: Some(label),
         entries: &entries,
     })
+}
+
+/// A surface group-0 layout: the constants (uniform) at 0, then `read` read-only and `written`
+/// read-write storage buffers.
+fn surface_layout(
+    device: &wgpu::Device,
+    label: &str,
+    read: u32,
+    written: u32,
+) -> wgpu::BindGroupLayout {
+    let constants = wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: NonZeroU64::new(std::mem::size_of::<SurfaceParams>() as u64),
+        },
+        count: None,
+    };
+    let entries: Vec<_> = std::iter::once(constants)
+        .chain((1..=read).map(|b| storage(b, true)))
+        .chain((read + 1..=read + written).map(|b| storage(b, false)))
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+impl SurfaceLayouts {
+    fn new(device: &wgpu::Device) -> Self {
+        Self {
+            drift: surface_layout(device, "meshsmooth drift", 4, 1),
+            normals: surface_layout(device, "meshsmooth normals", 2, 1),
+            measure: surface_layout(device, "meshsmooth measures", 5, 2),
+            looked_at: positions_layout(device, "meshsmooth looked-at positions", 0),
+        }
+    }
 }
 
 impl Layouts {
@@ -80,25 +142,34 @@ impl Layouts {
             pair: positions_layout(device, "meshsmooth gathered/written", 1),
             sinc_first: positions_layout(device, "meshsmooth sinc first term", 3),
             sinc_term: positions_layout(device, "meshsmooth sinc term", 2),
+            surface: SurfaceLayouts::new(device),
         }
     }
 }
 
 impl Pipelines {
     pub(crate) fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
-        let layout = |group1: &wgpu::BindGroupLayout| {
+        let two_groups = |group0: &wgpu::BindGroupLayout, group1: &wgpu::BindGroupLayout| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
-                bind_group_layouts: &[Some(&layouts.mesh), Some(group1)],
+                bind_group_layouts: &[Some(group0), Some(group1)],
                 immediate_size: 0,
             })
         };
+        let layout = |group1: &wgpu::BindGroupLayout| two_groups(&layouts.mesh, group1);
         let pair = layout(&layouts.pair);
         let sinc_first = layout(&layouts.sinc_first);
         let sinc_term = layout(&layouts.sinc_term);
+        let surface = &layouts.surface;
+        let drift_layout = two_groups(&surface.drift, &surface.looked_at);
+        let normals_layout = two_groups(&surface.normals, &surface.looked_at);
+        let measure_layout = two_groups(&surface.measure, &surface.looked_at);
         let umbrella = UMBRELLA.create_module(device);
         let hc = HC.create_module(device);
         let sinc = SINC.create_module(device);
+        let drift = DRIFT.create_module(device);
+        let normals = NORMALS.create_module(device);
+        let measure = MEASURE.create_module(device);
         let pipeline = |layout: &wgpu::PipelineLayout,
                         module: &wgpu::ShaderModule,
                         kernel: Kernel,
@@ -120,6 +191,10 @@ impl Pipelines {
             sinc_first: pipeline(&sinc_first, &sinc, SINC, "sinc_first"),
             sinc_term: pipeline(&sinc_term, &sinc, SINC, "sinc_term"),
             sinc_finish: pipeline(&sinc_term, &sinc, SINC, "sinc_finish"),
+            reference_reset: pipeline(&drift_layout, &drift, DRIFT, "reference_reset"),
+            reference_drift: pipeline(&drift_layout, &drift, DRIFT, "reference_drift"),
+            vertex_normals: pipeline(&normals_layout, &normals, NORMALS, "vertex_normals"),
+            measure_vertices: pipeline(&measure_layout, &measure, MEASURE, "measure_vertices"),
         }
     }
 }

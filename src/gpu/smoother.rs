@@ -1,16 +1,21 @@
 //! The GPU smoothing engine: pipelines created once per device, runs recorded as one submission
-//! (every iteration's dispatches in one compute pass, no readback in between).
+//! (every iteration's dispatches in one compute pass, no readback in between, the reference
+//! vertices drifting along), and the surface passes on a run's result (normals, measures).
 
 use super::layout::{dispatch_size, StepParams, HAS_BOUND, HAS_WEIGHTS, MAX_STEP_SLOTS};
+use super::measures::MeasureReadback;
 use super::mesh_buffers::{GpuMesh, Slot};
 use super::pipelines::{Layouts, Pipelines};
 use super::GpuError;
 use crate::mesh::{Mesh, Topology};
+use crate::metrics::Original;
 use crate::smooth::{sinc_coefficients, Filter, Params};
 
 /// Smooths meshes on a device handed in by the caller (the app's, the CLI's, a test's), so
 /// every caller shares one engine. Matches [`crate::smooth::smooth`] (the CPU reference) up to
-/// float rounding.
+/// float rounding; on a mesh uploaded with its measures, also the CPU's drifting reference,
+/// vertex normals and measure pass. Needs WebGPU's default limits (8 storage buffers per
+/// shader stage), which eframe requests on WebGPU.
 pub struct GpuSmoother {
     layouts: Layouts,
     pipelines: Pipelines,
@@ -36,10 +41,28 @@ impl GpuSmoother {
         GpuMesh::upload(device, &self.layouts, mesh, topology)
     }
 
+    /// [`Self::upload`] of `original`'s mesh and topology, plus what the drifting reference, the
+    /// normals and the measures need: the full 1-ring and the triangle fans of the original,
+    /// boundary flags, reference vertices, normal and measure buffers (about 100 bytes per
+    /// vertex more). Refuses, before uploading anything, a mesh over the device's limits. Runs
+    /// on such a mesh drift the reference (see [`GpuMesh::set_track_reference`]).
+    pub fn upload_with_measures(
+        &self,
+        device: &wgpu::Device,
+        original: &Original,
+    ) -> Result<GpuMesh, GpuError> {
+        GpuMesh::upload_with_measures(device, &self.layouts, original)
+    }
+
     /// Smooths `mesh` from its original positions with `params`, honouring the weights set with
     /// [`GpuMesh::set_weights`] and `params.max_displacement`, exactly as the CPU engine
     /// defines them. Submits the whole run and returns without waiting; the result is then
     /// [`GpuMesh::positions_buffer`] (read it back with [`super::read_positions`]).
+    ///
+    /// On a mesh with measures the reference vertices start as the identity and, while
+    /// [`GpuMesh::tracks_reference`], drift after every step exactly when
+    /// [`crate::metrics::DriftingReference`] would as the CPU run's observer: Laplace and HC once
+    /// per iteration, Taubin twice, windowed sinc `iterations` times towards its result.
     pub fn smooth(
         &self,
         device: &wgpu::Device,
@@ -71,7 +94,7 @@ impl GpuSmoother {
         let n = mesh.vertex_count;
         let grid = dispatch_size(n, device.limits().max_compute_workgroups_per_dimension);
         let result = match grid {
-            Some((x, y)) if n > 0 => self.record(&mut encoder, mesh, params, (x, y)),
+            Some(grid) if n > 0 => self.record(&mut encoder, mesh, params, grid),
             // Nothing to smooth (grid == None cannot happen: upload checked the limits).
             _ => Slot::Original,
         };
@@ -85,26 +108,25 @@ impl GpuSmoother {
         encoder: &mut wgpu::CommandEncoder,
         mesh: &GpuMesh,
         params: &Params,
-        (x, y): (u32, u32),
+        grid: (u32, u32),
     ) -> Slot {
         let p = &self.pipelines;
         let g = &mesh.groups;
-        let stride = mesh.step_stride as u32;
         if params.filter != Filter::Sinc {
             // Laplace, Taubin and HC iterate on `a`, starting from the original.
             encoder.copy_buffer_to_buffer(&mesh.original, 0, &mesh.a, 0, mesh.original.size());
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        let pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("meshsmooth smoothing"),
             timestamp_writes: None,
         });
-        let mut dispatch =
-            |pipeline: &wgpu::ComputePipeline, slot: u32, group: &wgpu::BindGroup| {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &mesh.mesh_group, &[slot * stride]);
-                pass.set_bind_group(1, group, &[]);
-                pass.dispatch_workgroups(x, y, 1);
-            };
+        let mut run = Recorder {
+            pass,
+            mesh,
+            pipelines: p,
+            grid,
+        };
+        run.reset_reference();
         let iterations = params.iterations;
         match params.filter {
             Filter::Laplace | Filter::Taubin => {
@@ -117,8 +139,9 @@ impl GpuSmoother {
                 for _ in 0..iterations {
                     for slot in 0..factors {
                         let group = if in_a { &g.a_to_b } else { &g.b_to_a };
-                        dispatch(&p.umbrella_step, slot, group);
+                        run.step(&p.umbrella_step, slot, group);
                         in_a = !in_a;
+                        run.drift(if in_a { Slot::A } else { Slot::B });
                     }
                 }
                 if in_a {
@@ -129,14 +152,15 @@ impl GpuSmoother {
             }
             Filter::Hc => {
                 for _ in 0..iterations {
-                    dispatch(&p.hc_differences, 0, &g.a_to_aux);
-                    dispatch(&p.hc_correct, 0, &g.aux_to_a);
+                    run.step(&p.hc_differences, 0, &g.a_to_aux);
+                    run.step(&p.hc_correct, 0, &g.aux_to_a);
+                    run.drift(Slot::A);
                 }
                 Slot::A
             }
             Filter::Sinc => {
                 // T_0 in `b`, T_1 in `a`; each term overwrites T_{k-1} with T_{k+1}.
-                dispatch(&p.sinc_first, 0, &g.sinc_first);
+                run.step(&p.sinc_first, 0, &g.sinc_first);
                 let mut current_in_a = true;
                 for slot in 1..iterations {
                     let group = if current_in_a {
@@ -144,15 +168,145 @@ impl GpuSmoother {
                     } else {
                         &g.sinc_from_b
                     };
-                    dispatch(&p.sinc_term, slot, group);
+                    run.step(&p.sinc_term, slot, group);
                     current_in_a = !current_in_a;
                 }
                 if mesh.has_weights || bound(params).is_some() {
-                    dispatch(&p.sinc_finish, 0, &g.sinc_from_a);
+                    run.step(&p.sinc_finish, 0, &g.sinc_from_a);
+                }
+                // As the CPU's observers see it: the result once per degree.
+                for _ in 0..iterations {
+                    run.drift(Slot::Aux);
                 }
                 Slot::Aux
             }
         }
+    }
+}
+
+/// Records the dispatches of one run into one compute pass.
+struct Recorder<'p, 'm> {
+    pass: wgpu::ComputePass<'p>,
+    mesh: &'m GpuMesh,
+    pipelines: &'m Pipelines,
+    grid: (u32, u32),
+}
+
+impl Recorder<'_, '_> {
+    fn dispatch(&mut self) {
+        self.pass.dispatch_workgroups(self.grid.0, self.grid.1, 1);
+    }
+
+    /// One smoothing kernel with the step record in `slot` and the position group `group`.
+    fn step(&mut self, pipeline: &wgpu::ComputePipeline, slot: u32, group: &wgpu::BindGroup) {
+        let stride = self.mesh.step_stride as u32;
+        self.pass.set_pipeline(pipeline);
+        self.pass
+            .set_bind_group(0, &self.mesh.mesh_group, &[slot * stride]);
+        self.pass.set_bind_group(1, group, &[]);
+        self.dispatch();
+    }
+
+    /// Every vertex its own reference, when the mesh has one.
+    fn reset_reference(&mut self) {
+        if let Some(surface) = &self.mesh.surface {
+            self.pass.set_pipeline(&self.pipelines.reference_reset);
+            self.pass.set_bind_group(0, &surface.drift_group, &[]);
+            self.pass
+                .set_bind_group(1, surface.looked_at(Slot::Original), &[]);
+            self.dispatch();
+        }
+    }
+
+    /// One drift step towards the positions in `towards`, when the mesh tracks its reference.
+    fn drift(&mut self, towards: Slot) {
+        let Some(surface) = self.mesh.surface.as_ref().filter(|s| s.track_reference) else {
+            return;
+        };
+        self.pass.set_pipeline(&self.pipelines.reference_drift);
+        self.pass.set_bind_group(0, &surface.drift_group, &[]);
+        self.pass.set_bind_group(1, surface.looked_at(towards), &[]);
+        self.dispatch();
+    }
+}
+
+impl GpuSmoother {
+    /// Computes the unit vertex normals of `mesh`'s latest result (or of the original before
+    /// any run) into [`GpuMesh::normals_buffer`], as [`crate::mesh::vertex_normals`] defines
+    /// them. Submits and returns without waiting. Needs a mesh with measures.
+    pub fn compute_normals(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &GpuMesh,
+    ) -> Result<wgpu::SubmissionIndex, GpuError> {
+        let surface = mesh.surface()?;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("meshsmooth normals"),
+        });
+        self.surface_pass(
+            device,
+            &mut encoder,
+            mesh,
+            &self.pipelines.vertex_normals,
+            &surface.normals_group,
+        );
+        Ok(queue.submit([encoder.finish()]))
+    }
+
+    /// The measure pass on `mesh`'s latest result against its original, with the reference
+    /// vertices of the run: per-vertex local error and `K_G` into
+    /// [`GpuMesh::vertex_measures_buffer`], the volume, and per-workgroup sums that come back
+    /// in the returned readback (with the per-vertex arrays too when `with_vertices`).
+    /// Submits and returns without waiting; poll [`MeasureReadback::try_take`]. Equals
+    /// [`crate::metrics::measure_vertices`] of the same positions and references up to f32
+    /// rounding. Needs a mesh with measures.
+    pub fn measure(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &GpuMesh,
+        with_vertices: bool,
+    ) -> Result<MeasureReadback, GpuError> {
+        let surface = mesh.surface()?;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("meshsmooth measures"),
+        });
+        self.surface_pass(
+            device,
+            &mut encoder,
+            mesh,
+            &self.pipelines.measure_vertices,
+            &surface.measure_group,
+        );
+        MeasureReadback::start(device, queue, encoder, mesh, with_vertices)
+    }
+
+    /// One surface kernel over every vertex, looking at the latest result.
+    fn surface_pass(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        pipeline: &wgpu::ComputePipeline,
+        group: &wgpu::BindGroup,
+    ) {
+        let n = mesh.vertex_count;
+        let max = device.limits().max_compute_workgroups_per_dimension;
+        let (Some((x, y)), Some(surface)) = (dispatch_size(n, max), &mesh.surface) else {
+            return;
+        };
+        if n == 0 {
+            return;
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("meshsmooth surface"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.set_bind_group(1, surface.looked_at(mesh.result), &[]);
+        pass.dispatch_workgroups(x, y, 1);
     }
 }
 

@@ -21,3 +21,6 @@ pub use report::{
     exact_distances, exact_error, measure, measure_vertices, ErrorSummary, Metrics, VertexMeasures,
 };
 pub use score::ScoreTerms;
+
+// What the GPU engine's measure pass shares with the CPU's.
+pub(crate) use report::{metrics as metrics_from_sums, Sums};

@@ -81,6 +81,12 @@ impl Original {
         &self.fan_corners[o[i] as usize..o[i + 1] as usize]
     }
 
+    /// [`Self::fan_corners`] of every vertex, in vertex order (parallel to the topology's
+    /// `vertex_triangles`): what the GPU engine uploads.
+    pub(crate) fn all_fan_corners(&self) -> &[[u32; 2]] {
+        &self.fan_corners
+    }
+
     pub(crate) fn stay_radius2(&self) -> &[f32] {
         &self.stay_radius2
     }

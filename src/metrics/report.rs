@@ -159,7 +159,9 @@ pub fn exact_distances(bvh: &TriangleBvh, original: &Original, positions: &[[f32
         .collect()
 }
 
-fn metrics(original: &Original, sums: &Sums, tau: f64) -> Metrics {
+/// The report of a measure pass's totals (the GPU engine builds its totals from per-workgroup
+/// partial sums and reports through here, so both engines derive the numbers alike).
+pub(crate) fn metrics(original: &Original, sums: &Sums, tau: f64) -> Metrics {
     let volume0 = original.volume();
     let volume = volume0.map(|_| sums.volume());
     let volume_change = match (volume, volume0) {
@@ -204,6 +206,22 @@ pub(crate) struct Sums {
 }
 
 impl Sums {
+    /// Totals summed elsewhere (the GPU engine's measure pass).
+    pub(crate) fn from_totals(
+        volume6: f64,
+        (curvature_sum, curvature_count): (f64, usize),
+        (error_sum, error_max, error_count): (f64, f64, usize),
+    ) -> Self {
+        Self {
+            volume6,
+            curvature_sum,
+            curvature_count,
+            error_sum,
+            error_max,
+            error_count,
+        }
+    }
+
     fn add(&mut self, o: &Sums) {
         self.volume6 += o.volume6;
         self.curvature_sum += o.curvature_sum;

@@ -1,0 +1,189 @@
+//! What the surface kernels (drifting reference, vertex normals, measures) add to an uploaded
+//! mesh: the original mesh's full 1-ring and triangle fans, its boundary flags and the drift's
+//! stay radii (as [`crate::metrics::Original`] holds them), the reference vertices, the normals,
+//! the per-vertex measures and the per-workgroup sums, with their bind groups. Created once, by
+//! [`super::GpuSmoother::upload_with_measures`].
+
+use wgpu::util::DeviceExt;
+
+use super::layout::{dispatch_size, MeasurePartial, SurfaceParams};
+use super::limits::{check_surface_fits, POSITION_BYTES, VERTEX_MEASURE_BYTES};
+use super::mesh_buffers::{bind_group, storage_init, Slot};
+use super::pipelines::SurfaceLayouts;
+use super::GpuError;
+use crate::metrics::Original;
+
+/// The surface buffers of one mesh.
+pub(crate) struct SurfaceBuffers {
+    /// Each vertex's reference vertex on the original mesh (u32), the identity at upload.
+    pub reference: wgpu::Buffer,
+    /// Unit vertex normals of the latest [`super::GpuSmoother::compute_normals`] (`vec4<f32>`).
+    pub normals: wgpu::Buffer,
+    /// Per vertex (local error, K_G) of the latest measure pass (`vec2<f32>`).
+    pub vertex_measures: wgpu::Buffer,
+    /// One [`MeasurePartial`] per workgroup of the latest measure pass.
+    pub partials: wgpu::Buffer,
+    pub partial_count: u32,
+    pub drift_group: wgpu::BindGroup,
+    pub normals_group: wgpu::BindGroup,
+    pub measure_group: wgpu::BindGroup,
+    /// Group 1 of the surface kernels for each slot: original, a, b, aux.
+    looked_at: [wgpu::BindGroup; 4],
+    /// Whether smoothing runs drift the reference (else it stays the identity).
+    pub track_reference: bool,
+}
+
+/// A storage buffer the kernels write and the host may copy out of (and a renderer may bind).
+fn written(device: &wgpu::Device, label: &str, bytes: u64, vertex: bool) -> wgpu::Buffer {
+    let extra = if vertex {
+        wgpu::BufferUsages::VERTEX
+    } else {
+        wgpu::BufferUsages::empty()
+    };
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST
+            | extra,
+        mapped_at_creation: false,
+    })
+}
+
+/// The position buffers of a mesh, in [`Slot`] order.
+pub(crate) struct SlotBuffers<'a> {
+    pub original: &'a wgpu::Buffer,
+    pub a: &'a wgpu::Buffer,
+    pub b: &'a wgpu::Buffer,
+    pub aux: &'a wgpu::Buffer,
+}
+
+impl SurfaceBuffers {
+    /// Uploads `original`'s surface data for a mesh whose position buffers are `slots`, with
+    /// `centre` as the volume's centre. Refuses, before uploading anything, what exceeds the
+    /// device's limits.
+    pub(crate) fn upload(
+        device: &wgpu::Device,
+        layouts: &SurfaceLayouts,
+        original: &Original,
+        slots: SlotBuffers<'_>,
+        centre: [f32; 3],
+    ) -> Result<Self, GpuError> {
+        let mesh = original.mesh();
+        let topology = original.topology();
+        let n = mesh.vertex_count();
+        let limits = device.limits();
+        let (x, y) = dispatch_size(n as u32, limits.max_compute_workgroups_per_dimension)
+            .ok_or_else(|| GpuError::Device("no workgroup grid covers the mesh".into()))?;
+        let partial_count = x * y;
+        let fans = original.all_fan_corners();
+        check_surface_fits(
+            &limits,
+            n,
+            topology.neighbors.len(),
+            fans.len(),
+            partial_count as usize,
+        )?;
+
+        let params = SurfaceParams {
+            vertex_count: n as u32,
+            centre: [centre[0], centre[1], centre[2], 0.0],
+            ..SurfaceParams::default()
+        };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("meshsmooth surface constants"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let cast = bytemuck::cast_slice::<u32, u8>;
+        let ring_offsets = storage_init(
+            device,
+            "meshsmooth 1-ring offsets",
+            cast(&topology.neighbor_offsets),
+        );
+        let ring = storage_init(device, "meshsmooth 1-ring", cast(&topology.neighbors));
+        let fan_offsets = storage_init(
+            device,
+            "meshsmooth fan offsets",
+            cast(&topology.triangle_offsets),
+        );
+        let fan_corners =
+            storage_init(device, "meshsmooth fan corners", bytemuck::cast_slice(fans));
+        let boundary: Vec<u32> = topology.is_boundary.iter().map(|&b| b as u32).collect();
+        let boundary = storage_init(device, "meshsmooth boundary flags", cast(&boundary));
+        let stay = storage_init(
+            device,
+            "meshsmooth stay radii",
+            bytemuck::cast_slice(original.stay_radius2()),
+        );
+        let n64 = n as u64;
+        // The identity until a run drifts it.
+        let reference = storage_init(
+            device,
+            "meshsmooth reference vertices",
+            cast(&crate::metrics::identity(n)),
+        );
+        let normals = written(device, "meshsmooth normals", n64 * POSITION_BYTES, true);
+        let vertex_measures = written(
+            device,
+            "meshsmooth vertex measures",
+            n64 * VERTEX_MEASURE_BYTES,
+            false,
+        );
+        let partials = written(
+            device,
+            "meshsmooth measure partials",
+            u64::from(partial_count) * std::mem::size_of::<MeasurePartial>() as u64,
+            false,
+        );
+
+        let group = |layout, buffers: &[&wgpu::Buffer]| {
+            let mut all = vec![&params];
+            all.extend_from_slice(buffers);
+            bind_group(device, layout, &all)
+        };
+        let drift_group = group(
+            &layouts.drift,
+            &[slots.original, &ring_offsets, &ring, &stay, &reference],
+        );
+        let normals_group = group(&layouts.normals, &[&fan_offsets, &fan_corners, &normals]);
+        let measure_group = group(
+            &layouts.measure,
+            &[
+                slots.original,
+                &fan_offsets,
+                &fan_corners,
+                &boundary,
+                &reference,
+                &vertex_measures,
+                &partials,
+            ],
+        );
+        let looked_at = [slots.original, slots.a, slots.b, slots.aux]
+            .map(|b| bind_group(device, &layouts.looked_at, &[b]));
+        Ok(Self {
+            reference,
+            normals,
+            vertex_measures,
+            partials,
+            partial_count,
+            drift_group,
+            normals_group,
+            measure_group,
+            looked_at,
+            track_reference: true,
+        })
+    }
+
+    /// Group 1 of a surface kernel looking at the positions in `slot`.
+    pub(crate) fn looked_at(&self, slot: Slot) -> &wgpu::BindGroup {
+        let k = match slot {
+            Slot::Original => 0,
+            Slot::A => 1,
+            Slot::B => 2,
+            Slot::Aux => 3,
+        };
+        &self.looked_at[k]
+    }
+}
