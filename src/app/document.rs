@@ -31,6 +31,9 @@ impl Backend {
     }
 }
 
+/// CPU work per frame (ms) before the frame is drawn; leaves room for drawing at 30+ fps.
+pub const FRAME_BUDGET_MS: f64 = 20.0;
+
 pub struct Document {
     pub session: Session,
     pub backend: Backend,
@@ -99,9 +102,10 @@ impl Document {
         }
     }
 
-    /// The CPU engine's step for this frame: smooth and measure the current parameters.
+    /// The CPU engine's share of this frame: works on the current parameters' result for
+    /// about [`FRAME_BUDGET_MS`], so a long run is spread over frames and the page stays live.
     pub fn compute_on_cpu(&mut self) {
-        if let Some(t) = self.session.smooth_cpu(&now_ms) {
+        if let Some(t) = self.session.step_cpu(&now_ms, FRAME_BUDGET_MS) {
             self.timings = Some(t);
         }
     }
@@ -158,7 +162,9 @@ mod tests {
         }));
         doc.answer_waiting();
         assert_eq!(answered.get(), 0, "nothing computed yet");
-        doc.compute_on_cpu();
+        while doc.busy() {
+            doc.compute_on_cpu();
+        }
         doc.answer_waiting();
         assert_eq!(answered.get(), 1);
         assert!(doc.timings.is_some());

@@ -187,7 +187,13 @@ impl Shell {
                     t.smooth_ms, t.measure_ms
                 ));
             }
-            if doc.busy() || self.files.reading() > 0 {
+            if let Some((done, total)) = doc.session.progress() {
+                ui.add(
+                    egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                        .desired_width(160.0)
+                        .text(format!("smoothing {done}/{total}")),
+                );
+            } else if doc.busy() || self.files.reading() > 0 {
                 ui.spinner();
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
@@ -241,6 +247,9 @@ impl eframe::App for Shell {
             let mut doc = self.doc.borrow_mut();
             doc.compute_on_cpu();
             doc.answer_waiting();
+            if doc.busy() {
+                ctx.request_repaint();
+            }
         }
 
         egui::Panel::top("top_bar").show(ui, |ui| self.top_bar(ui));

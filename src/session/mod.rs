@@ -80,7 +80,6 @@ pub struct Smoothed {
     pub revision: u64,
     pub params: Params,
     pub positions: Vec<[f32; 3]>,
-    pub normals: Vec<[f32; 3]>,
     pub metrics: Metrics,
     pub vertex: VertexMeasures,
 }
@@ -90,7 +89,7 @@ pub struct Smoothed {
 pub struct Timings {
     /// Smoothing, with the drifting reference's updates.
     pub smooth_ms: f64,
-    /// The measure pass, per-vertex measures and normals.
+    /// The measure pass with the per-vertex measures.
     pub measure_ms: f64,
 }
 
@@ -386,6 +385,36 @@ impl Session {
         true
     }
 
+    /// Accepts a result measured elsewhere (the GPU engine's smoothing and measure pass) for
+    /// `revision`. Returns false, and keeps nothing, when the session moved on since or the
+    /// arrays do not fit the model.
+    pub fn accept_measured(
+        &mut self,
+        revision: u64,
+        positions: Vec<[f32; 3]>,
+        metrics: Metrics,
+        vertex: VertexMeasures,
+    ) -> bool {
+        let Some(model) = &self.model else {
+            return false;
+        };
+        let n = model.mesh().vertex_count();
+        let fits = positions.len() == n
+            && vertex.local_error.len() == n
+            && vertex.gaussian_curvature.len() == n;
+        if revision != self.revision || !fits {
+            return false;
+        }
+        self.result = Some(Smoothed {
+            revision,
+            params: *self.params(),
+            positions,
+            metrics,
+            vertex,
+        });
+        true
+    }
+
     /// The mesh report of the open model as the CLI's `info --json` prints it.
     pub fn info_json(&self) -> Option<serde_json::Value> {
         self.model
@@ -421,18 +450,14 @@ impl Session {
     ) -> Result<Vec<u8>, String> {
         let model = self.model.as_ref().ok_or("no mesh is open")?;
         let triangles = model.mesh().triangles.clone();
-        let (mesh, normals, extras) = match self.last_result() {
+        let (mesh, extras) = match self.last_result() {
             Some(r) => (
                 Mesh::new(r.positions.clone(), triangles),
-                r.normals.clone(),
                 Some(export::smoothing_extras(&r.params, &r.metrics)),
             ),
-            None => {
-                let mesh = model.mesh().clone();
-                let normals = vertex_normals(&mesh.positions, &mesh.triangles);
-                (mesh, normals, None)
-            }
+            None => (model.mesh().clone(), None),
         };
+        let normals = vertex_normals(&mesh.positions, &mesh.triangles);
         let options = ExportOptions {
             normals: Some(&normals),
             colors,
@@ -467,12 +492,10 @@ fn measured(
     reference: &[u32],
 ) -> Smoothed {
     let (metrics, vertex) = metrics::measure_vertices(&model.original, &positions, reference, tau);
-    let normals = vertex_normals(&positions, &model.mesh().triangles);
     Smoothed {
         revision,
         params,
         positions,
-        normals,
         metrics,
         vertex,
     }

@@ -229,3 +229,28 @@ fn a_change_mid_run_starts_over() {
     assert!(s.step_cpu(&clock, -1.0).is_none());
     assert_eq!(s.progress(), Some((1, 4)));
 }
+
+#[test]
+fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
+    let mut s = sample_session();
+    s.smooth_cpu(&|| 0.0);
+    let r = s.result().unwrap().clone();
+    let old = s.revision();
+    s.set_params_json(&serde_json::json!({"iterations": 2}))
+        .unwrap();
+    assert!(!s.accept_measured(old, r.positions.clone(), r.metrics, r.vertex.clone()));
+    let mut short = r.vertex.clone();
+    short.local_error.pop();
+    assert!(!s.accept_measured(s.revision(), r.positions.clone(), r.metrics, short));
+    assert!(s.accept_measured(
+        s.revision(),
+        r.positions.clone(),
+        r.metrics,
+        r.vertex.clone()
+    ));
+    assert_eq!(s.result().unwrap().params.iterations, 2);
+    assert_eq!(
+        s.metrics_json().unwrap(),
+        serde_json::to_value(r.metrics).unwrap()
+    );
+}
