@@ -238,10 +238,15 @@ fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
     let old = s.revision();
     s.set_params_json(&serde_json::json!({"iterations": 2}))
         .unwrap();
-    assert!(!s.accept_measured(old, r.positions.clone(), r.metrics, r.vertex.clone()));
+    assert!(!s.accept_measured(
+        old,
+        r.positions.clone(),
+        r.metrics.clone(),
+        r.vertex.clone()
+    ));
     let mut short = r.vertex.clone();
     short.local_error.pop();
-    assert!(!s.accept_measured(s.revision(), r.positions.clone(), r.metrics, short));
+    assert!(!s.accept_measured(s.revision(), r.positions.clone(), r.metrics.clone(), short));
     assert!(s.accept_measured(
         s.revision(),
         r.positions.clone(),
