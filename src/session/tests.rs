@@ -250,12 +250,12 @@ fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
     assert!(s.accept_measured(
         s.revision(),
         r.positions.clone(),
-        r.metrics,
+        r.metrics.clone(),
         r.vertex.clone()
     ));
     assert_eq!(s.result().unwrap().params.iterations, 2);
     assert_eq!(
         s.metrics_json().unwrap(),
-        serde_json::to_value(r.metrics).unwrap()
+        serde_json::to_value(&r.metrics).unwrap()
     );
 }
