@@ -4,7 +4,8 @@
 //! Every edit goes to the session as a whole parameter set; the session refuses invalid sets
 //! (e.g. Taubin's mu >= -lambda) and the message shows under the controls until fixed.
 
-use crate::session::{ColorField, Session, Timings};
+use super::document::EngineTimings;
+use crate::session::{ColorField, Session};
 use crate::smooth::{Filter, Params};
 use eframe::egui;
 
@@ -153,7 +154,7 @@ fn percent(v: f64) -> String {
 }
 
 /// The measures of the latest result, as a table.
-pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<Timings>) {
+pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<EngineTimings>) {
     let Some(result) = session.last_result() else {
         ui.label("Not smoothed yet.");
         return;
@@ -208,10 +209,7 @@ pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<Timings>) 
     if session.result().is_none() {
         ui.small("Updating…");
     } else if let Some(t) = timings {
-        ui.small(format!(
-            "smoothing {:.1} ms, measures {:.1} ms",
-            t.smooth_ms, t.measure_ms
-        ));
+        ui.small(t.describe());
     }
 }
 

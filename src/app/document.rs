@@ -34,11 +34,35 @@ impl Backend {
 /// CPU work per frame (ms) before the frame is drawn; leaves room for drawing at 30+ fps.
 pub const FRAME_BUDGET_MS: f64 = 20.0;
 
+/// How long the last result took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EngineTimings {
+    /// The CPU engine: smoothing and the measure pass, each on its own.
+    Cpu(Timings),
+    /// The GPU engine: from submitting the run (smoothing, drift, normals, measures) to
+    /// having its results back on the CPU.
+    Gpu { run_ms: f64 },
+}
+
+impl EngineTimings {
+    pub fn describe(&self) -> String {
+        match self {
+            EngineTimings::Cpu(t) => format!(
+                "{:.1} ms smoothing, {:.1} ms measures",
+                t.smooth_ms, t.measure_ms
+            ),
+            EngineTimings::Gpu { run_ms } => {
+                format!("{run_ms:.1} ms smoothing + measures on the GPU, with readback")
+            }
+        }
+    }
+}
+
 pub struct Document {
     pub session: Session,
     pub backend: Backend,
     /// Timings of the last result.
-    pub timings: Option<Timings>,
+    pub timings: Option<EngineTimings>,
     /// Bumped when a new model is opened, so views re-upload it.
     pub model_generation: u64,
     waiting: Vec<Waiter>,
@@ -106,7 +130,7 @@ impl Document {
     /// about [`FRAME_BUDGET_MS`], so a long run is spread over frames and the page stays live.
     pub fn compute_on_cpu(&mut self) {
         if let Some(t) = self.session.step_cpu(&now_ms, FRAME_BUDGET_MS) {
-            self.timings = Some(t);
+            self.timings = Some(EngineTimings::Cpu(t));
         }
     }
 

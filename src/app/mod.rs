@@ -14,6 +14,7 @@ mod controls;
 mod document;
 mod download;
 mod file_input;
+mod gpu_engine;
 mod legend;
 mod page;
 mod query;

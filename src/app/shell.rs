@@ -5,6 +5,7 @@
 use super::controls::{self, Controls};
 use super::document::{Backend, Document, SharedDocument};
 use super::file_input::FileInput;
+use super::gpu_engine::GpuEngine;
 use super::shortcuts::{self, Action};
 use super::{api, download, legend, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
@@ -24,12 +25,23 @@ pub struct Shell {
     help_open: bool,
     /// Why the last export failed.
     export_error: Option<String>,
+    /// The WebGPU engine, where the page has WebGPU.
+    gpu: Option<GpuEngine>,
+    /// Why the GPU engine was given up for the CPU engine.
+    gpu_fallback: Option<String>,
 }
 
 impl Shell {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Self {
-        // The GPU engine is not wired into the app yet: every backend smooths on the CPU.
-        let doc = Rc::new(RefCell::new(Document::new(Backend::Cpu)));
+        // WebGPU: the GPU engine on eframe's device. WebGL2 (no compute shaders): the CPU engine.
+        let gpu = cc.wgpu_render_state.as_ref().and_then(|rs| {
+            let info = rs.adapter.get_info();
+            log::info!("adapter: {} ({:?})", info.name, info.backend);
+            (info.backend == wgpu::Backend::BrowserWebGpu)
+                .then(|| GpuEngine::new(&rs.device, &rs.queue))
+        });
+        let backend = if gpu.is_some() { Backend::WebGpu } else { Backend::Cpu };
+        let doc = Rc::new(RefCell::new(Document::new(backend)));
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
         let files = FileInput::new(&cc.egui_ctx);
@@ -46,7 +58,26 @@ impl Shell {
             show_original: false,
             help_open: false,
             export_error: None,
+            gpu,
+            gpu_fallback: None,
         }
+    }
+
+    /// This frame's engine work: the GPU engine where there is one, else the CPU engine.
+    fn compute(&mut self) {
+        let mut doc = self.doc.borrow_mut();
+        if let Some(gpu) = &mut self.gpu {
+            match gpu.step(&mut doc) {
+                Ok(_) => return,
+                Err(why) => {
+                    log::error!("GPU engine failed, using the CPU engine: {why}");
+                    self.gpu = None;
+                    self.gpu_fallback = Some(why);
+                    doc.backend = Backend::Cpu;
+                }
+            }
+        }
+        doc.compute_on_cpu();
     }
 
     fn receive_files(&mut self, ctx: &egui::Context) {
@@ -182,10 +213,11 @@ impl Shell {
             }
             ui.label(format!("engine: {}", doc.backend.name()));
             if let Some(t) = doc.timings {
-                ui.label(format!(
-                    "{:.1} ms smoothing, {:.1} ms measures",
-                    t.smooth_ms, t.measure_ms
-                ));
+                ui.label(t.describe());
+            }
+            if let Some(why) = &self.gpu_fallback {
+                ui.colored_label(ui.visuals().warn_fg_color, "CPU fallback")
+                    .on_hover_text(why);
             }
             if let Some((done, total)) = doc.session.progress() {
                 ui.add(
@@ -243,9 +275,9 @@ impl eframe::App for Shell {
         for action in shortcuts::pressed(&ctx) {
             self.apply(action);
         }
+        self.compute();
         {
             let mut doc = self.doc.borrow_mut();
-            doc.compute_on_cpu();
             doc.answer_waiting();
             if doc.busy() {
                 ctx.request_repaint();

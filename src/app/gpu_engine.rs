@@ -1,0 +1,136 @@
+//! The WebGPU path: smoothing, the drifting reference, normals and the measure pass run as WGSL
+//! compute on eframe's own device, so the view draws from the engine's buffers. Only the
+//! measures and the positions (for colours, exports and the API) come back, asynchronously:
+//! a frame never waits for the GPU.
+
+use super::document::{now_ms, Document, EngineTimings};
+use crate::gpu::{GpuMesh, GpuSmoother, MeasureReadback, ResultReadback};
+
+/// A run submitted for one session revision, its results still on the way back.
+struct InFlight {
+    revision: u64,
+    started_ms: f64,
+    positions: ResultReadback,
+    measures: MeasureReadback,
+    result: Option<Vec<[f32; 3]>>,
+}
+
+pub struct GpuEngine {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    smoother: GpuSmoother,
+    /// The open model on the GPU, with the document's model generation it belongs to.
+    mesh: Option<(u64, GpuMesh)>,
+    in_flight: Option<InFlight>,
+}
+
+/// What a frame's step did for the view.
+pub enum Step {
+    /// Nothing new to draw.
+    Idle,
+    /// A new run was submitted: its positions and normals are in these buffers now.
+    Submitted,
+}
+
+impl GpuEngine {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        Self {
+            device: device.clone(),
+            queue: queue.clone(),
+            smoother: GpuSmoother::new(device),
+            mesh: None,
+            in_flight: None,
+        }
+    }
+
+    /// The buffers of the latest run: positions and normals, vec4 per vertex.
+    pub fn buffers(&self) -> Option<(&wgpu::Buffer, &wgpu::Buffer)> {
+        let (_, mesh) = self.mesh.as_ref()?;
+        Some((mesh.positions_buffer(), mesh.normals_buffer()?))
+    }
+
+    /// One frame's work: collects a finished run into the session, and submits a run for the
+    /// current parameters when the session needs one and none is in flight. An error (a mesh
+    /// over the device's limits, a lost device) comes back for the caller to fall back to the
+    /// CPU engine.
+    pub fn step(&mut self, doc: &mut Document) -> Result<Step, String> {
+        self.collect(doc)?;
+        if self.in_flight.is_some() || !doc.session.needs_smoothing() {
+            return Ok(Step::Idle);
+        }
+        let Some(model) = doc.session.model() else {
+            return Ok(Step::Idle);
+        };
+        let generation = doc.model_generation;
+        if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
+            self.mesh = None;
+            let uploaded = self
+                .smoother
+                .upload_with_measures(&self.device, &model.original)
+                .map_err(|e| e.to_string())?;
+            self.mesh = Some((generation, uploaded));
+        }
+        let Some((_, mesh)) = self.mesh.as_mut() else {
+            return Ok(Step::Idle);
+        };
+        let params = *doc.session.params();
+        let started_ms = now_ms();
+        let e = |e: crate::gpu::GpuError| e.to_string();
+        self.smoother
+            .smooth(&self.device, &self.queue, mesh, &params)
+            .map_err(e)?;
+        self.smoother
+            .compute_normals(&self.device, &self.queue, mesh)
+            .map_err(e)?;
+        let measures = self
+            .smoother
+            .measure(&self.device, &self.queue, mesh, true)
+            .map_err(e)?;
+        let positions = ResultReadback::start(&self.device, &self.queue, mesh).map_err(e)?;
+        self.in_flight = Some(InFlight {
+            revision: doc.session.revision(),
+            started_ms,
+            positions,
+            measures,
+            result: None,
+        });
+        Ok(Step::Submitted)
+    }
+
+    /// Takes a finished run's results into the session (a run for an older revision is
+    /// dropped: the next step submits the current one).
+    fn collect(&mut self, doc: &mut Document) -> Result<(), String> {
+        let Some(run) = self.in_flight.as_mut() else {
+            return Ok(());
+        };
+        if run.result.is_none() {
+            match run.positions.try_take() {
+                None => return Ok(()),
+                Some(r) => run.result = Some(r.map_err(|e| e.to_string())?.positions),
+            }
+        }
+        let Some(model) = doc.session.model() else {
+            self.in_flight = None;
+            return Ok(());
+        };
+        let measured = match run.measures.try_take(&model.original, doc.session.tau()) {
+            None => return Ok(()),
+            Some(m) => m.map_err(|e| e.to_string())?,
+        };
+        let Some(run) = self.in_flight.take() else {
+            return Ok(());
+        };
+        let (Some(positions), Some(vertex)) = (run.result, measured.vertex) else {
+            return Err("the GPU measure pass returned no per-vertex measures".into());
+        };
+        if doc
+            .session
+            .accept_measured(run.revision, positions, measured.metrics, vertex)
+        {
+            doc.timings = Some(EngineTimings::Gpu {
+                run_ms: now_ms() - run.started_ms,
+            });
+        }
+        Ok(())
+    }
+}
