@@ -6,13 +6,14 @@
 //!
 //! Modules: `state` (the loaded model and the last error), `file_input` (the file picker and
 //! dropped files, both delivering bytes asynchronously), `report_view` (the report as a table),
-//! `shell` (the `eframe::App` that lays these out).
+//! `shell` (the `eframe::App` that lays these out), `viewer` (the 3D view).
 
 mod file_input;
 mod page;
 mod report_view;
 mod shell;
 mod state;
+pub mod viewer;
 
 pub use state::{AppState, LoadedModel};
 
@@ -32,7 +33,11 @@ pub fn start() {
             Ok(canvas) => runner
                 .start(
                     canvas,
-                    eframe::WebOptions::default(),
+                    eframe::WebOptions {
+                        // The 3D view draws into egui's render pass and needs its depth buffer.
+                        depth_buffer: viewer::DEPTH_BUFFER_BITS,
+                        ..Default::default()
+                    },
                     Box::new(|cc| Ok(Box::new(shell::Shell::new(cc)))),
                 )
                 .await

@@ -235,9 +235,11 @@ mod tests {
 
     #[test]
     fn default_direction_is_from_the_front_and_above() {
-        let mut camera = OrbitCamera::default();
-        camera.yaw = 0.0;
-        camera.pitch = 0.0;
+        let mut camera = OrbitCamera {
+            yaw: 0.0,
+            pitch: 0.0,
+            ..Default::default()
+        };
         assert_close(camera.direction(), -Vec3::Y, 1e-6);
         let (right, up) = camera.screen_axes();
         assert_close(right, Vec3::X, 1e-6);
