@@ -17,13 +17,16 @@ pub const PITCH_LIMIT: f32 = std::f32::consts::FRAC_PI_2 - 0.01;
 /// proportions are not distorted, wide enough to feel 3D.
 pub const DEFAULT_FOV: f32 = 35.0 * std::f32::consts::PI / 180.0;
 
-/// The view [`OrbitCamera::fit`] starts from: a three-quarter view from front-left, a little
-/// above, so that both the shape and its surface relief read at first sight.
+/// The view [`OrbitCamera::reset_direction`] returns to: a three-quarter view from front-left,
+/// a little above, so that both the shape and its surface relief read at first sight.
 pub const DEFAULT_YAW: f32 = -0.5;
 pub const DEFAULT_PITCH: f32 = 0.35;
 
-/// A fitted mesh fills this fraction of the view (the bounding sphere touches the frustum at 1).
-const FIT_MARGIN: f32 = 1.05;
+/// A fitted box's widest corner reaches this fraction of the view's shorter half-side.
+const FIT_MARGIN: f32 = 1.08;
+
+/// Rounds of centring and moving in by which [`OrbitCamera::fit_points`] settles.
+const FIT_ROUNDS: usize = 4;
 
 /// Zoom limits in bounding-sphere radii from the target: close enough to inspect a detail from
 /// inside, far enough to see the mesh as a small object; never through the target.
@@ -54,7 +57,7 @@ pub struct OrbitCamera {
 }
 
 impl Default for OrbitCamera {
-    /// Framing the unit cube at the origin.
+    /// Framing the unit cube at the origin from the default direction.
     fn default() -> Self {
         let mut camera = Self {
             target: Vec3::ZERO,
@@ -71,24 +74,91 @@ impl Default for OrbitCamera {
 }
 
 impl OrbitCamera {
-    /// Frames the box `bbox_min..bbox_max` from the default direction: the target at its centre,
-    /// the distance at which its bounding sphere fits the field of view with a small margin.
-    /// A degenerate or non-finite box is framed as a unit sphere around its (finite) centre.
+    /// Frames the box `bbox_min..bbox_max` as seen from the current direction: the target at its
+    /// centre, the eye as close as it can be with every corner of the box in view (across the
+    /// shorter side, so in any aspect ratio). A degenerate or non-finite box is framed as a unit
+    /// sphere around its (finite) centre.
     pub fn fit(&mut self, bbox_min: Vec3, bbox_max: Vec3) {
         let mut center = (bbox_min + bbox_max) * 0.5;
         if !center.is_finite() {
             center = Vec3::ZERO;
         }
-        let mut radius = (bbox_max - bbox_min).length() * 0.5;
-        if !(radius.is_finite() && radius > 0.0) {
-            radius = 1.0;
+        let mut half = (bbox_max - bbox_min).abs() * 0.5;
+        if !(half.is_finite() && half.length() > 0.0) {
+            half = Vec3::splat(1.0 / 3f32.sqrt());
         }
         self.bounds_center = center;
-        self.bounds_radius = radius;
+        self.bounds_radius = half.length();
         self.target = center;
+
+        // Each corner in the camera's frame: (x, y) across the view, z away from the eye. It is
+        // in view when |x| and |y| are within tan(fov / 2) of its depth, distance + z.
+        let tan_half = (self.fov * 0.5).tan() / FIT_MARGIN;
+        let (right, up) = self.screen_axes();
+        let forward = -self.direction();
+        let mut distance = 0.0f32;
+        for i in 0..8 {
+            let sign = |bit: u32| if i & bit == 0 { -1.0 } else { 1.0 };
+            let corner = half * Vec3::new(sign(1), sign(2), sign(4));
+            let (x, y, z) = (corner.dot(right), corner.dot(up), corner.dot(forward));
+            distance = distance.max(x.abs().max(y.abs()) / tan_half - z);
+        }
+        let r = self.bounds_radius;
+        self.distance = distance.clamp(MIN_DISTANCE * r, MAX_DISTANCE * r);
+    }
+
+    /// Frames a point set (a mesh's vertices) as seen from the current direction, tighter than
+    /// its bounding box: the target moves to the middle of the points' extent across the view,
+    /// and the eye as close as it can be with every point in view. The depth range still
+    /// encloses the bounding box, from any direction. Non-finite points are ignored.
+    pub fn fit_points(&mut self, points: &[[f32; 3]]) {
+        let finite = || {
+            points
+                .iter()
+                .map(|&p| Vec3::from(p))
+                .filter(|p| p.is_finite())
+        };
+        let Some(first) = finite().next() else {
+            self.fit(Vec3::ZERO, Vec3::ZERO);
+            return;
+        };
+        let (lo, hi) = finite().fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        self.fit(lo, hi);
+
+        // Centre the points' perspective extent and move in until the outermost touches the
+        // margin; moving in changes the perspective, so a few rounds settle both.
+        let (right, up) = self.screen_axes();
+        let forward = -self.direction();
+        let tan_half = (self.fov * 0.5).tan() / FIT_MARGIN;
+        let r = self.bounds_radius;
+        for _ in 0..FIT_ROUNDS {
+            let (target, distance) = (self.target, self.distance);
+            // Each point's direction from the eye, as tangents across the view.
+            let seen = |p: Vec3| {
+                let q = p - target;
+                let depth = (distance + q.dot(forward)).max(1e-6 * r);
+                Vec2::new(q.dot(right), q.dot(up)) / depth
+            };
+            let (min, max) = finite().map(seen).fold(
+                (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+                |(min, max), t| (min.min(t), max.max(t)),
+            );
+            let middle = (min + max) * 0.5 * distance;
+            self.target += middle.x * right + middle.y * up;
+            let target = self.target;
+            let needed = finite().fold(0.0f32, |needed, p| {
+                let q = p - target;
+                let widest = q.dot(right).abs().max(q.dot(up).abs());
+                needed.max(widest / tan_half - q.dot(forward))
+            });
+            self.distance = needed.clamp(MIN_DISTANCE * r, MAX_DISTANCE * r);
+        }
+    }
+
+    /// Turns the eye back to the default direction (the target and distance stay).
+    pub fn reset_direction(&mut self) {
         self.yaw = DEFAULT_YAW;
         self.pitch = DEFAULT_PITCH;
-        self.distance = radius / (self.fov * 0.5).sin() * FIT_MARGIN;
     }
 
     /// Turns the eye around the target by a mouse drag of `(dx, dy)` points: dragging right
@@ -136,7 +206,7 @@ impl OrbitCamera {
     }
 
     /// The screen's right and up directions in world space.
-    fn screen_axes(&self) -> (Vec3, Vec3) {
+    pub fn screen_axes(&self) -> (Vec3, Vec3) {
         let forward = -self.direction();
         let right = forward.cross(Vec3::Z).normalize();
         (right, right.cross(forward))
@@ -205,30 +275,121 @@ mod tests {
         assert!((a - b).length() <= tol, "{a} vs {b}");
     }
 
+    fn assert_in_view(camera: &OrbitCamera, lo: Vec3, hi: Vec3, aspect: f32) -> f32 {
+        let m = camera.view_proj(aspect);
+        let mut widest = 0.0f32;
+        for p in corners(lo, hi) {
+            let clip = m * p.extend(1.0);
+            assert!(clip.w > 0.0, "corner {p} behind the eye");
+            let ndc = clip.truncate() / clip.w;
+            assert!(
+                ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
+                "{ndc} at {aspect}"
+            );
+            assert!((0.0..=1.0).contains(&ndc.z), "depth {} at {aspect}", ndc.z);
+            widest = widest.max(ndc.x.abs()).max(ndc.y.abs());
+        }
+        widest
+    }
+
     #[test]
     fn fit_puts_the_whole_box_inside_the_frustum_from_any_side() {
+        let boxes = [
+            staircase_box(),
+            (Vec3::ZERO, Vec3::new(100.0, 1.0, 1.0)),
+            (Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, 5.0, 0.0)),
+        ];
+        for (lo, hi) in boxes {
+            let mut camera = OrbitCamera::default();
+            for (dx, dy) in [(0.0, 0.0), (200.0, 0.0), (-150.0, 300.0), (90.0, -1000.0)] {
+                camera.orbit(dx, dy);
+                camera.fit(lo, hi);
+                assert_eq!(camera.target, (lo + hi) * 0.5);
+                for aspect in [0.4, 1.0, 16.0 / 9.0, 3.0] {
+                    assert_in_view(&camera, lo, hi, aspect);
+                }
+                // Framed tightly: in a square view the widest corner nearly touches the edge.
+                let widest = assert_in_view(&camera, lo, hi, 1.0);
+                assert!(widest > 0.85, "the box spans only {widest} of the view");
+            }
+        }
+    }
+
+    /// A voxelised-looking arc like the bundled sample: it fills little of its bounding box.
+    fn arc() -> Vec<[f32; 3]> {
+        (0..200)
+            .map(|i| {
+                let t = i as f32 / 199.0 * 1.5 * PI;
+                [
+                    30.0 + 15.0 * t.cos(),
+                    25.0 + 20.0 * t.sin(),
+                    20.0 + 0.1 * i as f32,
+                ]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn fitting_the_points_frames_tighter_than_the_box_and_keeps_them_in_view() {
+        let points = arc();
+        let mut by_box = OrbitCamera::default();
+        let (lo, hi) = crate::mesh::bounding_box(&points).expect("points");
+        by_box.fit(Vec3::from(lo), Vec3::from(hi));
+        let mut by_points = OrbitCamera::default();
+        by_points.fit_points(&points);
+        assert!(by_points.distance < by_box.distance);
+        for aspect in [0.5, 1.0, 2.0] {
+            let m = by_points.view_proj(aspect);
+            for &p in &points {
+                let ndc = m.project_point3(Vec3::from(p));
+                assert!(
+                    ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
+                    "{ndc} at {aspect}"
+                );
+                assert!((0.0..=1.0).contains(&ndc.z));
+            }
+        }
+        // Centred: the extremes on either side sit at about the same distance from the edge.
+        let m = by_points.view_proj(1.0);
+        let ndc: Vec<Vec3> = points
+            .iter()
+            .map(|&p| m.project_point3(Vec3::from(p)))
+            .collect();
+        let (left, right) = ndc
+            .iter()
+            .fold((1f32, -1f32), |(l, r), q| (l.min(q.x), r.max(q.x)));
+        let (bottom, top) = ndc
+            .iter()
+            .fold((1f32, -1f32), |(b, t), q| (b.min(q.y), t.max(q.y)));
+        assert!(
+            (left + right).abs() < 0.05 && (bottom + top).abs() < 0.05,
+            "x {left}..{right}, y {bottom}..{top}"
+        );
+        assert!(right.max(top) > 0.85, "spans only {right} x {top}");
+        // The depth range still holds the whole box after orbiting.
+        by_points.orbit(300.0, 100.0);
+        let m = by_points.view_proj(1.0);
+        for p in corners(Vec3::from(lo), Vec3::from(hi)) {
+            assert!((0.0..=1.0).contains(&m.project_point3(p).z));
+        }
+        // Nothing finite to frame: the unit sphere at the origin.
+        let mut empty = OrbitCamera::default();
+        empty.fit_points(&[[f32::NAN; 3]]);
+        assert_eq!(empty.target, Vec3::ZERO);
+        assert!(empty.view_proj(1.0).is_finite());
+    }
+
+    #[test]
+    fn orbiting_after_a_fit_keeps_the_mesh_within_the_depth_range() {
         let (lo, hi) = staircase_box();
         let mut camera = OrbitCamera::default();
         camera.fit(lo, hi);
-        assert_eq!(camera.target, (lo + hi) * 0.5);
-        for (dx, dy) in [(0.0, 0.0), (200.0, 0.0), (-150.0, 300.0), (90.0, -1000.0)] {
+        for (dx, dy) in [(200.0, 0.0), (-150.0, 300.0), (90.0, -1000.0)] {
             camera.orbit(dx, dy);
-            for aspect in [0.4, 1.0, 16.0 / 9.0, 3.0] {
-                let m = camera.view_proj(aspect);
-                let mut widest = 0.0f32;
-                for p in corners(lo, hi) {
-                    let clip = m * p.extend(1.0);
-                    assert!(clip.w > 0.0, "corner {p} behind the eye");
-                    let ndc = clip.truncate() / clip.w;
-                    assert!(
-                        ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
-                        "{ndc} at {aspect}"
-                    );
-                    assert!((0.0..=1.0).contains(&ndc.z), "depth {} at {aspect}", ndc.z);
-                    widest = widest.max(ndc.x.abs()).max(ndc.y.abs());
-                }
-                // Framed, not lost in the middle of the view.
-                assert!(widest > 0.5, "mesh spans only {widest} of the view");
+            let m = camera.view_proj(1.5);
+            for p in corners(lo, hi) {
+                let z = m.project_point3(p).z;
+                assert!((0.0..=1.0).contains(&z), "corner {p} at depth {z}");
             }
         }
     }
@@ -244,6 +405,7 @@ mod tests {
         let (right, up) = camera.screen_axes();
         assert_close(right, Vec3::X, 1e-6);
         assert_close(up, Vec3::Z, 1e-6);
+        camera.reset_direction();
         camera.fit(Vec3::splat(-1.0), Vec3::splat(1.0));
         assert!(camera.eye().z > 0.0 && camera.eye().y < 0.0);
     }
@@ -351,7 +513,7 @@ mod tests {
     fn degenerate_boxes_and_viewports_give_finite_matrices() {
         let mut camera = OrbitCamera::default();
         camera.fit(Vec3::splat(3.0), Vec3::splat(3.0));
-        assert_eq!(camera.bounds_radius, 1.0);
+        assert!((camera.bounds_radius - 1.0).abs() < 1e-6);
         assert_eq!(camera.target, Vec3::splat(3.0));
         camera.fit(Vec3::splat(f32::NAN), Vec3::ONE);
         assert!(camera.eye().is_finite());
