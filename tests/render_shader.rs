@@ -4,11 +4,13 @@
 
 use meshsmooth::view::{ViewUniforms, RENDER_SHADER};
 
-const ENTRY_POINTS: [(&str, naga::ShaderStage); 4] = [
+const ENTRY_POINTS: [(&str, naga::ShaderStage); 6] = [
     ("vs_surface", naga::ShaderStage::Vertex),
     ("fs_surface", naga::ShaderStage::Fragment),
     ("vs_wire", naga::ShaderStage::Vertex),
     ("fs_wire", naga::ShaderStage::Fragment),
+    ("vs_composite", naga::ShaderStage::Vertex),
+    ("fs_composite", naga::ShaderStage::Fragment),
 ];
 
 fn parse_and_validate(source: &str) -> (naga::Module, naga::valid::ModuleInfo) {
@@ -61,6 +63,7 @@ fn the_view_struct_matches_the_rust_record() {
     let rust = [
         ("view_proj", std::mem::offset_of!(ViewUniforms, view_proj)),
         ("eye", std::mem::offset_of!(ViewUniforms, eye)),
+        ("light", std::mem::offset_of!(ViewUniforms, light)),
         ("base_color", std::mem::offset_of!(ViewUniforms, base_color)),
         ("back_tint", std::mem::offset_of!(ViewUniforms, back_tint)),
         ("wire_color", std::mem::offset_of!(ViewUniforms, wire_color)),

@@ -34,8 +34,8 @@ pub fn start() {
                 .start(
                     canvas,
                     eframe::WebOptions {
-                        // The 3D view draws into egui's render pass and needs its depth buffer.
-                        depth_buffer: viewer::DEPTH_BUFFER_BITS,
+                        // The 3D view's composite pipeline must match egui's depth buffer.
+                        depth_buffer: viewer::EGUI_DEPTH_BUFFER_BITS,
                         ..Default::default()
                     },
                     Box::new(|cc| Ok(Box::new(shell::Shell::new(cc)))),

@@ -20,6 +20,8 @@ pub struct MeshBuffers {
     pub vertex_count: u32,
     pub triangle_indices: u32,
     pub edge_indices: u32,
+    /// Counts every change of the buffers' contents, so a drawn image knows it is stale.
+    pub generation: u64,
 }
 
 /// Positions or normals as the vertex buffers hold them: vec4 with w = 0.
@@ -149,12 +151,13 @@ impl MeshBuffers {
             vertex,
             bytemuck::cast_slice(&vec4s(normals)),
         );
+        self.generation += 1;
         Ok(())
     }
 
     /// Copies positions and normals from vec4 buffers on the same device, GPU to GPU.
     pub fn copy_positions_from(
-        &self,
+        &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         positions: &wgpu::Buffer,
@@ -185,15 +188,17 @@ impl MeshBuffers {
         encoder.copy_buffer_to_buffer(positions, 0, own_positions, 0, bytes);
         encoder.copy_buffer_to_buffer(normals, 0, own_normals, 0, bytes);
         queue.submit([encoder.finish()]);
+        self.generation += 1;
         Ok(())
     }
 
     /// Writes per-vertex RGBA8 colours.
-    pub fn set_colors(&self, queue: &wgpu::Queue, colors: &[[u8; 4]]) -> Result<(), String> {
+    pub fn set_colors(&mut self, queue: &wgpu::Queue, colors: &[[u8; 4]]) -> Result<(), String> {
         self.check_vertex_count("colours", colors.len())?;
         if let Some(buffer) = &self.colors {
             queue.write_buffer(buffer, 0, bytemuck::cast_slice(colors));
         }
+        self.generation += 1;
         Ok(())
     }
 

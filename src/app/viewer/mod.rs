@@ -1,29 +1,30 @@
-//! The 3D view: the mesh drawn with wgpu inside egui (a paint callback in egui's own render
-//! pass), lit by a headlight, two-sided, with an optional wireframe; orbit, pan and zoom.
+//! The 3D view: the mesh drawn with wgpu inside egui (a paint callback), lit by lights fixed to
+//! the camera, two-sided, anti-aliased (4x MSAA in its own target, composited into egui's
+//! pass), with an optional wireframe; orbit, pan and zoom.
 //!
 //! Works on WebGPU and on WebGL2. The camera math and the per-frame record are in
-//! [`crate::view`]; here are the GPU side (`pipelines`, `buffers`, `callback`) and the input
-//! (`controls`).
+//! [`crate::view`].
 //!
-//! Modules: `pipelines` (surface and wireframe pipelines), `buffers` (the model's vertex and
-//! index buffers), `callback` (the egui-wgpu callback and the resources it draws with),
-//! `controls` (input to camera moves).
+//! Modules: `pipelines` (surface, wireframe and composite pipelines), `target` (the view's
+//! multisampled render target), `buffers` (the model's vertex and index buffers), `callback`
+//! (the egui-wgpu callback and the resources it draws with), `controls` (input to camera moves).
 
 mod buffers;
 mod callback;
 mod controls;
 mod pipelines;
+mod target;
 
 use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu};
-use glam::Vec3;
 
 use crate::view::{OrbitCamera, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS};
 use callback::{ViewCallback, ViewResources};
+use pipelines::Pipelines;
 
-/// Bits of the depth buffer eframe creates for egui's render pass (`WebOptions::depth_buffer`);
-/// the view's pipelines use the matching format.
-pub const DEPTH_BUFFER_BITS: u8 = 24;
+/// Bits of the depth buffer eframe gives egui's render pass (`WebOptions::depth_buffer`). The
+/// view has its own depth buffer, so none; the composite pipeline matches whatever this is.
+pub const EGUI_DEPTH_BUFFER_BITS: u8 = 0;
 
 /// Behind the model: dark and slightly cool, so the warm lit surface stands out.
 const BACKGROUND: egui::Color32 = egui::Color32::from_rgb(22, 24, 28);
@@ -34,8 +35,8 @@ pub struct Viewer {
     /// Draw the triangle edges over the surface.
     pub wireframe: bool,
     camera: OrbitCamera,
-    /// The model's bounding box, which [`Self::reset_view`] frames; `None` with no model.
-    bounds: Option<(Vec3, Vec3)>,
+    /// The model framed from the default direction, where [`Self::reset_view`] returns to.
+    home: OrbitCamera,
     vertex_count: usize,
     has_colors: bool,
     /// egui's framebuffer is sRGB: the shader writes linear light.
@@ -46,28 +47,30 @@ pub struct Viewer {
 
 impl Viewer {
     pub fn new(render_state: &egui_wgpu::RenderState) -> Self {
-        let depth_format = egui_wgpu::depth_format_from_bits(DEPTH_BUFFER_BITS, 0)
-            .unwrap_or(wgpu::TextureFormat::Depth24Plus);
-        let resources = ViewResources::new(
+        let pipelines = Pipelines::new(
             &render_state.device,
+            &render_state.adapter,
             render_state.target_format,
-            depth_format,
+            egui_wgpu::depth_format_from_bits(EGUI_DEPTH_BUFFER_BITS, 0),
         );
+        let info = render_state.adapter.get_info();
+        log::info!(
+            "3D view on {:?} ({:?}), framebuffer {:?}, {}x MSAA",
+            info.backend,
+            info.name,
+            render_state.target_format,
+            pipelines.samples
+        );
+        let resources = ViewResources::new(&render_state.device, pipelines);
         render_state
             .renderer
             .write()
             .callback_resources
             .insert(resources);
-        log::info!(
-            "3D view on {:?} ({:?}), framebuffer {:?}",
-            render_state.adapter.get_info().backend,
-            render_state.adapter.get_info().name,
-            render_state.target_format
-        );
         Self {
             wireframe: false,
             camera: OrbitCamera::default(),
-            bounds: None,
+            home: OrbitCamera::default(),
             vertex_count: 0,
             has_colors: false,
             output_linear: render_state.target_format.is_srgb(),
@@ -92,8 +95,8 @@ impl Viewer {
             Ok(()) => {
                 self.vertex_count = positions.len();
                 self.has_colors = false;
-                self.bounds = crate::mesh::bounding_box(positions)
-                    .map(|(lo, hi)| (Vec3::from(lo), Vec3::from(hi)));
+                self.home = OrbitCamera::default();
+                self.home.fit_points(positions);
                 self.problem = None;
                 self.reset_view();
             }
@@ -173,6 +176,7 @@ impl Viewer {
                 flags |= OUTPUT_LINEAR;
             }
             let callback = ViewCallback {
+                rect,
                 uniforms: ViewUniforms::new(&self.camera, rect.width() / rect.height(), flags),
                 wireframe: self.wireframe,
             };
@@ -184,10 +188,7 @@ impl Viewer {
 
     /// Frames the whole model from the default direction.
     pub fn reset_view(&mut self) {
-        match self.bounds {
-            Some((lo, hi)) => self.camera.fit(lo, hi),
-            None => self.camera = OrbitCamera::default(),
-        }
+        self.camera = self.home;
     }
 
     /// Records why the model cannot be shown; the view shows the reason instead.
