@@ -2,7 +2,8 @@
 //!
 //! Data flows one way: bytes -> [`io`] (parse, weld) -> [`mesh`] (indexed mesh, CSR topology,
 //! report) -> [`smooth`] (CPU reference) -> [`metrics`] -> [`export`]. The command-line tool
-//! (native) and the web app (wasm32) sit on top and own no algorithm.
+//! (native) and the web app (wasm32) sit on top and own no algorithm. [`view`] is the 3D view's
+//! camera and shading record, kept apart from the app so it is tested natively.
 
 pub mod export;
 pub mod gpu;
@@ -12,6 +13,7 @@ pub mod metrics;
 pub mod session;
 pub mod smooth;
 pub mod suggest;
+pub mod view;
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod cli;

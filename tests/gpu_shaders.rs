@@ -59,6 +59,8 @@ fn every_wgsl_file_is_loaded_by_the_runtime() {
     files.sort();
     let mut loaded: Vec<String> = KERNELS.iter().map(|k| k.file.to_string()).collect();
     loaded.extend(PRELUDE_FILES.iter().map(|f| f.to_string()));
+    // The 3D view's shader; tests/render_shader.rs validates it.
+    loaded.push("render.wgsl".to_string());
     loaded.sort();
     loaded.dedup();
     assert_eq!(files, loaded);

@@ -22,6 +22,8 @@ pub struct GpuEngine {
     /// The open model on the GPU, with the document's model generation it belongs to.
     mesh: Option<(u64, GpuMesh)>,
     in_flight: Option<InFlight>,
+    /// The revision of the latest run submitted (its positions are in the buffers).
+    submitted: Option<u64>,
 }
 
 /// What a frame's step did for the view.
@@ -40,7 +42,13 @@ impl GpuEngine {
             smoother: GpuSmoother::new(device),
             mesh: None,
             in_flight: None,
+            submitted: None,
         }
+    }
+
+    /// The revision whose run the buffers hold (submitted; maybe not finished yet).
+    pub fn submitted(&self) -> Option<u64> {
+        self.submitted
     }
 
     /// The buffers of the latest run: positions and normals, vec4 per vertex.
@@ -64,6 +72,7 @@ impl GpuEngine {
         let generation = doc.model_generation;
         if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
             self.mesh = None;
+            self.submitted = None;
             let uploaded = self
                 .smoother
                 .upload_with_measures(&self.device, &model.original)
@@ -87,6 +96,7 @@ impl GpuEngine {
             .measure(&self.device, &self.queue, mesh, true)
             .map_err(e)?;
         let positions = ResultReadback::start(&self.device, &self.queue, mesh).map_err(e)?;
+        self.submitted = Some(doc.session.revision());
         self.in_flight = Some(InFlight {
             revision: doc.session.revision(),
             started_ms,

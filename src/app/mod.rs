@@ -7,7 +7,7 @@
 //! Modules: `document` (the session shared by the UI and the API, waiting API calls, timings),
 //! `api` (`window.meshsmooth`), `file_input` and `query` (bytes in: picker, drops, `?model=`),
 //! `download` (bytes out), `controls`, `legend`, `report_view`, `shortcuts` (the panels),
-//! `shell` (the `eframe::App` that lays these out).
+//! `shell` (the `eframe::App` that lays these out), `viewer` (the 3D view).
 
 mod api;
 mod controls;
@@ -21,6 +21,7 @@ mod query;
 mod report_view;
 mod shell;
 mod shortcuts;
+pub mod viewer;
 
 pub use document::{Backend, Document};
 
@@ -40,7 +41,11 @@ pub fn start() {
             Ok(canvas) => runner
                 .start(
                     canvas,
-                    eframe::WebOptions::default(),
+                    eframe::WebOptions {
+                        // The 3D view's composite pipeline must match egui's depth buffer.
+                        depth_buffer: viewer::EGUI_DEPTH_BUFFER_BITS,
+                        ..Default::default()
+                    },
                     Box::new(|cc| Ok(Box::new(shell::Shell::new(cc)))),
                 )
                 .await

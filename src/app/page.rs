@@ -53,10 +53,45 @@ pub fn install_crash_message_hook() {
     }));
 }
 
+/// True when the page's URL sets the flag `name` in its query: `?name`, `?name=1` or
+/// `?name=true` (for example `?wireframe=1`, which screenshots and tests use).
+pub fn query_flag(name: &str) -> bool {
+    let search = web_sys::window()
+        .and_then(|w| w.location().search().ok())
+        .unwrap_or_default();
+    query_has_flag(&search, name)
+}
+
+fn query_has_flag(search: &str, name: &str) -> bool {
+    search
+        .trim_start_matches('?')
+        .split('&')
+        .any(|pair| match pair.split_once('=') {
+            Some((key, value)) => key == name && matches!(value, "1" | "true"),
+            None => pair == name,
+        })
+}
+
 /// Best-effort text of a JavaScript error value.
 pub fn js_error_text(value: &wasm_bindgen::JsValue) -> String {
     if let Some(error) = value.dyn_ref::<js_sys::Error>() {
         return String::from(error.message());
     }
     value.as_string().unwrap_or_else(|| format!("{value:?}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::query_has_flag;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test]
+    fn query_flags_are_read_from_the_search_string() {
+        assert!(query_has_flag("?wireframe=1", "wireframe"));
+        assert!(query_has_flag("?a=2&wireframe", "wireframe"));
+        assert!(query_has_flag("?wireframe=true&b", "wireframe"));
+        assert!(!query_has_flag("?wireframe=0", "wireframe"));
+        assert!(!query_has_flag("?wireframes=1", "wireframe"));
+        assert!(!query_has_flag("", "wireframe"));
+    }
 }

@@ -5,13 +5,15 @@
 use super::controls::{self, Controls};
 use super::document::{Backend, Document, SharedDocument};
 use super::file_input::FileInput;
-use super::gpu_engine::GpuEngine;
+use super::gpu_engine::{GpuEngine, Step};
 use super::shortcuts::{self, Action};
-use super::{api, download, legend, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
+use super::viewer::Viewer;
+use super::{api, download, legend, page, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
-use crate::session::ColorField;
+use crate::session::{ColorField, Legend};
 use crate::smooth::Filter;
 use eframe::egui;
+use eframe::egui_wgpu;
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -29,6 +31,30 @@ pub struct Shell {
     gpu: Option<GpuEngine>,
     /// Why the GPU engine was given up for the CPU engine.
     gpu_fallback: Option<String>,
+    /// The 3D view and the GPU it draws with; `None` when eframe has no wgpu renderer.
+    view: Option<(Viewer, egui_wgpu::RenderState)>,
+    /// What the view shows now, so it is re-uploaded only when that changes.
+    shown: Shown,
+}
+
+/// Where the view's positions come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Positions {
+    Original,
+    /// The CPU engine's result for this revision.
+    Cpu(u64),
+    /// The GPU engine's buffers after the run for this revision.
+    Gpu(u64),
+}
+
+/// The state of the view's buffers.
+#[derive(Default)]
+struct Shown {
+    generation: u64,
+    positions: Option<Positions>,
+    /// Field and result revision of the colours, `None` for plain shading.
+    colors: Option<(ColorField, u64)>,
+    legend: Option<Legend>,
 }
 
 impl Shell {
@@ -40,8 +66,17 @@ impl Shell {
             (info.backend == wgpu::Backend::BrowserWebGpu)
                 .then(|| GpuEngine::new(&rs.device, &rs.queue))
         });
-        let backend = if gpu.is_some() { Backend::WebGpu } else { Backend::Cpu };
+        let backend = if gpu.is_some() {
+            Backend::WebGpu
+        } else {
+            Backend::Cpu
+        };
         let doc = Rc::new(RefCell::new(Document::new(backend)));
+        let view = cc.wgpu_render_state.as_ref().map(|rs| {
+            let mut viewer = Viewer::new(rs);
+            viewer.wireframe = page::query_flag("wireframe");
+            (viewer, rs.clone())
+        });
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
         let files = FileInput::new(&cc.egui_ctx);
@@ -60,6 +95,70 @@ impl Shell {
             export_error: None,
             gpu,
             gpu_fallback: None,
+            view,
+            shown: Shown::default(),
+        }
+    }
+
+    /// Brings the view's buffers up to date with the document: a new model, new positions
+    /// (the original, the CPU result or the GPU buffers), new colours.
+    fn sync_view(&mut self) {
+        let Some((viewer, rs)) = &mut self.view else {
+            return;
+        };
+        let doc = self.doc.borrow();
+        let session = &doc.session;
+        let Some(model) = session.model() else {
+            return;
+        };
+        let mesh = model.mesh();
+        if self.shown.generation != doc.model_generation || self.shown.positions.is_none() {
+            let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
+            viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
+            self.shown = Shown {
+                generation: doc.model_generation,
+                positions: Some(Positions::Original),
+                ..Shown::default()
+            };
+        }
+        let result = session.last_result();
+        let wanted = if self.show_original {
+            Positions::Original
+        } else if let Some(gpu) = &self.gpu {
+            gpu.submitted().map_or(Positions::Original, Positions::Gpu)
+        } else {
+            result.map_or(Positions::Original, |r| Positions::Cpu(r.revision))
+        };
+        if self.shown.positions != Some(wanted) {
+            match wanted {
+                Positions::Original => {
+                    let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
+                    viewer.set_positions(rs, &mesh.positions, &normals);
+                }
+                Positions::Cpu(_) => {
+                    if let Some(r) = result {
+                        let normals = crate::mesh::vertex_normals(&r.positions, &mesh.triangles);
+                        viewer.set_positions(rs, &r.positions, &normals);
+                    }
+                }
+                Positions::Gpu(_) => {
+                    if let Some((positions, normals)) = self.gpu.as_ref().and_then(|g| g.buffers())
+                    {
+                        viewer.copy_positions_from(rs, positions, normals);
+                    }
+                }
+            }
+            self.shown.positions = Some(wanted);
+        }
+        let colors = self
+            .coloring
+            .filter(|_| !self.show_original)
+            .zip(result.map(|r| r.revision));
+        if self.shown.colors != colors {
+            let computed = colors.and_then(|(field, _)| session.colors(field));
+            viewer.set_colors(rs, computed.as_ref().map(|(c, _)| c.as_slice()));
+            self.shown.legend = computed.map(|(_, l)| l);
+            self.shown.colors = colors;
         }
     }
 
@@ -68,7 +167,7 @@ impl Shell {
         let mut doc = self.doc.borrow_mut();
         if let Some(gpu) = &mut self.gpu {
             match gpu.step(&mut doc) {
-                Ok(_) => return,
+                Ok(Step::Idle | Step::Submitted) => return,
                 Err(why) => {
                     log::error!("GPU engine failed, using the CPU engine: {why}");
                     self.gpu = None;
@@ -130,9 +229,17 @@ impl Shell {
     fn apply(&mut self, action: Action) {
         match action {
             Action::Open => self.open_picker(),
-            Action::ToggleWireframe => {}
+            Action::ToggleWireframe => {
+                if let Some((viewer, _)) = &mut self.view {
+                    viewer.wireframe = !viewer.wireframe;
+                }
+            }
             Action::ToggleOriginal => self.show_original = !self.show_original,
-            Action::ResetView => {}
+            Action::ResetView => {
+                if let Some((viewer, _)) = &mut self.view {
+                    viewer.reset_view();
+                }
+            }
             Action::NextColoring => {
                 let all = ColorField::ALL;
                 self.coloring = match self.coloring {
@@ -174,6 +281,13 @@ impl Shell {
             ui.separator();
             ui.toggle_value(&mut self.show_original, "Original")
                 .on_hover_text("Before/after: show the original mesh (B)");
+            if let Some((viewer, _)) = &mut self.view {
+                ui.toggle_value(&mut viewer.wireframe, "Wireframe")
+                    .on_hover_text("W");
+                if ui.button("Reset view").on_hover_text("R").clicked() {
+                    viewer.reset_view();
+                }
+            }
             ui.separator();
             if ui.button("Help").on_hover_text("H").clicked() {
                 self.help_open = !self.help_open;
@@ -235,21 +349,48 @@ impl Shell {
     }
 
     fn view(&mut self, ui: &mut egui::Ui) {
+        let rect = match &mut self.view {
+            Some((viewer, _)) => viewer.show(ui).rect,
+            None => {
+                ui.label("The 3D view needs WebGPU or WebGL2, which this browser did not provide.");
+                ui.available_rect_before_wrap()
+            }
+        };
+        if let Some(l) = &self.shown.legend {
+            legend::paint(ui, rect, l);
+        }
+        // Messages over the view's top-left corner.
         let doc = self.doc.borrow();
+        let mut lines = Vec::new();
         if let Some(error) = doc.session.error().or(self.export_error.as_deref()) {
-            ui.colored_label(ui.visuals().error_fg_color, error);
+            lines.push((error.to_string(), ui.visuals().error_fg_color));
         }
         if self.files.reading() > 0 {
-            ui.horizontal(|ui| {
-                ui.spinner();
-                ui.label("Reading file…");
-            });
+            lines.push(("Reading file…".to_string(), egui::Color32::WHITE));
         }
-        let rect = ui.available_rect_before_wrap();
-        if let Some(field) = self.coloring.filter(|_| !self.show_original) {
-            if let Some((_, l)) = doc.session.colors(field) {
-                legend::paint(ui, rect, &l);
-            }
+        if self.show_original {
+            lines.push((
+                "Showing the original mesh (B to go back)".to_string(),
+                egui::Color32::WHITE,
+            ));
+        }
+        let painter = ui.painter_at(rect);
+        let mut y = rect.top() + 10.0;
+        for (text, color) in lines {
+            let galley = painter.layout(
+                text,
+                egui::FontId::proportional(15.0),
+                color,
+                rect.width() * 0.6,
+            );
+            let at = egui::pos2(rect.left() + 12.0, y);
+            painter.rect_filled(
+                egui::Rect::from_min_size(at, galley.size()).expand(6.0),
+                4.0,
+                egui::Color32::from_black_alpha(170),
+            );
+            y += galley.size().y + 16.0;
+            painter.galley(at, galley, color);
         }
     }
 }
@@ -276,6 +417,7 @@ impl eframe::App for Shell {
             self.apply(action);
         }
         self.compute();
+        self.sync_view();
         {
             let mut doc = self.doc.borrow_mut();
             doc.answer_waiting();
@@ -302,7 +444,7 @@ impl eframe::App for Shell {
                     }
                 });
             });
-        egui::CentralPanel::default_margins().show(ui, |ui| self.view(ui));
+        egui::CentralPanel::no_frame().show(ui, |ui| self.view(ui));
         shortcuts::help_window(&ctx, &mut self.help_open);
 
         if ctx.input(|i| !i.raw.hovered_files.is_empty()) {

@@ -136,6 +136,22 @@ impl Topology {
     pub fn edge_count(&self) -> usize {
         self.neighbors.len() / 2
     }
+
+    /// Every undirected edge once, as `[i, j]` with `i < j`, ascending by `i` then `j`: the
+    /// line list the 3D view draws as a wireframe.
+    pub fn edges(&self) -> Vec<[u32; 2]> {
+        let mut edges = Vec::with_capacity(self.edge_count());
+        for i in 0..self.vertex_count() {
+            let i = i as u32;
+            edges.extend(
+                self.neighbors_of(i as usize)
+                    .iter()
+                    .filter(|&&j| i < j)
+                    .map(|&j| [i, j]),
+            );
+        }
+        edges
+    }
 }
 
 /// Vertices per parallel work item when building the rings.
@@ -288,6 +304,17 @@ mod tests {
         assert!(t.edge_triangle_counts.iter().all(|&c| c == 2));
         assert_eq!(t.smoothing_ring().1, &t.neighbors[..]);
         assert_eq!(t.edge_count(), 6);
+    }
+
+    #[test]
+    fn edges_lists_each_undirected_edge_once() {
+        let t = Topology::build(&square());
+        assert_eq!(t.edges(), vec![[0, 1], [0, 2], [0, 3], [1, 2], [2, 3]]);
+        let m = crate::mesh::fixtures::tetrahedron();
+        let edges = Topology::build(&m).edges();
+        assert_eq!(edges.len(), 6);
+        assert!(edges.iter().all(|[i, j]| i < j));
+        assert!(Topology::build(&Mesh::default()).edges().is_empty());
     }
 
     #[test]

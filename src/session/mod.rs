@@ -41,7 +41,7 @@ impl Model {
         let topology = Topology::build(&mesh);
         let report = MeshReport::new(&mesh, &topology);
         let warnings = report.warnings();
-        let edges = unique_edges(&topology);
+        let edges = topology.edges();
         Self {
             name: name.to_string(),
             original: Original::new(&mesh, &topology),
@@ -58,19 +58,6 @@ impl Model {
     pub fn topology(&self) -> &Topology {
         self.original.topology()
     }
-}
-
-/// Each undirected edge of the 1-ring CSR once, as `[i, j]` with `i < j`.
-fn unique_edges(topology: &Topology) -> Vec<[u32; 2]> {
-    (0..topology.vertex_count())
-        .flat_map(|i| {
-            topology
-                .neighbors_of(i)
-                .iter()
-                .filter(move |&&j| (i as u32) < j)
-                .map(move |&j| [i as u32, j])
-        })
-        .collect()
 }
 
 /// A smoothing run's result and its measures.

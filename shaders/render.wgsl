@@ -1,0 +1,153 @@
+// The 3D view, drawn inside egui's render pass: a lit, two-sided surface and a wireframe overlay.
+//
+// Runs on WebGPU and on WebGL2 (eframe's fallback), so it uses only what both have: one uniform
+// buffer, vertex attributes, no storage buffers. Positions and normals are vec4 per vertex (the
+// GPU engine's layout, w ignored); colours are sRGB-encoded RGBA8.
+
+// `ViewUniforms` in src/view/uniforms.rs, 160 bytes.
+struct View {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    light: vec4<f32>,
+    base_color: vec4<f32>,
+    back_tint: vec4<f32>,
+    wire_color: vec4<f32>,
+    flags: u32,
+}
+
+// Flags, as in src/view/uniforms.rs.
+const VERTEX_COLORS: u32 = 1u;
+const OUTPUT_LINEAR: u32 = 2u;
+
+// Lighting, all fixed to the camera: a key light above-left of the eye shapes the surface, a
+// fill light at the eye keeps what faces the viewer bright, ambient keeps the rest visible, and
+// a small specular highlight shows surface relief (voxel steps, smoothing noise).
+const AMBIENT: f32 = 0.07;
+const KEY: f32 = 0.72;
+const FILL: f32 = 0.3;
+const SPECULAR: f32 = 0.22;
+const SHININESS: f32 = 40.0;
+// Back faces are shaded a little darker, besides their tint.
+const BACK_SHADE: f32 = 0.8;
+
+@group(0) @binding(0) var<uniform> view: View;
+
+fn linear_from_srgb(srgb: vec3<f32>) -> vec3<f32> {
+    let low = srgb / 12.92;
+    let high = pow((srgb + vec3<f32>(0.055)) / 1.055, vec3<f32>(2.4));
+    return select(high, low, srgb <= vec3<f32>(0.04045));
+}
+
+fn srgb_from_linear(linear: vec3<f32>) -> vec3<f32> {
+    let low = linear * 12.92;
+    let high = 1.055 * pow(linear, vec3<f32>(1.0 / 2.4)) - 0.055;
+    return select(high, low, linear <= vec3<f32>(0.0031308));
+}
+
+// Linear RGB and straight alpha to what the framebuffer expects, premultiplied as egui blends:
+// linear for an sRGB framebuffer (the hardware encodes), sRGB-encoded otherwise.
+fn encode(rgb: vec3<f32>, alpha: f32) -> vec4<f32> {
+    let c = clamp(rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+    if (view.flags & OUTPUT_LINEAR) != 0u {
+        return vec4<f32>(c * alpha, alpha);
+    }
+    return vec4<f32>(srgb_from_linear(c) * alpha, alpha);
+}
+
+struct SurfaceVertex {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) color: vec4<f32>,
+}
+
+struct SurfaceFragment {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) albedo: vec3<f32>,
+}
+
+@vertex
+fn vs_surface(v: SurfaceVertex) -> SurfaceFragment {
+    var out: SurfaceFragment;
+    out.clip = view.view_proj * vec4<f32>(v.position.xyz, 1.0);
+    out.world = v.position.xyz;
+    out.normal = v.normal.xyz;
+    if (view.flags & VERTEX_COLORS) != 0u {
+        out.albedo = linear_from_srgb(v.color.rgb);
+    } else {
+        out.albedo = view.base_color.rgb;
+    }
+    return out;
+}
+
+@fragment
+fn fs_surface(f: SurfaceFragment, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let to_eye = normalize(view.eye.xyz - f.world);
+    // Vertices without area have a zero normal: light them as if facing the eye.
+    var n = to_eye;
+    let length_n = length(f.normal);
+    if length_n > 1e-6 {
+        n = f.normal / length_n;
+    }
+    var albedo = f.albedo;
+    if !front {
+        // Two-sided: the inside of an open mesh is lit from its own side, tinted.
+        n = -n;
+        albedo = mix(albedo, view.back_tint.rgb, view.back_tint.a) * BACK_SHADE;
+    }
+    let to_light = view.light.xyz;
+    let key = max(dot(n, to_light), 0.0);
+    let fill = max(dot(n, to_eye), 0.0);
+    // Blinn-Phong highlight of the key light, only where the key light reaches.
+    let half_vector = normalize(to_light + to_eye);
+    let highlight = select(0.0, pow(max(dot(n, half_vector), 0.0), SHININESS), key > 0.0);
+    let rgb = albedo * (AMBIENT + KEY * key + FILL * fill) + vec3<f32>(SPECULAR * highlight);
+    return encode(rgb, 1.0);
+}
+
+// Wireframe lines lie exactly on the surface, so each is moved this fraction of its distance
+// towards the eye to win the depth test against it. Relative to the distance, the pull covers
+// the surface's depth change across a pixel for surfaces up to ~75 degrees from facing the eye
+// (in a view 750 pixels high), while lines behind anything thicker than 0.3% of the viewing
+// distance stay hidden. (Depth bias on the surface would do the same, but it lets back faces
+// win at silhouettes.)
+const WIRE_PULL: f32 = 0.003;
+
+@vertex
+fn vs_wire(@location(0) position: vec4<f32>) -> @builtin(position) vec4<f32> {
+    let pulled = mix(position.xyz, view.eye.xyz, WIRE_PULL);
+    return view.view_proj * vec4<f32>(pulled, 1.0);
+}
+
+@fragment
+fn fs_wire() -> @location(0) vec4<f32> {
+    return encode(view.wire_color.rgb, view.wire_color.a);
+}
+
+// Composite: egui's render pass has no multisampling on the web, so the view is drawn with 4x
+// MSAA into its own target and this copies the resolved image into egui's pass, one texel per
+// pixel (the viewport is the view's rectangle). Colours are already encoded and premultiplied.
+
+@group(1) @binding(0) var frame: texture_2d<f32>;
+@group(1) @binding(1) var frame_sampler: sampler;
+
+struct CompositeFragment {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+}
+
+// One triangle covering the viewport: vertices (-1, -1), (3, -1), (-1, 3).
+@vertex
+fn vs_composite(@builtin(vertex_index) index: u32) -> CompositeFragment {
+    let xy = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u)) * 2.0 - 1.0;
+    var out: CompositeFragment;
+    out.clip = vec4<f32>(xy, 0.0, 1.0);
+    out.uv = vec2<f32>(xy.x + 1.0, 1.0 - xy.y) * 0.5;
+    return out;
+}
+
+@fragment
+fn fs_composite(f: CompositeFragment) -> @location(0) vec4<f32> {
+    return textureSample(frame, frame_sampler, f.uv);
+}

@@ -1,0 +1,213 @@
+//! The 3D view as an egui paint callback. The GPU resources live in egui-wgpu's
+//! `callback_resources` (created once by the `Viewer`); each frame's callback carries only the
+//! per-frame record and what to draw.
+//!
+//! `prepare` draws the mesh into the view's own multisampled target (in egui's command encoder,
+//! before egui's pass), and only when something changed: egui repaints for every pointer move
+//! over any widget. `paint` composites the result into egui's pass.
+
+use eframe::egui;
+use eframe::egui_wgpu::{self, wgpu, CallbackResources, CallbackTrait};
+
+use super::buffers::MeshBuffers;
+use super::pipelines::Pipelines;
+use super::target::Target;
+use crate::view::ViewUniforms;
+
+/// Everything the view keeps on the GPU, stored in egui-wgpu's type map: one view per app.
+pub struct ViewResources {
+    pub pipelines: Pipelines,
+    pub uniforms: wgpu::Buffer,
+    pub view_group: wgpu::BindGroup,
+    pub mesh: MeshBuffers,
+    target: Option<Target>,
+    /// What the target holds, to skip drawing the same frame again.
+    drawn: Option<Frame>,
+}
+
+/// Everything a drawn image depends on.
+#[derive(Clone, Copy, PartialEq)]
+struct Frame {
+    uniforms: ViewUniforms,
+    wireframe: bool,
+    mesh_generation: u64,
+    size: [u32; 2],
+}
+
+impl ViewResources {
+    pub fn new(device: &wgpu::Device, pipelines: Pipelines) -> Self {
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("meshsmooth view uniforms"),
+            size: std::mem::size_of::<ViewUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("meshsmooth view"),
+            layout: &pipelines.view_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniforms.as_entire_binding(),
+            }],
+        });
+        Self {
+            pipelines,
+            uniforms,
+            view_group,
+            mesh: MeshBuffers::default(),
+            target: None,
+            drawn: None,
+        }
+    }
+
+    /// Draws the mesh into the target (cleared to transparent) and resolves it.
+    fn draw(&self, encoder: &mut wgpu::CommandEncoder, target: &Target, wireframe: bool) {
+        let (color, resolve_target) = match &target.multisampled {
+            Some(multisampled) => (multisampled, Some(&target.resolved)),
+            None => (&target.resolved, None),
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("meshsmooth view"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: color,
+                depth_slice: None,
+                resolve_target,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    // Only the resolved image is read later.
+                    store: if resolve_target.is_some() {
+                        wgpu::StoreOp::Discard
+                    } else {
+                        wgpu::StoreOp::Store
+                    },
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &target.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let mesh = &self.mesh;
+        let (Some(positions), Some(normals), Some(colors), Some(triangles)) = (
+            &mesh.positions,
+            &mesh.normals,
+            &mesh.colors,
+            &mesh.triangles,
+        ) else {
+            return;
+        };
+        pass.set_bind_group(0, &self.view_group, &[]);
+        pass.set_pipeline(&self.pipelines.surface);
+        pass.set_vertex_buffer(0, positions.slice(..));
+        pass.set_vertex_buffer(1, normals.slice(..));
+        pass.set_vertex_buffer(2, colors.slice(..));
+        pass.set_index_buffer(triangles.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..mesh.triangle_indices, 0, 0..1);
+
+        if let (true, Some(edges)) = (wireframe, &mesh.edges) {
+            pass.set_pipeline(&self.pipelines.wire);
+            pass.set_index_buffer(edges.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..mesh.edge_indices, 0, 0..1);
+        }
+    }
+}
+
+/// One frame of the view.
+pub struct ViewCallback {
+    /// The view's rectangle in points, as egui will hand it to `paint`.
+    pub rect: egui::Rect,
+    pub uniforms: ViewUniforms,
+    pub wireframe: bool,
+}
+
+impl CallbackTrait for ViewCallback {
+    fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        screen: &egui_wgpu::ScreenDescriptor,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &mut CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        let Some(view) = resources.get_mut::<ViewResources>() else {
+            return Vec::new();
+        };
+        // The viewport `paint` will get, computed the same way.
+        let viewport = egui::epaint::ViewportInPixels::from_points(
+            &self.rect,
+            screen.pixels_per_point,
+            screen.size_in_pixels,
+        );
+        if viewport.width_px <= 0 || viewport.height_px <= 0 {
+            return Vec::new();
+        }
+        let size = [viewport.width_px as u32, viewport.height_px as u32];
+        if view.target.as_ref().map(|t| t.size) != Some(size) {
+            view.target = Some(Target::new(device, &view.pipelines, size));
+        }
+        let frame = Frame {
+            uniforms: self.uniforms,
+            wireframe: self.wireframe,
+            mesh_generation: view.mesh.generation,
+            size,
+        };
+        if view.drawn == Some(frame) {
+            return Vec::new();
+        }
+        queue.write_buffer(&view.uniforms, 0, bytemuck::bytes_of(&self.uniforms));
+        if let Some(target) = &view.target {
+            view.draw(encoder, target, self.wireframe);
+        }
+        view.drawn = Some(frame);
+        Vec::new()
+    }
+
+    fn paint(
+        &self,
+        info: egui::PaintCallbackInfo,
+        pass: &mut wgpu::RenderPass<'static>,
+        resources: &CallbackResources,
+    ) {
+        let Some(view) = resources.get::<ViewResources>() else {
+            return;
+        };
+        let Some(target) = &view.target else {
+            return;
+        };
+        // egui's pass is shared: draw only inside our rectangle, clipped as egui clips it.
+        let viewport = info.viewport_in_pixels();
+        let clip = info.clip_rect_in_pixels();
+        if viewport.width_px <= 0
+            || viewport.height_px <= 0
+            || clip.width_px <= 0
+            || clip.height_px <= 0
+        {
+            return;
+        }
+        pass.set_viewport(
+            viewport.left_px as f32,
+            viewport.top_px as f32,
+            viewport.width_px as f32,
+            viewport.height_px as f32,
+            0.0,
+            1.0,
+        );
+        pass.set_scissor_rect(
+            clip.left_px as u32,
+            clip.top_px as u32,
+            clip.width_px as u32,
+            clip.height_px as u32,
+        );
+        pass.set_pipeline(&view.pipelines.composite);
+        pass.set_bind_group(0, &view.view_group, &[]);
+        pass.set_bind_group(1, &target.composite_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

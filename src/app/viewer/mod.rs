@@ -1,0 +1,221 @@
+//! The 3D view: the mesh drawn with wgpu inside egui (a paint callback), lit by lights fixed to
+//! the camera, two-sided, anti-aliased (4x MSAA in its own target, composited into egui's
+//! pass), with an optional wireframe; orbit, pan and zoom.
+//!
+//! Works on WebGPU and on WebGL2. The camera math and the per-frame record are in
+//! [`crate::view`].
+//!
+//! Modules: `pipelines` (surface, wireframe and composite pipelines), `target` (the view's
+//! multisampled render target), `buffers` (the model's vertex and index buffers), `callback`
+//! (the egui-wgpu callback and the resources it draws with), `controls` (input to camera moves).
+
+mod buffers;
+mod callback;
+mod controls;
+mod pipelines;
+mod target;
+
+use eframe::egui;
+use eframe::egui_wgpu::{self, wgpu};
+
+use crate::view::{OrbitCamera, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS};
+use callback::{ViewCallback, ViewResources};
+use pipelines::Pipelines;
+
+/// Bits of the depth buffer eframe gives egui's render pass (`WebOptions::depth_buffer`). The
+/// view has its own depth buffer, so none; the composite pipeline matches whatever this is.
+pub const EGUI_DEPTH_BUFFER_BITS: u8 = 0;
+
+/// Behind the model: dark and slightly cool, so the warm lit surface stands out.
+const BACKGROUND: egui::Color32 = egui::Color32::from_rgb(22, 24, 28);
+
+/// The 3D view of one model. Its GPU resources live in egui-wgpu's callback resources, so one
+/// `Viewer` per app.
+pub struct Viewer {
+    /// Draw the triangle edges over the surface.
+    pub wireframe: bool,
+    camera: OrbitCamera,
+    /// The model framed from the default direction, where [`Self::reset_view`] returns to.
+    home: OrbitCamera,
+    vertex_count: usize,
+    has_colors: bool,
+    /// egui's framebuffer is sRGB: the shader writes linear light.
+    output_linear: bool,
+    /// Why the model is not shown (too large for this GPU, mismatched arrays), if so.
+    problem: Option<String>,
+}
+
+impl Viewer {
+    pub fn new(render_state: &egui_wgpu::RenderState) -> Self {
+        let pipelines = Pipelines::new(
+            &render_state.device,
+            &render_state.adapter,
+            render_state.target_format,
+            egui_wgpu::depth_format_from_bits(EGUI_DEPTH_BUFFER_BITS, 0),
+        );
+        let info = render_state.adapter.get_info();
+        log::info!(
+            "3D view on {:?} ({:?}), framebuffer {:?}, {}x MSAA",
+            info.backend,
+            info.name,
+            render_state.target_format,
+            pipelines.samples
+        );
+        let resources = ViewResources::new(&render_state.device, pipelines);
+        render_state
+            .renderer
+            .write()
+            .callback_resources
+            .insert(resources);
+        Self {
+            wireframe: false,
+            camera: OrbitCamera::default(),
+            home: OrbitCamera::default(),
+            vertex_count: 0,
+            has_colors: false,
+            output_linear: render_state.target_format.is_srgb(),
+            problem: None,
+        }
+    }
+
+    /// A new model: uploads triangles and edges, sets positions/normals, no colours, fits the camera.
+    pub fn set_mesh(
+        &mut self,
+        rs: &egui_wgpu::RenderState,
+        positions: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        edges: &[[u32; 2]],
+    ) {
+        let result = with_resources(rs, |view| {
+            view.mesh
+                .set_mesh(&rs.device, &rs.queue, positions, normals, triangles, edges)
+        });
+        match result {
+            Ok(()) => {
+                self.vertex_count = positions.len();
+                self.has_colors = false;
+                self.home = OrbitCamera::default();
+                self.home.fit_points(positions);
+                self.problem = None;
+                self.reset_view();
+            }
+            Err(e) => self.fail(e),
+        }
+    }
+
+    /// New positions for the same model (after smoothing on the CPU).
+    pub fn set_positions(
+        &mut self,
+        rs: &egui_wgpu::RenderState,
+        positions: &[[f32; 3]],
+        normals: &[[f32; 3]],
+    ) {
+        let result = with_resources(rs, |view| {
+            view.mesh
+                .set_positions(&rs.device, &rs.queue, positions, normals)
+        });
+        if let Err(e) = result {
+            self.fail(e);
+        }
+    }
+
+    /// New positions from buffers on the same device (WebGPU path: the smoothing engine's vec4
+    /// position buffer and a vec4 normal buffer), copied GPU-to-GPU with copy_buffer_to_buffer,
+    /// no CPU round trip. Both buffers have COPY_SRC usage and hold vertex_count * 16 bytes.
+    pub fn copy_positions_from(
+        &mut self,
+        rs: &egui_wgpu::RenderState,
+        positions: &wgpu::Buffer,
+        normals: &wgpu::Buffer,
+    ) {
+        let result = with_resources(rs, |view| {
+            view.mesh
+                .copy_positions_from(&rs.device, &rs.queue, positions, normals)
+        });
+        if let Err(e) = result {
+            self.fail(e);
+        }
+    }
+
+    /// Per-vertex colours (RGBA8, sRGB-encoded as a colour map gives them), or None for the base colour.
+    pub fn set_colors(&mut self, rs: &egui_wgpu::RenderState, colors: Option<&[[u8; 4]]>) {
+        let Some(colors) = colors else {
+            // The shader stops reading the colour buffer; nothing to upload.
+            self.has_colors = false;
+            return;
+        };
+        match with_resources(rs, |view| view.mesh.set_colors(&rs.queue, colors)) {
+            Ok(()) => self.has_colors = self.vertex_count > 0,
+            Err(e) => self.fail(e),
+        }
+    }
+
+    /// Paints into all the space `ui` has left. Left drag orbits, shift+left drag pans, the
+    /// wheel or a pinch zooms, a double click resets the view. Right and middle drags are not
+    /// used here: the caller reads them from the returned `Response`.
+    pub fn show(&mut self, ui: &mut egui::Ui) -> egui::Response {
+        let (rect, response) =
+            ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
+        controls::apply(&mut self.camera, ui, &response);
+        if response.double_clicked_by(egui::PointerButton::Primary) {
+            self.reset_view();
+        }
+
+        ui.painter().rect_filled(rect, 0.0, BACKGROUND);
+        if let Some(problem) = &self.problem {
+            centered_note(ui, rect, problem, ui.visuals().error_fg_color);
+        } else if self.vertex_count == 0 {
+            centered_note(ui, rect, "Nothing to show", ui.visuals().weak_text_color());
+        } else if rect.width() >= 1.0 && rect.height() >= 1.0 {
+            let mut flags = 0;
+            if self.has_colors {
+                flags |= VERTEX_COLORS;
+            }
+            if self.output_linear {
+                flags |= OUTPUT_LINEAR;
+            }
+            let callback = ViewCallback {
+                rect,
+                uniforms: ViewUniforms::new(&self.camera, rect.width() / rect.height(), flags),
+                wireframe: self.wireframe,
+            };
+            ui.painter()
+                .add(egui_wgpu::Callback::new_paint_callback(rect, callback));
+        }
+        response
+    }
+
+    /// Frames the whole model from the default direction.
+    pub fn reset_view(&mut self) {
+        self.camera = self.home;
+    }
+
+    /// Records why the model cannot be shown; the view shows the reason instead.
+    fn fail(&mut self, problem: String) {
+        log::error!("3D view: {problem}");
+        self.problem = Some(problem);
+    }
+}
+
+/// Runs `f` on the view's GPU resources (created by [`Viewer::new`]).
+fn with_resources(
+    rs: &egui_wgpu::RenderState,
+    f: impl FnOnce(&mut ViewResources) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut renderer = rs.renderer.write();
+    match renderer.callback_resources.get_mut::<ViewResources>() {
+        Some(view) => f(view),
+        None => Err("the 3D view's GPU resources are missing".into()),
+    }
+}
+
+fn centered_note(ui: &egui::Ui, rect: egui::Rect, text: &str, color: egui::Color32) {
+    ui.painter().text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        text,
+        egui::FontId::proportional(16.0),
+        color,
+    );
+}

@@ -1,0 +1,258 @@
+//! The 3D view's render pipelines: the surface and the wireframe draw into the view's own
+//! multisampled target; the composite copies its resolved image into egui's render pass.
+//!
+//! egui's pass on the web has one sample per pixel, which leaves silhouettes and lines jagged;
+//! jaggies on a staircase mesh would pass for the very artefacts the app smooths. Only
+//! WebGL2-level features are used: vertex attributes, one uniform buffer, a sampled texture,
+//! 4x MSAA (which WebGPU and WebGL2 both guarantee for 8-bit RGBA).
+
+use std::borrow::Cow;
+use std::num::NonZeroU64;
+
+use eframe::egui_wgpu::wgpu;
+
+use crate::view::{ViewUniforms, RENDER_SHADER};
+
+/// Bytes per vertex of the position and normal buffers: vec4<f32>, as the GPU engine stores
+/// positions (w ignored).
+pub const VEC4_STRIDE: u64 = 16;
+/// Bytes per vertex of the colour buffer: RGBA8.
+pub const COLOR_STRIDE: u64 = 4;
+
+/// The view's own depth buffer.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24Plus;
+
+/// Samples per pixel of the view's target when the device allows it.
+const MSAA_SAMPLES: u32 = 4;
+
+pub struct Pipelines {
+    /// Group 0: the per-frame `View` record.
+    pub view_layout: wgpu::BindGroupLayout,
+    /// Group 1 of the composite: the resolved image and its sampler.
+    pub composite_layout: wgpu::BindGroupLayout,
+    /// Lit, two-sided triangles; writes depth.
+    pub surface: wgpu::RenderPipeline,
+    /// Edges as a line list over the same positions; tests depth, writes none.
+    pub wire: wgpu::RenderPipeline,
+    /// The resolved image into egui's pass.
+    pub composite: wgpu::RenderPipeline,
+    /// Samples per pixel of the surface and wireframe target.
+    pub samples: u32,
+    /// Format of the view's colour target: egui's, so the shader's encoding is egui's too.
+    pub color_format: wgpu::TextureFormat,
+}
+
+/// Vertex attributes, one buffer each, at the locations shaders/render.wgsl reads.
+const POSITION: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x4];
+const NORMAL: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![1 => Float32x4];
+const COLOR: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![2 => Unorm8x4];
+
+fn per_vertex(
+    stride: u64,
+    attributes: &'static [wgpu::VertexAttribute],
+) -> Option<wgpu::VertexBufferLayout<'static>> {
+    Some(wgpu::VertexBufferLayout {
+        array_stride: stride,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes,
+    })
+}
+
+/// 4x when the adapter can multisample both the colour format and the depth format, else 1.
+fn sample_count(adapter: &wgpu::Adapter, color_format: wgpu::TextureFormat) -> u32 {
+    let supports = |format| {
+        adapter
+            .get_texture_format_features(format)
+            .flags
+            .sample_count_supported(MSAA_SAMPLES)
+    };
+    if supports(color_format) && supports(DEPTH_FORMAT) {
+        MSAA_SAMPLES
+    } else {
+        1
+    }
+}
+
+impl Pipelines {
+    /// Pipelines for egui's framebuffer format and egui's depth format (`None` when egui's
+    /// pass has no depth buffer; the composite must match the pass it draws in).
+    pub fn new(
+        device: &wgpu::Device,
+        adapter: &wgpu::Adapter,
+        target_format: wgpu::TextureFormat,
+        egui_depth_format: Option<wgpu::TextureFormat>,
+    ) -> Self {
+        let samples = sample_count(adapter, target_format);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("meshsmooth view"),
+            source: wgpu::ShaderSource::Wgsl(Cow::Borrowed(RENDER_SHADER)),
+        });
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("meshsmooth view"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: NonZeroU64::new(std::mem::size_of::<ViewUniforms>() as u64),
+                },
+                count: None,
+            }],
+        });
+        let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("meshsmooth view composite"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("meshsmooth view"),
+            bind_group_layouts: &[Some(&view_layout)],
+            immediate_size: 0,
+        });
+        let composite_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("meshsmooth view composite"),
+                bind_group_layouts: &[Some(&view_layout), Some(&composite_layout)],
+                immediate_size: 0,
+            });
+        let multisample = wgpu::MultisampleState {
+            count: samples,
+            ..Default::default()
+        };
+        let depth = |write: bool, compare| {
+            Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(write),
+                depth_compare: Some(compare),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            })
+        };
+        let target = |blend| {
+            [Some(wgpu::ColorTargetState {
+                format: target_format,
+                blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            })]
+        };
+
+        let surface_buffers = [
+            per_vertex(VEC4_STRIDE, &POSITION),
+            per_vertex(VEC4_STRIDE, &NORMAL),
+            per_vertex(COLOR_STRIDE, &COLOR),
+        ];
+        let surface = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("meshsmooth surface"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_surface"),
+                compilation_options: Default::default(),
+                buffers: &surface_buffers,
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                // Two-sided: open meshes show their inside.
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: depth(true, wgpu::CompareFunction::Less),
+            multisample,
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_surface"),
+                compilation_options: Default::default(),
+                // Opaque.
+                targets: &target(None),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+
+        let wire = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("meshsmooth wireframe"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_wire"),
+                compilation_options: Default::default(),
+                buffers: &[per_vertex(VEC4_STRIDE, &POSITION)],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::LineList,
+                ..Default::default()
+            },
+            // Lines are pulled towards the eye in the shader (`WIRE_PULL`), so the surface
+            // they lie on does not hide them while anything nearer still does.
+            depth_stencil: depth(false, wgpu::CompareFunction::LessEqual),
+            multisample,
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_wire"),
+                compilation_options: Default::default(),
+                // The shader writes premultiplied alpha, as egui blends.
+                targets: &target(Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+
+        let composite = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("meshsmooth view composite"),
+            layout: Some(&composite_pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_composite"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            // egui's pass: its depth buffer (if any) is neither tested nor written.
+            depth_stencil: egui_depth_format.map(|format| wgpu::DepthStencilState {
+                format,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_composite"),
+                compilation_options: Default::default(),
+                // Premultiplied over the view's background; transparent where there is no mesh.
+                targets: &target(Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+
+        Self {
+            view_layout,
+            composite_layout,
+            surface,
+            wire,
+            composite,
+            samples,
+            color_format: target_format,
+        }
+    }
+}
