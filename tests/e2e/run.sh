@@ -10,13 +10,16 @@
 #
 # Screenshots and exported files: target/e2e/<mode>/; benchmark lines: target/e2e/bench.json.
 # Needs: web/node_modules (npm ci in web/, .ci/install.sh), /usr/bin/chromium, ../shared/data.
+# To test another build: E2E_DIST=/path/to/dist MESHSMOOTH_CLI=/path/to/meshsmooth (then the
+# CLI is not built here).
 set -euo pipefail
 
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 export PATH="$PWD/web/node_modules/.bin:$HOME/.cargo/bin:$PATH"
 
-if [ ! -f dist/index.html ]; then
-    echo "tests/e2e/run.sh: dist/index.html is missing: build the page first (trunk build --release)" >&2
+dist="${E2E_DIST:-dist}"
+if [ ! -f "$dist/index.html" ]; then
+    echo "tests/e2e/run.sh: $dist/index.html is missing: build the page first (trunk build --release)" >&2
     exit 1
 fi
 if [ ! -d web/node_modules/playwright-core ] || [ ! -d web/node_modules/gltf-validator ]; then
@@ -26,13 +29,15 @@ fi
 
 # The CLI is the reference for every number the app reports; cargo skips the build when it is
 # up to date.
-cargo build --release --quiet
-target_dir="${CARGO_TARGET_DIR:-target}"
-case "$target_dir" in
-    /*) ;;
-    *) target_dir="$PWD/$target_dir" ;;
-esac
-export MESHSMOOTH_CLI="$target_dir/release/meshsmooth"
+if [ -z "${MESHSMOOTH_CLI:-}" ]; then
+    cargo build --release --quiet
+    target_dir="${CARGO_TARGET_DIR:-target}"
+    case "$target_dir" in
+        /*) ;;
+        *) target_dir="$PWD/$target_dir" ;;
+    esac
+    export MESHSMOOTH_CLI="$target_dir/release/meshsmooth"
+fi
 
 rm -rf target/e2e
 mkdir -p target/e2e

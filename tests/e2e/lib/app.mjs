@@ -17,12 +17,12 @@ export class AppPage {
      * text) or crashed (then throws with the page's crash message). Requests and console
      * messages are recorded from before the first navigation.
      */
-    static async open(browser, server, outDir, { startTimeoutMs = 60_000 } = {}) {
+    static async open(browser, server, outDir, { startTimeoutMs = 60_000, query = "" } = {}) {
         const context = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1 });
         const page = await context.newPage();
         const app = new AppPage(context, page, server, outDir);
         const started = Date.now();
-        await page.goto(server.url, { waitUntil: "load", timeout: startTimeoutMs });
+        await page.goto(server.url + query, { waitUntil: "load", timeout: startTimeoutMs });
         await app.waitForStart(startTimeoutMs);
         app.startSeconds = (Date.now() - started) / 1000;
         return app;

@@ -7,14 +7,17 @@ export function relativeDifference(actual, expected, scale = 0) {
 }
 
 /**
- * Compares two JSON values: same keys, the same booleans, strings and nulls, numbers within `rtol`
- * relative (for counts below 1e9 and rtol <= 1e-9 that is equality). Returns a list of differences (empty when equal) as readable lines.
+ * Compares two JSON values: the same keys, booleans, strings and nulls; numbers within `rtol`
+ * relative (for counts below 1e9 and rtol <= 1e-9 that is equality); numbers under a key of
+ * `f32Keys` equal once rounded to f32. Returns the differences as readable lines (none: equal).
  */
-export function jsonDifferences(actual, expected, rtol, path = "") {
+export function jsonDifferences(actual, expected, rtol, { f32Keys = [] } = {}, path = "", asF32 = false) {
     const where = path || "(top)";
     if (expected === null || typeof expected !== "object") {
         if (typeof expected === "number" && typeof actual === "number") {
-            // Counts are below 1e9, so within 1e-9 relative they are equal.
+            if (asF32) {
+                return Math.fround(actual) === Math.fround(expected) ? [] : [`${where}: ${actual}, expected ${expected} (different as f32)`];
+            }
             const d = relativeDifference(actual, expected);
             return d <= rtol ? [] : [`${where}: ${actual}, expected ${expected} (relative difference ${d.toExponential(2)} > ${rtol})`];
         }
@@ -24,7 +27,7 @@ export function jsonDifferences(actual, expected, rtol, path = "") {
         if (!Array.isArray(actual) || actual.length !== expected.length) {
             return [`${where}: ${JSON.stringify(actual)}, expected ${JSON.stringify(expected)}`];
         }
-        return expected.flatMap((e, i) => jsonDifferences(actual[i], e, rtol, `${path}[${i}]`));
+        return expected.flatMap((e, i) => jsonDifferences(actual[i], e, rtol, { f32Keys }, `${path}[${i}]`, asF32));
     }
     if (actual === null || typeof actual !== "object") {
         return [`${where}: ${JSON.stringify(actual)}, expected an object`];
@@ -36,7 +39,8 @@ export function jsonDifferences(actual, expected, rtol, path = "") {
     if (extra.length) lines.push(`${where}: unexpected keys ${extra.join(", ")}`);
     for (const key of Object.keys(expected)) {
         if (key in actual) {
-            lines.push(...jsonDifferences(actual[key], expected[key], rtol, path ? `${path}.${key}` : key));
+            const keyPath = path ? `${path}.${key}` : key;
+            lines.push(...jsonDifferences(actual[key], expected[key], rtol, { f32Keys }, keyPath, asF32 || f32Keys.includes(key)));
         }
     }
     return lines;
