@@ -1,6 +1,6 @@
 // End-to-end tests of the built web app (dist/) in headless Chromium, in one mode per run:
 //
-//   E2E_MODE=webgpu|cpu node --test tests/e2e/   (tests/e2e/run.sh runs both)
+//   E2E_MODE=webgpu|cpu node --test tests/e2e/app.test.mjs   (tests/e2e/run.sh runs both)
 //
 // `webgpu`: WebGPU on SwiftShader, the app smooths on its GPU engine. `cpu`: no WebGPU, eframe
 // draws with WebGL2 and the app smooths with its CPU engine. The native CLI is the reference for
@@ -111,8 +111,8 @@ async function withLoaded(file, body) {
 }
 
 /**
- * The app logs every mesh it opens ("opened NAME: N vertices, M faces", src/app/state.rs) and
- * every file it cannot open ("cannot open NAME: why"). The tests that must pass without the
+ * The app logs every mesh it opens ("opened NAME: N vertices, M faces") and every file it
+ * cannot open ("Cannot open NAME: why") to the console (src/app). The tests that need no
  * embedding API use these lines as their evidence.
  */
 const escape = (text) => text.replace(/[.*+?^${}()|[\]\\]/g, "\\$&");
