@@ -99,7 +99,9 @@ else
     say "trunk $TRUNK_VERSION present"
 fi
 
-# --- npm tools of the web build (wasm-opt from binaryen), installed from the lock file ---
+# --- npm packages, installed from the lock file: wasm-opt (binaryen) for the web build;
+# playwright-core (drives the apt-installed chromium, downloads no browser) and gltf-validator
+# for the end-to-end tests ---
 lock_sum="$(sha256sum web/package-lock.json | cut -d' ' -f1)"
 stamp=web/node_modules/.installed-from-lock
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$lock_sum" ]; then

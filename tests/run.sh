@@ -51,8 +51,9 @@ stage test-native cargo test
 # browser.
 stage test-wasm32-browser wasm-pack test --headless --chrome -- --lib --test wasm_io --test wasm_gpu
 stage web-build trunk build --release
-# End-to-end browser tests of the built app go here, one line:
-# stage e2e <command>
+# End-to-end tests of the built app (dist/) in headless Chromium, with WebGPU and without, against
+# the CLI's numbers; screenshots in target/e2e/.
+stage e2e bash tests/e2e/run.sh
 
 echo
 echo "tests/run.sh: all ${#passed[@]} stages passed (${passed[*]}) in $((SECONDS - started)) s"

@@ -1,0 +1,487 @@
+// End-to-end tests of the built web app (dist/) in headless Chromium, in one mode per run:
+//
+//   E2E_MODE=webgpu|cpu node --test tests/e2e/app.test.mjs   (tests/e2e/run.sh runs both)
+//
+// `webgpu`: WebGPU on SwiftShader, the app smooths on its GPU engine. `cpu`: no WebGPU, eframe
+// draws with WebGL2 and the app smooths with its CPU engine. The native CLI is the reference for
+// every number. Screenshots go to target/e2e/<mode>/.
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { appendFileSync, existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+
+import { AppPage } from "./lib/app.mjs";
+import { MODES, launchBrowser, modeFromEnv } from "./lib/browser.mjs";
+import * as cli from "./lib/cli.mjs";
+import { jsonDifferences, metricDifferences, relativeDifference } from "./lib/compare.mjs";
+import { gltfValidator } from "./lib/deps.mjs";
+import { colourHistogram, flatBoxes } from "./lib/png.mjs";
+import { DIST, E2E_OUT, meshPath, outputDir } from "./lib/paths.mjs";
+import { serveDirectory } from "./lib/server.mjs";
+
+const MODE = modeFromEnv();
+const OUT = outputDir(MODE);
+
+const SAMPLE = { name: "bent_tube_staircase.ply", vertices: 2296, faces: 4588 };
+const TORUS = meshPath("synthetic/synthetic_torus_R24_r8.ply");
+const SCALP = meshPath("real/fsaverage_head_scalp_mne.ply");
+const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
+
+/** The page must be up within this many seconds (it takes about 2 s on SwiftShader). */
+const START_LIMIT_S = 20;
+
+/**
+ * Tolerances of the app's measures against the native CLI's (relative; see compare.mjs).
+ * cpu: the wasm build runs the same Rust code on the same f32 positions; only the order of f64
+ * sums may differ (rayon splits them natively, wasm runs one thread). Measured on the scalp,
+ * all four filters: at most 2.2e-16 (one ulp of curvature0). 1e-9 keeps a wide margin and still
+ * catches any real divergence (a changed parameter moves the measures by 1e-3 or more).
+ * webgpu: smoothing runs as WGSL in f32. Natively on lavapipe the GPU engine's positions were
+ * bit-identical to the CPU's for these cases (and HC 50, sinc 100), so the measures were equal;
+ * but WGSL lets a GPU fuse multiply-adds and round division and square roots differently (a
+ * few ulp per operation, ~1e-7 relative), which 100 iterations and the drifting reference of
+ * the local error can grow. 1e-4 allows that on real GPUs while a wrong parameter (1e-3 and
+ * more) still fails. Each run prints the differences it saw (metrics-vs-cli lines).
+ */
+const METRIC_RTOL = { cpu: 1e-9, webgpu: 1e-4 }[MODE];
+/** info is computed from the parsed file, the same code natively and in wasm. */
+const INFO_RTOL = 1e-9;
+/**
+ * The bounding box holds f32 coordinates. The CLI prints each as the shortest decimal of the f32
+ * (-83.23214); the app's JSON widens it to f64 first (-83.23213958740234): the same f32, a
+ * relative difference of ~1e-8 in the text. Compared as f32, exactly.
+ */
+const INFO_F32_KEYS = ["bbox_min", "bbox_max"];
+
+/** Non-default parameters per filter (defaults and ranges: ../shared/docs/ALGORITHMS.md). */
+const FILTER_CASES = {
+    laplace: { lambda: 0.3, iterations: 7 },
+    taubin: { lambda: 0.4, mu: -0.45, iterations: 12 },
+    hc: { alpha: 0.2, beta: 0.6, iterations: 15, max_displacement: 0.8 },
+    sinc: { passband: 0.05, iterations: 30 },
+};
+
+const API_TIMEOUT = 5 * 60_000;
+
+let server;
+let browser;
+let tmp;
+
+before(async () => {
+    if (!existsSync(join(DIST, "index.html"))) {
+        throw new Error(`${DIST}/index.html is missing: build the page first (trunk build --release)`);
+    }
+    cli.requireCli();
+    tmp = mkdtempSync(join(tmpdir(), "meshsmooth-e2e-"));
+    server = await serveDirectory(DIST);
+    browser = await launchBrowser(MODE);
+    console.log(`e2e: mode ${MODE}, Chromium ${browser.version()}, serving ${DIST} at ${server.url}`);
+});
+
+after(async () => {
+    await browser?.close();
+    await server?.close();
+    if (tmp) rmSync(tmp, { recursive: true, force: true });
+});
+
+/**
+ * Runs `body` with a freshly opened page, closes it after, and checks that the page asked
+ * nothing of any origin but its own while it was open.
+ */
+async function withApp(body, options = {}) {
+    const app = await AppPage.open(browser, server, OUT, options);
+    try {
+        const result = await body(app);
+        assert.deepEqual(app.foreignRequests(), [], "the page requested something outside its own origin");
+        assert.deepEqual(app.pageErrors.map(String), [], "uncaught errors in the page");
+        return result;
+    } finally {
+        await app.close();
+    }
+}
+
+/** Opens the app and loads `file` through the API. */
+async function withLoaded(file, body) {
+    return withApp(async (app) => {
+        const name = file.split("/").pop();
+        const info = await app.loadMesh(readFileSync(file), name);
+        return body(app, info, name);
+    });
+}
+
+/**
+ * The app logs every mesh it opens ("opened NAME: N vertices, M faces") and every file it
+ * cannot open ("Cannot open NAME: why") to the console (src/app). The tests that need no
+ * embedding API use these lines as their evidence.
+ */
+const escape = (text) => text.replace(/[.*+?^${}()|[\]\\]/g, "\\$&");
+const openedLog = (name, vertices) => new RegExp(`opened ${escape(name)}: ${vertices ?? "\\d+"} vertices`);
+const refusedLog = (name) => new RegExp(`cannot open ${escape(name)}: `, "i");
+
+const isRed = (image, i) => image.rgba[i] >= 180 && image.rgba[i + 1] <= 90 && image.rgba[i + 2] <= 90;
+
+/** Pixels of an error colour (egui draws errors in red) below the top bar. */
+function redPixels(image) {
+    let count = 0;
+    for (let i = image.width * 4 * 30; i < image.rgba.length; i += 4) {
+        if (isRed(image, i)) count++;
+    }
+    return count;
+}
+
+// --- 1: start-up ---
+
+test("1a the page starts with the bundled sample within seconds", { timeout: 120_000 }, async () => {
+    await withApp(async (app) => {
+        assert.ok(
+            app.startSeconds <= START_LIMIT_S,
+            `the app took ${app.startSeconds.toFixed(1)} s to start (limit ${START_LIMIT_S} s)`,
+        );
+        await app.waitForConsole(openedLog(SAMPLE.name, SAMPLE.vertices));
+        await app.screenshot("01-start");
+        // The browser is in the mode this run claims: a WebGPU adapter exactly in the webgpu run.
+        const adapter = await app.page.evaluate(async () =>
+            navigator.gpu ? (await navigator.gpu.requestAdapter()) !== null : false,
+        );
+        assert.equal(adapter, MODE === "webgpu", `navigator.gpu.requestAdapter() ${adapter ? "found" : "found no"} adapter in the ${MODE} run`);
+        console.log(`e2e ${MODE}: started in ${app.startSeconds.toFixed(2)} s`);
+    });
+});
+
+test("1b the API reports the sample and the engine backend", { timeout: 120_000 }, async () => {
+    await withApp(async (app) => {
+        const state = await app.state();
+        assert.equal(state.model, SAMPLE.name, "state().model");
+        assert.equal(state.vertices, SAMPLE.vertices, "state().vertices");
+        assert.equal(state.faces, SAMPLE.faces, "state().faces");
+        assert.equal(state.error, null, "state().error");
+        assert.equal(typeof state.busy, "boolean", "state().busy");
+        assert.equal(await app.backend(), MODES[MODE].backend, `backend() in the ${MODE} run`);
+    });
+});
+
+// --- 2: privacy ---
+
+test("2 every request the page makes goes to its own origin", { timeout: 120_000 }, async () => {
+    await withApp(async (app) => {
+        await app.waitForConsole(openedLog(SAMPLE.name));
+        await app.page.waitForLoadState("networkidle");
+        assert.ok(
+            app.requests.some((url) => url.endsWith(".wasm")),
+            `the page's requests were recorded from the first navigation (got ${app.requests.join(", ")})`,
+        );
+        assert.deepEqual(app.foreignRequests(), [], "requests outside the page's origin");
+        console.log(`e2e ${MODE}: requests: ${app.requests.map((u) => new URL(u).pathname).join(" ")}`);
+    });
+    // A link that names a model elsewhere must not make the page fetch it.
+    for (const model of ["http://example.invalid/scan.ply", "//example.invalid/scan.stl"]) {
+        await withApp(
+            async (app) => {
+                await app.waitForConsole(openedLog(SAMPLE.name));
+                await app.page.waitForLoadState("networkidle");
+                assert.deepEqual(app.foreignRequests(), [], `requests outside the page's origin with ?model=${model}`);
+            },
+            { query: `?model=${encodeURIComponent(model)}` },
+        );
+    }
+});
+
+// --- 3: the Open button and the file input ---
+
+test("3 Open… opens the file chooser, and the chosen torus is loaded", { timeout: API_TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        // Listen first: Playwright starts intercepting file choosers when the listener is added,
+        // asynchronously; a click right after it sometimes opened a chooser nobody caught.
+        const chooserOpened = app.page.waitForEvent("filechooser", { timeout: 30_000 });
+        chooserOpened.catch(() => {}); // awaited below; a rejection before then is not unhandled
+        // The button is drawn in the canvas: find it in a screenshot of the top bar (the first
+        // flat-filled box from the left: the title and the hint are text, not boxes).
+        const topBarBoxes = (image) => flatBoxes(image, { y0: 0, y1: 48 });
+        const image = await app.screenshotWhen("03-before-open", (i) => topBarBoxes(i).length > 0, "a button in the top bar");
+        const button = topBarBoxes(image)[0];
+        await app.page.mouse.click(button.x + button.width / 2, button.y + button.height / 2);
+        const chooser = await chooserOpened.catch((e) => {
+            throw new Error(
+                `clicking the top bar's first button at (${button.x}, ${button.y}, ${button.width}x${button.height}) ` +
+                    `opened no file chooser (${e.message}); see ${image.path}`,
+            );
+        });
+        assert.equal(chooser.isMultiple(), false, "the chooser takes one file");
+        await chooser.setFiles(TORUS);
+        const name = "synthetic_torus_R24_r8.ply";
+        await app.waitForConsole(openedLog(name));
+        await app.screenshot("03-torus-opened");
+        await app.api();
+        await app.page.waitForFunction((name) => window.meshsmooth.state().model === name, name, { timeout: 60_000 });
+        const [state, expected] = await Promise.all([app.state(), cli.info(TORUS)]);
+        assert.equal(state.error, null, "state().error");
+        assert.equal(state.vertices, expected.vertices, "state().vertices");
+        assert.equal(state.faces, expected.faces, "state().faces");
+    });
+});
+
+// --- 4: loading through the API ---
+
+test("4 loadMesh resolves with the CLI's info --json", { timeout: API_TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        const [info, expected] = await Promise.all([
+            app.loadMesh(readFileSync(SCALP), "fsaverage_head_scalp_mne.ply"),
+            cli.info(SCALP),
+        ]);
+        const differences = jsonDifferences(info, expected, INFO_RTOL, { f32Keys: INFO_F32_KEYS });
+        assert.deepEqual(differences, [], `loadMesh's info differs from \`meshsmooth info --json\`:\n${differences.join("\n")}`);
+        const state = await app.state();
+        assert.equal(state.model, "fsaverage_head_scalp_mne.ply", "state().model");
+        assert.equal(state.vertices, expected.vertices, "state().vertices");
+        assert.equal(state.faces, expected.faces, "state().faces");
+        assert.equal(state.error, null, "state().error");
+        await app.screenshot("04-scalp-loaded");
+    });
+});
+
+// --- 5: smoothing and measures against the CLI ---
+
+for (const [filter, params] of Object.entries(FILTER_CASES)) {
+    test(`5 ${filter}: metrics() equals the CLI's smooth --json for ${JSON.stringify(params)}`, { timeout: API_TIMEOUT }, async (t) => {
+        const reference = cli.smooth(SCALP, join(tmp, `scalp-${filter}.ply`), filter, params);
+        await withLoaded(SCALP, async (app) => {
+            await app.setFilter(filter);
+            await app.setParams(params);
+            const metrics = await app.metrics();
+            const state = await app.state();
+            assert.equal(state.filter, filter, "state().filter");
+            for (const [key, value] of Object.entries(params)) {
+                // The engine may keep a parameter as f32: 0.3 reads back as 0.30000001192...
+                assert.ok(
+                    typeof state.params[key] === "number" && relativeDifference(state.params[key], value) <= 1e-6,
+                    `state().params.${key} is ${JSON.stringify(state.params[key])}, expected ${value}`,
+                );
+            }
+            const expected = (await reference).metrics;
+            const { problems, differences } = metricDifferences(metrics, expected, METRIC_RTOL);
+            const worst = Math.max(...Object.values(differences));
+            t.diagnostic(`largest relative difference ${worst.toExponential(2)} (tolerance ${METRIC_RTOL})`);
+            console.log(JSON.stringify({ e2e: "metrics-vs-cli", mode: MODE, filter, params, relative_differences: differences }));
+            assert.deepEqual(problems, [], `metrics() differs from the CLI's (${MODE}):\n${problems.join("\n")}`);
+            if (filter === "hc") {
+                await app.screenshot("05-scalp-smoothed-hc");
+            }
+        });
+    });
+}
+
+test("5 setFilter and setParams refuse bad values with the engine's message", { timeout: API_TIMEOUT }, async () => {
+    const rangeMessage = await cli.refusal("smooth", SCALP, "-o", join(tmp, "refused.ply"), "--iterations", "1000");
+    await withApp(async (app) => {
+        const unknown = await app.attempt("setFilter", "bilateral");
+        assert.equal(unknown.ok, false, "setFilter('bilateral') was accepted");
+        assert.ok(unknown.isError, `setFilter('bilateral') threw a non-Error: ${unknown.message}`);
+        assert.match(unknown.message, /bilateral/, "the message names the unknown filter");
+
+        const before = await app.state();
+        const range = await app.attempt("setParams", { iterations: 1000 });
+        assert.equal(range.ok, false, "setParams({iterations: 1000}) was accepted");
+        assert.ok(range.isError, `setParams threw a non-Error: ${range.message}`);
+        assert.ok(
+            range.message.includes(rangeMessage),
+            `setParams({iterations: 1000}) threw "${range.message}"; expected the engine's message "${rangeMessage}"`,
+        );
+        const afterRefusal = await app.state();
+        assert.deepEqual(afterRefusal.params, before.params, "a refused value changed state().params");
+    });
+});
+
+// --- 6: exports ---
+
+test("6 every export format reads back with the CLI; the GLB is valid glTF", { timeout: API_TIMEOUT }, async (t) => {
+    const expected = await cli.info(SCALP);
+    await withLoaded(SCALP, async (app) => {
+        await app.setFilter("hc");
+        await app.metrics();
+        for (const format of ["glb", "stl", "ply", "obj"]) {
+            await t.test(format, async () => {
+                const bytes = await app.exportMesh(format);
+                assert.ok(bytes.length > 0, `exportMesh('${format}') is empty`);
+                const file = join(OUT, `06-scalp-export.${format}`);
+                writeFileSync(file, bytes);
+                const info = await cli.info(file);
+                // An STL stores each triangle's corners: the CLI welds them back, so the vertex
+                // count equals the indexed mesh's again.
+                assert.equal(info.vertices, expected.vertices, `vertices of the exported ${format} (${file})`);
+                assert.equal(info.faces, expected.faces, `faces of the exported ${format} (${file})`);
+                assert.equal(info.closed, expected.closed, `closed, exported ${format}`);
+                if (format === "glb") {
+                    const report = await gltfValidator.validateBytes(new Uint8Array(bytes), { uri: "export.glb", format: "glb" });
+                    const errors = report.issues.messages.filter((m) => m.severity === 0);
+                    assert.equal(
+                        report.issues.numErrors,
+                        0,
+                        `glTF-Validator found errors in ${file}:\n${errors.map((m) => `${m.code} ${m.pointer ?? ""}: ${m.message}`).join("\n")}`,
+                    );
+                    t.diagnostic(`glTF-Validator: ${report.issues.numWarnings} warnings, ${report.issues.numInfos} infos`);
+                }
+            });
+        }
+    });
+});
+
+test("6 no export carries the input STL's header text (a patient name)", { timeout: API_TIMEOUT }, async (t) => {
+    const stl = join(tmp, "jane.stl");
+    await cli.cli("convert", TORUS, stl);
+    const bytes = readFileSync(stl);
+    bytes.fill(0x20, 0, 80);
+    bytes.write("patient: Jane Doe, born 1970-01-01", 0, "latin1");
+    const expected = await cli.info(TORUS);
+    await withApp(async (app) => {
+        const info = await app.loadMesh(bytes, "scan.stl");
+        assert.equal(info.vertices, expected.vertices, "the STL's corners are welded on load");
+        for (const format of ["stl", "glb", "ply", "obj"]) {
+            await t.test(format, async () => {
+                const exported = await app.exportMesh(format);
+                writeFileSync(join(OUT, `06-jane-export.${format}`), exported);
+                assert.equal(exported.includes("Jane Doe"), false, `the exported ${format} contains "Jane Doe"`);
+                if (format === "stl") {
+                    const header = exported.subarray(0, 80).toString("latin1");
+                    assert.equal(/patient/i.test(header), false, `the STL header was copied: "${header.trim()}"`);
+                }
+            });
+        }
+    });
+});
+
+// --- 7: a file that cannot be read ---
+
+const BROKEN = Buffer.from("solid\x00\x01\x02\x03\x04", "latin1"); // 10 bytes: no STL
+
+test("7a a bad file dropped on the page is reported on screen and the sample stays", { timeout: 120_000 }, async () => {
+    await withApp(async (app) => {
+        await app.waitForConsole(openedLog(SAMPLE.name));
+        const before = await app.screenshot("07-before-drop");
+        const redBefore = redPixels(before);
+        await app.dropFile(BROKEN, "broken.stl");
+        const warning = await app.waitForConsole(refusedLog("broken.stl"));
+        assert.equal(
+            app.console.some((line) => openedLog("broken.stl").test(line.text)),
+            false,
+            "the app claims to have opened broken.stl",
+        );
+        const shown = await app.screenshotWhen(
+            "07-drop-error",
+            (image) => redPixels(image) > redBefore + 200,
+            "the error text in red",
+        );
+        console.log(`e2e ${MODE}: drop reported: ${warning.text}; red pixels ${redBefore} -> ${redPixels(shown)}`);
+    });
+});
+
+test("7b after a bad drop state() names the file and keeps the model; loadMesh of garbage rejects", { timeout: API_TIMEOUT }, async () => {
+    const brokenFile = join(tmp, "broken.stl");
+    writeFileSync(brokenFile, BROKEN);
+    const garbage = Buffer.from("hello, this is not a mesh\n");
+    const garbageFile = join(tmp, "garbage.ply");
+    writeFileSync(garbageFile, garbage);
+    // The CLI prefixes its message with the path it was given; the engine's reason follows.
+    const brokenReason = (await cli.refusal("info", brokenFile)).replace(`${brokenFile}: `, "");
+    const garbageReason = (await cli.refusal("info", garbageFile)).replace(`${garbageFile}: `, "");
+
+    await withApp(async (app) => {
+        await app.api();
+        await app.dropFile(BROKEN, "broken.stl");
+        await app.page.waitForFunction(() => window.meshsmooth.state().error !== null, null, { timeout: 60_000 });
+        const state = await app.state();
+        assert.match(state.error, /broken\.stl/, "state().error names the file");
+        assert.ok(state.error.includes(brokenReason), `state().error "${state.error}" lacks the engine's reason "${brokenReason}"`);
+        assert.equal(state.model, SAMPLE.name, "the previous model stays");
+        assert.equal(state.vertices, SAMPLE.vertices, "the previous model's vertices stay");
+
+        const result = await app.attemptLoad(garbage, "garbage.ply");
+        assert.equal(result.ok, false, "loadMesh of garbage resolved");
+        assert.ok(result.isError, `loadMesh rejected with a non-Error: ${result.message}`);
+        assert.ok(
+            result.message.includes(garbageReason),
+            `loadMesh rejected with "${result.message}"; expected the engine's message "${garbageReason}"`,
+        );
+        assert.equal((await app.state()).model, SAMPLE.name, "the previous model stays after a rejected loadMesh");
+    });
+});
+
+// --- 8: the 3D view ---
+
+/**
+ * Whether the middle of the page (where the 3D view centres the mesh, between the side panels)
+ * shows something: at least 5 % of its pixels differ from its most common colour and it has
+ * many colours (shading or colour-coding), rather than one flat panel colour.
+ */
+function middleShowsSomething(image) {
+    const box = {
+        x0: Math.round(image.width * 0.4),
+        x1: Math.round(image.width * 0.6),
+        y0: Math.round(image.height * 0.35),
+        y1: Math.round(image.height * 0.65),
+    };
+    const histogram = colourHistogram(image, box);
+    const total = (box.x1 - box.x0) * (box.y1 - box.y0);
+    return histogram.length >= 32 && 1 - histogram[0][1] / total >= 0.05;
+}
+
+test("8 the 3D view draws the mesh: the sample at start, the scalp smoothed and colour-coded", { timeout: API_TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.screenshotWhen("08-view-sample", middleShowsSomething, "the sample mesh in the middle of the page", 30_000);
+        await app.loadMesh(readFileSync(SCALP), "fsaverage_head_scalp_mne.ply");
+        await app.setFilter("hc");
+        await app.setParams(FILTER_CASES.hc);
+        await app.metrics();
+        await app.screenshotWhen("08-view-scalp-hc", middleShowsSomething, "the smoothed scalp in the middle of the page", 30_000);
+    });
+});
+
+// --- 9: benchmark, printed and never asserted ---
+
+test("9 benchmark: HC, 20 iterations, on the 206k-vertex segmentation (printed)", { timeout: 20 * 60_000 }, async () => {
+    const native = await cli.cliJson("bench", BRAIN, "--filter", "hc", "--iterations", "20", "--repeat", "3", "--json");
+    const lines = [
+        {
+            bench: "native",
+            backend: native.backend,
+            threads: native.threads,
+            mesh: "seg_mni152_gm_plus_wm_p0.5_1mm.ply",
+            vertices: native.vertices,
+            filter: "hc",
+            iterations: 20,
+            smooth_seconds: native.seconds,
+            measure_seconds: native.measure_seconds,
+            drift_seconds: native.drift_seconds,
+        },
+    ];
+    const emit = (line) => {
+        console.log(JSON.stringify(line));
+        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
+    };
+    emit(lines[0]);
+    const reference = cli.smooth(BRAIN, join(tmp, "brain-hc20.ply"), "hc", { iterations: 20 });
+    await withLoaded(BRAIN, async (app, info) => {
+        await app.setFilter("hc");
+        await app.metrics(); // the default 10 iterations first: load-time work stays out of the timing
+        const { seconds, metrics } = await app.page.evaluate(async () => {
+            const start = performance.now();
+            await window.meshsmooth.setParams({ iterations: 20 });
+            const metrics = await window.meshsmooth.metrics();
+            return { seconds: (performance.now() - start) / 1000, metrics };
+        });
+        // Not a speed assertion: the timing counts only if it timed the 20-iteration result.
+        const { problems } = metricDifferences(metrics, (await reference).metrics, METRIC_RTOL);
+        assert.deepEqual(problems, [], `the timed metrics() are not HC with 20 iterations:\n${problems.join("\n")}`);
+        emit({
+            bench: "browser",
+            mode: MODE,
+            backend: await app.backend(),
+            mesh: "seg_mni152_gm_plus_wm_p0.5_1mm.ply",
+            vertices: info.vertices,
+            filter: "hc",
+            iterations: 20,
+            seconds_set_params_and_metrics: seconds,
+        });
+        await app.screenshot("09-brain-smoothed-hc");
+    });
+});

@@ -1,0 +1,307 @@
+// One page of the app under test, and the embedding API (`window.meshsmooth`) seen from Node.
+//
+// Every test opens its own page (a fresh browser context), so no test depends on what another
+// left behind: the app starts with its bundled sample each time.
+import { writeFileSync } from "node:fs";
+import { join } from "node:path";
+import { assertNotBlank, decodePng } from "./png.mjs";
+
+/** How long a started page may take to announce `window.meshsmooth` (meshsmooth-ready). */
+const API_WAIT_MS = Number(process.env.E2E_API_WAIT_MS ?? 10_000);
+
+export const VIEWPORT = { width: 1280, height: 800 };
+
+export class AppPage {
+    /**
+     * Opens the served page and waits until the app has started (eframe removed the loading
+     * text) or crashed (then throws with the page's crash message). Requests and console
+     * messages are recorded from before the first navigation.
+     */
+    static async open(browser, server, outDir, { startTimeoutMs = 60_000, query = "" } = {}) {
+        const context = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1 });
+        const page = await context.newPage();
+        const app = new AppPage(context, page, server, outDir);
+        const started = Date.now();
+        await page.goto(server.url + query, { waitUntil: "load", timeout: startTimeoutMs });
+        await app.waitForStart(startTimeoutMs);
+        app.startSeconds = (Date.now() - started) / 1000;
+        return app;
+    }
+
+    constructor(context, page, server, outDir) {
+        this.context = context;
+        this.page = page;
+        this.server = server;
+        this.outDir = outDir;
+        /** Every URL the page requested, in order. */
+        this.requests = [];
+        /** Console messages as `{type, text}`, in order. */
+        this.console = [];
+        this.pageErrors = [];
+        this.consoleWaiters = new Set();
+        page.on("request", (request) => this.requests.push(request.url()));
+        page.on("pageerror", (error) => this.pageErrors.push(error));
+        page.on("console", (message) => {
+            const line = { type: message.type(), text: message.text() };
+            this.console.push(line);
+            for (const waiter of this.consoleWaiters) {
+                waiter(line);
+            }
+        });
+    }
+
+    async close() {
+        await this.context.close();
+    }
+
+    async waitForStart(timeoutMs) {
+        const handle = await this.page.waitForFunction(
+            () => {
+                const crash = document.getElementById("crash_message");
+                if (crash && !crash.hidden) {
+                    return { crashed: crash.innerText };
+                }
+                return document.getElementById("loading_text") === null ? { started: true } : false;
+            },
+            null,
+            { timeout: timeoutMs },
+        );
+        const result = await handle.jsonValue();
+        if (result.crashed) {
+            throw new Error(`the app crashed while starting: ${result.crashed}`);
+        }
+    }
+
+    /** The first console message (already logged or still to come) whose text matches `pattern`. */
+    waitForConsole(pattern, timeoutMs = 30_000) {
+        const found = this.console.find((line) => pattern.test(line.text));
+        if (found) {
+            return Promise.resolve(found);
+        }
+        return new Promise((resolve, reject) => {
+            const timer = setTimeout(() => {
+                this.consoleWaiters.delete(waiter);
+                const recent = this.console.slice(-10).map((l) => `  [${l.type}] ${l.text}`);
+                reject(new Error(`no console message matching ${pattern} within ${timeoutMs} ms; last messages:\n${recent.join("\n")}`));
+            }, timeoutMs);
+            const waiter = (line) => {
+                if (pattern.test(line.text)) {
+                    clearTimeout(timer);
+                    this.consoleWaiters.delete(waiter);
+                    resolve(line);
+                }
+            };
+            this.consoleWaiters.add(waiter);
+        });
+    }
+
+    /** Saves a screenshot as `<outDir>/<name>.png`, checks it is not blank, returns the image. */
+    async screenshot(name) {
+        const bytes = await this.page.screenshot();
+        const path = join(this.outDir, `${name}.png`);
+        writeFileSync(path, bytes);
+        const image = decodePng(bytes);
+        assertNotBlank(image, path);
+        image.path = path;
+        return image;
+    }
+
+    /**
+     * Takes screenshots until `predicate(image)` holds (the next frames may still be on their
+     * way), then saves the last one as `<name>.png`.
+     */
+    async screenshotWhen(name, predicate, what, timeoutMs = 30_000) {
+        const deadline = Date.now() + timeoutMs;
+        for (;;) {
+            const image = await this.screenshot(name);
+            if (predicate(image)) {
+                return image;
+            }
+            if (Date.now() > deadline) {
+                throw new Error(`${what}: not seen on screen within ${timeoutMs} ms (last screenshot: ${image.path})`);
+            }
+            // Wait for the next frames the browser paints, not for a fixed time.
+            await this.page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+        }
+    }
+
+    /** URLs the page requested outside its own origin (data: URLs and own-origin blob: URLs are local). */
+    foreignRequests() {
+        return this.requests.filter((url) => {
+            const parsed = new URL(url);
+            if (parsed.protocol === "data:") {
+                return false;
+            }
+            if (parsed.protocol === "blob:") {
+                return new URL(parsed.pathname).origin !== this.server.origin;
+            }
+            return parsed.origin !== this.server.origin;
+        });
+    }
+
+    // --- the embedding API ---
+
+    /**
+     * Waits for `window.meshsmooth` (it may already be there, or come with the
+     * `meshsmooth-ready` event); throws "window.meshsmooth missing" when it does not come.
+     */
+    async api() {
+        if (this.apiReady) {
+            return;
+        }
+        const seen = await this.page.evaluate(
+            (ms) =>
+                new Promise((resolve) => {
+                    if (window.meshsmooth) {
+                        resolve("present");
+                        return;
+                    }
+                    const timer = setTimeout(() => resolve(window.meshsmooth ? "present" : "none"), ms);
+                    window.addEventListener(
+                        "meshsmooth-ready",
+                        () => {
+                            clearTimeout(timer);
+                            resolve(window.meshsmooth ? "present" : "event-only");
+                        },
+                        { once: true },
+                    );
+                }),
+            API_WAIT_MS,
+        );
+        if (seen === "none") {
+            throw new Error(
+                `window.meshsmooth missing: the app started, but no meshsmooth-ready event came within ${API_WAIT_MS} ms ` +
+                    "and window.meshsmooth is undefined (this build of dist/ has no embedding API)",
+            );
+        }
+        if (seen === "event-only") {
+            throw new Error("window.meshsmooth missing: the meshsmooth-ready event fired but window.meshsmooth is undefined");
+        }
+        this.apiReady = true;
+    }
+
+    /** Calls `window.meshsmooth[method](...args)` and awaits its result. */
+    async call(method, ...args) {
+        await this.api();
+        return this.page.evaluate(
+            async ([method, args]) => {
+                if (typeof window.meshsmooth[method] !== "function") {
+                    throw new Error(`window.meshsmooth.${method} is not a function`);
+                }
+                return await window.meshsmooth[method](...args);
+            },
+            [method, args],
+        );
+    }
+
+    /**
+     * Calls a method and reports how it ended, without throwing: `{ok, value}` or
+     * `{ok: false, isError, message}` (whether it threw/rejected with an Error, and its message).
+     */
+    async attempt(method, ...args) {
+        await this.api();
+        return this.page.evaluate(
+            async ([method, args]) => {
+                try {
+                    return { ok: true, value: await window.meshsmooth[method](...args) };
+                } catch (e) {
+                    return { ok: false, isError: e instanceof Error, message: e instanceof Error ? e.message : String(e) };
+                }
+            },
+            [method, args],
+        );
+    }
+
+    state() {
+        return this.call("state");
+    }
+
+    backend() {
+        return this.call("backend");
+    }
+
+    setFilter(name) {
+        return this.call("setFilter", name);
+    }
+
+    setParams(params) {
+        return this.call("setParams", params);
+    }
+
+    metrics() {
+        return this.call("metrics");
+    }
+
+    /** `loadMesh(bytes, name)` with the bytes of a Node Buffer; resolves with the info object. */
+    async loadMesh(bytes, name) {
+        const result = await this.attemptLoad(bytes, name);
+        if (!result.ok) {
+            throw new Error(`loadMesh(${name}) rejected: ${result.message}`);
+        }
+        return result.value;
+    }
+
+    /** `loadMesh` without throwing: `{ok, value}` or `{ok: false, isError, message}`. */
+    async attemptLoad(bytes, name) {
+        await this.api();
+        return this.page.evaluate(
+            async ([base64, name]) => {
+                const text = atob(base64);
+                const bytes = new Uint8Array(text.length);
+                for (let i = 0; i < text.length; i++) {
+                    bytes[i] = text.charCodeAt(i);
+                }
+                try {
+                    return { ok: true, value: await window.meshsmooth.loadMesh(bytes, name) };
+                } catch (e) {
+                    return { ok: false, isError: e instanceof Error, message: e instanceof Error ? e.message : String(e) };
+                }
+            },
+            [Buffer.from(bytes).toString("base64"), name],
+        );
+    }
+
+    /** `exportMesh(format)` as a Node Buffer; throws unless it resolves with a Uint8Array. */
+    async exportMesh(format) {
+        await this.api();
+        const result = await this.page.evaluate(async (format) => {
+            const bytes = await window.meshsmooth.exportMesh(format);
+            if (!(bytes instanceof Uint8Array)) {
+                return { error: `exportMesh(${format}) resolved with ${Object.prototype.toString.call(bytes)}, not a Uint8Array` };
+            }
+            let text = "";
+            for (let i = 0; i < bytes.length; i += 0x8000) {
+                text += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
+            }
+            return { base64: btoa(text) };
+        }, format);
+        if (result.error) {
+            throw new Error(result.error);
+        }
+        return Buffer.from(result.base64, "base64");
+    }
+
+    /**
+     * Drops a file on the canvas the way a browser does: dragenter, dragover, then drop, each
+     * carrying a DataTransfer built in the page with one File.
+     */
+    async dropFile(bytes, name) {
+        const dataTransfer = await this.page.evaluateHandle(
+            ([base64, name]) => {
+                const text = atob(base64);
+                const data = new Uint8Array(text.length);
+                for (let i = 0; i < text.length; i++) {
+                    data[i] = text.charCodeAt(i);
+                }
+                const transfer = new DataTransfer();
+                transfer.items.add(new File([data], name, { type: "application/octet-stream" }));
+                return transfer;
+            },
+            [Buffer.from(bytes).toString("base64"), name],
+        );
+        for (const type of ["dragenter", "dragover", "drop"]) {
+            await this.page.dispatchEvent("#meshsmooth_canvas", type, { dataTransfer });
+        }
+        await dataTransfer.dispose();
+    }
+}

@@ -1,0 +1,64 @@
+// A static file server for dist/ on a free port of 127.0.0.1: what Trunk built, nothing else.
+import { createServer } from "node:http";
+import { readFile, stat } from "node:fs/promises";
+import { extname, join, normalize, sep } from "node:path";
+
+const CONTENT_TYPES = {
+    ".html": "text/html; charset=utf-8",
+    ".js": "text/javascript; charset=utf-8",
+    ".mjs": "text/javascript; charset=utf-8",
+    ".wasm": "application/wasm",
+    ".css": "text/css; charset=utf-8",
+    ".json": "application/json",
+    ".png": "image/png",
+    ".svg": "image/svg+xml",
+    ".ico": "image/x-icon",
+    ".txt": "text/plain; charset=utf-8",
+};
+
+/**
+ * Serves `root` until `close()`. Every request is recorded in `served` (method and path), so a
+ * test can see what the page asked for from this side too.
+ */
+export async function serveDirectory(root) {
+    const rootDir = normalize(root + sep);
+    const served = [];
+    const server = createServer(async (request, response) => {
+        const path = decodeURIComponent(new URL(request.url, "http://localhost").pathname);
+        served.push(`${request.method} ${path}`);
+        const file = normalize(join(rootDir, path.endsWith("/") ? path + "index.html" : path));
+        if (!file.startsWith(rootDir) || (request.method !== "GET" && request.method !== "HEAD")) {
+            response.writeHead(404).end();
+            return;
+        }
+        try {
+            if (!(await stat(file)).isFile()) {
+                throw new Error("not a file");
+            }
+            const body = await readFile(file);
+            response.writeHead(200, {
+                "Content-Type": CONTENT_TYPES[extname(file)] ?? "application/octet-stream",
+                "Content-Length": body.length,
+                "Cache-Control": "no-store",
+            });
+            response.end(request.method === "HEAD" ? undefined : body);
+        } catch {
+            response.writeHead(404, { "Content-Type": "text/plain" }).end("not found\n");
+        }
+    });
+    await new Promise((resolve, reject) => {
+        server.once("error", reject);
+        server.listen(0, "127.0.0.1", resolve);
+    });
+    const { port } = server.address();
+    return {
+        url: `http://127.0.0.1:${port}/`,
+        origin: `http://127.0.0.1:${port}`,
+        served,
+        close: () =>
+            new Promise((resolve) => {
+                server.closeAllConnections();
+                server.close(() => resolve());
+            }),
+    };
+}

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# End-to-end tests of the built web app in headless Chromium, run twice:
+#   webgpu  WebGPU on SwiftShader (the app's GPU engine),
+#   cpu     no WebGPU: eframe falls back to WebGL2 and the app uses its CPU engine.
+# Both runs always happen; the script fails if either failed.
+#
+#   bash tests/e2e/run.sh              (after `trunk build --release` made dist/)
+#   E2E_MODES=cpu bash tests/e2e/run.sh
+#   bash tests/e2e/run.sh --test-name-pattern='^5 '   (extra arguments go to node --test)
+#
+# Screenshots and exported files: target/e2e/<mode>/; benchmark lines: target/e2e/bench.json.
+# Needs: web/node_modules (npm ci in web/, .ci/install.sh), /usr/bin/chromium, ../shared/data.
+# To test another build: E2E_DIST=/path/to/dist MESHSMOOTH_CLI=/path/to/meshsmooth (then the
+# CLI is not built here).
+set -euo pipefail
+
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+export PATH="$PWD/web/node_modules/.bin:$HOME/.cargo/bin:$PATH"
+
+dist="${E2E_DIST:-dist}"
+if [ ! -f "$dist/index.html" ]; then
+    echo "tests/e2e/run.sh: $dist/index.html is missing: build the page first (trunk build --release)" >&2
+    exit 1
+fi
+if [ ! -d web/node_modules/playwright-core ] || [ ! -d web/node_modules/gltf-validator ]; then
+    echo "tests/e2e/run.sh: web/node_modules lacks playwright-core or gltf-validator: run bash .ci/install.sh" >&2
+    exit 1
+fi
+
+# The CLI is the reference for every number the app reports; cargo skips the build when it is
+# up to date.
+if [ -z "${MESHSMOOTH_CLI:-}" ]; then
+    cargo build --release --quiet
+    target_dir="${CARGO_TARGET_DIR:-target}"
+    case "$target_dir" in
+        /*) ;;
+        *) target_dir="$PWD/$target_dir" ;;
+    esac
+    export MESHSMOOTH_CLI="$target_dir/release/meshsmooth"
+fi
+
+rm -rf target/e2e
+mkdir -p target/e2e
+
+failed=()
+for mode in ${E2E_MODES:-webgpu cpu}; do
+    echo
+    echo "=== e2e ($mode)"
+    if ! E2E_MODE="$mode" node --test --test-reporter=spec "$@" tests/e2e/*.test.mjs; then
+        failed+=("$mode")
+    fi
+done
+
+echo
+if [ ${#failed[@]} -gt 0 ]; then
+    echo "tests/e2e/run.sh: failed in: ${failed[*]} (screenshots in target/e2e/)" >&2
+    exit 1
+fi
+echo "tests/e2e/run.sh: both modes passed (screenshots in target/e2e/)"
