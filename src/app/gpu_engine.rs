@@ -8,6 +8,8 @@ use crate::gpu::{GpuMesh, GpuSmoother, MeasureReadback, ResultReadback};
 
 /// A run submitted for one session revision, its results still on the way back.
 struct InFlight {
+    /// The document's model generation and session revision it was submitted for.
+    generation: u64,
     revision: u64,
     started_ms: f64,
     positions: ResultReadback,
@@ -98,6 +100,7 @@ impl GpuEngine {
         let positions = ResultReadback::start(&self.device, &self.queue, mesh).map_err(e)?;
         self.submitted = Some(doc.session.revision());
         self.in_flight = Some(InFlight {
+            generation,
             revision: doc.session.revision(),
             started_ms,
             positions,
@@ -113,6 +116,12 @@ impl GpuEngine {
         let Some(run) = self.in_flight.as_mut() else {
             return Ok(());
         };
+        if run.generation != doc.model_generation {
+            // A run for a model that is no longer open: its measures belong to another
+            // original. Dropping it drops its pending mappings.
+            self.in_flight = None;
+            return Ok(());
+        }
         if run.result.is_none() {
             match run.positions.try_take() {
                 None => return Ok(()),
