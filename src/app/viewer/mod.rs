@@ -190,7 +190,7 @@ impl Viewer {
         response
     }
 
-    /// Frames the whole model from the default direction.
+    /// Frames the whole model as it was first shown (face-on when flat, else from the front-left).
     pub fn reset_view(&mut self) {
         self.camera = self.home;
     }
