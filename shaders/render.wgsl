@@ -1,4 +1,5 @@
-// The 3D view, drawn inside egui's render pass: a lit, two-sided surface and a wireframe overlay.
+// The 3D view: a lit, two-sided surface and a wireframe overlay, drawn into the view's own
+// multisampled target, and the composite that copies the result into egui's render pass.
 //
 // Runs on WebGPU and on WebGL2 (eframe's fallback), so it uses only what both have: one uniform
 // buffer, vertex attributes, no storage buffers. Positions and normals are vec4 per vertex (the

@@ -1,8 +1,10 @@
 //! An orbit camera: the eye on a sphere around a target point, Z up.
 //!
 //! Anatomical meshes are usually stored with Z pointing superior (RAS and LPS alike), so the
-//! turntable turns about Z and the default view looks from -Y (anterior in LPS) with X to the
-//! right. Matrices follow wgpu's conventions: right-handed world, clip-space depth in 0..1.
+//! turntable turns about Z. Yaw 0 looks from +Y, anterior in RAS (NIfTI, FreeSurfer, MNE, the
+//! meshes this app mostly gets), with the patient's right on the screen's left as in a
+//! radiological front view. Matrices follow wgpu's conventions: right-handed world, clip-space
+//! depth in 0..1.
 
 use glam::camera::rh::{proj, view};
 use glam::{Mat4, Vec2, Vec3};
@@ -17,9 +19,10 @@ pub const PITCH_LIMIT: f32 = std::f32::consts::FRAC_PI_2 - 0.01;
 /// proportions are not distorted, wide enough to feel 3D.
 pub const DEFAULT_FOV: f32 = 35.0 * std::f32::consts::PI / 180.0;
 
-/// The view [`OrbitCamera::reset_direction`] returns to: a three-quarter view from front-left,
-/// a little above, so that both the shape and its surface relief read at first sight.
-pub const DEFAULT_YAW: f32 = -0.5;
+/// The view [`OrbitCamera::reset_direction`] returns to: a three-quarter view from the front and
+/// the patient's left (in RAS), a little above, so that both the shape and its surface relief
+/// read at first sight.
+pub const DEFAULT_YAW: f32 = 0.5;
 pub const DEFAULT_PITCH: f32 = 0.35;
 
 /// A fitted box's widest corner reaches this fraction of the view's shorter half-side.
@@ -155,6 +158,17 @@ impl OrbitCamera {
         }
     }
 
+    /// Turns the eye to look from `direction` (from the target towards the eye), as near as the
+    /// pitch limit allows; a zero or non-finite direction changes nothing.
+    pub fn look_from(&mut self, direction: Vec3) {
+        let d = direction.normalize_or_zero();
+        if d == Vec3::ZERO {
+            return;
+        }
+        self.pitch = d.z.asin().clamp(-PITCH_LIMIT, PITCH_LIMIT);
+        self.yaw = (-d.x).atan2(d.y).rem_euclid(std::f32::consts::TAU);
+    }
+
     /// Turns the eye back to the default direction (the target and distance stay).
     pub fn reset_direction(&mut self) {
         self.yaw = DEFAULT_YAW;
@@ -198,7 +212,7 @@ impl OrbitCamera {
     pub fn direction(&self) -> Vec3 {
         let (sin_yaw, cos_yaw) = self.yaw.sin_cos();
         let (sin_pitch, cos_pitch) = self.pitch.sin_cos();
-        Vec3::new(sin_yaw * cos_pitch, -cos_yaw * cos_pitch, sin_pitch)
+        Vec3::new(-sin_yaw * cos_pitch, cos_yaw * cos_pitch, sin_pitch)
     }
 
     pub fn eye(&self) -> Vec3 {
@@ -401,13 +415,37 @@ mod tests {
             pitch: 0.0,
             ..Default::default()
         };
-        assert_close(camera.direction(), -Vec3::Y, 1e-6);
+        // From anterior (+Y in RAS): the patient's right (+X) on the screen's left.
+        assert_close(camera.direction(), Vec3::Y, 1e-6);
         let (right, up) = camera.screen_axes();
-        assert_close(right, Vec3::X, 1e-6);
+        assert_close(right, -Vec3::X, 1e-6);
         assert_close(up, Vec3::Z, 1e-6);
+        // The default: front, left (-X in RAS) and above.
         camera.reset_direction();
         camera.fit(Vec3::splat(-1.0), Vec3::splat(1.0));
-        assert!(camera.eye().z > 0.0 && camera.eye().y < 0.0);
+        let eye = camera.eye();
+        assert!(eye.y > 0.0 && eye.x < 0.0 && eye.z > 0.0, "{eye}");
+    }
+
+    #[test]
+    fn looking_from_a_direction_puts_the_eye_there() {
+        let mut camera = OrbitCamera::default();
+        for d in [
+            Vec3::X,
+            -Vec3::Y,
+            Vec3::new(0.3, -0.5, 0.8),
+            Vec3::new(-1.0, 2.0, -0.5),
+        ] {
+            camera.look_from(d);
+            assert_close(camera.direction(), d.normalize(), 1e-5);
+        }
+        // Straight down is held just short of the pole; nothing is no direction.
+        camera.look_from(-Vec3::Z);
+        assert_eq!(camera.pitch, -PITCH_LIMIT);
+        let before = camera;
+        camera.look_from(Vec3::ZERO);
+        camera.look_from(Vec3::NAN);
+        assert_eq!(camera, before);
     }
 
     #[test]

@@ -18,7 +18,7 @@ mod target;
 use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu};
 
-use crate::view::{OrbitCamera, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS};
+use crate::view::{face_on_direction, OrbitCamera, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS};
 use callback::{ViewCallback, ViewResources};
 use pipelines::Pipelines;
 
@@ -35,7 +35,8 @@ pub struct Viewer {
     /// Draw the triangle edges over the surface.
     pub wireframe: bool,
     camera: OrbitCamera,
-    /// The model framed from the default direction, where [`Self::reset_view`] returns to.
+    /// The model framed from its first direction (face-on when flat, else the default), where
+    /// [`Self::reset_view`] returns to.
     home: OrbitCamera,
     vertex_count: usize,
     has_colors: bool,
@@ -96,6 +97,9 @@ impl Viewer {
                 self.vertex_count = positions.len();
                 self.has_colors = false;
                 self.home = OrbitCamera::default();
+                if let Some(side) = face_on_direction(positions, self.home.direction()) {
+                    self.home.look_from(side);
+                }
                 self.home.fit_points(positions);
                 self.problem = None;
                 self.reset_view();
@@ -186,7 +190,7 @@ impl Viewer {
         response
     }
 
-    /// Frames the whole model from the default direction.
+    /// Frames the whole model as it was first shown (face-on when flat, else from the front-left).
     pub fn reset_view(&mut self) {
         self.camera = self.home;
     }
