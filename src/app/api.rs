@@ -8,7 +8,9 @@
 //!   parameters' result is computed
 //! - `exportMesh(format): Promise<Uint8Array>` for `glb stl ply obj`
 //! - `backend()`: `"webgpu"` or `"cpu"`
-//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, backend}`
+//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, backend, timings}`
+//!   (`timings`: the last result's `smooth_ms` and `measure_ms` of the CPU engine's own work, or
+//!   `gpu_run_ms` from submitting a GPU run to having its results back)
 //!
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.

@@ -138,6 +138,13 @@ impl Document {
     pub fn state_json(&self) -> serde_json::Value {
         let mut state = self.session.state_json(self.busy());
         state["backend"] = serde_json::json!(self.backend.name());
+        state["timings"] = match self.timings {
+            Some(EngineTimings::Cpu(t)) => {
+                serde_json::json!({"smooth_ms": t.smooth_ms, "measure_ms": t.measure_ms})
+            }
+            Some(EngineTimings::Gpu { run_ms }) => serde_json::json!({ "gpu_run_ms": run_ms }),
+            None => serde_json::Value::Null,
+        };
         state
     }
 }
