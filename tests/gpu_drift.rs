@@ -17,6 +17,8 @@
 mod data;
 #[path = "common_gpu/device.rs"]
 mod device;
+#[path = "common_gpu/open_scalp.rs"]
+mod open_scalp;
 #[path = "common_gpu/runs.rs"]
 mod runs;
 

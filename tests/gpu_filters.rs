@@ -9,11 +9,14 @@
 
 #[path = "common_gpu/device.rs"]
 mod device;
+#[path = "common_gpu/open_scalp.rs"]
+mod open_scalp;
 
 use device::{gpu, gpu_with, Gpu};
 use meshsmooth::gpu::{read_positions, GpuError};
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::smooth::{smooth, Filter, NoObserver, Params};
+use open_scalp::open_scalp;
 
 fn load(relative: &str) -> Mesh {
     let path = format!("{}/../shared/data/{relative}", env!("CARGO_MANIFEST_DIR"));
@@ -21,25 +24,8 @@ fn load(relative: &str) -> Mesh {
     meshsmooth::io::load(&bytes, relative).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
-/// The scalp opened: a cap cut off the top, every 40th triangle removed (small holes, some
-/// vertices joined only at a corner), and one vertex no triangle uses.
 fn open_mesh() -> Mesh {
-    let mesh = load("real/fsaverage_head_scalp_mne.ply");
-    let (lo, hi) = mesh.bounding_box().expect("not empty");
-    let cut = lo[2] + 0.8 * (hi[2] - lo[2]);
-    let triangles: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .enumerate()
-        .filter(|&(t, tri)| {
-            t % 40 != 7 && !tri.iter().all(|&v| mesh.positions[v as usize][2] > cut)
-        })
-        .map(|(_, &tri)| tri)
-        .collect();
-    assert!(triangles.len() < mesh.triangles.len());
-    let mut positions = mesh.positions.clone();
-    positions.push([lo[0], lo[1], lo[2]]);
-    Mesh::new(positions, triangles)
+    open_scalp(&load("real/fsaverage_head_scalp_mne.ply"))
 }
 
 fn test_weights(n: usize) -> Vec<f32> {

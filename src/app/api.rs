@@ -73,6 +73,21 @@ fn when_current(
     })
 }
 
+/// A function of one argument that edits the session, throwing the engine's message when it
+/// refuses, and redraws the page when it accepts.
+fn setter(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+    edit: impl Fn(&mut crate::session::Session, JsValue) -> Result<(), String> + 'static,
+) -> Closure<dyn FnMut(JsValue) -> Result<(), JsValue>> {
+    let (doc, ctx) = (doc.clone(), ctx.clone());
+    Closure::new(move |value: JsValue| {
+        edit(&mut doc.borrow_mut().session, value).map_err(|e| error(&e))?;
+        ctx.request_repaint();
+        Ok(())
+    })
+}
+
 /// Sets `f` as `object[name]` for the page's lifetime.
 fn define<F: ?Sized + wasm_bindgen::closure::WasmClosure>(
     object: &js_sys::Object,
@@ -116,33 +131,18 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
         ),
     )?;
 
-    let (d, c) = (doc.clone(), ctx.clone());
     define(
         &api,
         "setFilter",
-        Closure::<dyn FnMut(JsValue) -> Result<(), JsValue>>::new(move |name: JsValue| {
-            let name = name.as_string().unwrap_or_default();
-            d.borrow_mut()
-                .session
-                .set_filter_name(&name)
-                .map_err(|e| error(&e))?;
-            c.request_repaint();
-            Ok(())
+        setter(doc, ctx, |session, name| {
+            session.set_filter_name(&name.as_string().unwrap_or_default())
         }),
     )?;
-
-    let (d, c) = (doc.clone(), ctx.clone());
     define(
         &api,
         "setParams",
-        Closure::<dyn FnMut(JsValue) -> Result<(), JsValue>>::new(move |values: JsValue| {
-            let values = from_js(&values).map_err(|e| error(&e))?;
-            d.borrow_mut()
-                .session
-                .set_params_json(&values)
-                .map_err(|e| error(&e))?;
-            c.request_repaint();
-            Ok(())
+        setter(doc, ctx, |session, values| {
+            session.set_params_json(&from_js(&values)?)
         }),
     )?;
 
@@ -166,7 +166,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
         "exportMesh",
         Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
             let name = format.as_string().unwrap_or_default();
-            let Some(format) = ExportFormat::from_name(&format!("x.{name}")) else {
+            let Some(format) = ExportFormat::from_extension(&name) else {
                 return settled(Err(format!(
                     "unknown export format '{name}': use glb, stl, ply or obj"
                 )));

@@ -180,15 +180,10 @@ pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<EngineTimi
                 m.volume_change
                     .map_or("undefined (open mesh)".into(), percent),
             );
-            let ratio = if m.curvature0 > 0.0 {
-                m.curvature / m.curvature0
-            } else {
-                f64::NAN
-            };
             row(
                 "Curvature K/K0",
                 "Mean |Gaussian curvature| against the original's: lower is smoother",
-                format!("{ratio:.4}"),
+                format!("{:.4}", m.score_terms().curvature_ratio),
             );
             row(
                 "Mean error",

@@ -28,14 +28,6 @@ pub struct GpuEngine {
     submitted: Option<u64>,
 }
 
-/// What a frame's step did for the view.
-pub enum Step {
-    /// Nothing new to draw.
-    Idle,
-    /// A new run was submitted: its positions and normals are in these buffers now.
-    Submitted,
-}
-
 impl GpuEngine {
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         Self {
@@ -60,16 +52,17 @@ impl GpuEngine {
     }
 
     /// One frame's work: collects a finished run into the session, and submits a run for the
-    /// current parameters when the session needs one and none is in flight. An error (a mesh
+    /// current parameters when the session needs one and none is in flight ([`Self::submitted`]
+    /// then names its revision: its positions and normals are in [`Self::buffers`]). An error (a mesh
     /// over the device's limits, a lost device) comes back for the caller to fall back to the
     /// CPU engine.
-    pub fn step(&mut self, doc: &mut Document) -> Result<Step, String> {
+    pub fn step(&mut self, doc: &mut Document) -> Result<(), String> {
         self.collect(doc)?;
         if self.in_flight.is_some() || !doc.session.needs_smoothing() {
-            return Ok(Step::Idle);
+            return Ok(());
         }
         let Some(model) = doc.session.model() else {
-            return Ok(Step::Idle);
+            return Ok(());
         };
         let generation = doc.model_generation;
         if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
@@ -82,7 +75,7 @@ impl GpuEngine {
             self.mesh = Some((generation, uploaded));
         }
         let Some((_, mesh)) = self.mesh.as_mut() else {
-            return Ok(Step::Idle);
+            return Ok(());
         };
         let params = *doc.session.params();
         let started_ms = now_ms();
@@ -107,7 +100,7 @@ impl GpuEngine {
             measures,
             result: None,
         });
-        Ok(Step::Submitted)
+        Ok(())
     }
 
     /// Takes a finished run's results into the session (a run for an older revision is

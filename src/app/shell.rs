@@ -5,7 +5,7 @@
 use super::controls::{self, Controls};
 use super::document::{Backend, Document, SharedDocument};
 use super::file_input::FileInput;
-use super::gpu_engine::{GpuEngine, Step};
+use super::gpu_engine::GpuEngine;
 use super::shortcuts::{self, Action};
 use super::viewer::Viewer;
 use super::{api, download, legend, page, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
@@ -167,7 +167,7 @@ impl Shell {
         let mut doc = self.doc.borrow_mut();
         if let Some(gpu) = &mut self.gpu {
             match gpu.step(&mut doc) {
-                Ok(Step::Idle | Step::Submitted) => return,
+                Ok(()) => return,
                 Err(why) => {
                     log::error!("GPU engine failed, using the CPU engine: {why}");
                     self.gpu = None;
@@ -209,20 +209,14 @@ impl Shell {
             .filter(|_| self.bake_colors)
             .and_then(|f| session.colors(f))
             .map(|(c, _)| c);
-        let (ext, mime) = match format {
-            ExportFormat::Glb => ("glb", "model/gltf-binary"),
-            ExportFormat::Stl => ("stl", "model/stl"),
-            ExportFormat::Ply => ("ply", "application/octet-stream"),
-            ExportFormat::Obj => ("obj", "model/obj"),
-        };
         let stem = model
             .name
             .rsplit_once('.')
             .map_or(model.name.as_str(), |s| s.0);
-        let name = format!("{stem}_smoothed.{ext}");
+        let name = format!("{stem}_smoothed.{}", format.extension());
         self.export_error = session
             .export(format, colors.as_deref())
-            .and_then(|bytes| download::save(&name, &bytes, mime))
+            .and_then(|bytes| download::save(&name, &bytes, format.mime()))
             .err();
     }
 

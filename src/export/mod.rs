@@ -20,16 +20,42 @@ pub enum ExportFormat {
 }
 
 impl ExportFormat {
+    pub const ALL: [ExportFormat; 4] = [
+        ExportFormat::Glb,
+        ExportFormat::Stl,
+        ExportFormat::Ply,
+        ExportFormat::Obj,
+    ];
+
     /// The format named by a file name's extension (case-insensitive).
     pub fn from_name(name: &str) -> Option<ExportFormat> {
-        let ext = name.rsplit_once('.')?.1.to_ascii_lowercase();
-        Some(match ext.as_str() {
-            "ply" => ExportFormat::Ply,
-            "stl" => ExportFormat::Stl,
-            "obj" => ExportFormat::Obj,
-            "glb" => ExportFormat::Glb,
-            _ => return None,
-        })
+        Self::from_extension(name.rsplit_once('.')?.1)
+    }
+
+    /// The format of an extension without its dot (`glb stl ply obj`, case-insensitive).
+    pub fn from_extension(ext: &str) -> Option<ExportFormat> {
+        Self::ALL
+            .into_iter()
+            .find(|f| f.extension().eq_ignore_ascii_case(ext))
+    }
+
+    pub fn extension(self) -> &'static str {
+        match self {
+            ExportFormat::Ply => "ply",
+            ExportFormat::Stl => "stl",
+            ExportFormat::Obj => "obj",
+            ExportFormat::Glb => "glb",
+        }
+    }
+
+    /// The media type a download of this format carries.
+    pub fn mime(self) -> &'static str {
+        match self {
+            ExportFormat::Glb => "model/gltf-binary",
+            ExportFormat::Stl => "model/stl",
+            ExportFormat::Obj => "model/obj",
+            ExportFormat::Ply => "application/octet-stream",
+        }
     }
 }
 

@@ -165,23 +165,27 @@ pub fn colorize(
     result: &Smoothed,
     voxel_diagonal: Option<f64>,
 ) -> (Vec<[u8; 4]>, Legend) {
-    let values: Vec<f32> = match field {
-        ColorField::LocalError => result.vertex.local_error.clone(),
-        ColorField::Curvature => result.vertex.gaussian_curvature.clone(),
-        ColorField::Displacement => original
-            .iter()
-            .zip(&result.positions)
-            .map(|(p, q)| {
-                let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
-            })
-            .collect(),
+    let displacement: Vec<f32>;
+    let values: &[f32] = match field {
+        ColorField::LocalError => &result.vertex.local_error,
+        ColorField::Curvature => &result.vertex.gaussian_curvature,
+        ColorField::Displacement => {
+            displacement = original
+                .iter()
+                .zip(&result.positions)
+                .map(|(p, q)| {
+                    let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+                    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+                })
+                .collect();
+            &displacement
+        }
     };
     let (stops, min, max): (&[[u8; 3]], f64, f64) = if field.diverging() {
-        let c = round_up(quantile_abs(&values, 0.95));
+        let c = round_up(quantile_abs(values, 0.95));
         (&COOL_WARM, -c, c)
     } else {
-        (&VIRIDIS, 0.0, round_up(quantile_abs(&values, 0.99)))
+        (&VIRIDIS, 0.0, round_up(quantile_abs(values, 0.99)))
     };
     let t = |v: f64| (v - min) / (max - min);
     let colors = values.iter().map(|&v| sample(stops, t(v as f64))).collect();

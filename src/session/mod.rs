@@ -294,14 +294,18 @@ impl Session {
                 smooth_ms: 0.0,
             },
         };
-        while job.done < params.iterations || params.filter == Filter::Sinc {
-            if params.filter == Filter::Sinc {
-                // Its terms are not shorter filters' results: one piece.
-                (job.positions, job.reference) =
-                    metrics::smooth_drifting(&model.original, &params, None);
-                job.done = params.iterations;
-                break;
-            }
+        if params.filter == Filter::Sinc {
+            // Its terms are not shorter filters' results: one piece.
+            (job.positions, job.reference) =
+                metrics::smooth_drifting(&model.original, &params, None);
+            job.done = params.iterations;
+        }
+        // Iterations per call: one at first, then as many as the time per iteration so far
+        // lets fit in what is left of the budget (each call re-checks the rings and allocates
+        // its second buffer, so fewer, longer calls cost less).
+        let mut chunk = 1;
+        while job.done < params.iterations {
+            let chunk_start = clock();
             let mut drift = DriftingReference::resume(&model.original, job.reference);
             let positions = std::mem::take(&mut job.positions);
             job.positions = smooth::resume(
@@ -311,15 +315,20 @@ impl Session {
                 None,
                 positions,
                 job.done,
-                1,
+                chunk,
                 &mut drift,
             )
             .unwrap_or_default();
             job.reference = drift.into_reference();
-            job.done += 1;
-            if clock() - start >= budget_ms {
+            job.done += chunk;
+            let now = clock();
+            let left = budget_ms - (now - start);
+            if left <= 0.0 {
                 break;
             }
+            let per_iteration = ((now - chunk_start) / chunk as f64).max(1e-3);
+            let remaining = params.iterations - job.done;
+            chunk = ((left / per_iteration).floor() as u32).clamp(1, remaining.max(1));
         }
         let smoothed = clock();
         job.smooth_ms += smoothed - start;
@@ -349,27 +358,6 @@ impl Session {
             .as_ref()
             .filter(|j| j.revision == self.revision && self.needs_smoothing())
             .map(|j| (j.done, self.params().iterations))
-    }
-
-    /// Accepts positions and drifted references computed elsewhere (the GPU engine) for
-    /// `revision` and measures them. Returns false, and keeps nothing, when the session moved
-    /// on since or the arrays do not fit the model.
-    pub fn accept(&mut self, revision: u64, positions: Vec<[f32; 3]>, reference: &[u32]) -> bool {
-        let Some(model) = &self.model else {
-            return false;
-        };
-        let n = model.mesh().vertex_count();
-        let fits = positions.len() == n
-            && reference.len() == n
-            && reference.iter().all(|&r| (r as usize) < n);
-        if revision != self.revision || !fits {
-            return false;
-        }
-        let params = *self.params();
-        self.result = Some(measured(
-            model, revision, params, self.tau, positions, reference,
-        ));
-        true
     }
 
     /// Accepts a result measured elsewhere (the GPU engine's smoothing and measure pass) for

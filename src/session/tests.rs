@@ -60,8 +60,8 @@ fn every_change_makes_the_result_stale_and_late_results_are_refused() {
     s.smooth_cpu(&|| 0.0);
     assert!(!s.needs_smoothing());
     let old = s.revision();
-    let positions = s.result().unwrap().positions.clone();
-    let n = positions.len();
+    let r = s.result().unwrap().clone();
+    let n = r.positions.len();
 
     s.set_params_json(&serde_json::json!({"iterations": 3}))
         .unwrap();
@@ -70,12 +70,14 @@ fn every_change_makes_the_result_stale_and_late_results_are_refused() {
         s.last_result().is_some(),
         "the old result is shown meanwhile"
     );
-    assert!(!s.accept(old, positions.clone(), &metrics::identity(n)));
-    assert!(!s.accept(s.revision(), positions[1..].to_vec(), &metrics::identity(n)));
-    let mut bad_reference = metrics::identity(n);
-    bad_reference[0] = n as u32;
-    assert!(!s.accept(s.revision(), positions.clone(), &bad_reference));
-    assert!(s.accept(s.revision(), positions, &metrics::identity(n)));
+    let take = |s: &mut Session, revision, positions: Vec<[f32; 3]>| {
+        s.accept_measured(revision, positions, r.metrics.clone(), r.vertex.clone())
+    };
+    assert!(!take(&mut s, old, r.positions.clone()));
+    let current = s.revision();
+    assert!(!take(&mut s, current, r.positions[1..].to_vec()));
+    assert_eq!(n, s.model().unwrap().mesh().vertex_count());
+    assert!(take(&mut s, current, r.positions.clone()));
     assert!(!s.needs_smoothing());
 
     // Setting the same values again is not a change.

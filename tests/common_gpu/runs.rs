@@ -3,8 +3,9 @@
 
 use super::data;
 use super::device::Gpu;
+use super::open_scalp::open_scalp;
 use meshsmooth::gpu::{read_result, GpuMesh, SmoothResult};
-use meshsmooth::mesh::{Mesh, Topology};
+use meshsmooth::mesh::Topology;
 use meshsmooth::metrics::Original;
 use meshsmooth::smooth::{Filter, Params};
 
@@ -20,24 +21,10 @@ pub fn original(relative: &str) -> Original {
     Original::new(&mesh, &topology)
 }
 
-/// The scalp opened: a cap cut off the top, every 40th triangle removed, and one vertex no
-/// triangle uses (as in tests/gpu_filters.rs).
+/// The scalp opened (see `open_scalp`), as the measures see it.
 pub fn open_original() -> Original {
-    let (mesh, _) = data::load(SCALP);
-    let (lo, hi) = mesh.bounding_box().expect("not empty");
-    let cut = lo[2] + 0.8 * (hi[2] - lo[2]);
-    let triangles: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .enumerate()
-        .filter(|&(t, tri)| {
-            t % 40 != 7 && !tri.iter().all(|&v| mesh.positions[v as usize][2] > cut)
-        })
-        .map(|(_, &tri)| tri)
-        .collect();
-    let mut positions = mesh.positions.clone();
-    positions.push(lo);
-    let mesh = Mesh::new(positions, triangles);
+    let (scalp, _) = data::load(SCALP);
+    let mesh = open_scalp(&scalp);
     let topology = Topology::build(&mesh);
     assert!(topology.has_boundary());
     Original::new(&mesh, &topology)
