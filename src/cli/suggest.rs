@@ -5,8 +5,7 @@ use super::params::filter as parse_filter;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::{Filter, Params};
-use crate::suggest::{suggest, SearchMethod, Suggestion, Terms};
-use serde::Serialize;
+use crate::suggest::{suggest, SearchMethod, Suggestion};
 use std::path::PathBuf;
 
 /// Parses a search method for clap.
@@ -37,17 +36,6 @@ pub(super) struct SuggestArgs {
     pub json: bool,
 }
 
-/// `suggest --json`.
-#[derive(Serialize)]
-struct SuggestJson {
-    filter: Filter,
-    params: serde_json::Value,
-    score: f64,
-    terms: Terms,
-    evaluations: usize,
-    seconds: f64,
-}
-
 pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
     super::check_tau(args.tau)?;
     let mut base = Params::defaults(args.filter);
@@ -61,15 +49,7 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
-        let out = SuggestJson {
-            filter: s.filter,
-            params: s.params.to_json(),
-            score: s.score,
-            terms: s.terms,
-            evaluations: s.evaluations,
-            seconds,
-        };
-        println!("{}", super::to_json(&out)?);
+        println!("{}", super::to_json(&s.to_json(seconds))?);
     } else {
         print!("{}", text(&s, seconds));
     }

@@ -7,8 +7,7 @@ use super::params::FilterArgs;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::Filter;
-use crate::suggest::{quality_graphs, Curve, QualityGraphs};
-use serde::Serialize;
+use crate::suggest::{quality_graphs, QualityGraphs};
 use std::path::{Path, PathBuf};
 
 /// The arguments of `meshsmooth sweep`.
@@ -34,15 +33,6 @@ pub(super) struct SweepArgs {
     /// Voxel edge length (mm) of the segmentation: draws half the voxel diagonal on the error axis.
     #[arg(long)]
     pub voxel_size: Option<f64>,
-}
-
-#[derive(Serialize)]
-struct SweepJson<'a> {
-    filter: Filter,
-    tau: f64,
-    current: serde_json::Value,
-    curves: &'a [Curve],
-    seconds: f64,
 }
 
 pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
@@ -73,14 +63,7 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
         plot::draw(&graphs, &figure, path).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     if args.json {
-        let out = SweepJson {
-            filter: current.filter,
-            tau: args.tau,
-            current: current.to_json(),
-            curves: &graphs.curves,
-            seconds,
-        };
-        println!("{}", super::to_json(&out)?);
+        println!("{}", super::to_json(&graphs.to_json(seconds))?);
     } else if args.csv {
         print!("{}", csv(&graphs));
     } else {

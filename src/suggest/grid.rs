@@ -63,9 +63,12 @@ impl Task for GridSearch {
 
     fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
         if let Some(run) = self.runs.get(self.next) {
-            self.measured
-                .measure(&self.space, &self.base, evaluator, run);
-            self.next += 1;
+            if self
+                .measured
+                .measure(&self.space, &self.base, evaluator, run)
+            {
+                self.next += 1;
+            }
         }
         self.next >= self.runs.len()
     }
@@ -116,13 +119,22 @@ impl EvaluatedGrid {
 
 #[cfg(test)]
 mod tests {
-    use super::super::synthetic::{bowl, smoothing_model, FnEvaluator};
+    use super::super::synthetic::{bowl, smoothing_model, FnEvaluator, Slow};
     use super::*;
     use crate::suggest::run;
 
     fn grid(filter: Filter, ev: &mut dyn Evaluator) -> EvaluatedGrid {
         let task = GridSearch::new(filter, &Params::defaults(filter)).unwrap();
         run(task, ev, &mut |_| true).unwrap()
+    }
+
+    #[test]
+    fn an_evaluator_that_answers_later_gets_the_same_grid() {
+        for filter in Filter::ALL {
+            let now = grid(filter, &mut FnEvaluator::new(smoothing_model(filter)));
+            let mut slow = Slow::new(FnEvaluator::new(smoothing_model(filter)), 1);
+            assert_eq!(grid(filter, &mut slow), now, "{filter:?}");
+        }
     }
 
     #[test]

@@ -115,10 +115,14 @@ impl Task for LocalSearch {
 
     fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
         self.advance();
-        if let Some(run) = self.pending.pop_front() {
-            self.measured
-                .measure(&self.space, &self.base, evaluator, &run);
-            self.advance();
+        if let Some(run) = self.pending.front() {
+            if self
+                .measured
+                .measure(&self.space, &self.base, evaluator, run)
+            {
+                self.pending.pop_front();
+                self.advance();
+            }
         }
         self.phase == Phase::Done
     }
@@ -171,7 +175,7 @@ pub struct LocalOutcome {
 
 #[cfg(test)]
 mod tests {
-    use super::super::synthetic::{bowl, smoothing_model, two_basins, FnEvaluator};
+    use super::super::synthetic::{bowl, smoothing_model, two_basins, FnEvaluator, Slow};
     use super::super::GridSearch;
     use super::*;
     use crate::suggest::run;
@@ -179,6 +183,19 @@ mod tests {
     fn local(filter: Filter, tau: f64, ev: &mut dyn Evaluator) -> LocalOutcome {
         let task = LocalSearch::new(filter, &Params::defaults(filter), tau).unwrap();
         run(task, ev, &mut |_| true).unwrap()
+    }
+
+    #[test]
+    fn an_evaluator_that_answers_later_gets_the_same_search() {
+        for filter in Filter::ALL {
+            let now = local(filter, 0.4, &mut FnEvaluator::new(smoothing_model(filter)));
+            let later = local(
+                filter,
+                0.4,
+                &mut Slow::new(FnEvaluator::new(smoothing_model(filter)), 2),
+            );
+            assert_eq!(now, later, "{filter:?}");
+        }
     }
 
     #[test]

@@ -62,14 +62,14 @@ impl<'a> MeshEvaluator<'a> {
     }
 
     /// The terms of the unchanged mesh (no volume term when it is open).
-    fn unchanged(&self) -> Terms {
+    pub(crate) fn unchanged(&self) -> Terms {
         Terms {
             volume_change: self.original.volume().map(|_| 0.0),
             ..Terms::UNCHANGED
         }
     }
 
-    fn measure_positions(&self, positions: &[[f32; 3]], reference: &[u32]) -> Terms {
+    pub(crate) fn measure_positions(&self, positions: &[[f32; 3]], reference: &[u32]) -> Terms {
         terms_of(&measure(self.original, positions, reference, 0.5))
     }
 }
@@ -98,7 +98,7 @@ impl StepObserver for Along<'_, '_> {
 }
 
 impl Evaluator for MeshEvaluator<'_> {
-    fn measure(&mut self, params: &Params, at: &[u32]) -> Vec<Terms> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
         let mesh = self.original.mesh();
         let topology = self.original.topology();
         let mut out = Vec::with_capacity(at.len());
@@ -107,7 +107,7 @@ impl Evaluator for MeshEvaluator<'_> {
         out.extend((0..zeros).map(|_| self.unchanged()));
         let rest = &at[zeros..];
         if rest.is_empty() {
-            return out;
+            return Some(out);
         }
         if is_cumulative(params.filter) {
             let mut p = *params;
@@ -137,7 +137,7 @@ impl Evaluator for MeshEvaluator<'_> {
                 self.runs += 1;
             }
         }
-        out
+        Some(out)
     }
 }
 

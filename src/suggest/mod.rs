@@ -14,6 +14,7 @@ mod grid;
 mod local;
 mod mesh_evaluator;
 mod points;
+mod sliced;
 mod space;
 mod sweep;
 
@@ -21,6 +22,7 @@ pub use auto::{quality_graphs, suggest, suggest_for_mesh, SuggestError};
 pub use grid::{EvaluatedGrid, GridSearch};
 pub use local::{LocalOutcome, LocalSearch};
 pub use mesh_evaluator::{check_weights, terms_of, MeshEvaluator, WeightsError};
+pub use sliced::{Sliced, SlicedRuns};
 pub use space::{Axis, GridPoint, Param, ParamSpace};
 pub use sweep::{Curve, QualityGraphs, QualitySweep, Sample};
 
@@ -71,7 +73,11 @@ pub trait Evaluator {
     ///
     /// For filters whose k-iteration result is a prefix of a longer run (all but windowed sinc)
     /// this is one run measured along the way; callers pass sinc one count at a time.
-    fn measure(&mut self, params: &Params, at: &[u32]) -> Vec<Terms>;
+    ///
+    /// `None` means the run is under way but not finished: the caller asks again, with the same
+    /// request, later. Evaluators that spread a run over several calls (the web app's frames)
+    /// use it; the others always answer.
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>>;
 }
 
 /// Whether the k-iteration result of `filter` is the state after k iterations of a longer run.
@@ -92,6 +98,8 @@ pub struct Progress {
 pub trait Task {
     type Output;
     /// Does one smoothing run (or finishes without one); returns `true` once nothing is left.
+    /// When the evaluator has not finished the run ([`Evaluator::measure`] gave `None`) nothing
+    /// advances and the next call asks for the same run.
     fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool;
     fn progress(&self) -> Progress;
     /// The result, once [`Task::step`] has returned `true`; `None` before.
@@ -165,6 +173,19 @@ impl Suggestion {
     /// Whether the suggestion is to leave the mesh as it is.
     pub fn leaves_mesh_unchanged(&self) -> bool {
         self.params.iterations == 0
+    }
+
+    /// What `suggest --json` prints and the web API's `suggest()` resolves with; `seconds` is
+    /// how long the search took.
+    pub fn to_json(&self, seconds: f64) -> serde_json::Value {
+        serde_json::json!({
+            "filter": self.filter,
+            "params": self.params.to_json(),
+            "score": self.score,
+            "terms": self.terms,
+            "evaluations": self.evaluations,
+            "seconds": seconds,
+        })
     }
 }
 

@@ -63,16 +63,17 @@ impl Measured {
             .collect()
     }
 
-    /// Smooths once and records the terms of every point of `run`.
+    /// Smooths once and records the terms of every point of `run`; `false` when the evaluator
+    /// has not finished the run yet (nothing recorded).
     pub fn measure(
         &mut self,
         space: &ParamSpace,
         base: &Params,
         evaluator: &mut dyn Evaluator,
         run: &Run,
-    ) {
+    ) -> bool {
         let Some(&first) = run.points.first() else {
-            return;
+            return true;
         };
         let params = space.params_at(base, first);
         let at: Vec<u32> = run
@@ -80,10 +81,13 @@ impl Measured {
             .iter()
             .map(|&p| space.params_at(base, p).iterations)
             .collect();
-        let terms = evaluator.measure(&params, &at);
+        let Some(terms) = evaluator.measure(&params, &at) else {
+            return false;
+        };
         for (&p, t) in run.points.iter().zip(terms) {
             self.terms.insert(p, t);
         }
+        true
     }
 }
 

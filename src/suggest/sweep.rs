@@ -67,6 +67,18 @@ pub struct QualityGraphs {
 }
 
 impl QualityGraphs {
+    /// What `sweep --json` prints and the web API's `sweep()` resolves with; `seconds` is how
+    /// long the sweep took.
+    pub fn to_json(&self, seconds: f64) -> serde_json::Value {
+        serde_json::json!({
+            "filter": self.current.filter,
+            "tau": self.tau,
+            "current": self.current.to_json(),
+            "curves": self.curves,
+            "seconds": seconds,
+        })
+    }
+
     /// Recomputes S and each curve's minimum for another tau (no smoothing needed).
     pub fn rescored(mut self, tau: f64) -> Self {
         let space = ParamSpace::of(self.current.filter);
@@ -170,7 +182,9 @@ impl Task for QualitySweep {
     fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
         if let Some(job) = self.jobs.get(self.next) {
             let counts: Vec<u32> = job.at.iter().map(|&(_, k)| k).collect();
-            let terms = evaluator.measure(&job.params, &counts);
+            let Some(terms) = evaluator.measure(&job.params, &counts) else {
+                return false;
+            };
             let curve = &mut self.graphs.curves[job.curve];
             for (&(i, _), t) in job.at.iter().zip(terms) {
                 curve.samples[i].terms = t;
@@ -198,13 +212,23 @@ impl Task for QualitySweep {
 
 #[cfg(test)]
 mod tests {
-    use super::super::synthetic::{smoothing_model, FnEvaluator};
+    use super::super::synthetic::{smoothing_model, FnEvaluator, Slow};
     use super::*;
     use crate::smooth::Filter;
     use crate::suggest::run;
 
     fn sweep(p: &Params, tau: f64, ev: &mut dyn Evaluator) -> QualityGraphs {
         run(QualitySweep::new(p, tau).unwrap(), ev, &mut |_| true).unwrap()
+    }
+
+    #[test]
+    fn an_evaluator_that_answers_later_gets_the_same_graphs() {
+        for filter in Filter::ALL {
+            let p = Params::defaults(filter);
+            let now = sweep(&p, 0.5, &mut FnEvaluator::new(smoothing_model(filter)));
+            let mut slow = Slow::new(FnEvaluator::new(smoothing_model(filter)), 3);
+            assert_eq!(sweep(&p, 0.5, &mut slow), now, "{filter:?}");
+        }
     }
 
     #[test]

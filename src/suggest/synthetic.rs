@@ -27,7 +27,7 @@ impl<F: FnMut(&Params) -> Terms> FnEvaluator<F> {
 }
 
 impl<F: FnMut(&Params) -> Terms> Evaluator for FnEvaluator<F> {
-    fn measure(&mut self, params: &Params, at: &[u32]) -> Vec<Terms> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
         assert!(!at.is_empty());
         assert!(at.windows(2).all(|w| w[0] < w[1]), "unsorted {at:?}");
         if !is_cumulative(params.filter) {
@@ -35,14 +35,52 @@ impl<F: FnMut(&Params) -> Terms> Evaluator for FnEvaluator<F> {
         }
         self.runs += 1;
         self.iterations_run += u64::from(*at.last().unwrap_or(&0));
-        at.iter()
-            .map(|&k| {
-                let mut p = *params;
-                p.iterations = k;
-                self.seen.push(p);
-                (self.f)(&p)
-            })
-            .collect()
+        Some(
+            at.iter()
+                .map(|&k| {
+                    let mut p = *params;
+                    p.iterations = k;
+                    self.seen.push(p);
+                    (self.f)(&p)
+                })
+                .collect(),
+        )
+    }
+}
+
+/// Answers each request only on its `delay + 1`-th asking, like an evaluator that spreads its
+/// runs over frames; checks that the task asks again for the same run meanwhile.
+pub struct Slow<E> {
+    pub inner: E,
+    delay: usize,
+    asked: Option<(Params, Vec<u32>, usize)>,
+}
+
+impl<E> Slow<E> {
+    pub fn new(inner: E, delay: usize) -> Self {
+        Self {
+            inner,
+            delay,
+            asked: None,
+        }
+    }
+}
+
+impl<E: Evaluator> Evaluator for Slow<E> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        let times = match &self.asked {
+            Some((p, a, n)) => {
+                assert_eq!((p, a.as_slice()), (params, at), "asked for another run");
+                n + 1
+            }
+            None => 1,
+        };
+        if times <= self.delay {
+            self.asked = Some((*params, at.to_vec(), times));
+            return None;
+        }
+        self.asked = None;
+        self.inner.measure(params, at)
     }
 }
 

@@ -1,0 +1,272 @@
+//! An evaluator that spreads each smoothing run over several calls, each within a time budget,
+//! so the web app (one thread on wasm32) can compute quality graphs and suggestions between
+//! frames. Its results are those of [`MeshEvaluator`], bit for bit: the run is the same
+//! iterations resumed in chunks ([`crate::smooth::resume`]), measured at the same counts.
+
+use super::mesh_evaluator::{MeshEvaluator, WeightsError};
+use super::{is_cumulative, Evaluator, Terms};
+use crate::metrics::{self, DriftingReference, Original};
+use crate::smooth::{self, Params};
+
+/// A run under way between calls.
+struct Partial {
+    params: Params,
+    at: Vec<u32>,
+    positions: Vec<[f32; 3]>,
+    reference: Vec<u32>,
+    done: u32,
+    terms: Vec<Terms>,
+}
+
+/// What a sliced evaluation keeps between calls: the run under way and how long work took so
+/// far (to size the next chunk). Belongs to one model: [`SlicedRuns::reset`] when it changes.
+#[derive(Default)]
+pub struct SlicedRuns {
+    partial: Option<Partial>,
+    /// Milliseconds per smoothing iteration and per measure pass, as last seen.
+    iteration_ms: Option<f64>,
+    measure_ms: Option<f64>,
+    /// Smoothing runs finished.
+    pub runs: usize,
+}
+
+impl SlicedRuns {
+    /// Forgets the run under way and the timings (another model, other weights).
+    pub fn reset(&mut self) {
+        *self = Self::default();
+    }
+}
+
+/// One call's view of a sliced evaluation: the model, the state kept between calls, a clock
+/// (milliseconds) and the moment this call must stop starting new work.
+pub struct Sliced<'a> {
+    evaluator: MeshEvaluator<'a>,
+    original: &'a Original,
+    weights: Option<&'a [f32]>,
+    runs: &'a mut SlicedRuns,
+    clock: &'a dyn Fn() -> f64,
+    deadline: f64,
+    /// Whether this call has done any work yet: the first piece always runs, so every call
+    /// makes progress however small the budget.
+    worked: bool,
+}
+
+impl<'a> Sliced<'a> {
+    /// Work started by this evaluator ends near `clock() + budget_ms`: a piece of work is
+    /// started only when its estimated time fits (or nothing was done yet in this call). One
+    /// measure pass or one windowed-sinc run is the smallest piece.
+    pub fn new(
+        original: &'a Original,
+        weights: Option<&'a [f32]>,
+        runs: &'a mut SlicedRuns,
+        clock: &'a dyn Fn() -> f64,
+        budget_ms: f64,
+    ) -> Result<Self, WeightsError> {
+        let deadline = clock() + budget_ms;
+        Ok(Self {
+            evaluator: MeshEvaluator::new(original, weights)?,
+            original,
+            weights,
+            runs,
+            clock,
+            deadline,
+            worked: false,
+        })
+    }
+
+    /// Whether a piece estimated to take `estimate_ms` may start now.
+    fn fits(&self, estimate_ms: Option<f64>) -> bool {
+        if !self.worked {
+            return true;
+        }
+        let now = (self.clock)();
+        now + estimate_ms.unwrap_or(0.0) <= self.deadline
+    }
+
+    fn start(&self, params: &Params, at: &[u32]) -> Partial {
+        Partial {
+            params: *params,
+            at: at.to_vec(),
+            positions: self.original.mesh().positions.clone(),
+            reference: metrics::identity(self.original.mesh().vertex_count()),
+            done: 0,
+            terms: Vec::with_capacity(at.len()),
+        }
+    }
+
+    fn measure_now(&mut self, partial: &Partial) -> Terms {
+        let t0 = (self.clock)();
+        let terms = if partial.done == 0 {
+            self.evaluator.unchanged()
+        } else {
+            self.evaluator
+                .measure_positions(&partial.positions, &partial.reference)
+        };
+        self.runs.measure_ms = Some((self.clock)() - t0);
+        self.worked = true;
+        terms
+    }
+
+    /// Smooths `partial` towards `target` iterations, as many as fit in the budget (at least
+    /// one). Windowed sinc, whose k-iteration result is no prefix of a longer run, is one piece.
+    fn advance(&mut self, partial: &mut Partial, target: u32) {
+        let t0 = (self.clock)();
+        let mut params = partial.params;
+        let chunk = if is_cumulative(params.filter) {
+            let left = self.deadline - t0;
+            let fit = match self.runs.iteration_ms {
+                Some(ms) if ms > 0.0 => (left / ms).floor().max(1.0) as u32,
+                _ => 1,
+            };
+            fit.clamp(1, target - partial.done)
+        } else {
+            target - partial.done
+        };
+        let positions = std::mem::take(&mut partial.positions);
+        let reference = std::mem::take(&mut partial.reference);
+        let mut drift = DriftingReference::resume(self.original, reference);
+        partial.positions = if is_cumulative(params.filter) {
+            smooth::resume(
+                self.original.mesh(),
+                self.original.topology(),
+                &params,
+                self.weights,
+                positions,
+                partial.done,
+                chunk,
+                &mut drift,
+            )
+            .unwrap_or_default()
+        } else {
+            params.iterations = target;
+            smooth::smooth(
+                self.original.mesh(),
+                self.original.topology(),
+                &params,
+                self.weights,
+                &mut drift,
+            )
+        };
+        partial.reference = drift.into_reference();
+        partial.done += chunk;
+        self.runs.iteration_ms = Some(((self.clock)() - t0) / f64::from(chunk.max(1)));
+        self.worked = true;
+    }
+}
+
+impl Evaluator for Sliced<'_> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        let mut partial = match self.runs.partial.take() {
+            Some(p) if p.params == *params && p.at == at => p,
+            _ => self.start(params, at),
+        };
+        loop {
+            let Some(&next) = partial.at.get(partial.terms.len()) else {
+                self.runs.runs += 1;
+                return Some(partial.terms);
+            };
+            if partial.done >= next {
+                if !self.fits(self.runs.measure_ms) {
+                    break;
+                }
+                let t = self.measure_now(&partial);
+                partial.terms.push(t);
+            } else {
+                if !self.fits(self.runs.iteration_ms) {
+                    break;
+                }
+                self.advance(&mut partial, next);
+            }
+        }
+        self.runs.partial = Some(partial);
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{run, GridSearch, LocalSearch, QualitySweep, Task};
+    use super::*;
+    use crate::io;
+    use crate::mesh::Topology;
+    use crate::smooth::Filter;
+    use std::cell::Cell;
+
+    const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+
+    fn sample() -> Original {
+        let mesh = io::load(SAMPLE, "sample.ply").expect("the sample loads");
+        let topology = Topology::build(&mesh);
+        Original::new(&mesh, &topology)
+    }
+
+    /// Runs `task` with a fresh [`Sliced`] per "frame" on a clock that ticks one millisecond
+    /// per reading, so every frame stops after a few pieces; returns the output and the frames.
+    fn sliced<T: Task>(
+        original: &Original,
+        weights: Option<&[f32]>,
+        mut task: T,
+        budget_ms: f64,
+    ) -> (T::Output, usize) {
+        let ticks = Cell::new(0.0);
+        let clock = || {
+            ticks.set(ticks.get() + 1.0);
+            ticks.get()
+        };
+        let mut runs = SlicedRuns::default();
+        let mut frames = 0;
+        loop {
+            frames += 1;
+            let mut ev = Sliced::new(original, weights, &mut runs, &clock, budget_ms).unwrap();
+            if task.step(&mut ev) {
+                break;
+            }
+            assert!(frames < 100_000, "the task never finishes");
+        }
+        (task.into_output().unwrap(), frames)
+    }
+
+    fn whole<T: Task>(original: &Original, weights: Option<&[f32]>, task: T) -> T::Output {
+        let mut ev = MeshEvaluator::new(original, weights).unwrap();
+        run(task, &mut ev, &mut |_| true).unwrap()
+    }
+
+    #[test]
+    fn sliced_quality_graphs_equal_whole_runs() {
+        let original = sample();
+        for filter in [Filter::Hc, Filter::Taubin] {
+            let mut p = Params::defaults(filter);
+            p.iterations = 6;
+            let task = || QualitySweep::new(&p, 0.5).unwrap();
+            let (graphs, frames) = sliced(&original, None, task(), 4.0);
+            assert_eq!(graphs, whole(&original, None, task()), "{filter:?}");
+            // At most a few pieces (an iteration chunk or a measure pass) per frame.
+            let samples = task().progress().total;
+            assert!(3 * frames >= samples, "{frames} frames for {samples} samples");
+        }
+    }
+
+    #[test]
+    fn sliced_searches_equal_whole_runs_with_weights_and_a_bound() {
+        let original = sample();
+        let n = original.mesh().vertex_count();
+        let weights: Vec<f32> = (0..n).map(|i| if i % 7 == 0 { 0.0 } else { 0.8 }).collect();
+        let mut base = Params::defaults(Filter::Laplace);
+        base.max_displacement = Some(0.3);
+        let local = || LocalSearch::new(Filter::Laplace, &base, 0.6).unwrap();
+        let (a, _) = sliced(&original, Some(&weights), local(), 3.0);
+        assert_eq!(a, whole(&original, Some(&weights), local()));
+        let grid = || GridSearch::new(Filter::Sinc, &Params::defaults(Filter::Sinc)).unwrap();
+        let (a, _) = sliced(&original, None, grid(), 2.0);
+        assert_eq!(a, whole(&original, None, grid()));
+    }
+
+    #[test]
+    fn every_call_makes_progress_even_without_budget() {
+        let original = sample();
+        let mut p = Params::defaults(Filter::Laplace);
+        p.iterations = 3;
+        let (graphs, _) = sliced(&original, None, QualitySweep::new(&p, 0.5).unwrap(), 0.0);
+        assert_eq!(graphs, whole(&original, None, QualitySweep::new(&p, 0.5).unwrap()));
+    }
+}
