@@ -7,8 +7,10 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod colors;
+mod guidance;
 
 pub use colors::{ColorField, Legend, LegendTick};
+pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::io;
@@ -104,6 +106,13 @@ pub struct Session {
     job: Option<CpuJob>,
     /// Why the last file could not be opened; cleared by the next successful open.
     error: Option<String>,
+    /// Counts the models opened, so background results of another model are told apart.
+    model_id: u64,
+    /// Per-vertex smoothing weights of the open model (0 locks a vertex), `None` for all 1.
+    weights: Option<Vec<f32>>,
+    /// Counts changes of `weights`.
+    weights_version: u64,
+    guidance: guidance::Guidance,
 }
 
 impl Default for Session {
@@ -118,6 +127,10 @@ impl Default for Session {
             result: None,
             job: None,
             error: None,
+            model_id: 0,
+            weights: None,
+            weights_version: 0,
+            guidance: guidance::Guidance::default(),
         }
     }
 }
@@ -198,6 +211,12 @@ impl Session {
         self.error = None;
         self.result = None;
         self.changed();
+        self.model_id += 1;
+        self.weights = None;
+        self.weights_version += 1;
+        self.reset_guidance();
+        // A suggestion for the new model, ready to apply with one click.
+        self.queue_suggest(crate::suggest::SearchMethod::Local);
         self.model.insert(model)
     }
 

@@ -154,12 +154,36 @@ impl<'a> Sliced<'a> {
     }
 }
 
-impl Evaluator for Sliced<'_> {
-    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
-        let mut partial = match self.runs.partial.take() {
+impl Sliced<'_> {
+    /// The run under way if it is this request, else a new one.
+    fn resume(&mut self, params: &Params, at: &[u32]) -> Partial {
+        match self.runs.partial.take() {
             Some(p) if p.params == *params && p.at == at => p,
             _ => self.start(params, at),
-        };
+        }
+    }
+
+    /// The positions after `params.iterations` iterations and their drifted reference vertices
+    /// (as [`crate::metrics::smooth_drifting`] gives them), spread over calls like
+    /// [`Evaluator::measure`]: `None` until the run is done.
+    pub fn smoothed(&mut self, params: &Params) -> Option<(Vec<[f32; 3]>, Vec<u32>)> {
+        // An empty `at` tells this run from a measured one with the same parameters.
+        let mut partial = self.resume(params, &[]);
+        while partial.done < params.iterations {
+            if !self.fits(self.runs.iteration_ms) {
+                self.runs.partial = Some(partial);
+                return None;
+            }
+            self.advance(&mut partial, params.iterations);
+        }
+        self.runs.runs += 1;
+        Some((partial.positions, partial.reference))
+    }
+}
+
+impl Evaluator for Sliced<'_> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        let mut partial = self.resume(params, at);
         loop {
             let Some(&next) = partial.at.get(partial.terms.len()) else {
                 self.runs.runs += 1;
@@ -242,7 +266,10 @@ mod tests {
             assert_eq!(graphs, whole(&original, None, task()), "{filter:?}");
             // At most a few pieces (an iteration chunk or a measure pass) per frame.
             let samples = task().progress().total;
-            assert!(3 * frames >= samples, "{frames} frames for {samples} samples");
+            assert!(
+                3 * frames >= samples,
+                "{frames} frames for {samples} samples"
+            );
         }
     }
 
@@ -262,11 +289,44 @@ mod tests {
     }
 
     #[test]
+    fn sliced_smoothing_equals_smooth_drifting() {
+        let original = sample();
+        let ticks = Cell::new(0.0);
+        let clock = || {
+            ticks.set(ticks.get() + 1.0);
+            ticks.get()
+        };
+        for filter in [Filter::Hc, Filter::Sinc] {
+            let mut p = Params::defaults(filter);
+            p.iterations = 9;
+            let mut runs = SlicedRuns::default();
+            let mut calls = 0;
+            let got = loop {
+                calls += 1;
+                let mut ev = Sliced::new(&original, None, &mut runs, &clock, 2.0).unwrap();
+                if let Some(r) = ev.smoothed(&p) {
+                    break r;
+                }
+            };
+            assert_eq!(
+                got,
+                metrics::smooth_drifting(&original, &p, None),
+                "{filter:?}"
+            );
+            let expected_calls = if filter == Filter::Sinc { 1 } else { 3 };
+            assert!(calls >= expected_calls, "{filter:?}: {calls} calls");
+        }
+    }
+
+    #[test]
     fn every_call_makes_progress_even_without_budget() {
         let original = sample();
         let mut p = Params::defaults(Filter::Laplace);
         p.iterations = 3;
         let (graphs, _) = sliced(&original, None, QualitySweep::new(&p, 0.5).unwrap(), 0.0);
-        assert_eq!(graphs, whole(&original, None, QualitySweep::new(&p, 0.5).unwrap()));
+        assert_eq!(
+            graphs,
+            whole(&original, None, QualitySweep::new(&p, 0.5).unwrap())
+        );
     }
 }

@@ -1,0 +1,711 @@
+//! The work that guides the user, done in the background between frames: the quality graphs of
+//! the active filter around its current parameters, the suggested parameters for a target
+//! smoothness tau (grid or local search), and a gallery of the model smoothed as suggested at
+//! several tau values.
+//!
+//! Every job runs on [`Sliced`] evaluators: a call to [`Session::step_guidance`] works for about
+//! the budget it is given and the job goes on at the next call, so the page never blocks. A job
+//! belongs to the model, filter, weights and displacement bound it was started for: when one of
+//! them changes it is dropped (the graphs also when any parameter changes) and its result no
+//! longer shown as current.
+
+use super::Session;
+use crate::metrics::{self, VertexMeasures};
+use crate::smooth::{Filter, Params};
+use crate::suggest::{
+    EvaluatedGrid, GridSearch, LocalOutcome, LocalSearch, Progress, QualityGraphs, QualitySweep,
+    SearchMethod, Sliced, SlicedRuns, Suggestion, Task, Terms,
+};
+
+/// The tau values of the gallery, from accuracy to smoothness.
+pub const GALLERY_TAUS: [f64; 5] = [0.1, 0.3, 0.5, 0.7, 0.9];
+
+/// What a search result depends on besides tau: the model, the weights, the filter and the
+/// displacement bound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SearchKey {
+    model: u64,
+    weights: u64,
+    filter: Filter,
+    bound: Option<f32>,
+}
+
+/// A job under way with the sliced-run state it keeps between calls.
+struct Running<T> {
+    task: T,
+    runs: SlicedRuns,
+    /// When the first piece of work began (ms).
+    started_ms: Option<f64>,
+}
+
+impl<T> Running<T> {
+    fn new(task: T) -> Self {
+        Self {
+            task,
+            runs: SlicedRuns::default(),
+            started_ms: None,
+        }
+    }
+
+    /// A sliced evaluator for this job's next piece of work.
+    fn evaluator<'a>(
+        &'a mut self,
+        original: &'a metrics::Original,
+        weights: Option<&'a [f32]>,
+        clock: &'a dyn Fn() -> f64,
+        budget_ms: f64,
+    ) -> Option<(&'a mut T, Sliced<'a>)> {
+        self.started_ms.get_or_insert_with(clock);
+        let ev = Sliced::new(original, weights, &mut self.runs, clock, budget_ms).ok()?;
+        Some((&mut self.task, ev))
+    }
+}
+
+enum Search {
+    Grid(GridSearch),
+    Local(LocalSearch),
+}
+
+/// A suggestion search under way.
+struct SearchJob {
+    key: SearchKey,
+    tau: f64,
+    method: SearchMethod,
+    running: Running<Search>,
+}
+
+/// A finished suggestion with what it was computed for.
+#[derive(Clone, Debug)]
+pub struct Suggested {
+    pub suggestion: Suggestion,
+    pub key: SearchKey,
+    /// Wall time of the search (milliseconds), spread over frames.
+    pub elapsed_ms: f64,
+}
+
+/// The model smoothed as suggested for one tau, with its measures.
+#[derive(Clone, Debug)]
+pub struct GalleryPick {
+    pub tau: f64,
+    pub params: Params,
+    pub terms: Terms,
+    pub positions: Vec<[f32; 3]>,
+    pub vertex: VertexMeasures,
+}
+
+/// The gallery under way: the suggested parameters per tau first, then one smoothing per tau.
+struct GalleryJob {
+    key: SearchKey,
+    /// Suggested parameters and terms, in [`GALLERY_TAUS`] order, as they are found.
+    suggested: Vec<(Params, Terms)>,
+    search: Option<Running<LocalSearch>>,
+    smoothing: Running<()>,
+    picks: Vec<GalleryPick>,
+    problem: Option<String>,
+}
+
+/// What the background is doing, for progress bars.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Activity {
+    Graphs(Progress),
+    Suggest {
+        progress: Progress,
+        tau: f64,
+        method: SearchMethod,
+    },
+    Gallery {
+        done: usize,
+        total: usize,
+    },
+}
+
+impl Activity {
+    /// The fraction done, in [0, 1].
+    pub fn fraction(&self) -> f32 {
+        let (done, total) = match *self {
+            Activity::Graphs(p) | Activity::Suggest { progress: p, .. } => (p.done, p.total),
+            Activity::Gallery { done, total } => (done, total),
+        };
+        if total == 0 {
+            0.0
+        } else {
+            (done as f32 / total as f32).min(1.0)
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        match *self {
+            Activity::Graphs(p) => format!("Quality graphs: {} of {} samples", p.done, p.total),
+            Activity::Suggest {
+                progress,
+                tau,
+                method,
+            } => format!(
+                "Suggesting for tau {tau:.2} ({} search): {} parameter sets",
+                method.name(),
+                progress.done
+            ),
+            Activity::Gallery { done, total } => format!("Gallery: {done} of {total} models"),
+        }
+    }
+}
+
+/// The background jobs and their latest results.
+#[derive(Default)]
+pub struct Guidance {
+    /// The latest finished graphs (maybe for other parameters: see [`Session::graphs_current`]).
+    graphs: Option<(SearchKey, QualityGraphs)>,
+    sweep: Option<(SearchKey, Params, Running<QualitySweep>)>,
+    /// Whether the graphs are kept up to date.
+    pub graphs_wanted: bool,
+    suggested: Option<Suggested>,
+    /// The evaluated grid of the last grid search: a suggestion for any tau without smoothing.
+    grid: Option<(SearchKey, EvaluatedGrid)>,
+    search: Option<SearchJob>,
+    gallery: Vec<GalleryPick>,
+    gallery_key: Option<SearchKey>,
+    gallery_job: Option<GalleryJob>,
+    /// Why the last job gave no result.
+    pub problem: Option<String>,
+}
+
+impl Session {
+    fn search_key(&self) -> SearchKey {
+        SearchKey {
+            model: self.model_id,
+            weights: self.weights_version,
+            filter: self.filter,
+            bound: self.params().max_displacement,
+        }
+    }
+
+    /// Drops jobs and results of another model.
+    pub(super) fn reset_guidance(&mut self) {
+        let wanted = self.guidance.graphs_wanted;
+        self.guidance = Guidance {
+            graphs_wanted: wanted,
+            ..Guidance::default()
+        };
+    }
+
+    /// The latest finished quality graphs of the active filter (maybe for other parameters
+    /// than the current ones while new ones are computed), rescored at the current tau.
+    pub fn graphs(&self) -> Option<QualityGraphs> {
+        let (key, graphs) = self.guidance.graphs.as_ref()?;
+        (key.model == self.model_id && key.filter == self.filter)
+            .then(|| graphs.clone().rescored(self.tau))
+    }
+
+    /// Whether [`Self::graphs`] are for exactly the current parameters, weights and model.
+    pub fn graphs_current(&self) -> bool {
+        self.guidance
+            .graphs
+            .as_ref()
+            .is_some_and(|(key, g)| *key == self.search_key() && g.current == *self.params())
+    }
+
+    /// The last suggestion, if it is for the current model, filter, weights and bound; from
+    /// an evaluated grid it follows tau.
+    pub fn suggestion(&self) -> Option<Suggested> {
+        let key = self.search_key();
+        if let Some((k, grid)) = &self.guidance.grid {
+            if *k == key {
+                if let (Some(mut s), Some(last)) = (grid.best(self.tau), &self.guidance.suggested) {
+                    s.params.max_displacement = key.bound;
+                    return Some(Suggested {
+                        suggestion: s,
+                        key,
+                        elapsed_ms: last.elapsed_ms,
+                    });
+                }
+            }
+        }
+        // A local search answers for its own tau only; the caller shows which.
+        self.guidance.suggested.clone().filter(|s| s.key == key)
+    }
+
+    /// Starts a suggestion search for the active filter at the current tau (replacing one
+    /// under way). A grid already evaluated for this model, filter, weights and bound answers
+    /// at once.
+    pub fn start_suggest(&mut self, method: SearchMethod) {
+        self.guidance.search = None;
+        if self.model.is_some() {
+            self.queue_suggest(method);
+        }
+    }
+
+    /// Sets up a search for the current key (the model may be about to be set).
+    pub(super) fn queue_suggest(&mut self, method: SearchMethod) {
+        let key = self.search_key();
+        let base = *self.params();
+        let search = match method {
+            SearchMethod::Grid => GridSearch::new(base.filter, &base).map(Search::Grid),
+            SearchMethod::Local => {
+                LocalSearch::new(base.filter, &base, self.tau).map(Search::Local)
+            }
+        };
+        match search {
+            Ok(task) => {
+                self.guidance.search = Some(SearchJob {
+                    key,
+                    tau: self.tau,
+                    method,
+                    running: Running::new(task),
+                })
+            }
+            Err(e) => self.guidance.problem = Some(format!("No suggestion: {e}")),
+        }
+    }
+
+    /// Keeps the quality graphs of the active filter up to date in the background (or stops).
+    pub fn set_graphs_wanted(&mut self, wanted: bool) {
+        self.guidance.graphs_wanted = wanted;
+        if !wanted {
+            self.guidance.sweep = None;
+        }
+    }
+
+    /// Why the last background job gave no result.
+    pub fn guidance_problem(&self) -> Option<&str> {
+        self.guidance.problem.as_deref()
+    }
+
+    /// Whether a suggestion search is under way.
+    pub fn suggesting(&self) -> bool {
+        self.guidance.search.is_some()
+    }
+
+    /// Stops the suggestion search under way.
+    pub fn cancel_suggest(&mut self) {
+        self.guidance.search = None;
+    }
+
+    /// Starts the gallery of [`GALLERY_TAUS`] for the active filter.
+    pub fn start_gallery(&mut self) {
+        if self.model.is_none() {
+            self.guidance.gallery_job = None;
+            return;
+        }
+        let key = self.search_key();
+        // With an evaluated grid the suggestions are known already.
+        let suggested = match &self.guidance.grid {
+            Some((k, grid)) if *k == key => GALLERY_TAUS
+                .iter()
+                .filter_map(|&tau| grid.best(tau))
+                .map(|s| (with_bound(s.params, key.bound), s.terms))
+                .collect(),
+            _ => Vec::new(),
+        };
+        self.guidance.gallery_job = Some(GalleryJob {
+            key,
+            suggested,
+            search: None,
+            smoothing: Running::new(()),
+            picks: Vec::new(),
+            problem: None,
+        });
+    }
+
+    pub fn cancel_gallery(&mut self) {
+        self.guidance.gallery_job = None;
+    }
+
+    /// The last finished gallery, if it is for the current model, filter, weights and bound.
+    pub fn gallery(&self) -> &[GalleryPick] {
+        if self.guidance.gallery_key == Some(self.search_key()) {
+            &self.guidance.gallery
+        } else {
+            &[]
+        }
+    }
+
+    /// What the background is working on.
+    pub fn activities(&self) -> Vec<Activity> {
+        let mut out = Vec::new();
+        if let Some(job) = &self.guidance.search {
+            let progress = match &job.running.task {
+                Search::Grid(t) => t.progress(),
+                Search::Local(t) => t.progress(),
+            };
+            out.push(Activity::Suggest {
+                progress,
+                tau: job.tau,
+                method: job.method,
+            });
+        }
+        if let Some(job) = &self.guidance.gallery_job {
+            out.push(Activity::Gallery {
+                done: job.picks.len(),
+                total: GALLERY_TAUS.len(),
+            });
+        }
+        if let Some((_, _, running)) = &self.guidance.sweep {
+            out.push(Activity::Graphs(running.task.progress()));
+        }
+        out
+    }
+
+    /// Whether any background job is under way or due.
+    pub fn guidance_busy(&self) -> bool {
+        self.guidance.search.is_some()
+            || self.guidance.gallery_job.is_some()
+            || self.guidance.sweep.is_some()
+            || self.graphs_due()
+    }
+
+    fn graphs_due(&self) -> bool {
+        self.guidance.graphs_wanted && self.model.is_some() && !self.graphs_current()
+    }
+
+    /// Works on the background jobs for about `budget_ms`: the suggestion first (the user
+    /// asked and waits), then the gallery, then the graphs. Returns whether a job finished.
+    pub fn step_guidance(&mut self, clock: &dyn Fn() -> f64, budget_ms: f64) -> bool {
+        let key = self.search_key();
+        let params = *self.params();
+        // Jobs for another model, filter, weights or bound are dropped.
+        if self.guidance.search.as_ref().is_some_and(|j| j.key != key) {
+            self.guidance.search = None;
+        }
+        if self
+            .guidance
+            .gallery_job
+            .as_ref()
+            .is_some_and(|j| j.key != key)
+        {
+            self.guidance.gallery_job = None;
+        }
+        if self
+            .guidance
+            .sweep
+            .as_ref()
+            .is_some_and(|(k, p, _)| *k != key || *p != params)
+        {
+            self.guidance.sweep = None;
+        }
+        let Some(model) = self.model.as_ref() else {
+            return false;
+        };
+        let original = &model.original;
+        let weights = self.weights.as_deref();
+        let guidance = &mut self.guidance;
+
+        if let Some(job) = guidance.search.as_mut() {
+            let Some((task, mut ev)) = job.running.evaluator(original, weights, clock, budget_ms)
+            else {
+                guidance.search = None;
+                return false;
+            };
+            let finished = match task {
+                Search::Grid(t) => t.step(&mut ev),
+                Search::Local(t) => t.step(&mut ev),
+            };
+            if !finished {
+                return false;
+            }
+            let Some(job) = guidance.search.take() else {
+                return false;
+            };
+            let elapsed_ms = clock() - job.running.started_ms.unwrap_or_default();
+            let suggestion = match job.running.task {
+                Search::Grid(t) => t.into_output().and_then(|grid| {
+                    let best = grid.best(job.tau);
+                    guidance.grid = Some((key, grid));
+                    best
+                }),
+                Search::Local(t) => t.into_output().map(|o: LocalOutcome| o.suggestion),
+            };
+            if let Some(mut suggestion) = suggestion {
+                suggestion.params.max_displacement = key.bound;
+                guidance.suggested = Some(Suggested {
+                    suggestion,
+                    key,
+                    elapsed_ms,
+                });
+            }
+            return true;
+        }
+
+        if let Some(job) = guidance.gallery_job.as_mut() {
+            let finished = step_gallery(job, original, weights, clock, budget_ms);
+            if finished {
+                if let Some(job) = guidance.gallery_job.take() {
+                    guidance.problem = job.problem;
+                    guidance.gallery = job.picks;
+                    guidance.gallery_key = Some(job.key);
+                }
+            }
+            return finished;
+        }
+
+        if !guidance.graphs_wanted {
+            guidance.sweep = None;
+            return false;
+        }
+        let current = guidance
+            .graphs
+            .as_ref()
+            .is_some_and(|(k, g)| *k == key && g.current == params);
+        if current {
+            return false;
+        }
+        if guidance.sweep.is_none() {
+            match QualitySweep::new(&params, self.tau) {
+                Ok(task) => guidance.sweep = Some((key, params, Running::new(task))),
+                Err(e) => {
+                    guidance.problem = Some(format!("No quality graphs: {e}"));
+                    return false;
+                }
+            }
+        }
+        let Some((_, _, running)) = guidance.sweep.as_mut() else {
+            return false;
+        };
+        let Some((task, mut ev)) = running.evaluator(original, weights, clock, budget_ms) else {
+            guidance.sweep = None;
+            return false;
+        };
+        if !task.step(&mut ev) {
+            return false;
+        }
+        if let Some((key, _, running)) = guidance.sweep.take() {
+            if let Some(graphs) = running.task.into_output() {
+                guidance.graphs = Some((key, graphs));
+            }
+        }
+        true
+    }
+}
+
+fn with_bound(mut params: Params, bound: Option<f32>) -> Params {
+    params.max_displacement = bound;
+    params
+}
+
+/// One call's work on the gallery: the next tau's local search until every tau has
+/// parameters, then the next smoothing. Returns whether the gallery is complete.
+fn step_gallery(
+    job: &mut GalleryJob,
+    original: &metrics::Original,
+    weights: Option<&[f32]>,
+    clock: &dyn Fn() -> f64,
+    budget_ms: f64,
+) -> bool {
+    let n = GALLERY_TAUS.len();
+    if job.suggested.len() < n {
+        let tau = GALLERY_TAUS[job.suggested.len()];
+        let base = with_bound(Params::defaults(job.key.filter), job.key.bound);
+        if job.search.is_none() {
+            match LocalSearch::new(job.key.filter, &base, tau) {
+                Ok(task) => job.search = Some(Running::new(task)),
+                Err(e) => {
+                    job.problem = Some(format!("No gallery: {e}"));
+                    return true;
+                }
+            }
+        }
+        let Some(running) = job.search.as_mut() else {
+            return true;
+        };
+        let Some((task, mut ev)) = running.evaluator(original, weights, clock, budget_ms) else {
+            return true;
+        };
+        if task.step(&mut ev) {
+            if let Some(outcome) = job.search.take().and_then(|r| r.task.into_output()) {
+                let s = outcome.suggestion;
+                job.suggested
+                    .push((with_bound(s.params, job.key.bound), s.terms));
+            } else {
+                return true;
+            }
+        }
+        return false;
+    }
+    let Some(&(params, terms)) = job.suggested.get(job.picks.len()) else {
+        return true;
+    };
+    let tau = GALLERY_TAUS[job.picks.len()];
+    let Some((_, mut ev)) = job.smoothing.evaluator(original, weights, clock, budget_ms) else {
+        return true;
+    };
+    let Some((positions, reference)) = ev.smoothed(&params) else {
+        return false;
+    };
+    let (_, vertex) = metrics::measure_vertices(original, &positions, &reference, tau);
+    job.picks.push(GalleryPick {
+        tau,
+        params,
+        terms,
+        positions,
+        vertex,
+    });
+    job.picks.len() == n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::suggest::{quality_graphs, suggest};
+    use std::cell::Cell;
+
+    const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+
+    fn session(filter: &str) -> Session {
+        let mut s = Session::default();
+        s.open("sample.ply", SAMPLE).unwrap();
+        s.set_filter_name(filter).unwrap();
+        s
+    }
+
+    /// Steps the background until nothing is left, on a clock that ticks 1 ms per reading;
+    /// returns the calls it took.
+    fn settle(s: &mut Session) -> usize {
+        let ticks = Cell::new(0.0);
+        let clock = || {
+            ticks.set(ticks.get() + 1.0);
+            ticks.get()
+        };
+        let mut calls = 0;
+        while s.guidance_busy() {
+            s.step_guidance(&clock, 20.0);
+            calls += 1;
+            assert!(calls < 1_000_000, "the background never settles");
+        }
+        calls
+    }
+
+    #[test]
+    fn a_loaded_model_gets_the_local_search_suggestion() {
+        let mut s = Session::default();
+        s.open("sample.ply", SAMPLE).unwrap();
+        assert!(s.suggesting(), "a search starts with the model");
+        let calls = settle(&mut s);
+        assert!(calls > 10, "spread over {calls} calls");
+        let got = s.suggestion().expect("a suggestion").suggestion;
+        let model = s.model().unwrap();
+        let expected = suggest(
+            &model.original,
+            None,
+            s.params(),
+            s.tau(),
+            SearchMethod::Local,
+            &mut |_| true,
+        )
+        .unwrap();
+        assert_eq!(got, expected);
+    }
+
+    #[test]
+    fn a_grid_suggestion_follows_tau_without_smoothing_again() {
+        let mut s = session("laplace");
+        s.set_params_json(&serde_json::json!({"max_displacement": 0.4}))
+            .unwrap();
+        s.start_suggest(SearchMethod::Grid);
+        settle(&mut s);
+        for tau in [0.5, 0.2, 0.9] {
+            s.set_tau(tau).unwrap();
+            assert!(!s.guidance_busy());
+            let got = s.suggestion().unwrap().suggestion;
+            let expected = suggest(
+                &model_original(&s),
+                None,
+                s.params(),
+                tau,
+                SearchMethod::Grid,
+                &mut |_| true,
+            )
+            .unwrap();
+            assert_eq!(got, expected, "tau {tau}");
+            assert_eq!(got.params.max_displacement, Some(0.4));
+        }
+        // Another filter: the grid is not for it.
+        s.set_filter_name("hc").unwrap();
+        assert!(s.suggestion().is_none());
+    }
+
+    fn model_original(s: &Session) -> metrics::Original {
+        s.model().unwrap().original.clone()
+    }
+
+    #[test]
+    fn graphs_follow_the_parameters_in_the_background() {
+        let mut s = session("taubin");
+        s.cancel_suggest();
+        s.set_params_json(&serde_json::json!({"iterations": 8}))
+            .unwrap();
+        assert!(!s.guidance_busy(), "graphs are only made when wanted");
+        s.set_graphs_wanted(true);
+        settle(&mut s);
+        assert!(s.graphs_current());
+        let original = model_original(&s);
+        let expected = quality_graphs(&original, None, s.params(), s.tau(), &mut |_| true).unwrap();
+        assert_eq!(s.graphs().unwrap(), expected);
+
+        // A new value: the old graphs stay on show, marked stale, until new ones are made.
+        s.set_params_json(&serde_json::json!({"lambda": 0.4}))
+            .unwrap();
+        assert!(!s.graphs_current());
+        assert_eq!(s.graphs().unwrap(), expected);
+        assert!(s.guidance_busy());
+        settle(&mut s);
+        assert!(s.graphs_current());
+        assert_eq!(s.graphs().unwrap().current, *s.params());
+
+        // tau rescored without smoothing.
+        s.set_tau(0.9).unwrap();
+        assert!(!s.guidance_busy());
+        assert_eq!(s.graphs().unwrap().tau, 0.9);
+    }
+
+    #[test]
+    fn the_gallery_holds_the_local_suggestion_of_each_tau() {
+        let mut s = session("laplace");
+        s.cancel_suggest();
+        s.start_gallery();
+        settle(&mut s);
+        let picks = s.gallery();
+        assert_eq!(picks.len(), GALLERY_TAUS.len());
+        let original = model_original(&s);
+        for (pick, &tau) in picks.iter().zip(&GALLERY_TAUS) {
+            let expected = suggest(
+                &original,
+                None,
+                s.params(),
+                tau,
+                SearchMethod::Local,
+                &mut |_| true,
+            )
+            .unwrap();
+            assert_eq!(
+                (pick.tau, pick.params, pick.terms),
+                (tau, expected.params, expected.terms)
+            );
+            let (positions, _) = metrics::smooth_drifting(&original, &pick.params, None);
+            assert_eq!(pick.positions, positions);
+            assert_eq!(pick.vertex.local_error.len(), positions.len());
+        }
+        // Stronger smoothing as tau grows.
+        let k: Vec<f64> = picks.iter().map(|p| p.terms.curvature_ratio).collect();
+        assert!(k.first() > k.last(), "{k:?}");
+    }
+
+    #[test]
+    fn a_search_for_another_filter_or_model_is_dropped() {
+        let mut s = session("hc");
+        s.start_suggest(SearchMethod::Local);
+        s.step_guidance(&|| 0.0, 1.0);
+        assert!(s.suggesting());
+        s.set_filter_name("sinc").unwrap();
+        s.step_guidance(&|| 0.0, 1.0);
+        assert!(!s.suggesting());
+        s.set_filter_name("hc").unwrap();
+        s.start_gallery();
+        s.open("again.ply", SAMPLE).unwrap();
+        assert!(s.gallery().is_empty());
+        assert_eq!(
+            s.activities().len(),
+            1,
+            "only the new model's suggestion: {:?}",
+            s.activities()
+        );
+    }
+}
