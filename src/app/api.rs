@@ -7,8 +7,15 @@
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
 //!   parameters' result is computed
 //! - `exportMesh(format): Promise<Uint8Array>` for `glb stl ply obj`
+//! - `suggest({tau, search}): Promise<object>`: sets tau and searches (`grid`, the default, or
+//!   `local`) for the active filter; resolves with the CLI's `suggest --json` keys (the
+//!   suggestion is shown, not applied)
+//! - `sweep(): Promise<object>`: the quality graphs of the active filter around the current
+//!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
-//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, backend, timings}`
+//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, backend, timings,
+//!   guidance}` (`guidance`: background work under way, whether the graphs are current, the
+//!   suggestion and the gallery)
 //!   (`timings`: the last result's `smooth_ms` and `measure_ms` of the CPU engine's own work, or
 //!   `gpu_run_ms` from submitting a GPU run to having its results back)
 //!
@@ -71,6 +78,66 @@ fn when_current(
         }));
         ctx.request_repaint();
     })
+}
+
+/// A promise resolved by the document once `ready` holds, with `answer` applied to the session.
+fn when_ready(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+    ready: super::document::Ready,
+    answer: impl FnOnce(&crate::session::Session) -> Result<JsValue, String> + 'static,
+) -> Promise {
+    let doc = doc.clone();
+    let ctx = ctx.clone();
+    let mut answer = Some(answer);
+    Promise::new(&mut |resolve: Function, reject: Function| {
+        let Some(answer) = answer.take() else { return };
+        doc.borrow_mut().when(
+            ready,
+            Box::new(move |session| {
+                let _ = match answer(session) {
+                    Ok(v) => resolve.call1(&JsValue::NULL, &v),
+                    Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
+                };
+            }),
+        );
+        ctx.request_repaint();
+    })
+}
+
+/// `suggest({tau, search})`: sets tau (default: the current one) and starts the search
+/// (default: grid, as the CLI); returns what the answer must match.
+fn start_suggest(
+    doc: &SharedDocument,
+    options: &JsValue,
+) -> Result<(f64, crate::suggest::SearchMethod), String> {
+    use crate::suggest::SearchMethod;
+    let options = if options.is_undefined() || options.is_null() {
+        serde_json::json!({})
+    } else {
+        from_js(options)?
+    };
+    let mut doc = doc.borrow_mut();
+    let session = &mut doc.session;
+    if session.model().is_none() {
+        return Err("no mesh is open: call loadMesh first".into());
+    }
+    let tau = match options.get("tau") {
+        None | Some(serde_json::Value::Null) => session.tau(),
+        Some(v) => v
+            .as_f64()
+            .ok_or_else(|| format!("suggest: tau must be a number in [0, 1], got {v}"))?,
+    };
+    let method = match options.get("search") {
+        None | Some(serde_json::Value::Null) => SearchMethod::Grid,
+        Some(v) => v
+            .as_str()
+            .and_then(SearchMethod::from_name)
+            .ok_or_else(|| format!("suggest: unknown search {v}: use grid or local"))?,
+    };
+    session.set_tau(tau)?;
+    session.start_suggest(method);
+    Ok((tau, method))
 }
 
 /// A function of one argument that edits the session, throwing the engine's message when it
@@ -157,6 +224,53 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                     .map(|v| to_js(&v))
                     .ok_or_else(|| "no measures".to_string())
             })
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "suggest",
+        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |options: JsValue| match start_suggest(
+            &d, &options,
+        ) {
+            Ok((tau, method)) => when_ready(
+                &d,
+                &c,
+                |s| !s.suggesting(),
+                move |s| match s.suggestion() {
+                    Some(x) if x.suggestion.tau == tau && x.suggestion.search == method => {
+                        Ok(to_js(&x.suggestion.to_json(x.elapsed_ms / 1000.0)))
+                    }
+                    _ => Err(s
+                        .guidance_problem()
+                        .unwrap_or("the suggestion was cancelled or replaced")
+                        .to_string()),
+                },
+            ),
+            Err(e) => settled(Err(e)),
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "sweep",
+        Closure::<dyn FnMut() -> Promise>::new(move || {
+            if d.borrow().session.model().is_none() {
+                return settled(Err("no mesh is open: call loadMesh first".into()));
+            }
+            d.borrow_mut().session.set_graphs_wanted(true);
+            when_ready(
+                &d,
+                &c,
+                |s| s.graphs_current(),
+                |s| {
+                    s.graphs_json()
+                        .map(|v| to_js(&v))
+                        .ok_or_else(|| "no quality graphs".to_string())
+                },
+            )
         }),
     )?;
 

@@ -58,6 +58,9 @@ impl EngineTimings {
     }
 }
 
+/// When a waiting call is answered.
+pub type Ready = fn(&Session) -> bool;
+
 pub struct Document {
     pub session: Session,
     pub backend: Backend,
@@ -66,6 +69,8 @@ pub struct Document {
     /// Bumped when a new model is opened, so views re-upload it.
     pub model_generation: u64,
     waiting: Vec<Waiter>,
+    /// Calls waiting for background work (a suggestion, the graphs).
+    waiting_for: Vec<(Ready, Waiter)>,
 }
 
 /// The handle the shell and the API hold.
@@ -79,6 +84,7 @@ impl Document {
             timings: None,
             model_generation: 0,
             waiting: Vec::new(),
+            waiting_for: Vec::new(),
         }
     }
 
@@ -116,14 +122,34 @@ impl Document {
         }
     }
 
-    /// Answers the waiting calls if the current result is there.
+    /// Runs `waiter` once `ready` holds for the session (checked every frame).
+    pub fn when(&mut self, ready: Ready, waiter: Waiter) {
+        self.waiting_for.push((ready, waiter));
+    }
+
+    /// Answers the waiting calls whose result is there.
     pub fn answer_waiting(&mut self) {
+        if !self.waiting_for.is_empty() {
+            let (ready, later): (Vec<_>, Vec<_>) = std::mem::take(&mut self.waiting_for)
+                .into_iter()
+                .partition(|(ready, _)| ready(&self.session));
+            self.waiting_for = later;
+            for (_, waiter) in ready {
+                waiter(&self.session);
+            }
+        }
         if self.busy() || self.waiting.is_empty() {
             return;
         }
         for waiter in std::mem::take(&mut self.waiting) {
             waiter(&self.session);
         }
+    }
+
+    /// Whether anything is computing (the current result or background work), so the page
+    /// keeps drawing frames.
+    pub fn working(&self) -> bool {
+        self.busy() || self.session.guidance_busy()
     }
 
     /// The CPU engine's share of this frame: works on the current parameters' result for
@@ -134,9 +160,20 @@ impl Document {
         }
     }
 
+    /// The background work's share of this frame (graphs, suggestions, the gallery), about
+    /// [`FRAME_BUDGET_MS`] of CPU time. With the CPU engine it waits until the current
+    /// parameters' result is there: what the user is looking at comes first.
+    pub fn compute_guidance(&mut self) {
+        if self.backend == Backend::Cpu && self.busy() {
+            return;
+        }
+        self.session.step_guidance(&now_ms, FRAME_BUDGET_MS);
+    }
+
     /// What the API's `state()` returns.
     pub fn state_json(&self) -> serde_json::Value {
         let mut state = self.session.state_json(self.busy());
+        state["guidance"] = self.session.guidance_json();
         state["backend"] = serde_json::json!(self.backend.name());
         state["timings"] = match self.timings {
             Some(EngineTimings::Cpu(t)) => {

@@ -15,6 +15,8 @@ mod document;
 mod download;
 mod file_input;
 mod gpu_engine;
+mod graphs;
+mod guide;
 mod legend;
 mod page;
 mod query;

@@ -6,11 +6,12 @@ use super::controls::{self, Controls};
 use super::document::{Backend, Document, SharedDocument};
 use super::file_input::FileInput;
 use super::gpu_engine::GpuEngine;
+use super::guide::Guide;
 use super::shortcuts::{self, Action};
 use super::viewer::Viewer;
-use super::{api, download, legend, page, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
+use super::{api, download, graphs, legend, page, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
-use crate::session::{ColorField, Legend};
+use crate::session::{Activity, ColorField, Legend};
 use crate::smooth::Filter;
 use eframe::egui;
 use eframe::egui_wgpu;
@@ -21,6 +22,9 @@ pub struct Shell {
     doc: SharedDocument,
     files: FileInput,
     controls: Controls,
+    guide: Guide,
+    /// Whether the quality graphs are shown (and kept up to date).
+    graphs_open: bool,
     coloring: Option<ColorField>,
     bake_colors: bool,
     show_original: bool,
@@ -80,6 +84,7 @@ impl Shell {
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
         let files = FileInput::new(&cc.egui_ctx);
+        doc.borrow_mut().session.set_graphs_wanted(true);
         open_start_model(&doc, &files, &cc.egui_ctx);
         if let Err(e) = api::install(&doc, &cc.egui_ctx) {
             log::error!("no embedding API: {e}");
@@ -88,6 +93,8 @@ impl Shell {
             doc,
             files,
             controls: Controls::default(),
+            guide: Guide::default(),
+            graphs_open: true,
             coloring: Some(ColorField::LocalError),
             bake_colors: false,
             show_original: false,
@@ -273,6 +280,13 @@ impl Shell {
                 ui.checkbox(&mut self.bake_colors, "Bake colours (GLB, PLY)");
             });
             ui.separator();
+            if ui
+                .toggle_value(&mut self.graphs_open, "Graphs")
+                .on_hover_text("Model quality graphs of the active filter (G)")
+                .changed()
+            {
+                self.set_graphs_open(self.graphs_open);
+            }
             ui.toggle_value(&mut self.show_original, "Original")
                 .on_hover_text("Before/after: show the original mesh (B)");
             if let Some((viewer, _)) = &mut self.view {
@@ -296,11 +310,40 @@ impl Shell {
         ui.heading("Smoothing");
         self.controls.filter(ui, &mut doc.session);
         ui.separator();
+        ui.heading("Suggest");
+        self.guide.show(ui, &mut doc.session);
+        ui.separator();
         ui.heading("Measures");
         controls::measures(ui, &doc.session, timings);
         ui.separator();
         ui.heading("Colours");
         controls::coloring(ui, &mut self.coloring, &mut doc.session);
+    }
+
+    fn set_graphs_open(&mut self, open: bool) {
+        self.graphs_open = open;
+        self.doc.borrow_mut().session.set_graphs_wanted(open);
+    }
+
+    fn graphs_panel(&mut self, ui: &mut egui::Ui) {
+        let mut doc = self.doc.borrow_mut();
+        ui.horizontal(|ui| {
+            ui.heading("Model quality graphs");
+            let filter = doc.session.filter();
+            ui.label(format!("{filter} filter: each column varies one parameter"));
+            for a in doc.session.activities() {
+                if let Activity::Graphs(_) = a {
+                    ui.add(
+                        egui::ProgressBar::new(a.fraction())
+                            .desired_width(220.0)
+                            .text(a.describe()),
+                    );
+                }
+            }
+        });
+        if let Some(p) = graphs::show(ui, &doc.session) {
+            let _ = doc.session.set_params(p);
+        }
     }
 
     fn status_bar(&self, ui: &mut egui::Ui) {
@@ -411,11 +454,12 @@ impl eframe::App for Shell {
             self.apply(action);
         }
         self.compute();
+        self.doc.borrow_mut().compute_guidance();
         self.sync_view();
         {
             let mut doc = self.doc.borrow_mut();
             doc.answer_waiting();
-            if doc.busy() {
+            if doc.working() {
                 ctx.request_repaint();
             }
         }
@@ -428,6 +472,12 @@ impl eframe::App for Shell {
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.smoothing_panel(ui));
             });
+        if self.graphs_open {
+            egui::Panel::bottom("graphs")
+                .resizable(true)
+                .default_size(380.0)
+                .show(ui, |ui| self.graphs_panel(ui));
+        }
         egui::Panel::right("report")
             .resizable(true)
             .default_size(260.0)

@@ -57,20 +57,12 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
 }
 
 fn text(s: &Suggestion, seconds: f64) -> String {
-    let params: Vec<String> = match s.params.to_json() {
-        serde_json::Value::Object(m) => m
-            .into_iter()
-            .filter(|(_, v)| !v.is_null())
-            .map(|(k, v)| format!("{k} {v}"))
-            .collect(),
-        _ => Vec::new(),
-    };
     let mut out = format!(
         "{} filter, tau {}, {} search: {}\n",
         s.filter,
         s.tau,
         s.search.name(),
-        params.join(", ")
+        s.params.describe()
     );
     if s.leaves_mesh_unchanged() {
         out += "(no smoothing: the mesh is best left as it is at this tau)\n";

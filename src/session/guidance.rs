@@ -155,6 +155,8 @@ impl Activity {
 pub struct Guidance {
     /// The latest finished graphs (maybe for other parameters: see [`Session::graphs_current`]).
     graphs: Option<(SearchKey, QualityGraphs)>,
+    /// How long the sweep of `graphs` took (ms of wall time, spread over frames).
+    graphs_elapsed_ms: f64,
     sweep: Option<(SearchKey, Params, Running<QualitySweep>)>,
     /// Whether the graphs are kept up to date.
     pub graphs_wanted: bool,
@@ -194,6 +196,15 @@ impl Session {
         let (key, graphs) = self.guidance.graphs.as_ref()?;
         (key.model == self.model_id && key.filter == self.filter)
             .then(|| graphs.clone().rescored(self.tau))
+    }
+
+    /// What `sweep --json` prints for the current graphs, once they are current.
+    pub fn graphs_json(&self) -> Option<serde_json::Value> {
+        if !self.graphs_current() {
+            return None;
+        }
+        let graphs = self.graphs()?;
+        Some(graphs.to_json(self.guidance.graphs_elapsed_ms / 1000.0))
     }
 
     /// Whether [`Self::graphs`] are for exactly the current parameters, weights and model.
@@ -268,6 +279,27 @@ impl Session {
     /// Why the last background job gave no result.
     pub fn guidance_problem(&self) -> Option<&str> {
         self.guidance.problem.as_deref()
+    }
+
+    /// What the embedding API's `state().guidance` holds: the background work under way and
+    /// whether the graphs are current.
+    pub fn guidance_json(&self) -> serde_json::Value {
+        let activities: Vec<serde_json::Value> = self
+            .activities()
+            .iter()
+            .map(|a| serde_json::json!({"what": a.describe(), "fraction": a.fraction()}))
+            .collect();
+        serde_json::json!({
+            "activities": activities,
+            "graphs_current": self.graphs_current(),
+            "suggestion": self.suggestion().map(|s| s.suggestion.to_json(s.elapsed_ms / 1000.0)),
+            "gallery": self.gallery().iter().map(|p| serde_json::json!({
+                "tau": p.tau,
+                "params": p.params.to_json(),
+                "terms": p.terms,
+            })).collect::<Vec<_>>(),
+            "problem": self.guidance_problem(),
+        })
     }
 
     /// Whether a suggestion search is under way.
@@ -468,6 +500,7 @@ impl Session {
             return false;
         }
         if let Some((key, _, running)) = guidance.sweep.take() {
+            guidance.graphs_elapsed_ms = clock() - running.started_ms.unwrap_or_default();
             if let Some(graphs) = running.task.into_output() {
                 guidance.graphs = Some((key, graphs));
             }

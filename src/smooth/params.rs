@@ -135,6 +135,20 @@ impl Params {
 }
 
 impl Params {
+    /// The parameters this filter reads as `name value` pairs, e.g. `lambda 0.5, iterations 10`
+    /// (an unset displacement bound left out).
+    pub fn describe(&self) -> String {
+        match self.to_json() {
+            serde_json::Value::Object(m) => m
+                .into_iter()
+                .filter(|(_, v)| !v.is_null())
+                .map(|(k, v)| format!("{k} {v}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            _ => String::new(),
+        }
+    }
+
     /// The parameters this filter reads, as JSON (the others are left out so a report is not
     /// misread): the `params` object of the CLI's reports and of the embedding API.
     pub fn to_json(&self) -> serde_json::Value {

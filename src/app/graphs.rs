@@ -1,0 +1,215 @@
+//! The model quality graphs (paper section 5.2), one column per parameter of the active filter.
+//!
+//! The paper's users found three curves on one unlabelled axis confusing, so each measure has
+//! its own strip with its own labelled axis, in its own unit: smoothness (K/K0), accuracy (mean
+//! local error in mm, with half the voxel diagonal as a reference line when the voxel size is
+//! known), volume change (%), and the score S(tau) with its minimum marked. A dashed line marks
+//! the current value in every strip; clicking or dragging in any strip sets the parameter.
+
+use crate::session::Session;
+use crate::smooth::Params;
+use crate::suggest::{Curve, Param};
+use eframe::egui;
+use egui_plot::{HLine, HoverPosition, Line, LineStyle, Plot, PlotPoints, Points, VLine};
+
+const CURVATURE: egui::Color32 = egui::Color32::from_rgb(0x5d, 0xa5, 0xda);
+const ERROR: egui::Color32 = egui::Color32::from_rgb(0xfa, 0xa4, 0x3a);
+const VOLUME: egui::Color32 = egui::Color32::from_rgb(0x60, 0xbd, 0x68);
+const SCORE: egui::Color32 = egui::Color32::from_rgb(0xf1, 0x7c, 0xb0);
+const CURRENT: egui::Color32 = egui::Color32::from_gray(230);
+const REFERENCE: egui::Color32 = egui::Color32::from_rgb(0xb2, 0x76, 0xb2);
+
+/// One strip: which measure, how it reads.
+struct Strip {
+    title: &'static str,
+    help: &'static str,
+    color: egui::Color32,
+    value: fn(&crate::suggest::Sample) -> Option<f64>,
+}
+
+const STRIPS: [Strip; 4] = [
+    Strip {
+        title: "Smoothness K/K0",
+        help: "Mean |Gaussian curvature| against the original's. Lower is smoother: 1 is the \
+               original, 0.5 has half its bumpiness.",
+        color: CURVATURE,
+        value: |s| Some(s.terms.curvature_ratio),
+    },
+    Strip {
+        title: "Mean error (mm)",
+        help: "Mean distance of the smoothed surface from the original. Lower is more \
+               accurate. The dotted line is half a voxel diagonal, when the voxel size is set.",
+        color: ERROR,
+        value: |s| Some(s.terms.mean_error),
+    },
+    Strip {
+        title: "Volume change (%)",
+        help: "Change of the enclosed volume against the original. Closer to 0 is better.",
+        color: VOLUME,
+        value: |s| s.terms.volume_change.map(|v| 100.0 * v),
+    },
+    Strip {
+        title: "Score S(τ)",
+        help: "The quality score for the current τ: τ·K/K0 + (1-τ)·accuracy. Lower is \
+               better; the marked point is its minimum, this parameter's suggestion with the \
+               others held.",
+        color: SCORE,
+        value: |s| Some(s.score),
+    },
+];
+
+/// Shows the graphs; returns new parameters when the user clicked or dragged in a strip.
+pub fn show(ui: &mut egui::Ui, session: &Session) -> Option<Params> {
+    let Some(graphs) = session.graphs() else {
+        ui.label("The quality graphs are being computed…");
+        return None;
+    };
+    let stale = !session.graphs_current();
+    let half_vd = session.voxel_diagonal().map(|d| d / 2.0);
+    let mut picked = None;
+    let columns = graphs.curves.len().max(1);
+    ui.columns(columns, |cols| {
+        for (ui, curve) in cols.iter_mut().zip(&graphs.curves) {
+            if let Some(value) = column(ui, curve, half_vd, stale) {
+                let mut p = *session.params();
+                curve.param.set(&mut p, value);
+                picked = Some(p);
+            }
+        }
+    });
+    picked.filter(|p| p.validate().is_ok() && p != session.params())
+}
+
+/// One parameter's strips; returns the sample value picked.
+fn column(ui: &mut egui::Ui, curve: &Curve, half_vd: Option<f64>, stale: bool) -> Option<f64> {
+    let param = curve.param;
+    let unit = param.unit();
+    let mut heading = format!(
+        "{}{}",
+        label(param),
+        if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" ({unit})")
+        }
+    );
+    if let Some(best) = curve.suggestion() {
+        heading += &format!("   best S at {}", format_value(param, best));
+    }
+    ui.strong(heading).on_hover_text(format!(
+        "Each strip varies {} with the other parameters held at their current values. Click or \
+         drag in a strip to set it.",
+        label(param)
+    ));
+    if stale {
+        ui.small("Updating for the new values…");
+    }
+    let strip_height = ((ui.available_height() - 40.0) / STRIPS.len() as f32).clamp(48.0, 110.0);
+    let link = ui.scope_id().with(("graphs_x", format!("{param:?}")));
+    let mut picked = None;
+    for (k, strip) in STRIPS.iter().enumerate() {
+        let points: Vec<[f64; 2]> = curve
+            .samples
+            .iter()
+            .filter_map(|s| (strip.value)(s).map(|v| [s.value, v]))
+            .filter(|p| p[1].is_finite())
+            .collect();
+        let last = k + 1 == STRIPS.len();
+        let plot = Plot::new(("graph", format!("{param:?}"), k))
+            .height(strip_height)
+            .link_axis(link, [true, false])
+            .link_cursor(link, [true, false])
+            .allow_zoom(false)
+            .allow_scroll(false)
+            .allow_drag(false)
+            .allow_boxed_zoom(false)
+            .allow_double_click_reset(false)
+            .show_x(true)
+            .show_y(true)
+            .y_axis_label(strip.title)
+            .y_axis_min_width(44.0)
+            .show_axes([last, true])
+            .x_axis_label(if last { label(param) } else { String::new() })
+            .label_formatter(move |hover| {
+                let (HoverPosition::NearDataPoint { position, .. }
+                | HoverPosition::Elsewhere { position }) = hover;
+                Some(format!(
+                    "{} = {}\n{:.4}",
+                    label(param),
+                    format_value(param, position.x),
+                    position.y
+                ))
+            });
+        let response = plot.show(ui, |plot_ui| {
+            if points.is_empty() {
+                return None;
+            }
+            plot_ui.line(
+                Line::new(strip.title, PlotPoints::from(points.clone()))
+                    .color(strip.color)
+                    .width(2.0),
+            );
+            plot_ui.vline(
+                VLine::new("current value", curve.current)
+                    .color(CURRENT)
+                    .style(LineStyle::dashed_loose()),
+            );
+            if k == 1 {
+                if let Some(h) = half_vd {
+                    plot_ui.hline(
+                        HLine::new("half voxel diagonal", h)
+                            .color(REFERENCE)
+                            .style(LineStyle::dotted_dense()),
+                    );
+                }
+            }
+            if let Some(best) = curve.best.and_then(|i| curve.samples.get(i)) {
+                if let Some(v) = (strip.value)(best) {
+                    plot_ui.points(
+                        Points::new("lowest S", vec![[best.value, v]])
+                            .color(SCORE)
+                            .radius(if last { 5.0 } else { 3.5 })
+                            .shape(egui_plot::MarkerShape::Diamond),
+                    );
+                }
+            }
+            let r = plot_ui.response();
+            (r.clicked() || r.dragged())
+                .then(|| plot_ui.pointer_coordinate())
+                .flatten()
+        });
+        response.response.clone().on_hover_text(strip.help);
+        if let Some(at) = response.inner {
+            picked = nearest(curve, at.x);
+        }
+    }
+    picked
+}
+
+/// The sample value nearest to `x` (samples are the values the sweep could set).
+fn nearest(curve: &Curve, x: f64) -> Option<f64> {
+    curve
+        .samples
+        .iter()
+        .map(|s| s.value)
+        .min_by(|a, b| (a - x).abs().total_cmp(&(b - x).abs()))
+}
+
+fn label(param: Param) -> String {
+    match param {
+        Param::Lambda => "λ".into(),
+        Param::Mu => "μ".into(),
+        Param::Alpha => "α".into(),
+        Param::Beta => "β".into(),
+        Param::Passband => "pass band".into(),
+        Param::Iterations => "iterations".into(),
+    }
+}
+
+fn format_value(param: Param, v: f64) -> String {
+    match param {
+        Param::Iterations => format!("{v:.0}"),
+        Param::Passband => format!("{v:.3}"),
+        _ => format!("{v:.2}"),
+    }
+}
