@@ -160,14 +160,14 @@ impl Document {
         }
     }
 
-    /// The background work's share of this frame (graphs, suggestions, the gallery), about
-    /// [`FRAME_BUDGET_MS`] of CPU time. With the CPU engine it waits until the current
-    /// parameters' result is there: what the user is looking at comes first.
-    pub fn compute_guidance(&mut self) {
+    /// The background work's share of this frame (graphs, suggestions, the gallery):
+    /// `budget_ms` of CPU time. With the CPU engine it waits until the current parameters'
+    /// result is there: what the user is looking at comes first.
+    pub fn compute_guidance(&mut self, budget_ms: f64) {
         if self.backend == Backend::Cpu && self.busy() {
             return;
         }
-        self.session.step_guidance(&now_ms, FRAME_BUDGET_MS);
+        self.session.step_guidance(&now_ms, budget_ms);
     }
 
     /// What the API's `state()` returns.

@@ -104,7 +104,7 @@ fn column(ui: &mut egui::Ui, curve: &Curve, half_vd: Option<f64>, stale: bool) -
     if stale {
         ui.small("Updating for the new values…");
     }
-    let strip_height = ((ui.available_height() - 40.0) / STRIPS.len() as f32).clamp(48.0, 110.0);
+    let strip_height = ((ui.available_height() - 30.0) / STRIPS.len() as f32).clamp(56.0, 120.0);
     let link = ui.scope_id().with(("graphs_x", format!("{param:?}")));
     let mut picked = None;
     for (k, strip) in STRIPS.iter().enumerate() {
@@ -126,8 +126,7 @@ fn column(ui: &mut egui::Ui, curve: &Curve, half_vd: Option<f64>, stale: bool) -
             .allow_double_click_reset(false)
             .show_x(true)
             .show_y(true)
-            .y_axis_label(strip.title)
-            .y_axis_min_width(44.0)
+            .y_axis_min_width(40.0)
             .show_axes([last, true])
             .x_axis_label(if last { label(param) } else { String::new() })
             .label_formatter(move |hover| {
@@ -178,6 +177,15 @@ fn column(ui: &mut egui::Ui, curve: &Curve, half_vd: Option<f64>, stale: bool) -
                 .then(|| plot_ui.pointer_coordinate())
                 .flatten()
         });
+        // The measure's name inside its strip, top left: every axis says what it is.
+        let rect = response.response.rect;
+        ui.painter().text(
+            egui::pos2(rect.left() + 46.0, rect.top() + 2.0),
+            egui::Align2::LEFT_TOP,
+            strip.title,
+            egui::FontId::proportional(12.0),
+            strip.color,
+        );
         response.response.clone().on_hover_text(strip.help);
         if let Some(at) = response.inner {
             picked = nearest(curve, at.x);

@@ -3,7 +3,7 @@
 //! and the view in the middle. Owns no algorithm: edits go to the shared document's session.
 
 use super::controls::{self, Controls};
-use super::document::{Backend, Document, SharedDocument};
+use super::document::{now_ms, Backend, Document, SharedDocument, FRAME_BUDGET_MS};
 use super::file_input::FileInput;
 use super::gpu_engine::GpuEngine;
 use super::guide::Guide;
@@ -39,7 +39,18 @@ pub struct Shell {
     view: Option<(Viewer, egui_wgpu::RenderState)>,
     /// What the view shows now, so it is re-uploaded only when that changes.
     shown: Shown,
+    /// Frame pacing for the background work: when this frame started, and the time the
+    /// last frame spent outside our computing (drawing, the browser), smoothed.
+    frame_start_ms: f64,
+    compute_ms: f64,
+    draw_ms: f64,
+    /// Whether the last frame asked for the next at once.
+    repainting: bool,
 }
+
+/// The background work gets as much time per frame as drawing a frame takes (so the frame rate
+/// at most halves while it runs), within these bounds (ms).
+const GUIDANCE_BUDGET_MS: std::ops::RangeInclusive<f64> = FRAME_BUDGET_MS..=250.0;
 
 /// Where the view's positions come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,6 +115,10 @@ impl Shell {
             gpu_fallback: None,
             view,
             shown: Shown::default(),
+            frame_start_ms: 0.0,
+            compute_ms: 0.0,
+            draw_ms: 0.0,
+            repainting: false,
         }
     }
 
@@ -255,6 +270,13 @@ impl Shell {
             Action::Filter(k) => self.doc.borrow_mut().session.set_filter(Filter::ALL[k]),
             Action::ExportGlb => self.export(ExportFormat::Glb),
             Action::ToggleHelp => self.help_open = !self.help_open,
+            Action::ApplySuggestion => {
+                let mut doc = self.doc.borrow_mut();
+                if let Some(s) = doc.session.suggestion() {
+                    let _ = doc.session.set_params(s.suggestion.params);
+                }
+            }
+            Action::ToggleGraphs => self.set_graphs_open(!self.graphs_open),
         }
     }
 
@@ -453,13 +475,25 @@ impl eframe::App for Shell {
         for action in shortcuts::pressed(&ctx) {
             self.apply(action);
         }
+        let start = now_ms();
+        // Only back-to-back frames tell how long drawing takes (else the page waited for input).
+        if self.frame_start_ms > 0.0 && self.repainting {
+            let other = (start - self.frame_start_ms - self.compute_ms).max(0.0);
+            self.draw_ms = 0.8 * self.draw_ms + 0.2 * other;
+        }
+        self.frame_start_ms = start;
         self.compute();
-        self.doc.borrow_mut().compute_guidance();
+        let budget = self
+            .draw_ms
+            .clamp(*GUIDANCE_BUDGET_MS.start(), *GUIDANCE_BUDGET_MS.end());
+        self.doc.borrow_mut().compute_guidance(budget);
+        self.compute_ms = now_ms() - start;
         self.sync_view();
         {
             let mut doc = self.doc.borrow_mut();
             doc.answer_waiting();
-            if doc.working() {
+            self.repainting = doc.working();
+            if self.repainting {
                 ctx.request_repaint();
             }
         }
@@ -475,7 +509,8 @@ impl eframe::App for Shell {
         if self.graphs_open {
             egui::Panel::bottom("graphs")
                 .resizable(true)
-                .default_size(380.0)
+                .default_size(330.0)
+                .min_size(240.0)
                 .show(ui, |ui| self.graphs_panel(ui));
         }
         egui::Panel::right("report")

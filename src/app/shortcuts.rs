@@ -13,9 +13,11 @@ pub enum Action {
     Filter(usize),
     ExportGlb,
     ToggleHelp,
+    ApplySuggestion,
+    ToggleGraphs,
 }
 
-const KEYS: [(egui::Key, Action, &str); 11] = [
+const KEYS: [(egui::Key, Action, &str); 13] = [
     (egui::Key::O, Action::Open, "Open a mesh file"),
     (egui::Key::W, Action::ToggleWireframe, "Wireframe on/off"),
     (
@@ -37,6 +39,16 @@ const KEYS: [(egui::Key, Action, &str); 11] = [
         egui::Key::E,
         Action::ExportGlb,
         "Export the smoothed mesh as GLB",
+    ),
+    (
+        egui::Key::A,
+        Action::ApplySuggestion,
+        "Apply the suggested parameters",
+    ),
+    (
+        egui::Key::G,
+        Action::ToggleGraphs,
+        "Model quality graphs on/off",
     ),
     (egui::Key::H, Action::ToggleHelp, "This help"),
 ];
