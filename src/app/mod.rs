@@ -7,6 +7,7 @@
 //! Modules: `document` (the session shared by the UI and the API, waiting API calls, timings),
 //! `api` (`window.meshsmooth`), `file_input` and `query` (bytes in: picker, drops, `?model=`),
 //! `download` (bytes out), `controls`, `legend`, `report_view`, `shortcuts` (the panels),
+//! `gallery` (thumbnails of results at several target smoothness values),
 //! `shell` (the `eframe::App` that lays these out), `viewer` (the 3D view).
 
 mod api;
@@ -14,6 +15,9 @@ mod controls;
 mod document;
 mod download;
 mod file_input;
+// Not shown yet: the shell wires it in next.
+#[allow(dead_code)]
+mod gallery;
 mod gpu_engine;
 mod graphs;
 mod guide;

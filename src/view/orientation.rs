@@ -5,6 +5,7 @@
 //! face-on it is the bend it is. A rounder mesh (a head, a hemisphere, a bone end) keeps the
 //! anatomical default.
 
+use super::OrbitCamera;
 use glam::{DMat3, DVec3, Vec3};
 
 /// Points are flat when their spread (standard deviation) along the thinnest principal axis is
@@ -22,6 +23,18 @@ pub fn face_on_direction(points: &[[f32; 3]], default: Vec3) -> Option<Vec3> {
         return None;
     }
     Some(if axis.dot(default) < 0.0 { -axis } else { axis })
+}
+
+/// The camera a mesh is first shown with: from [`face_on_direction`] when the points are flat,
+/// else from the default direction, fitted to the points (what the 3D view does on opening a
+/// model; thumbnails use it to frame a mesh the same way).
+pub fn first_view(points: &[[f32; 3]]) -> OrbitCamera {
+    let mut camera = OrbitCamera::default();
+    if let Some(side) = face_on_direction(points, camera.direction()) {
+        camera.look_from(side);
+    }
+    camera.fit_points(points);
+    camera
 }
 
 /// The points' thinnest principal axis (unit) and its spread relative to the middle axis's

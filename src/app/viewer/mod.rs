@@ -18,7 +18,7 @@ mod target;
 use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu};
 
-use crate::view::{face_on_direction, OrbitCamera, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS};
+use crate::view::{first_view, OrbitCamera, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS};
 use callback::{ViewCallback, ViewResources};
 use pipelines::Pipelines;
 
@@ -27,7 +27,11 @@ use pipelines::Pipelines;
 pub const EGUI_DEPTH_BUFFER_BITS: u8 = 0;
 
 /// Behind the model: dark and slightly cool, so the warm lit surface stands out.
-const BACKGROUND: egui::Color32 = egui::Color32::from_rgb(22, 24, 28);
+/// (Thumbnails share it: [`crate::view::thumbnail::BACKGROUND_SRGBA`].)
+const BACKGROUND: egui::Color32 = {
+    let [r, g, b, _] = crate::view::thumbnail::BACKGROUND_SRGBA;
+    egui::Color32::from_rgb(r, g, b)
+};
 
 /// The 3D view of one model. Its GPU resources live in egui-wgpu's callback resources, so one
 /// `Viewer` per app.
@@ -96,11 +100,7 @@ impl Viewer {
             Ok(()) => {
                 self.vertex_count = positions.len();
                 self.has_colors = false;
-                self.home = OrbitCamera::default();
-                if let Some(side) = face_on_direction(positions, self.home.direction()) {
-                    self.home.look_from(side);
-                }
-                self.home.fit_points(positions);
+                self.home = first_view(positions);
                 self.problem = None;
                 self.reset_view();
             }
