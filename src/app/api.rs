@@ -10,6 +10,8 @@
 //! - `suggest({tau, search}): Promise<object>`: sets tau and searches (`grid`, the default, or
 //!   `local`) for the active filter; resolves with the CLI's `suggest --json` keys (the
 //!   suggestion is shown, not applied)
+//! - `gallery(): Promise<array>`: makes the gallery of the active filter and shows it;
+//!   resolves with `{tau, params, terms}` per picture
 //! - `sweep(): Promise<object>`: the quality graphs of the active filter around the current
 //!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
@@ -269,6 +271,36 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                     s.graphs_json()
                         .map(|v| to_js(&v))
                         .ok_or_else(|| "no quality graphs".to_string())
+                },
+            )
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "gallery",
+        Closure::<dyn FnMut() -> Promise>::new(move || {
+            {
+                let mut doc = d.borrow_mut();
+                if doc.session.model().is_none() {
+                    return settled(Err("no mesh is open: call loadMesh first".into()));
+                }
+                doc.session.start_gallery();
+                doc.show_gallery = true;
+            }
+            when_ready(
+                &d,
+                &c,
+                |s| !s.making_gallery(),
+                |s| {
+                    if s.gallery().is_empty() {
+                        return Err(s
+                            .guidance_problem()
+                            .unwrap_or("the gallery was cancelled")
+                            .to_string());
+                    }
+                    Ok(to_js(&s.guidance_json()["gallery"]))
                 },
             )
         }),

@@ -71,6 +71,8 @@ pub struct Document {
     waiting: Vec<Waiter>,
     /// Calls waiting for background work (a suggestion, the graphs).
     waiting_for: Vec<(Ready, Waiter)>,
+    /// Set by the API's `gallery()`: the page shows the gallery tab.
+    pub show_gallery: bool,
 }
 
 /// The handle the shell and the API hold.
@@ -85,6 +87,7 @@ impl Document {
             model_generation: 0,
             waiting: Vec::new(),
             waiting_for: Vec::new(),
+            show_gallery: false,
         }
     }
 

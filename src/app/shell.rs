@@ -5,6 +5,7 @@
 use super::controls::{self, Controls};
 use super::document::{now_ms, Backend, Document, SharedDocument, FRAME_BUDGET_MS};
 use super::file_input::FileInput;
+use super::gallery_view::GalleryView;
 use super::gpu_engine::GpuEngine;
 use super::guide::Guide;
 use super::shortcuts::{self, Action};
@@ -23,8 +24,11 @@ pub struct Shell {
     files: FileInput,
     controls: Controls,
     guide: Guide,
-    /// Whether the quality graphs are shown (and kept up to date).
+    /// Whether the bottom panel (quality graphs or gallery) is shown.
     graphs_open: bool,
+    /// Which the bottom panel shows.
+    gallery_tab: bool,
+    gallery: GalleryView,
     coloring: Option<ColorField>,
     bake_colors: bool,
     show_original: bool,
@@ -106,6 +110,8 @@ impl Shell {
             controls: Controls::default(),
             guide: Guide::default(),
             graphs_open: true,
+            gallery_tab: false,
+            gallery: GalleryView::default(),
             coloring: Some(ColorField::LocalError),
             bake_colors: false,
             show_original: false,
@@ -344,13 +350,39 @@ impl Shell {
 
     fn set_graphs_open(&mut self, open: bool) {
         self.graphs_open = open;
-        self.doc.borrow_mut().session.set_graphs_wanted(open);
+        let wanted = open && !self.gallery_tab;
+        self.doc.borrow_mut().session.set_graphs_wanted(wanted);
+    }
+
+    fn bottom_panel(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let mut gallery = self.gallery_tab;
+            ui.selectable_value(
+                &mut gallery,
+                false,
+                egui::RichText::new("Quality graphs").heading(),
+            );
+            ui.selectable_value(&mut gallery, true, egui::RichText::new("Gallery").heading());
+            if gallery != self.gallery_tab {
+                self.gallery_tab = gallery;
+                // The graphs are kept current only while they are shown.
+                self.doc.borrow_mut().session.set_graphs_wanted(!gallery);
+            }
+        });
+        if self.gallery_tab {
+            let mut doc = self.doc.borrow_mut();
+            if let Some((tau, params)) = self.gallery.show(ui, &mut doc.session) {
+                let _ = doc.session.set_tau(tau);
+                let _ = doc.session.set_params(params);
+            }
+        } else {
+            self.graphs_panel(ui);
+        }
     }
 
     fn graphs_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
         ui.horizontal(|ui| {
-            ui.heading("Model quality graphs");
             let filter = doc.session.filter();
             ui.label(format!("{filter} filter: each column varies one parameter"));
             for a in doc.session.activities() {
@@ -488,6 +520,11 @@ impl eframe::App for Shell {
             .clamp(*GUIDANCE_BUDGET_MS.start(), *GUIDANCE_BUDGET_MS.end());
         self.doc.borrow_mut().compute_guidance(budget);
         self.compute_ms = now_ms() - start;
+        self.gallery.update(&ctx, &self.doc.borrow().session);
+        if std::mem::take(&mut self.doc.borrow_mut().show_gallery) {
+            self.gallery_tab = true;
+            self.set_graphs_open(true);
+        }
         self.sync_view();
         {
             let mut doc = self.doc.borrow_mut();
@@ -511,7 +548,7 @@ impl eframe::App for Shell {
                 .resizable(true)
                 .default_size(330.0)
                 .min_size(240.0)
-                .show(ui, |ui| self.graphs_panel(ui));
+                .show(ui, |ui| self.bottom_panel(ui));
         }
         egui::Panel::right("report")
             .resizable(true)

@@ -157,6 +157,26 @@ fn format_value(v: f64) -> String {
     }
 }
 
+/// Colours distances (the local error of several results) on one viridis scale from 0 to a
+/// round value above the 99th percentile of all of them, so results can be compared by eye;
+/// returns the colours of each set and the scale's top (mm).
+pub fn shared_error_colors(sets: &[&[f32]]) -> (Vec<Vec<[u8; 4]>>, f64) {
+    let max = sets
+        .iter()
+        .map(|v| quantile_abs(v, 0.99))
+        .fold(0.0, f64::max);
+    let max = round_up(max);
+    let colors = sets
+        .iter()
+        .map(|v| {
+            v.iter()
+                .map(|&x| sample(&VIRIDIS, x as f64 / max))
+                .collect()
+        })
+        .collect();
+    (colors, max)
+}
+
 /// Colours every vertex of `result` by `field`; `original` holds the original positions and
 /// `voxel_diagonal` (mm), when known, adds voxel-diagonal labels to distance legends.
 pub fn colorize(

@@ -166,6 +166,8 @@ pub struct Guidance {
     search: Option<SearchJob>,
     gallery: Vec<GalleryPick>,
     gallery_key: Option<SearchKey>,
+    /// Counts finished galleries, so views know when to redraw their thumbnails.
+    gallery_version: u64,
     gallery_job: Option<GalleryJob>,
     /// Why the last job gave no result.
     pub problem: Option<String>,
@@ -338,6 +340,16 @@ impl Session {
         });
     }
 
+    /// Changes when a gallery is finished.
+    pub fn gallery_version(&self) -> u64 {
+        self.guidance.gallery_version
+    }
+
+    /// Whether a gallery is being made.
+    pub fn making_gallery(&self) -> bool {
+        self.guidance.gallery_job.is_some()
+    }
+
     pub fn cancel_gallery(&mut self) {
         self.guidance.gallery_job = None;
     }
@@ -477,6 +489,7 @@ impl Session {
                     guidance.problem = job.problem;
                     guidance.gallery = job.picks;
                     guidance.gallery_key = Some(job.key);
+                    guidance.gallery_version += 1;
                 }
             }
             return finished;

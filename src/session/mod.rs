@@ -9,7 +9,7 @@
 mod colors;
 mod guidance;
 
-pub use colors::{ColorField, Legend, LegendTick};
+pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 
 use crate::export::{self, ExportFormat, ExportOptions};
