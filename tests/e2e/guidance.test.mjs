@@ -1,0 +1,200 @@
+// End-to-end tests of the guidance features (issue 7): suggestions, quality graphs, the gallery,
+// and the frame rate while the background computes. Run by tests/e2e/run.sh in both modes.
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { appendFileSync, existsSync, mkdtempSync, readFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+
+import { AppPage, VIEWPORT } from "./lib/app.mjs";
+import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
+import * as cli from "./lib/cli.mjs";
+import { jsonDifferences, metricDifferences } from "./lib/compare.mjs";
+import { DIST, E2E_OUT, ROOT, meshPath, outputDir } from "./lib/paths.mjs";
+import { serveDirectory } from "./lib/server.mjs";
+
+const MODE = modeFromEnv();
+const OUT = outputDir(MODE);
+const SAMPLE = join(ROOT, "web/sample/bent_tube_staircase.ply");
+const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
+/** The background searches run the same Rust code on the CPU in both modes (wasm: one thread,
+ * so f64 sums may differ in order from the native CLI's: 1e-9 relative allows that). */
+const RTOL = 1e-9;
+const TIMEOUT = 10 * 60_000;
+
+let server;
+let browser;
+
+before(async () => {
+    if (!existsSync(join(DIST, "index.html"))) {
+        throw new Error(`${DIST}/index.html is missing: build the page first (trunk build --release)`);
+    }
+    cli.requireCli();
+    server = await serveDirectory(DIST);
+    browser = await launchBrowser(MODE);
+});
+
+after(async () => {
+    await browser?.close();
+    await server?.close();
+});
+
+async function withApp(body) {
+    const app = await AppPage.open(browser, server, OUT);
+    try {
+        await app.api();
+        const result = await body(app);
+        assert.deepEqual(app.foreignRequests(), [], "the page requested something outside its own origin");
+        assert.deepEqual(app.pageErrors.map(String), [], "uncaught errors in the page");
+        return result;
+    } finally {
+        await app.close();
+    }
+}
+
+const state = (app) => app.page.evaluate(() => window.meshsmooth.state());
+
+function assertClose(actual, expected, what) {
+    const diffs = jsonDifferences(actual, expected, RTOL);
+    assert.deepEqual(diffs, [], `${what}: app and CLI differ`);
+}
+
+test("G1 suggest() equals the CLI's suggest --json for the same mesh, filter and tau", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.call("setFilter", "laplace");
+        for (const search of ["local", "grid"]) {
+            const got = await app.call("suggest", { tau: 0.6, search });
+            const want = await cli.cliJson("suggest", SAMPLE, "--filter", "laplace", "--tau", "0.6", "--search", search, "--json");
+            assert.deepEqual(got.params, want.params, `${search}: parameters`);
+            assert.equal(got.evaluations, want.evaluations, `${search}: evaluations`);
+            assertClose(got.terms, want.terms, `${search}: terms`);
+            assertClose(got.score, want.score, `${search}: score`);
+            console.log(`suggest ${search}: ${JSON.stringify(got.params)} in ${got.seconds.toFixed(2)} s (CLI ${want.seconds.toFixed(2)} s)`);
+        }
+        assert.equal((await state(app)).tau, 0.6, "suggest() sets tau");
+        // The suggestion is shown, not applied, until the user takes it (key A).
+        const suggested = (await state(app)).guidance.suggestion.params;
+        assert.notDeepEqual((await state(app)).params, suggested);
+        await app.page.mouse.click(640, 200);
+        await app.page.keyboard.press("a");
+        await app.page.waitForFunction((p) => JSON.stringify(window.meshsmooth.state().params) === JSON.stringify(p), suggested);
+        const metrics = await app.call("metrics");
+        // ...and the measures are those of the CLI smoothing with the suggested parameters.
+        const given = Object.fromEntries(Object.entries(suggested).filter(([, v]) => v !== null));
+        const out = join(mkdtempSync(join(tmpdir(), "meshsmooth-g1-")), "s.ply");
+        const reference = await cli.smooth(SAMPLE, out, "laplace", given);
+        // The CLI's score is for its default tau 0.5; the page's for the tau just set (0.6).
+        const { score: _a, ...measured } = metrics;
+        const { score: _b, ...expected } = reference.metrics;
+        assert.deepEqual(metricDifferences(measured, expected, RTOL).problems, []);
+    });
+});
+
+test("G2 sweep() equals the CLI's sweep --json; a click in a graph sets the parameter", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        const got = await app.call("sweep");
+        const want = await cli.cliJson("sweep", SAMPLE, "--filter", "hc", "--json");
+        assert.deepEqual(got.current, want.current);
+        assert.equal(got.curves.length, 3);
+        for (const [k, curve] of got.curves.entries()) {
+            assert.equal(curve.param, want.curves[k].param);
+            assert.equal(curve.best, want.curves[k].best, `${curve.param}: lowest S`);
+            assert.deepEqual(curve.samples.map((s) => s.value), want.curves[k].samples.map((s) => s.value));
+            assertClose(curve.samples, want.curves[k].samples, `${curve.param} samples`);
+        }
+        const before = await state(app);
+        const shot = await app.screenshot("guidance-graphs");
+        console.log(`graphs screenshot: ${shot.path}`);
+        // The graphs fill the bottom panel right of the smoothing panel, one column per
+        // parameter (HC: alpha, beta, iterations). A click in the middle of the last column's
+        // second strip picks an iteration count from the middle of its range.
+        const left = 310;
+        const column = (VIEWPORT.width - left) / 3;
+        const x = left + 2 * column + 0.6 * column;
+        await app.page.mouse.click(x, VIEWPORT.height - 200);
+        await app.page.waitForFunction(
+            (it) => window.meshsmooth.state().params.iterations !== it,
+            before.params.iterations,
+            { timeout: 10_000 },
+        );
+        const after = await state(app);
+        assert.equal(after.params.alpha, before.params.alpha, "only the clicked parameter changes");
+        assert.ok(after.params.iterations >= 10 && after.params.iterations <= 45, `iterations ${after.params.iterations}`);
+        await app.screenshotWhen(
+            "guidance-graphs-after-click",
+            () => true,
+            "graphs",
+        );
+        // The graphs follow: new ones for the new value.
+        const again = await app.call("sweep");
+        assert.equal(again.current.iterations, after.params.iterations);
+    });
+});
+
+test("G3 the gallery shows five results; a click on one takes its tau and parameters", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.call("setFilter", "laplace");
+        const picks = await app.call("gallery");
+        assert.deepEqual(picks.map((p) => p.tau), [0.1, 0.3, 0.5, 0.7, 0.9]);
+        for (const p of picks) {
+            const want = await cli.cliJson("suggest", SAMPLE, "--filter", "laplace", "--tau", String(p.tau), "--search", "local", "--json");
+            assert.deepEqual(p.params, want.params, `tau ${p.tau}`);
+        }
+        // Pictures are drawn one per frame after the gallery is made.
+        await app.page.waitForTimeout(1500);
+        const shot = await app.screenshot("guidance-gallery");
+        console.log(`gallery screenshot: ${shot.path}`);
+        // The cards sit in a row at the top of the bottom panel, right of the smoothing panel;
+        // the second is tau 0.3 (the first, tau 0.1, leaves this mesh unchanged).
+        const target = picks[1];
+        await app.page.mouse.click(580, VIEWPORT.height - 160);
+        await app.page.waitForFunction(
+            (p) => JSON.stringify(window.meshsmooth.state().params) === JSON.stringify(p),
+            target.params,
+            { timeout: 10_000 },
+        );
+        assert.equal((await state(app)).tau, target.tau);
+    });
+});
+
+test("G4 benchmark: frame times while the quality graphs compute on the 206k-vertex mesh (printed)", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(BRAIN), "brain.ply");
+        await app.call("metrics");
+        // Let the suggestion that starts with a model run while we measure, then the graphs.
+        const frames = () =>
+            app.page.evaluate(
+                (ms) =>
+                    new Promise((resolve) => {
+                        const times = [];
+                        const start = performance.now();
+                        const tick = (now) => {
+                            times.push(now);
+                            if (now - start < ms) requestAnimationFrame(tick);
+                            else {
+                                const d = times.slice(1).map((t, i) => t - times[i]).sort((a, b) => a - b);
+                                const q = (f) => d[Math.min(d.length - 1, Math.floor(f * d.length))];
+                                resolve({ frames: d.length, p50_ms: q(0.5), p95_ms: q(0.95), max_ms: d[d.length - 1] });
+                            }
+                        };
+                        requestAnimationFrame(tick);
+                    }),
+                8000,
+            );
+        const background = await frames();
+        const busy = (await state(app)).guidance.activities.map((a) => a.what);
+        // Interaction while it computes: parameter changes every half second.
+        const interacting = app.page.evaluate(async () => {
+            for (let k = 0; k < 12; k++) {
+                window.meshsmooth.setParams({ alpha: 0.05 + 0.01 * k });
+                await new Promise((r) => setTimeout(r, 500));
+            }
+        });
+        const withInteraction = await frames();
+        await interacting;
+        const line = { test: "guidance-frames", mode: MODE, mesh: "seg_mni152 206k", background, withInteraction, busy };
+        console.log(JSON.stringify(line));
+        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
+        assert.ok(background.frames > 0);
+    });
+});
