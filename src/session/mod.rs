@@ -7,8 +7,10 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod colors;
+mod weights;
 
 pub use colors::{ColorField, Legend, LegendTick};
+pub use weights::WeightsSummary;
 
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::io;
@@ -104,6 +106,8 @@ pub struct Session {
     job: Option<CpuJob>,
     /// Why the last file could not be opened; cleared by the next successful open.
     error: Option<String>,
+    /// Per-vertex weights painted on the open model.
+    weights: weights::Weights,
 }
 
 impl Default for Session {
@@ -118,6 +122,7 @@ impl Default for Session {
             result: None,
             job: None,
             error: None,
+            weights: weights::Weights::default(),
         }
     }
 }
@@ -197,6 +202,7 @@ impl Session {
     pub fn set_model(&mut self, model: Model) -> &Model {
         self.error = None;
         self.result = None;
+        self.weights.reset();
         self.changed();
         self.model.insert(model)
     }
@@ -283,6 +289,7 @@ impl Session {
         }
         let model = self.model.as_ref()?;
         let params = *self.params();
+        let weights = self.weights.get();
         let start = clock();
         let mut job = match self.job.take() {
             Some(job) if job.revision == self.revision => job,
@@ -297,7 +304,7 @@ impl Session {
         if params.filter == Filter::Sinc {
             // Its terms are not shorter filters' results: one piece.
             (job.positions, job.reference) =
-                metrics::smooth_drifting(&model.original, &params, None);
+                metrics::smooth_drifting(&model.original, &params, weights);
             job.done = params.iterations;
         }
         // Iterations per call: one at first, then as many as the time per iteration so far
@@ -312,7 +319,7 @@ impl Session {
                 model.mesh(),
                 model.topology(),
                 &params,
-                None,
+                weights,
                 positions,
                 job.done,
                 chunk,
@@ -403,9 +410,14 @@ impl Session {
             .and_then(|r| serde_json::to_value(&r.metrics).ok())
     }
 
-    /// Per-vertex colours of `field` on the latest result, with the legend that explains them.
+    /// Per-vertex colours of `field` on the latest result (the weights: as painted now), with
+    /// the legend that explains them.
     pub fn colors(&self, field: ColorField) -> Option<(Vec<[u8; 4]>, Legend)> {
         let model = self.model.as_ref()?;
+        if field == ColorField::Weights {
+            let n = model.mesh().vertex_count();
+            return Some(colors::weight_colors(self.weights(), n));
+        }
         let result = self.last_result()?;
         Some(colors::colorize(
             field,
@@ -453,6 +465,7 @@ impl Session {
             "params": self.params().to_json(),
             "tau": self.tau,
             "busy": busy,
+            "weights": weights::summarize(self.weights()),
         })
     }
 }
