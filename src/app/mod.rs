@@ -7,12 +7,15 @@
 //! Modules: `document` (the session shared by the UI and the API, waiting API calls, timings),
 //! `api` (`window.meshsmooth`), `file_input` and `query` (bytes in: picker, drops, `?model=`),
 //! `download` (bytes out), `controls`, `legend`, `report_view`, `shortcuts` (the panels),
+//! `brush` and `drag_params` (painting weights and dragging parameters over the view),
 //! `shell` (the `eframe::App` that lays these out), `viewer` (the 3D view).
 
 mod api;
+mod brush;
 mod controls;
 mod document;
 mod download;
+mod drag_params;
 mod file_input;
 mod gpu_engine;
 mod legend;

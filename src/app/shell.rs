@@ -2,8 +2,10 @@
 //! left (filter, parameters, measures, colours), the mesh report on the right, the status bar,
 //! and the view in the middle. Owns no algorithm: edits go to the shared document's session.
 
+use super::brush::Brush;
 use super::controls::{self, Controls};
-use super::document::{Backend, Document, SharedDocument};
+use super::document::{Backend, Document, SharedDocument, ViewReport};
+use super::drag_params::DragParams;
 use super::file_input::FileInput;
 use super::gpu_engine::GpuEngine;
 use super::shortcuts::{self, Action};
@@ -21,6 +23,8 @@ pub struct Shell {
     doc: SharedDocument,
     files: FileInput,
     controls: Controls,
+    brush: Brush,
+    drag_params: DragParams,
     coloring: Option<ColorField>,
     bake_colors: bool,
     show_original: bool,
@@ -88,6 +92,8 @@ impl Shell {
             doc,
             files,
             controls: Controls::default(),
+            brush: Brush::default(),
+            drag_params: DragParams::default(),
             coloring: Some(ColorField::LocalError),
             bake_colors: false,
             show_original: false,
@@ -150,10 +156,14 @@ impl Shell {
             }
             self.shown.positions = Some(wanted);
         }
-        let colors = self
-            .coloring
-            .filter(|_| !self.show_original)
-            .zip(result.map(|r| r.revision));
+        // The brush shows what it paints; the weights' colours follow their own changes.
+        let colors = if self.brush.active {
+            Some((ColorField::Weights, session.weights_generation()))
+        } else {
+            self.coloring
+                .filter(|_| !self.show_original)
+                .zip(result.map(|r| r.revision))
+        };
         if self.shown.colors != colors {
             let computed = colors.and_then(|(field, _)| session.colors(field));
             viewer.set_colors(rs, computed.as_ref().map(|(c, _)| c.as_slice()));
@@ -248,6 +258,7 @@ impl Shell {
             Action::Filter(k) => self.doc.borrow_mut().session.set_filter(Filter::ALL[k]),
             Action::ExportGlb => self.export(ExportFormat::Glb),
             Action::ToggleHelp => self.help_open = !self.help_open,
+            Action::ToggleBrush => self.brush.active = !self.brush.active,
         }
     }
 
@@ -295,6 +306,9 @@ impl Shell {
         let timings = doc.timings;
         ui.heading("Smoothing");
         self.controls.filter(ui, &mut doc.session);
+        self.drag_params.panel(ui, doc.session.filter());
+        ui.separator();
+        self.brush.panel(ui, &mut doc.session);
         ui.separator();
         ui.heading("Measures");
         controls::measures(ui, &doc.session, timings);
@@ -344,7 +358,28 @@ impl Shell {
 
     fn view(&mut self, ui: &mut egui::Ui) {
         let rect = match &mut self.view {
-            Some((viewer, _)) => viewer.show(ui).rect,
+            Some((viewer, _)) => {
+                viewer.painting = self.brush.active;
+                let response = viewer.show(ui);
+                let mut doc = self.doc.borrow_mut();
+                let doc = &mut *doc;
+                let shown = match self.shown.positions {
+                    Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
+                    _ => None,
+                };
+                let surface = (doc.model_generation, shown);
+                let camera = viewer.camera();
+                self.brush
+                    .interact(ui, &response, camera, &mut doc.session, surface);
+                self.drag_params.interact(ui, &response, &mut doc.session);
+                let r = response.rect;
+                doc.view = ViewReport {
+                    rect: [r.left(), r.top(), r.width(), r.height()],
+                    brush_on: self.brush.active,
+                    pick_ms: self.brush.pick_ms,
+                };
+                response.rect
+            }
             None => {
                 ui.label("The 3D view needs WebGPU or WebGL2, which this browser did not provide.");
                 ui.available_rect_before_wrap()

@@ -13,9 +13,10 @@ pub enum Action {
     Filter(usize),
     ExportGlb,
     ToggleHelp,
+    ToggleBrush,
 }
 
-const KEYS: [(egui::Key, Action, &str); 11] = [
+const KEYS: [(egui::Key, Action, &str); 12] = [
     (egui::Key::O, Action::Open, "Open a mesh file"),
     (egui::Key::W, Action::ToggleWireframe, "Wireframe on/off"),
     (
@@ -37,6 +38,11 @@ const KEYS: [(egui::Key, Action, &str); 11] = [
         egui::Key::E,
         Action::ExportGlb,
         "Export the smoothed mesh as GLB",
+    ),
+    (
+        egui::Key::P,
+        Action::ToggleBrush,
+        "Weight brush on/off (paint where smoothing may act)",
     ),
     (egui::Key::H, Action::ToggleHelp, "This help"),
 ];
@@ -64,10 +70,19 @@ pub fn help_window(ctx: &egui::Context, open: &mut bool) {
             ui.label(egui::RichText::new("Mouse").strong());
             egui::Grid::new("mouse_help").num_columns(2).show(ui, |ui| {
                 for (what, does) in [
-                    ("Left drag", "Orbit"),
+                    ("Left or middle drag", "Orbit"),
                     ("Shift + left drag", "Pan"),
                     ("Scroll / pinch", "Zoom"),
                     ("Double click", "Reset the view"),
+                    (
+                        "Right drag",
+                        "Drive two smoothing parameters: left/right and down/up \
+                         (chosen in the Smoothing panel)",
+                    ),
+                    (
+                        "Brush on (P): left drag",
+                        "Paint weights; Ctrl/⌘ + left or middle drag orbits",
+                    ),
                 ] {
                     ui.monospace(what);
                     ui.label(does);

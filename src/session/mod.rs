@@ -465,7 +465,7 @@ impl Session {
             "params": self.params().to_json(),
             "tau": self.tau,
             "busy": busy,
-            "weights": weights::summarize(self.weights()),
+            "weights": self.weights_summary(),
         })
     }
 }

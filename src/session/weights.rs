@@ -40,7 +40,7 @@ pub struct WeightsSummary {
 }
 
 /// The summary of `weights`, or `None` when nothing is painted.
-pub fn summarize(weights: Option<&[f32]>) -> Option<WeightsSummary> {
+fn summarize(weights: Option<&[f32]>) -> Option<WeightsSummary> {
     let w = weights?;
     Some(WeightsSummary {
         painted: w.iter().filter(|&&x| x < 1.0).count(),
@@ -54,6 +54,11 @@ impl Session {
     /// The painted weights (one per vertex in [0, 1]), or `None` while every vertex is free.
     pub fn weights(&self) -> Option<&[f32]> {
         self.weights.get()
+    }
+
+    /// How many vertices are painted and locked, and the lowest weight; `None` when nothing is.
+    pub fn weights_summary(&self) -> Option<WeightsSummary> {
+        summarize(self.weights())
     }
 
     /// Changes whenever the weights change (paint, erase, clear, a new model).

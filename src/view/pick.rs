@@ -135,7 +135,7 @@ pub fn moller_trumbore(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<f32> {
 /// The brush's falloff at distance `d` from its centre for radius `r`: 1 within half the
 /// radius, easing (smoothstep) to 0 at the rim, 0 beyond.
 pub fn brush_falloff(d: f32, r: f32) -> f32 {
-    if !(r > 0.0) {
+    if r.is_nan() || r <= 0.0 {
         return 0.0;
     }
     let t = ((r - d) / (0.5 * r)).clamp(0.0, 1.0);
