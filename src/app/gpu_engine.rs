@@ -26,7 +26,7 @@ pub struct GpuEngine {
     in_flight: Option<InFlight>,
     /// The revision of the latest run submitted (its positions are in the buffers).
     submitted: Option<u64>,
-    /// The session's weights generation the mesh's weight buffer holds: uploaded once per change.
+    /// The session's weights version the mesh's weight buffer holds: uploaded once per change.
     weights_uploaded: Option<u64>,
 }
 
@@ -84,11 +84,11 @@ impl GpuEngine {
         let params = *doc.session.params();
         let started_ms = now_ms();
         let e = |e: crate::gpu::GpuError| e.to_string();
-        let weights_generation = doc.session.weights_generation();
-        if self.weights_uploaded != Some(weights_generation) {
+        let weights_version = doc.session.weights_version();
+        if self.weights_uploaded != Some(weights_version) {
             mesh.set_weights(&self.queue, doc.session.weights())
                 .map_err(e)?;
-            self.weights_uploaded = Some(weights_generation);
+            self.weights_uploaded = Some(weights_version);
         }
         self.smoother
             .smooth(&self.device, &self.queue, mesh, &params)

@@ -158,7 +158,7 @@ impl Shell {
         }
         // The brush shows what it paints; the weights' colours follow their own changes.
         let colors = if self.brush.active {
-            Some((ColorField::Weights, session.weights_generation()))
+            Some((ColorField::Weights, session.weights_version()))
         } else {
             self.coloring
                 .filter(|_| !self.show_original)

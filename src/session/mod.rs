@@ -106,8 +106,10 @@ pub struct Session {
     job: Option<CpuJob>,
     /// Why the last file could not be opened; cleared by the next successful open.
     error: Option<String>,
-    /// Per-vertex weights painted on the open model.
-    weights: weights::Weights,
+    /// Per-vertex smoothing weights of the open model (0 locks a vertex), `None` for all 1.
+    weights: Option<Vec<f32>>,
+    /// Counts changes of `weights`.
+    weights_version: u64,
 }
 
 impl Default for Session {
@@ -122,7 +124,8 @@ impl Default for Session {
             result: None,
             job: None,
             error: None,
-            weights: weights::Weights::default(),
+            weights: None,
+            weights_version: 0,
         }
     }
 }
@@ -202,8 +205,9 @@ impl Session {
     pub fn set_model(&mut self, model: Model) -> &Model {
         self.error = None;
         self.result = None;
-        self.weights.reset();
         self.changed();
+        self.weights = None;
+        self.weights_version += 1;
         self.model.insert(model)
     }
 
@@ -289,7 +293,7 @@ impl Session {
         }
         let model = self.model.as_ref()?;
         let params = *self.params();
-        let weights = self.weights.get();
+        let weights = self.weights.as_deref();
         let start = clock();
         let mut job = match self.job.take() {
             Some(job) if job.revision == self.revision => job,

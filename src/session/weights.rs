@@ -1,32 +1,12 @@
 //! Per-vertex smoothing weights painted by the user (ALGORITHMS.md: each step moves a vertex by
 //! `w_i` times its filter displacement; 0 locks it). The session keeps them for the open model;
 //! every change bumps the session's revision (the result is recomputed) and the weights'
-//! own generation (the GPU engine uploads them once per change).
+//! own version (the GPU engine uploads them once per change).
 //!
 //! Painting takes the minimum with the brush's profile and erasing the maximum, so dabbing the
 //! same spot again in one stroke changes nothing: a stroke never "builds up" with the frame rate.
 
 use super::Session;
-
-/// The painted weights of the open model: `None` while every vertex is free (weight 1).
-#[derive(Clone, Debug, Default)]
-pub(super) struct Weights {
-    values: Option<Vec<f32>>,
-    /// Bumped on every change, including a new model's reset.
-    generation: u64,
-}
-
-impl Weights {
-    /// Back to every vertex free (a new model, or Clear).
-    pub(super) fn reset(&mut self) {
-        self.values = None;
-        self.generation += 1;
-    }
-
-    pub(super) fn get(&self) -> Option<&[f32]> {
-        self.values.as_deref()
-    }
-}
 
 /// What `state()` reports about the weights.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -53,7 +33,7 @@ fn summarize(weights: Option<&[f32]>) -> Option<WeightsSummary> {
 impl Session {
     /// The painted weights (one per vertex in [0, 1]), or `None` while every vertex is free.
     pub fn weights(&self) -> Option<&[f32]> {
-        self.weights.get()
+        self.weights.as_deref()
     }
 
     /// How many vertices are painted and locked, and the lowest weight; `None` when nothing is.
@@ -62,8 +42,8 @@ impl Session {
     }
 
     /// Changes whenever the weights change (paint, erase, clear, a new model).
-    pub fn weights_generation(&self) -> u64 {
-        self.weights.generation
+    pub fn weights_version(&self) -> u64 {
+        self.weights_version
     }
 
     /// Lowers the weights under a brush dab: vertex `i` with falloff `f` in [0, 1] (1 at the
@@ -82,10 +62,11 @@ impl Session {
 
     /// Every vertex free again. Returns whether anything was painted.
     pub fn clear_weights(&mut self) -> bool {
-        if self.weights.values.is_none() {
+        if self.weights.is_none() {
             return false;
         }
-        self.weights.reset();
+        self.weights = None;
+        self.weights_version += 1;
         self.changed();
         true
     }
@@ -95,7 +76,7 @@ impl Session {
             return false;
         };
         let n = model.mesh().vertex_count();
-        let mut values = self.weights.values.take().unwrap_or_else(|| vec![1.0; n]);
+        let mut values = self.weights.take().unwrap_or_else(|| vec![1.0; n]);
         let mut changed = false;
         for &(i, f) in footprint {
             let Some(w) = values.get_mut(i as usize) else {
@@ -113,9 +94,9 @@ impl Session {
             }
         }
         // All free again: no weights at all, so the result is exactly the unweighted one.
-        self.weights.values = values.iter().any(|&w| w < 1.0).then_some(values);
+        self.weights = values.iter().any(|&w| w < 1.0).then_some(values);
         if changed {
-            self.weights.generation += 1;
+            self.weights_version += 1;
             self.changed();
         }
         changed
@@ -211,9 +192,9 @@ mod tests {
     fn a_dab_repeated_changes_nothing_and_keeps_the_results() {
         let mut s = sample_session();
         let footprint = [(3, 1.0), (4, 0.5), (5, 0.0), (6, f32::NAN), (99_999, 1.0)];
-        let generation = s.weights_generation();
+        let generation = s.weights_version();
         assert!(s.paint_weights(&footprint, 0.0));
-        assert_eq!(s.weights_generation(), generation + 1);
+        assert_eq!(s.weights_version(), generation + 1);
         let w = s.weights().unwrap();
         assert_eq!((w[3], w[4], w[5], w[6]), (0.0, 0.5, 1.0, 1.0));
         s.smooth_cpu(&|| 0.0);
@@ -238,7 +219,7 @@ mod tests {
         s.open("again.ply", SAMPLE).unwrap();
         assert_eq!(s.weights(), None);
         assert_eq!(s.state_json(false)["weights"], serde_json::Value::Null);
-        assert!(s.weights_generation() > generation + 1);
+        assert!(s.weights_version() > generation + 1);
         // Nothing open, nothing to paint.
         assert!(!Session::default().paint_weights(&footprint, 0.0));
     }
