@@ -15,11 +15,14 @@
 //! - `sweep(): Promise<object>`: the quality graphs of the active filter around the current
 //!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
-//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, backend, timings,
-//!   guidance}` (`guidance`: background work under way, whether the graphs are current, the
-//!   suggestion and the gallery)
-//!   (`timings`: the last result's `smooth_ms` and `measure_ms` of the CPU engine's own work, or
-//!   `gpu_run_ms` from submitting a GPU run to having its results back)
+//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, backend,
+//!   timings, brush, view, guidance}` (`timings`: the last result's `smooth_ms` and `measure_ms`
+//!   of the CPU engine's own work, or `gpu_run_ms` from submitting a GPU run to having its
+//!   results back; `weights`: `{painted, locked, min, mean}` of the painted weights, or null;
+//!   `brush`: `{on, pick_ms}`, whether the weight brush is on and how long its latest pick took;
+//!   `view`: `{x, y, width, height}`, the 3D view's rectangle in CSS pixels; `guidance`:
+//!   background work under way, whether the graphs are current, the suggestion and the gallery)
+//! - `clearWeights()`: every vertex free again (undoes the weight brush)
 //!
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
@@ -329,6 +332,16 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
         &api,
         "backend",
         Closure::<dyn FnMut() -> JsValue>::new(move || d.borrow().backend.name().into()),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "clearWeights",
+        Closure::<dyn FnMut()>::new(move || {
+            d.borrow_mut().session.clear_weights();
+            c.request_repaint();
+        }),
     )?;
 
     let d = doc.clone();

@@ -1,5 +1,5 @@
 //! The side panel's controls: the filter with a slider and a number field per parameter, the
-//! displacement bound, the measures of the current result, and what the colours show.
+//! displacement bound (in mm, or voxel diagonals when the voxel size is known), the measures of the current result, and what the colours show.
 //!
 //! Every edit goes to the session as a whole parameter set; the session refuses invalid sets
 //! (e.g. Taubin's mu >= -lambda) and the message shows under the controls until fixed.
@@ -14,6 +14,8 @@ use eframe::egui;
 pub struct Controls {
     /// Why the last edit was refused.
     refused: Option<String>,
+    /// The displacement bound is entered in voxel diagonals (when the voxel size is known).
+    bound_in_voxels: bool,
 }
 
 /// A user-facing name for each filter.
@@ -119,22 +121,19 @@ impl Controls {
             ui.label("iterations");
             ui.add(egui::Slider::new(&mut p.iterations, min_it..=max_it));
         });
+        let voxel = session.voxel_diagonal().map(|d| d as f32);
         ui.horizontal(|ui| {
             let mut bounded = p.max_displacement.is_some();
             ui.checkbox(&mut bounded, "max displacement")
                 .on_hover_text("No vertex moves further than this from its original position");
             match (bounded, p.max_displacement) {
-                (true, None) => p.max_displacement = Some(1.0),
+                // Half a voxel diagonal is the natural bound (ALGORITHMS.md) where it is known.
+                (true, None) => p.max_displacement = Some(voxel.map_or(1.0, |v| 0.5 * v)),
                 (false, Some(_)) => p.max_displacement = None,
                 _ => {}
             }
             if let Some(d) = &mut p.max_displacement {
-                ui.add(
-                    egui::DragValue::new(d)
-                        .speed(0.01)
-                        .range(0.0..=1000.0)
-                        .suffix(" mm"),
-                );
+                self.bound_field(ui, d, voxel);
             }
         });
         if ui.small_button("Defaults").clicked() {
@@ -145,6 +144,40 @@ impl Controls {
         }
         if let Some(why) = &self.refused {
             ui.colored_label(ui.visuals().warn_fg_color, why);
+        }
+    }
+}
+
+impl Controls {
+    /// The displacement bound `d` (mm), entered in mm or, when the voxel diagonal `voxel`
+    /// (mm) is known and chosen, in voxel diagonals.
+    fn bound_field(&mut self, ui: &mut egui::Ui, d: &mut f32, voxel: Option<f32>) {
+        match voxel.filter(|_| self.bound_in_voxels) {
+            Some(v) => {
+                let mut in_voxels = *d / v;
+                let field = egui::DragValue::new(&mut in_voxels)
+                    .speed(0.01)
+                    .range(0.0..=1000.0 / v)
+                    .max_decimals(3)
+                    .suffix(" vd");
+                if ui.add(field).changed() {
+                    *d = in_voxels * v;
+                }
+                ui.weak(format!("= {:.3} mm", *d));
+            }
+            None => {
+                ui.add(
+                    egui::DragValue::new(d)
+                        .speed(0.01)
+                        .range(0.0..=1000.0)
+                        .suffix(" mm"),
+                );
+            }
+        }
+        if voxel.is_some() {
+            ui.selectable_value(&mut self.bound_in_voxels, false, "mm");
+            ui.selectable_value(&mut self.bound_in_voxels, true, "vd")
+                .on_hover_text("In voxel diagonals of the voxel size below");
         }
     }
 }

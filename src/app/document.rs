@@ -61,6 +61,16 @@ impl EngineTimings {
 /// When a waiting call is answered.
 pub type Ready = fn(&Session) -> bool;
 
+/// The 3D view's part of `state()`: where it is on the page, whether the weight brush is on
+/// and how long its latest pick took.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewReport {
+    /// Left, top, width, height in points (CSS pixels at zoom 1).
+    pub rect: [f32; 4],
+    pub brush_on: bool,
+    pub pick_ms: Option<f64>,
+}
+
 pub struct Document {
     pub session: Session,
     pub backend: Backend,
@@ -68,6 +78,8 @@ pub struct Document {
     pub timings: Option<EngineTimings>,
     /// Bumped when a new model is opened, so views re-upload it.
     pub model_generation: u64,
+    /// What the 3D view reports to `state()`.
+    pub view: ViewReport,
     waiting: Vec<Waiter>,
     /// Calls waiting for background work (a suggestion, the graphs).
     waiting_for: Vec<(Ready, Waiter)>,
@@ -85,6 +97,7 @@ impl Document {
             backend,
             timings: None,
             model_generation: 0,
+            view: ViewReport::default(),
             waiting: Vec::new(),
             waiting_for: Vec::new(),
             show_gallery: false,
@@ -185,6 +198,11 @@ impl Document {
             Some(EngineTimings::Gpu { run_ms }) => serde_json::json!({ "gpu_run_ms": run_ms }),
             None => serde_json::Value::Null,
         };
+        let v = &self.view;
+        state["brush"] = serde_json::json!({"on": v.brush_on, "pick_ms": v.pick_ms});
+        state["view"] = serde_json::json!({
+            "x": v.rect[0], "y": v.rect[1], "width": v.rect[2], "height": v.rect[3],
+        });
         state
     }
 }

@@ -26,6 +26,8 @@ pub struct GpuEngine {
     in_flight: Option<InFlight>,
     /// The revision of the latest run submitted (its positions are in the buffers).
     submitted: Option<u64>,
+    /// The session's weights version the mesh's weight buffer holds: uploaded once per change.
+    weights_uploaded: Option<u64>,
 }
 
 impl GpuEngine {
@@ -37,6 +39,7 @@ impl GpuEngine {
             mesh: None,
             in_flight: None,
             submitted: None,
+            weights_uploaded: None,
         }
     }
 
@@ -68,6 +71,7 @@ impl GpuEngine {
         if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
             self.mesh = None;
             self.submitted = None;
+            self.weights_uploaded = None;
             let uploaded = self
                 .smoother
                 .upload_with_measures(&self.device, &model.original)
@@ -80,6 +84,12 @@ impl GpuEngine {
         let params = *doc.session.params();
         let started_ms = now_ms();
         let e = |e: crate::gpu::GpuError| e.to_string();
+        let weights_version = doc.session.weights_version();
+        if self.weights_uploaded != Some(weights_version) {
+            mesh.set_weights(&self.queue, doc.session.weights())
+                .map_err(e)?;
+            self.weights_uploaded = Some(weights_version);
+        }
         self.smoother
             .smooth(&self.device, &self.queue, mesh, &params)
             .map_err(e)?;

@@ -8,12 +8,15 @@
 //! `api` (`window.meshsmooth`), `file_input` and `query` (bytes in: picker, drops, `?model=`),
 //! `download` (bytes out), `controls`, `legend`, `report_view`, `shortcuts` (the panels),
 //! `gallery` (thumbnails of results at several target smoothness values),
+//! `brush` and `drag_params` (painting weights and dragging parameters over the view),
 //! `shell` (the `eframe::App` that lays these out), `viewer` (the 3D view).
 
 mod api;
+mod brush;
 mod controls;
 mod document;
 mod download;
+mod drag_params;
 mod file_input;
 // Not shown yet: the shell wires it in next.
 mod gallery;

@@ -2,8 +2,10 @@
 //! left (filter, parameters, measures, colours), the mesh report on the right, the status bar,
 //! and the view in the middle. Owns no algorithm: edits go to the shared document's session.
 
+use super::brush::Brush;
 use super::controls::{self, Controls};
-use super::document::{now_ms, Backend, Document, SharedDocument, FRAME_BUDGET_MS};
+use super::document::{now_ms, Backend, Document, SharedDocument, ViewReport, FRAME_BUDGET_MS};
+use super::drag_params::DragParams;
 use super::file_input::FileInput;
 use super::gallery_view::GalleryView;
 use super::gpu_engine::GpuEngine;
@@ -29,6 +31,8 @@ pub struct Shell {
     /// Which the bottom panel shows.
     gallery_tab: bool,
     gallery: GalleryView,
+    brush: Brush,
+    drag_params: DragParams,
     coloring: Option<ColorField>,
     bake_colors: bool,
     show_original: bool,
@@ -112,6 +116,8 @@ impl Shell {
             graphs_open: true,
             gallery_tab: false,
             gallery: GalleryView::default(),
+            brush: Brush::default(),
+            drag_params: DragParams::default(),
             coloring: Some(ColorField::LocalError),
             bake_colors: false,
             show_original: false,
@@ -178,10 +184,14 @@ impl Shell {
             }
             self.shown.positions = Some(wanted);
         }
-        let colors = self
-            .coloring
-            .filter(|_| !self.show_original)
-            .zip(result.map(|r| r.revision));
+        // The brush shows what it paints; the weights' colours follow their own changes.
+        let colors = if self.brush.active {
+            Some((ColorField::Weights, session.weights_version()))
+        } else {
+            self.coloring
+                .filter(|_| !self.show_original)
+                .zip(result.map(|r| r.revision))
+        };
         if self.shown.colors != colors {
             let computed = colors.and_then(|(field, _)| session.colors(field));
             viewer.set_colors(rs, computed.as_ref().map(|(c, _)| c.as_slice()));
@@ -283,6 +293,7 @@ impl Shell {
                 }
             }
             Action::ToggleGraphs => self.set_graphs_open(!self.graphs_open),
+            Action::ToggleBrush => self.brush.active = !self.brush.active,
         }
     }
 
@@ -337,6 +348,9 @@ impl Shell {
         let timings = doc.timings;
         ui.heading("Smoothing");
         self.controls.filter(ui, &mut doc.session);
+        self.drag_params.panel(ui, doc.session.filter());
+        ui.separator();
+        self.brush.panel(ui, &mut doc.session);
         ui.separator();
         ui.heading("Suggest");
         self.guide.show(ui, &mut doc.session);
@@ -441,7 +455,28 @@ impl Shell {
 
     fn view(&mut self, ui: &mut egui::Ui) {
         let rect = match &mut self.view {
-            Some((viewer, _)) => viewer.show(ui).rect,
+            Some((viewer, _)) => {
+                viewer.painting = self.brush.active;
+                let response = viewer.show(ui);
+                let mut doc = self.doc.borrow_mut();
+                let doc = &mut *doc;
+                let shown = match self.shown.positions {
+                    Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
+                    _ => None,
+                };
+                let surface = (doc.model_generation, shown);
+                let camera = viewer.camera();
+                self.brush
+                    .interact(ui, &response, camera, &mut doc.session, surface);
+                self.drag_params.interact(ui, &response, &mut doc.session);
+                let r = response.rect;
+                doc.view = ViewReport {
+                    rect: [r.left(), r.top(), r.width(), r.height()],
+                    brush_on: self.brush.active,
+                    pick_ms: self.brush.pick_ms,
+                };
+                response.rect
+            }
             None => {
                 ui.label("The 3D view needs WebGPU or WebGL2, which this browser did not provide.");
                 ui.available_rect_before_wrap()

@@ -15,9 +15,10 @@ pub enum Action {
     ToggleHelp,
     ApplySuggestion,
     ToggleGraphs,
+    ToggleBrush,
 }
 
-const KEYS: [(egui::Key, Action, &str); 13] = [
+const KEYS: [(egui::Key, Action, &str); 14] = [
     (egui::Key::O, Action::Open, "Open a mesh file"),
     (egui::Key::W, Action::ToggleWireframe, "Wireframe on/off"),
     (
@@ -50,6 +51,11 @@ const KEYS: [(egui::Key, Action, &str); 13] = [
         Action::ToggleGraphs,
         "Model quality graphs on/off",
     ),
+    (
+        egui::Key::P,
+        Action::ToggleBrush,
+        "Weight brush on/off (paint where smoothing may act)",
+    ),
     (egui::Key::H, Action::ToggleHelp, "This help"),
 ];
 
@@ -76,10 +82,19 @@ pub fn help_window(ctx: &egui::Context, open: &mut bool) {
             ui.label(egui::RichText::new("Mouse").strong());
             egui::Grid::new("mouse_help").num_columns(2).show(ui, |ui| {
                 for (what, does) in [
-                    ("Left drag", "Orbit"),
+                    ("Left or middle drag", "Orbit"),
                     ("Shift + left drag", "Pan"),
                     ("Scroll / pinch", "Zoom"),
                     ("Double click", "Reset the view"),
+                    (
+                        "Right drag",
+                        "Drive two smoothing parameters: left/right and down/up \
+                         (chosen in the Smoothing panel)",
+                    ),
+                    (
+                        "Brush on (P): left drag",
+                        "Paint weights; Ctrl/⌘ + left or middle drag orbits",
+                    ),
                 ] {
                     ui.monospace(what);
                     ui.label(does);

@@ -1,5 +1,6 @@
 //! Colour-coding a result: per-vertex local error, Gaussian curvature or displacement mapped to
-//! colours, and the legend that reads them back in mm (and voxel diagonals when known).
+//! colours, and the legend that reads them back in mm (and voxel diagonals when known);
+//! or the painted smoothing weights (locked blue to free base colour).
 //!
 //! Ranges are robust (a high percentile, rounded up to a round number) so a few spikes at
 //! staircase corners do not wash the map out, and round so the legend's ticks read easily.
@@ -17,13 +18,16 @@ pub enum ColorField {
     Curvature,
     /// How far each vertex moved from its original position (mm).
     Displacement,
+    /// The painted smoothing weight of each vertex (0 locked, 1 free).
+    Weights,
 }
 
 impl ColorField {
-    pub const ALL: [ColorField; 3] = [
+    pub const ALL: [ColorField; 4] = [
         ColorField::LocalError,
         ColorField::Curvature,
         ColorField::Displacement,
+        ColorField::Weights,
     ];
 
     pub fn name(self) -> &'static str {
@@ -31,12 +35,14 @@ impl ColorField {
             ColorField::LocalError => "local error",
             ColorField::Curvature => "Gaussian curvature",
             ColorField::Displacement => "displacement",
+            ColorField::Weights => "weights",
         }
     }
 
     pub fn unit(self) -> &'static str {
         match self {
             ColorField::Curvature => "1/mm²",
+            ColorField::Weights => "0 locked, 1 free",
             _ => "mm",
         }
     }
@@ -88,6 +94,10 @@ const COOL_WARM: [[u8; 3]; 5] = [
     [244, 154, 123],
     [180, 4, 38],
 ];
+
+/// Locked (0) in a cool blue through to free (1) in the view's warm base colour, so painted
+/// regions stand out on an otherwise plainly shaded model (sRGB).
+const WEIGHT_MAP: [[u8; 3]; 3] = [[33, 102, 172], [130, 160, 190], [219, 204, 179]];
 
 /// The colour at `t` in [0, 1] along a piecewise-linear map.
 fn sample(stops: &[[u8; 3]], t: f64) -> [u8; 4] {
@@ -189,6 +199,8 @@ pub fn colorize(
     let values: &[f32] = match field {
         ColorField::LocalError => &result.vertex.local_error,
         ColorField::Curvature => &result.vertex.gaussian_curvature,
+        // The result does not hold the weights: see `weight_colors`.
+        ColorField::Weights => return weight_colors(None, original.len()),
         ColorField::Displacement => {
             displacement = original
                 .iter()
@@ -209,13 +221,36 @@ pub fn colorize(
     };
     let t = |v: f64| (v - min) / (max - min);
     let colors = values.iter().map(|&v| sample(stops, t(v as f64))).collect();
+    let legend = legend(field, stops, min, max, divisions(max - min), voxel_diagonal);
+    (colors, legend)
+}
 
-    let divisions = divisions(max - min);
+/// Colours `n` vertices by their painted `weights` (`None`: all free).
+pub fn weight_colors(weights: Option<&[f32]>, n: usize) -> (Vec<[u8; 4]>, Legend) {
+    let colors = match weights {
+        Some(w) => w.iter().map(|&w| sample(&WEIGHT_MAP, w as f64)).collect(),
+        None => vec![sample(&WEIGHT_MAP, 1.0); n],
+    };
+    let legend = legend(ColorField::Weights, &WEIGHT_MAP, 0.0, 1.0, 4, None);
+    (colors, legend)
+}
+
+fn legend(
+    field: ColorField,
+    stops: &[[u8; 3]],
+    min: f64,
+    max: f64,
+    divisions: usize,
+    voxel_diagonal: Option<f64>,
+) -> Legend {
     let ticks = (0..=divisions)
         .map(|k| {
             let at = k as f64 / divisions as f64;
             let value = min + at * (max - min);
-            let mut label = format!("{} {}", format_value(value), field.unit());
+            let mut label = format_value(value);
+            if field != ColorField::Weights {
+                label += &format!(" {}", field.unit());
+            }
             if let (Some(d), false) = (voxel_diagonal, field.diverging()) {
                 label += &format!(" ({} vd)", format_value(value / d));
             }
@@ -227,14 +262,13 @@ pub fn colorize(
         })
         .collect();
     let bar = (0..64).map(|k| sample(stops, k as f64 / 63.0)).collect();
-    let legend = Legend {
+    Legend {
         field,
         min,
         max,
         ticks,
         bar,
-    };
-    (colors, legend)
+    }
 }
 
 #[cfg(test)]

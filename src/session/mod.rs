@@ -8,9 +8,11 @@
 
 mod colors;
 mod guidance;
+mod weights;
 
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
+pub use weights::WeightsSummary;
 
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::io;
@@ -302,6 +304,7 @@ impl Session {
         }
         let model = self.model.as_ref()?;
         let params = *self.params();
+        let weights = self.weights.as_deref();
         let start = clock();
         let mut job = match self.job.take() {
             Some(job) if job.revision == self.revision => job,
@@ -316,7 +319,7 @@ impl Session {
         if params.filter == Filter::Sinc {
             // Its terms are not shorter filters' results: one piece.
             (job.positions, job.reference) =
-                metrics::smooth_drifting(&model.original, &params, None);
+                metrics::smooth_drifting(&model.original, &params, weights);
             job.done = params.iterations;
         }
         // Iterations per call: one at first, then as many as the time per iteration so far
@@ -331,7 +334,7 @@ impl Session {
                 model.mesh(),
                 model.topology(),
                 &params,
-                None,
+                weights,
                 positions,
                 job.done,
                 chunk,
@@ -422,9 +425,14 @@ impl Session {
             .and_then(|r| serde_json::to_value(&r.metrics).ok())
     }
 
-    /// Per-vertex colours of `field` on the latest result, with the legend that explains them.
+    /// Per-vertex colours of `field` on the latest result (the weights: as painted now), with
+    /// the legend that explains them.
     pub fn colors(&self, field: ColorField) -> Option<(Vec<[u8; 4]>, Legend)> {
         let model = self.model.as_ref()?;
+        if field == ColorField::Weights {
+            let n = model.mesh().vertex_count();
+            return Some(colors::weight_colors(self.weights(), n));
+        }
         let result = self.last_result()?;
         Some(colors::colorize(
             field,
@@ -472,6 +480,7 @@ impl Session {
             "params": self.params().to_json(),
             "tau": self.tau,
             "busy": busy,
+            "weights": self.weights_summary(),
         })
     }
 }

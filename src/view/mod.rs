@@ -1,17 +1,24 @@
 //! What the 3D view computes without a GPU: the orbit camera and its matrices, the side a mesh
-//! is first shown from, the per-frame record the render shader reads, and thumbnails drawn on
-//! the CPU with the same camera and lights.
+//! is first shown from, the per-frame record the render shader reads, thumbnails drawn on
+//! the CPU with the same camera and lights, picking (the triangle under the cursor and the
+//! vertices under the brush) and the window/level-style parameter drag.
 //!
 //! Free of egui and wgpu so that it builds and is unit-tested natively; the web app's
 //! renderer (`app::viewer`, wasm32) uploads what this module computes.
 
 mod camera;
 mod orientation;
+mod param_drag;
+mod pick;
 pub mod thumbnail;
 mod uniforms;
 
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
 pub use orientation::{face_on_direction, first_view};
+pub use param_drag::{
+    default_drag_axes, drag_choices, drag_range, dragged_params, POINTS_PER_RANGE,
+};
+pub use pick::{brush_falloff, brush_footprint, moller_trumbore, pick_triangle, Hit, Ray};
 pub use uniforms::{
     linear_from_srgb, ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS,
 };

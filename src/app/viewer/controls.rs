@@ -1,7 +1,9 @@
 //! Mouse, touch and wheel input over the view, turned into camera moves.
 //!
-//! Only the primary button is used (drag orbits, shift+drag pans, double click resets): right
-//! and middle drags are left to the caller through the view's `Response`.
+//! The primary button drags the camera (drag orbits, shift+drag pans, double click resets),
+//! the middle button orbits: right drags are left to the caller through the view's `Response`.
+//! While the caller paints with the primary button (`painting`), a plain primary drag is the
+//! caller's too, and Ctrl/⌘ + drag orbits instead.
 
 use eframe::egui;
 use glam::Vec2;
@@ -12,15 +14,19 @@ use crate::view::OrbitCamera;
 const ZOOM_PER_SCROLL_POINT: f32 = 0.002;
 
 /// Moves `camera` by this frame's input over the view (the double click is the caller's).
-pub fn apply(camera: &mut OrbitCamera, ui: &egui::Ui, response: &egui::Response) {
-    if response.dragged_by(egui::PointerButton::Primary) {
+pub fn apply(camera: &mut OrbitCamera, ui: &egui::Ui, response: &egui::Response, painting: bool) {
+    let (shift, command) = ui.input(|i| (i.modifiers.shift, i.modifiers.command));
+    let primary = response.dragged_by(egui::PointerButton::Primary);
+    if primary && shift {
         let delta = response.drag_delta();
-        if ui.input(|i| i.modifiers.shift) {
-            let size = response.rect.size();
-            camera.pan(delta.x, delta.y, Vec2::new(size.x, size.y));
-        } else {
-            camera.orbit(delta.x, delta.y);
-        }
+        let size = response.rect.size();
+        camera.pan(delta.x, delta.y, Vec2::new(size.x, size.y));
+        ui.ctx().set_cursor_icon(egui::CursorIcon::Grabbing);
+    } else if (primary && (!painting || command))
+        || response.dragged_by(egui::PointerButton::Middle)
+    {
+        let delta = response.drag_delta();
+        camera.orbit(delta.x, delta.y);
         ui.ctx().set_cursor_icon(egui::CursorIcon::Grabbing);
     }
     if response.contains_pointer() {

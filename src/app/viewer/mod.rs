@@ -38,6 +38,9 @@ const BACKGROUND: egui::Color32 = {
 pub struct Viewer {
     /// Draw the triangle edges over the surface.
     pub wireframe: bool,
+    /// The caller paints with a plain left drag (the brush): orbiting moves to Ctrl/⌘ + left
+    /// drag and the middle button.
+    pub painting: bool,
     camera: OrbitCamera,
     /// The model framed from its first direction (face-on when flat, else the default), where
     /// [`Self::reset_view`] returns to.
@@ -74,6 +77,7 @@ impl Viewer {
             .insert(resources);
         Self {
             wireframe: false,
+            painting: false,
             camera: OrbitCamera::default(),
             home: OrbitCamera::default(),
             vertex_count: 0,
@@ -155,14 +159,15 @@ impl Viewer {
         }
     }
 
-    /// Paints into all the space `ui` has left. Left drag orbits, shift+left drag pans, the
-    /// wheel or a pinch zooms, a double click resets the view. Right and middle drags are not
-    /// used here: the caller reads them from the returned `Response`.
+    /// Paints into all the space `ui` has left. Left (or middle) drag orbits, shift+left drag
+    /// pans, the wheel or a pinch zooms, a double click resets the view. Right drags are not
+    /// used here (nor plain left drags while [`Self::painting`]): the caller reads them from
+    /// the returned `Response`.
     pub fn show(&mut self, ui: &mut egui::Ui) -> egui::Response {
         let (rect, response) =
             ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
-        controls::apply(&mut self.camera, ui, &response);
-        if response.double_clicked_by(egui::PointerButton::Primary) {
+        controls::apply(&mut self.camera, ui, &response, self.painting);
+        if response.double_clicked_by(egui::PointerButton::Primary) && !self.painting {
             self.reset_view();
         }
 
@@ -188,6 +193,11 @@ impl Viewer {
                 .add(egui_wgpu::Callback::new_paint_callback(rect, callback));
         }
         response
+    }
+
+    /// The camera the view is drawn with (for picking).
+    pub fn camera(&self) -> &OrbitCamera {
+        &self.camera
     }
 
     /// Frames the whole model as it was first shown (face-on when flat, else from the front-left).

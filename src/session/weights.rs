@@ -1,0 +1,240 @@
+//! Per-vertex smoothing weights painted by the user (ALGORITHMS.md: each step moves a vertex by
+//! `w_i` times its filter displacement; 0 locks it). The session keeps them for the open model;
+//! every change bumps the session's revision (the result is recomputed) and the weights'
+//! own version (the GPU engine uploads them once per change).
+//!
+//! Painting takes the minimum with the brush's profile and erasing the maximum, so dabbing the
+//! same spot again in one stroke changes nothing: a stroke never "builds up" with the frame rate.
+
+use super::Session;
+
+/// What `state()` reports about the weights.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct WeightsSummary {
+    /// Vertices with a weight below 1.
+    pub painted: usize,
+    /// Vertices with weight 0 (they do not move).
+    pub locked: usize,
+    pub min: f32,
+    pub mean: f64,
+}
+
+/// The summary of `weights`, or `None` when nothing is painted.
+fn summarize(weights: Option<&[f32]>) -> Option<WeightsSummary> {
+    let w = weights?;
+    Some(WeightsSummary {
+        painted: w.iter().filter(|&&x| x < 1.0).count(),
+        locked: w.iter().filter(|&&x| x <= 0.0).count(),
+        min: w.iter().copied().fold(1.0, f32::min),
+        mean: w.iter().map(|&x| x as f64).sum::<f64>() / w.len().max(1) as f64,
+    })
+}
+
+impl Session {
+    /// The painted weights (one per vertex in [0, 1]), or `None` while every vertex is free.
+    pub fn weights(&self) -> Option<&[f32]> {
+        self.weights.as_deref()
+    }
+
+    /// How many vertices are painted and locked, and the lowest weight; `None` when nothing is.
+    pub fn weights_summary(&self) -> Option<WeightsSummary> {
+        summarize(self.weights())
+    }
+
+    /// Changes whenever the weights change (paint, erase, clear, a new model).
+    pub fn weights_version(&self) -> u64 {
+        self.weights_version
+    }
+
+    /// Lowers the weights under a brush dab: vertex `i` with falloff `f` in [0, 1] (1 at the
+    /// brush's centre) gets at most `1 - (1 - target) * f`, so `target` 0 locks the centre.
+    /// Returns whether anything changed (only then do the results recompute).
+    pub fn paint_weights(&mut self, footprint: &[(u32, f32)], target: f32) -> bool {
+        let target = target.clamp(0.0, 1.0);
+        self.edit_weights(footprint, |w, f| w.min(1.0 - (1.0 - target) * f))
+    }
+
+    /// Raises the weights under a brush dab back towards 1 (free): vertex `i` with falloff `f`
+    /// gets at least `f`. Returns whether anything changed.
+    pub fn erase_weights(&mut self, footprint: &[(u32, f32)]) -> bool {
+        self.edit_weights(footprint, |w, f| w.max(f))
+    }
+
+    /// Every vertex free again. Returns whether anything was painted.
+    pub fn clear_weights(&mut self) -> bool {
+        if self.weights.is_none() {
+            return false;
+        }
+        self.weights = None;
+        self.weights_version += 1;
+        self.changed();
+        true
+    }
+
+    fn edit_weights(&mut self, footprint: &[(u32, f32)], rule: impl Fn(f32, f32) -> f32) -> bool {
+        let Some(model) = &self.model else {
+            return false;
+        };
+        let n = model.mesh().vertex_count();
+        let mut values = self.weights.take().unwrap_or_else(|| vec![1.0; n]);
+        let mut changed = false;
+        for &(i, f) in footprint {
+            let Some(w) = values.get_mut(i as usize) else {
+                continue;
+            };
+            let f = if f.is_finite() {
+                f.clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let new = rule(*w, f).clamp(0.0, 1.0);
+            if new != *w {
+                *w = new;
+                changed = true;
+            }
+        }
+        // All free again: no weights at all, so the result is exactly the unweighted one.
+        self.weights = values.iter().any(|&w| w < 1.0).then_some(values);
+        if changed {
+            self.weights_version += 1;
+            self.changed();
+        }
+        changed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::session::ColorField;
+    use crate::smooth::Filter;
+
+    const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+
+    fn sample_session() -> Session {
+        let mut s = Session::default();
+        s.open("bent_tube_staircase.ply", SAMPLE)
+            .expect("the sample opens");
+        s
+    }
+
+    fn smoothed(s: &mut Session) -> Vec<[f32; 3]> {
+        s.smooth_cpu(&|| 0.0);
+        s.result().expect("a result").positions.clone()
+    }
+
+    /// The first `k` vertices at full strength.
+    fn dab(k: u32) -> Vec<(u32, f32)> {
+        (0..k).map(|i| (i, 1.0)).collect()
+    }
+
+    #[test]
+    fn locked_vertices_do_not_move_with_any_filter() {
+        let mut s = sample_session();
+        assert!(s.paint_weights(&dab(50), 0.0));
+        // A half weight on the next ones: they move, but less than unweighted.
+        assert!(s.paint_weights(&[(60, 1.0), (61, 1.0)], 0.5));
+        let original = s.model().unwrap().mesh().positions.clone();
+        for filter in Filter::ALL {
+            s.set_filter(filter);
+            let weighted = smoothed(&mut s);
+            for i in 0..50 {
+                assert_eq!(weighted[i], original[i], "{filter}: vertex {i} moved");
+            }
+            assert!(
+                weighted[60..62] != original[60..62],
+                "{filter}: half-weighted vertices move"
+            );
+            // In frame-sized chunks too (the browser's CPU engine).
+            let w = s.weights().unwrap().to_vec();
+            s.clear_weights();
+            assert!(s.paint_weights(
+                &w.iter()
+                    .enumerate()
+                    .map(|(i, &w)| (i as u32, 1.0 - w))
+                    .collect::<Vec<_>>(),
+                0.0
+            ));
+            assert_eq!(s.weights().unwrap(), w.as_slice());
+            let mut calls = 0;
+            while s.step_cpu(&|| 0.0, 0.0).is_none() {
+                calls += 1;
+                assert!(calls < 1000);
+            }
+            assert_eq!(s.result().unwrap().positions, weighted, "{filter}: chunked");
+        }
+    }
+
+    #[test]
+    fn clearing_restores_the_unweighted_result_exactly() {
+        let mut s = sample_session();
+        s.set_filter(Filter::Taubin);
+        let free = smoothed(&mut s);
+        let free_metrics = s.result().unwrap().metrics.clone();
+        let revision = s.revision();
+        assert!(s.paint_weights(&dab(400), 0.2));
+        assert!(s.revision() > revision, "painting recomputes");
+        let painted = smoothed(&mut s);
+        assert_ne!(painted, free);
+        assert!(s.clear_weights());
+        assert_eq!(s.weights(), None);
+        assert!(!s.clear_weights(), "nothing left to clear");
+        assert_eq!(smoothed(&mut s), free);
+        assert_eq!(s.result().unwrap().metrics, free_metrics);
+        // Erasing everything painted is the same as clearing.
+        assert!(s.paint_weights(&dab(400), 0.0));
+        assert!(s.erase_weights(&dab(400)));
+        assert_eq!(s.weights(), None);
+        assert_eq!(smoothed(&mut s), free);
+    }
+
+    #[test]
+    fn a_dab_repeated_changes_nothing_and_keeps_the_results() {
+        let mut s = sample_session();
+        let footprint = [(3, 1.0), (4, 0.5), (5, 0.0), (6, f32::NAN), (99_999, 1.0)];
+        let generation = s.weights_version();
+        assert!(s.paint_weights(&footprint, 0.0));
+        assert_eq!(s.weights_version(), generation + 1);
+        let w = s.weights().unwrap();
+        assert_eq!((w[3], w[4], w[5], w[6]), (0.0, 0.5, 1.0, 1.0));
+        s.smooth_cpu(&|| 0.0);
+        let revision = s.revision();
+        assert!(!s.paint_weights(&footprint, 0.0), "the same dab again");
+        // A weaker brush does not unlock what is locked.
+        assert!(!s.paint_weights(&footprint, 0.7));
+        assert_eq!(s.revision(), revision);
+        assert!(s.result().is_some(), "nothing to recompute");
+        // Erasing at half strength raises to at least the falloff.
+        assert!(s.erase_weights(&[(3, 0.25)]));
+        assert_eq!(s.weights().unwrap()[3], 0.25);
+
+        let summary = summarize(s.weights()).unwrap();
+        assert_eq!((summary.painted, summary.locked), (2, 0));
+        assert_eq!(summary.min, 0.25);
+        let state = s.state_json(false);
+        assert_eq!(state["weights"]["painted"], 2);
+        assert_eq!(state["weights"]["min"], 0.25);
+
+        // A new model starts free.
+        s.open("again.ply", SAMPLE).unwrap();
+        assert_eq!(s.weights(), None);
+        assert_eq!(s.state_json(false)["weights"], serde_json::Value::Null);
+        assert!(s.weights_version() > generation + 1);
+        // Nothing open, nothing to paint.
+        assert!(!Session::default().paint_weights(&footprint, 0.0));
+    }
+
+    #[test]
+    fn weights_colour_locked_apart_from_free() {
+        let mut s = sample_session();
+        let (free, legend) = s.colors(ColorField::Weights).expect("before any result");
+        assert_eq!(free.len(), s.model().unwrap().mesh().vertex_count());
+        assert!(free.iter().all(|c| *c == free[0]));
+        assert_eq!((legend.min, legend.max), (0.0, 1.0));
+        assert_eq!(legend.ticks[0].label, "0");
+        s.paint_weights(&dab(1), 0.0);
+        let (painted, _) = s.colors(ColorField::Weights).unwrap();
+        assert_ne!(painted[0], painted[1]);
+        assert_eq!(painted[1], free[1]);
+    }
+}
