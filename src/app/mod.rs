@@ -12,6 +12,7 @@
 //! `shell` (the `eframe::App` that lays these out), `viewer` (the 3D view).
 
 mod api;
+mod bottom_panel;
 mod brush;
 mod controls;
 mod document;

@@ -2,19 +2,19 @@
 //! left (filter, parameters, measures, colours), the mesh report on the right, the status bar,
 //! and the view in the middle. Owns no algorithm: edits go to the shared document's session.
 
+use super::bottom_panel::BottomPanel;
 use super::brush::Brush;
 use super::controls::{self, Controls};
 use super::document::{now_ms, Backend, Document, SharedDocument, ViewReport, FRAME_BUDGET_MS};
 use super::drag_params::DragParams;
 use super::file_input::FileInput;
-use super::gallery_view::GalleryView;
 use super::gpu_engine::GpuEngine;
 use super::guide::Guide;
 use super::shortcuts::{self, Action};
 use super::viewer::Viewer;
-use super::{api, download, graphs, legend, page, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
+use super::{api, download, legend, page, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
-use crate::session::{Activity, ColorField, Legend};
+use crate::session::{ColorField, Legend};
 use crate::smooth::Filter;
 use eframe::egui;
 use eframe::egui_wgpu;
@@ -26,11 +26,8 @@ pub struct Shell {
     files: FileInput,
     controls: Controls,
     guide: Guide,
-    /// Whether the bottom panel (quality graphs or gallery) is shown.
-    graphs_open: bool,
-    /// Which the bottom panel shows.
-    gallery_tab: bool,
-    gallery: GalleryView,
+    /// The quality graphs and the gallery.
+    bottom: BottomPanel,
     brush: Brush,
     drag_params: DragParams,
     coloring: Option<ColorField>,
@@ -113,9 +110,7 @@ impl Shell {
             files,
             controls: Controls::default(),
             guide: Guide::default(),
-            graphs_open: true,
-            gallery_tab: false,
-            gallery: GalleryView::default(),
+            bottom: BottomPanel::new(),
             brush: Brush::default(),
             drag_params: DragParams::default(),
             coloring: Some(ColorField::LocalError),
@@ -292,7 +287,11 @@ impl Shell {
                     let _ = doc.session.set_params(s.suggestion.params);
                 }
             }
-            Action::ToggleGraphs => self.set_graphs_open(!self.graphs_open),
+            Action::ToggleGraphs => {
+                let open = !self.bottom.open;
+                self.bottom
+                    .set_open(open, &mut self.doc.borrow_mut().session);
+            }
             Action::ToggleBrush => self.brush.active = !self.brush.active,
         }
     }
@@ -320,11 +319,13 @@ impl Shell {
             });
             ui.separator();
             if ui
-                .toggle_value(&mut self.graphs_open, "Graphs")
+                .toggle_value(&mut self.bottom.open, "Graphs")
                 .on_hover_text("Model quality graphs of the active filter (G)")
                 .changed()
             {
-                self.set_graphs_open(self.graphs_open);
+                let open = self.bottom.open;
+                self.bottom
+                    .set_open(open, &mut self.doc.borrow_mut().session);
             }
             ui.toggle_value(&mut self.show_original, "Original")
                 .on_hover_text("Before/after: show the original mesh (B)");
@@ -360,58 +361,6 @@ impl Shell {
         ui.separator();
         ui.heading("Colours");
         controls::coloring(ui, &mut self.coloring, &mut doc.session);
-    }
-
-    fn set_graphs_open(&mut self, open: bool) {
-        self.graphs_open = open;
-        let wanted = open && !self.gallery_tab;
-        self.doc.borrow_mut().session.set_graphs_wanted(wanted);
-    }
-
-    fn bottom_panel(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            let mut gallery = self.gallery_tab;
-            ui.selectable_value(
-                &mut gallery,
-                false,
-                egui::RichText::new("Quality graphs").heading(),
-            );
-            ui.selectable_value(&mut gallery, true, egui::RichText::new("Gallery").heading());
-            if gallery != self.gallery_tab {
-                self.gallery_tab = gallery;
-                // The graphs are kept current only while they are shown.
-                self.doc.borrow_mut().session.set_graphs_wanted(!gallery);
-            }
-        });
-        if self.gallery_tab {
-            let mut doc = self.doc.borrow_mut();
-            if let Some((tau, params)) = self.gallery.show(ui, &mut doc.session) {
-                let _ = doc.session.set_tau(tau);
-                let _ = doc.session.set_params(params);
-            }
-        } else {
-            self.graphs_panel(ui);
-        }
-    }
-
-    fn graphs_panel(&mut self, ui: &mut egui::Ui) {
-        let mut doc = self.doc.borrow_mut();
-        ui.horizontal(|ui| {
-            let filter = doc.session.filter();
-            ui.label(format!("{filter} filter: each column varies one parameter"));
-            for a in doc.session.activities() {
-                if let Activity::Graphs(_) = a {
-                    ui.add(
-                        egui::ProgressBar::new(a.fraction())
-                            .desired_width(220.0)
-                            .text(a.describe()),
-                    );
-                }
-            }
-        });
-        if let Some(p) = graphs::show(ui, &doc.session) {
-            let _ = doc.session.set_params(p);
-        }
     }
 
     fn status_bar(&self, ui: &mut egui::Ui) {
@@ -555,11 +504,7 @@ impl eframe::App for Shell {
             .clamp(*GUIDANCE_BUDGET_MS.start(), *GUIDANCE_BUDGET_MS.end());
         self.doc.borrow_mut().compute_guidance(budget);
         self.compute_ms = now_ms() - start;
-        self.gallery.update(&ctx, &self.doc.borrow().session);
-        if std::mem::take(&mut self.doc.borrow_mut().show_gallery) {
-            self.gallery_tab = true;
-            self.set_graphs_open(true);
-        }
+        self.bottom.update(&ctx, &mut self.doc.borrow_mut());
         self.sync_view();
         {
             let mut doc = self.doc.borrow_mut();
@@ -578,12 +523,14 @@ impl eframe::App for Shell {
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.smoothing_panel(ui));
             });
-        if self.graphs_open {
+        if self.bottom.open {
             egui::Panel::bottom("graphs")
                 .resizable(true)
                 .default_size(330.0)
                 .min_size(240.0)
-                .show(ui, |ui| self.bottom_panel(ui));
+                .show(ui, |ui| {
+                    self.bottom.show(ui, &mut self.doc.borrow_mut().session)
+                });
         }
         egui::Panel::right("report")
             .resizable(true)

@@ -10,11 +10,11 @@
 //! longer shown as current.
 
 use super::Session;
-use crate::metrics::{self, VertexMeasures};
+use crate::metrics;
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
     EvaluatedGrid, GridSearch, LocalOutcome, LocalSearch, Progress, QualityGraphs, QualitySweep,
-    SearchMethod, Sliced, SlicedRuns, Suggestion, Task, Terms,
+    SearchMethod, Sliced, SlicedRuns, Suggestion, Task,
 };
 
 /// The tau values of the gallery, from accuracy to smoothness.
@@ -81,27 +81,6 @@ pub struct Suggested {
     pub key: SearchKey,
     /// Wall time of the search (milliseconds), spread over frames.
     pub elapsed_ms: f64,
-}
-
-/// The model smoothed as suggested for one tau, with its measures.
-#[derive(Clone, Debug)]
-pub struct GalleryPick {
-    pub tau: f64,
-    pub params: Params,
-    pub terms: Terms,
-    pub positions: Vec<[f32; 3]>,
-    pub vertex: VertexMeasures,
-}
-
-/// The gallery under way: the suggested parameters per tau first, then one smoothing per tau.
-struct GalleryJob {
-    key: SearchKey,
-    /// Suggested parameters and terms, in [`GALLERY_TAUS`] order, as they are found.
-    suggested: Vec<(Params, Terms)>,
-    search: Option<Running<LocalSearch>>,
-    smoothing: Running<()>,
-    picks: Vec<GalleryPick>,
-    problem: Option<String>,
 }
 
 /// What the background is doing, for progress bars.
@@ -535,241 +514,9 @@ impl Session {
     }
 }
 
-fn with_bound(mut params: Params, bound: Option<f32>) -> Params {
-    params.max_displacement = bound;
-    params
-}
-
-/// One call's work on the gallery: the next tau's local search until every tau has
-/// parameters, then the next smoothing. Returns whether the gallery is complete.
-fn step_gallery(
-    job: &mut GalleryJob,
-    original: &metrics::Original,
-    weights: Option<&[f32]>,
-    clock: &dyn Fn() -> f64,
-    budget_ms: f64,
-) -> bool {
-    let n = GALLERY_TAUS.len();
-    if job.suggested.len() < n {
-        let tau = GALLERY_TAUS[job.suggested.len()];
-        let base = with_bound(Params::defaults(job.key.filter), job.key.bound);
-        if job.search.is_none() {
-            match LocalSearch::new(job.key.filter, &base, tau) {
-                Ok(task) => job.search = Some(Running::new(task)),
-                Err(e) => {
-                    job.problem = Some(format!("No gallery: {e}"));
-                    return true;
-                }
-            }
-        }
-        let Some(running) = job.search.as_mut() else {
-            return true;
-        };
-        let Some((task, mut ev)) = running.evaluator(original, weights, clock, budget_ms) else {
-            return true;
-        };
-        if task.step(&mut ev) {
-            if let Some(outcome) = job.search.take().and_then(|r| r.task.into_output()) {
-                let s = outcome.suggestion;
-                job.suggested
-                    .push((with_bound(s.params, job.key.bound), s.terms));
-            } else {
-                return true;
-            }
-        }
-        return false;
-    }
-    let Some(&(params, terms)) = job.suggested.get(job.picks.len()) else {
-        return true;
-    };
-    let tau = GALLERY_TAUS[job.picks.len()];
-    let Some((_, mut ev)) = job.smoothing.evaluator(original, weights, clock, budget_ms) else {
-        return true;
-    };
-    let Some((positions, reference)) = ev.smoothed(&params) else {
-        return false;
-    };
-    let (_, vertex) = metrics::measure_vertices(original, &positions, &reference, tau);
-    job.picks.push(GalleryPick {
-        tau,
-        params,
-        terms,
-        positions,
-        vertex,
-    });
-    job.picks.len() == n
-}
-
+mod gallery;
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::suggest::{quality_graphs, suggest};
-    use std::cell::Cell;
+mod tests;
 
-    const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
-
-    fn session(filter: &str) -> Session {
-        let mut s = Session::default();
-        s.open("sample.ply", SAMPLE).unwrap();
-        s.set_filter_name(filter).unwrap();
-        s
-    }
-
-    /// Steps the background until nothing is left, on a clock that ticks 1 ms per reading;
-    /// returns the calls it took.
-    fn settle(s: &mut Session) -> usize {
-        let ticks = Cell::new(0.0);
-        let clock = || {
-            ticks.set(ticks.get() + 1.0);
-            ticks.get()
-        };
-        let mut calls = 0;
-        while s.guidance_busy() {
-            s.step_guidance(&clock, 20.0);
-            calls += 1;
-            assert!(calls < 1_000_000, "the background never settles");
-        }
-        calls
-    }
-
-    #[test]
-    fn a_loaded_model_gets_the_local_search_suggestion() {
-        let mut s = Session::default();
-        s.open("sample.ply", SAMPLE).unwrap();
-        assert!(s.suggesting(), "a search starts with the model");
-        let calls = settle(&mut s);
-        assert!(calls > 10, "spread over {calls} calls");
-        let got = s.suggestion().expect("a suggestion").suggestion;
-        let model = s.model().unwrap();
-        let expected = suggest(
-            &model.original,
-            None,
-            s.params(),
-            s.tau(),
-            SearchMethod::Local,
-            &mut |_| true,
-        )
-        .unwrap();
-        assert_eq!(got, expected);
-    }
-
-    #[test]
-    fn a_grid_suggestion_follows_tau_without_smoothing_again() {
-        let mut s = session("laplace");
-        s.set_params_json(&serde_json::json!({"max_displacement": 0.4}))
-            .unwrap();
-        s.start_suggest(SearchMethod::Grid);
-        settle(&mut s);
-        for tau in [0.5, 0.2, 0.9] {
-            s.set_tau(tau).unwrap();
-            assert!(!s.guidance_busy());
-            let got = s.suggestion().unwrap().suggestion;
-            let expected = suggest(
-                &model_original(&s),
-                None,
-                s.params(),
-                tau,
-                SearchMethod::Grid,
-                &mut |_| true,
-            )
-            .unwrap();
-            assert_eq!(got, expected, "tau {tau}");
-            assert_eq!(got.params.max_displacement, Some(0.4));
-        }
-        // Another filter: the grid is not for it.
-        s.set_filter_name("hc").unwrap();
-        assert!(s.suggestion().is_none());
-    }
-
-    fn model_original(s: &Session) -> metrics::Original {
-        s.model().unwrap().original.clone()
-    }
-
-    #[test]
-    fn graphs_follow_the_parameters_in_the_background() {
-        let mut s = session("taubin");
-        s.cancel_suggest();
-        s.set_params_json(&serde_json::json!({"iterations": 8}))
-            .unwrap();
-        assert!(!s.guidance_busy(), "graphs are only made when wanted");
-        s.set_graphs_wanted(true);
-        settle(&mut s);
-        assert!(s.graphs_current());
-        let original = model_original(&s);
-        let expected = quality_graphs(&original, None, s.params(), s.tau(), &mut |_| true).unwrap();
-        assert_eq!(s.graphs().unwrap(), expected);
-
-        // A new value: the old graphs stay on show, marked stale, until new ones are made.
-        s.set_params_json(&serde_json::json!({"lambda": 0.4}))
-            .unwrap();
-        assert!(!s.graphs_current());
-        assert_eq!(s.graphs().unwrap(), expected);
-        assert!(s.guidance_busy());
-        settle(&mut s);
-        assert!(s.graphs_current());
-        assert_eq!(s.graphs().unwrap().current, *s.params());
-
-        // tau rescored without smoothing.
-        s.set_tau(0.9).unwrap();
-        assert!(!s.guidance_busy());
-        assert_eq!(s.graphs().unwrap().tau, 0.9);
-    }
-
-    #[test]
-    fn the_gallery_holds_the_local_suggestion_of_each_tau() {
-        let mut s = session("laplace");
-        s.cancel_suggest();
-        s.start_gallery();
-        settle(&mut s);
-        let picks = s.gallery();
-        assert_eq!(picks.len(), GALLERY_TAUS.len());
-        let original = model_original(&s);
-        for (pick, &tau) in picks.iter().zip(&GALLERY_TAUS) {
-            let expected = suggest(
-                &original,
-                None,
-                s.params(),
-                tau,
-                SearchMethod::Local,
-                &mut |_| true,
-            )
-            .unwrap();
-            assert_eq!(
-                (pick.tau, pick.params, pick.terms),
-                (tau, expected.params, expected.terms)
-            );
-            let (positions, _) = metrics::smooth_drifting(&original, &pick.params, None);
-            assert_eq!(pick.positions, positions);
-            assert_eq!(pick.vertex.local_error.len(), positions.len());
-        }
-        // Stronger smoothing as tau grows.
-        let k: Vec<f64> = picks.iter().map(|p| p.terms.curvature_ratio).collect();
-        assert!(k.first() > k.last(), "{k:?}");
-    }
-
-    #[test]
-    fn a_search_for_another_filter_or_model_is_dropped() {
-        let mut s = session("hc");
-        let ticks = Cell::new(0.0);
-        let clock = || {
-            ticks.set(ticks.get() + 1.0);
-            ticks.get()
-        };
-        s.start_suggest(SearchMethod::Local);
-        s.step_guidance(&clock, 1.0);
-        assert!(s.suggesting());
-        s.set_filter_name("sinc").unwrap();
-        s.step_guidance(&clock, 1.0);
-        assert!(!s.suggesting());
-        s.set_filter_name("hc").unwrap();
-        s.start_gallery();
-        s.open("again.ply", SAMPLE).unwrap();
-        assert!(s.gallery().is_empty());
-        assert_eq!(
-            s.activities().len(),
-            1,
-            "only the new model's suggestion: {:?}",
-            s.activities()
-        );
-    }
-}
+pub use gallery::GalleryPick;
+use gallery::{step_gallery, with_bound, GalleryJob};

@@ -1,20 +1,18 @@
 // End-to-end tests of the guidance features (issue 7): suggestions, quality graphs, the gallery,
 // and the frame rate while the background computes. Run by tests/e2e/run.sh in both modes.
-import { after, before, test } from "node:test";
+import { test } from "node:test";
 import assert from "node:assert/strict";
-import { appendFileSync, existsSync, mkdtempSync, readFileSync } from "node:fs";
+import { appendFileSync, mkdtempSync, readFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
-import { AppPage, VIEWPORT } from "./lib/app.mjs";
-import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
+import { VIEWPORT } from "./lib/app.mjs";
 import * as cli from "./lib/cli.mjs";
 import { jsonDifferences, metricDifferences } from "./lib/compare.mjs";
-import { DIST, E2E_OUT, ROOT, meshPath, outputDir } from "./lib/paths.mjs";
-import { serveDirectory } from "./lib/server.mjs";
+import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
+import { appSuite } from "./lib/suite.mjs";
 
-const MODE = modeFromEnv();
-const OUT = outputDir(MODE);
+const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 const SAMPLE = join(ROOT, "web/sample/bent_tube_staircase.ply");
 const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
 /** The background searches run the same Rust code on the CPU in both modes (wasm: one thread,
@@ -23,36 +21,6 @@ const RTOL = 1e-9;
 /** metrics() comes from the page's engine: on WebGPU its f32 WGSL (see app.test.mjs, METRIC_RTOL). */
 const METRIC_RTOL = { cpu: 1e-9, webgpu: 1e-4 }[MODE];
 const TIMEOUT = 10 * 60_000;
-
-let server;
-let browser;
-
-before(async () => {
-    if (!existsSync(join(DIST, "index.html"))) {
-        throw new Error(`${DIST}/index.html is missing: build the page first (trunk build --release)`);
-    }
-    cli.requireCli();
-    server = await serveDirectory(DIST);
-    browser = await launchBrowser(MODE);
-});
-
-after(async () => {
-    await browser?.close();
-    await server?.close();
-});
-
-async function withApp(body) {
-    const app = await AppPage.open(browser, server, OUT);
-    try {
-        await app.api();
-        const result = await body(app);
-        assert.deepEqual(app.foreignRequests(), [], "the page requested something outside its own origin");
-        assert.deepEqual(app.pageErrors.map(String), [], "uncaught errors in the page");
-        return result;
-    } finally {
-        await app.close();
-    }
-}
 
 const state = (app) => app.page.evaluate(() => window.meshsmooth.state());
 

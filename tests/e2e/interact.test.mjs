@@ -4,18 +4,14 @@
 // target/e2e/<mode>/.
 //
 //   bash tests/e2e/run.sh --test-name-pattern='^interact'
-import { after, before, test } from "node:test";
+import { test } from "node:test";
 import assert from "node:assert/strict";
-import { existsSync, readFileSync } from "node:fs";
-import { join } from "node:path";
+import { readFileSync } from "node:fs";
 
-import { AppPage } from "./lib/app.mjs";
-import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
-import { DIST, meshPath, outputDir } from "./lib/paths.mjs";
-import { serveDirectory } from "./lib/server.mjs";
+import { meshPath } from "./lib/paths.mjs";
+import { appSuite } from "./lib/suite.mjs";
 
-const MODE = modeFromEnv();
-const OUT = outputDir(MODE);
+const { MODE, OUT, withApp } = appSuite();
 
 const SPHERE = meshPath("synthetic/synthetic_sphere_r20.ply");
 const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
@@ -24,33 +20,6 @@ const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
 const POINTS_PER_RANGE = 400;
 
 const API_TIMEOUT = 5 * 60_000;
-
-let server;
-let browser;
-
-before(async () => {
-    if (!existsSync(join(DIST, "index.html"))) {
-        throw new Error(`${DIST}/index.html is missing: build the page first (trunk build --release)`);
-    }
-    server = await serveDirectory(DIST);
-    browser = await launchBrowser(MODE);
-});
-
-after(async () => {
-    await browser?.close();
-    await server?.close();
-});
-
-async function withApp(body) {
-    const app = await AppPage.open(browser, server, OUT);
-    try {
-        const result = await body(app);
-        assert.deepEqual(app.pageErrors.map(String), [], "uncaught errors in the page");
-        return result;
-    } finally {
-        await app.close();
-    }
-}
 
 /** Waits for the next two frames the page paints (input is handled once per frame). */
 const frames = (app) =>

@@ -1,0 +1,93 @@
+//! The gallery job: the suggested parameters for each of [`GALLERY_TAUS`] (local searches, or
+//! an evaluated grid's answers), then the model smoothed and measured with each.
+
+use super::{Running, SearchKey, GALLERY_TAUS};
+use crate::metrics::{self, VertexMeasures};
+use crate::smooth::Params;
+use crate::suggest::{LocalSearch, Task, Terms};
+
+/// The model smoothed as suggested for one tau, with its measures.
+#[derive(Clone, Debug)]
+pub struct GalleryPick {
+    pub tau: f64,
+    pub params: Params,
+    pub terms: Terms,
+    pub positions: Vec<[f32; 3]>,
+    pub vertex: VertexMeasures,
+}
+
+/// The gallery under way: the suggested parameters per tau first, then one smoothing per tau.
+pub(super) struct GalleryJob {
+    pub(super) key: SearchKey,
+    /// Suggested parameters and terms, in [`GALLERY_TAUS`] order, as they are found.
+    pub(super) suggested: Vec<(Params, Terms)>,
+    pub(super) search: Option<Running<LocalSearch>>,
+    pub(super) smoothing: Running<()>,
+    pub(super) picks: Vec<GalleryPick>,
+    pub(super) problem: Option<String>,
+}
+
+pub(super) fn with_bound(mut params: Params, bound: Option<f32>) -> Params {
+    params.max_displacement = bound;
+    params
+}
+
+/// One call's work on the gallery: the next tau's local search until every tau has
+/// parameters, then the next smoothing. Returns whether the gallery is complete.
+pub(super) fn step_gallery(
+    job: &mut GalleryJob,
+    original: &metrics::Original,
+    weights: Option<&[f32]>,
+    clock: &dyn Fn() -> f64,
+    budget_ms: f64,
+) -> bool {
+    let n = GALLERY_TAUS.len();
+    if job.suggested.len() < n {
+        let tau = GALLERY_TAUS[job.suggested.len()];
+        let base = with_bound(Params::defaults(job.key.filter), job.key.bound);
+        if job.search.is_none() {
+            match LocalSearch::new(job.key.filter, &base, tau) {
+                Ok(task) => job.search = Some(Running::new(task)),
+                Err(e) => {
+                    job.problem = Some(format!("No gallery: {e}"));
+                    return true;
+                }
+            }
+        }
+        let Some(running) = job.search.as_mut() else {
+            return true;
+        };
+        let Some((task, mut ev)) = running.evaluator(original, weights, clock, budget_ms) else {
+            return true;
+        };
+        if task.step(&mut ev) {
+            if let Some(outcome) = job.search.take().and_then(|r| r.task.into_output()) {
+                let s = outcome.suggestion;
+                job.suggested
+                    .push((with_bound(s.params, job.key.bound), s.terms));
+            } else {
+                return true;
+            }
+        }
+        return false;
+    }
+    let Some(&(params, terms)) = job.suggested.get(job.picks.len()) else {
+        return true;
+    };
+    let tau = GALLERY_TAUS[job.picks.len()];
+    let Some((_, mut ev)) = job.smoothing.evaluator(original, weights, clock, budget_ms) else {
+        return true;
+    };
+    let Some((positions, reference)) = ev.smoothed(&params) else {
+        return false;
+    };
+    let (_, vertex) = metrics::measure_vertices(original, &positions, &reference, tau);
+    job.picks.push(GalleryPick {
+        tau,
+        params,
+        terms,
+        positions,
+        vertex,
+    });
+    job.picks.len() == n
+}

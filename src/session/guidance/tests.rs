@@ -1,0 +1,170 @@
+use super::*;
+use crate::suggest::{quality_graphs, suggest};
+use std::cell::Cell;
+
+const SAMPLE: &[u8] = include_bytes!("../../../web/sample/bent_tube_staircase.ply");
+
+fn session(filter: &str) -> Session {
+    let mut s = Session::default();
+    s.open("sample.ply", SAMPLE).unwrap();
+    s.set_filter_name(filter).unwrap();
+    s
+}
+
+/// Steps the background until nothing is left, on a clock that ticks 1 ms per reading;
+/// returns the calls it took.
+fn settle(s: &mut Session) -> usize {
+    let ticks = Cell::new(0.0);
+    let clock = || {
+        ticks.set(ticks.get() + 1.0);
+        ticks.get()
+    };
+    let mut calls = 0;
+    while s.guidance_busy() {
+        s.step_guidance(&clock, 20.0);
+        calls += 1;
+        assert!(calls < 1_000_000, "the background never settles");
+    }
+    calls
+}
+
+#[test]
+fn a_loaded_model_gets_the_local_search_suggestion() {
+    let mut s = Session::default();
+    s.open("sample.ply", SAMPLE).unwrap();
+    assert!(s.suggesting(), "a search starts with the model");
+    let calls = settle(&mut s);
+    assert!(calls > 10, "spread over {calls} calls");
+    let got = s.suggestion().expect("a suggestion").suggestion;
+    let model = s.model().unwrap();
+    let expected = suggest(
+        &model.original,
+        None,
+        s.params(),
+        s.tau(),
+        SearchMethod::Local,
+        &mut |_| true,
+    )
+    .unwrap();
+    assert_eq!(got, expected);
+}
+
+#[test]
+fn a_grid_suggestion_follows_tau_without_smoothing_again() {
+    let mut s = session("laplace");
+    s.set_params_json(&serde_json::json!({"max_displacement": 0.4}))
+        .unwrap();
+    s.start_suggest(SearchMethod::Grid);
+    settle(&mut s);
+    for tau in [0.5, 0.2, 0.9] {
+        s.set_tau(tau).unwrap();
+        assert!(!s.guidance_busy());
+        let got = s.suggestion().unwrap().suggestion;
+        let expected = suggest(
+            &model_original(&s),
+            None,
+            s.params(),
+            tau,
+            SearchMethod::Grid,
+            &mut |_| true,
+        )
+        .unwrap();
+        assert_eq!(got, expected, "tau {tau}");
+        assert_eq!(got.params.max_displacement, Some(0.4));
+    }
+    // Another filter: the grid is not for it.
+    s.set_filter_name("hc").unwrap();
+    assert!(s.suggestion().is_none());
+}
+
+fn model_original(s: &Session) -> metrics::Original {
+    s.model().unwrap().original.clone()
+}
+
+#[test]
+fn graphs_follow_the_parameters_in_the_background() {
+    let mut s = session("taubin");
+    s.cancel_suggest();
+    s.set_params_json(&serde_json::json!({"iterations": 8}))
+        .unwrap();
+    assert!(!s.guidance_busy(), "graphs are only made when wanted");
+    s.set_graphs_wanted(true);
+    settle(&mut s);
+    assert!(s.graphs_current());
+    let original = model_original(&s);
+    let expected = quality_graphs(&original, None, s.params(), s.tau(), &mut |_| true).unwrap();
+    assert_eq!(s.graphs().unwrap(), expected);
+
+    // A new value: the old graphs stay on show, marked stale, until new ones are made.
+    s.set_params_json(&serde_json::json!({"lambda": 0.4}))
+        .unwrap();
+    assert!(!s.graphs_current());
+    assert_eq!(s.graphs().unwrap(), expected);
+    assert!(s.guidance_busy());
+    settle(&mut s);
+    assert!(s.graphs_current());
+    assert_eq!(s.graphs().unwrap().current, *s.params());
+
+    // tau rescored without smoothing.
+    s.set_tau(0.9).unwrap();
+    assert!(!s.guidance_busy());
+    assert_eq!(s.graphs().unwrap().tau, 0.9);
+}
+
+#[test]
+fn the_gallery_holds_the_local_suggestion_of_each_tau() {
+    let mut s = session("laplace");
+    s.cancel_suggest();
+    s.start_gallery();
+    settle(&mut s);
+    let picks = s.gallery();
+    assert_eq!(picks.len(), GALLERY_TAUS.len());
+    let original = model_original(&s);
+    for (pick, &tau) in picks.iter().zip(&GALLERY_TAUS) {
+        let expected = suggest(
+            &original,
+            None,
+            s.params(),
+            tau,
+            SearchMethod::Local,
+            &mut |_| true,
+        )
+        .unwrap();
+        assert_eq!(
+            (pick.tau, pick.params, pick.terms),
+            (tau, expected.params, expected.terms)
+        );
+        let (positions, _) = metrics::smooth_drifting(&original, &pick.params, None);
+        assert_eq!(pick.positions, positions);
+        assert_eq!(pick.vertex.local_error.len(), positions.len());
+    }
+    // Stronger smoothing as tau grows.
+    let k: Vec<f64> = picks.iter().map(|p| p.terms.curvature_ratio).collect();
+    assert!(k.first() > k.last(), "{k:?}");
+}
+
+#[test]
+fn a_search_for_another_filter_or_model_is_dropped() {
+    let mut s = session("hc");
+    let ticks = Cell::new(0.0);
+    let clock = || {
+        ticks.set(ticks.get() + 1.0);
+        ticks.get()
+    };
+    s.start_suggest(SearchMethod::Local);
+    s.step_guidance(&clock, 1.0);
+    assert!(s.suggesting());
+    s.set_filter_name("sinc").unwrap();
+    s.step_guidance(&clock, 1.0);
+    assert!(!s.suggesting());
+    s.set_filter_name("hc").unwrap();
+    s.start_gallery();
+    s.open("again.ply", SAMPLE).unwrap();
+    assert!(s.gallery().is_empty());
+    assert_eq!(
+        s.activities().len(),
+        1,
+        "only the new model's suggestion: {:?}",
+        s.activities()
+    );
+}
