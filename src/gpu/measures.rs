@@ -100,7 +100,7 @@ impl MeasureReadback {
 }
 
 /// The workgroups' partial sums added in f64.
-fn totals(partials: &[MeasurePartial]) -> Sums {
+pub(super) fn totals(partials: &[MeasurePartial]) -> Sums {
     let (mut volume6, mut curvature_sum, mut error_sum, mut error_max) = (0.0, 0.0, 0.0, 0.0f64);
     let (mut curvature_count, mut error_count) = (0usize, 0usize);
     for p in partials {

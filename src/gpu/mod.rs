@@ -25,6 +25,7 @@
 //! `bench`.
 
 mod error;
+mod evaluator;
 mod layout;
 mod limits;
 mod measures;
@@ -41,6 +42,7 @@ mod bench;
 mod device;
 
 pub use error::GpuError;
+pub use evaluator::GpuEvaluator;
 pub use layout::WORKGROUP_SIZE;
 pub use measures::{GpuMeasures, MeasureReadback};
 pub use mesh_buffers::GpuMesh;

@@ -13,6 +13,7 @@ use std::num::NonZeroU64;
 use super::layout::{StepParams, SurfaceParams};
 use super::shaders::{Kernel, DRIFT, HC, MEASURE, NORMALS, SINC, UMBRELLA};
 
+#[derive(Clone)]
 pub(crate) struct Layouts {
     /// Group 0: step parameters (uniform, dynamic offset), offsets, neighbours, original, weights.
     pub mesh: wgpu::BindGroupLayout,
@@ -25,6 +26,7 @@ pub(crate) struct Layouts {
     pub surface: SurfaceLayouts,
 }
 
+#[derive(Clone)]
 pub(crate) struct Pipelines {
     pub umbrella_step: wgpu::ComputePipeline,
     pub hc_differences: wgpu::ComputePipeline,
@@ -39,6 +41,7 @@ pub(crate) struct Pipelines {
 }
 
 /// Layouts of the surface kernels.
+#[derive(Clone)]
 pub(crate) struct SurfaceLayouts {
     /// Group 0 of the drift: constants, original, full ring offsets and entries, stay radii
     /// (read); the reference (written).

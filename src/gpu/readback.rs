@@ -30,9 +30,25 @@ impl Staging {
         label: &str,
         sources: &[(&wgpu::Buffer, u64)],
     ) -> Self {
-        let mut regions = Vec::with_capacity(sources.len());
+        let sizes: Vec<u64> = sources.iter().map(|&(_, bytes)| bytes).collect();
+        let staging = Self::create(device, label, &sizes);
+        for (&(source, bytes), region) in sources.iter().zip(&staging.regions) {
+            if bytes > 0 {
+                encoder.copy_buffer_to_buffer(source, 0, &staging.buffer, region.start, bytes);
+            }
+        }
+        queue.submit([encoder.finish()]);
+        staging.request_map();
+        staging
+    }
+
+    /// A staging buffer with one region per size, one after another, not yet written or
+    /// mapped: record copies into [`Self::region`]s, submit them, then [`Self::request_map`].
+    /// Every size must be a multiple of 4.
+    pub(crate) fn create(device: &wgpu::Device, label: &str, sizes: &[u64]) -> Self {
+        let mut regions = Vec::with_capacity(sizes.len());
         let mut end = 0;
-        for &(_, bytes) in sources {
+        for &bytes in sizes {
             regions.push(end..end + bytes);
             end += bytes;
         }
@@ -43,24 +59,27 @@ impl Staging {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        for (&(source, bytes), region) in sources.iter().zip(&regions) {
-            if bytes > 0 {
-                encoder.copy_buffer_to_buffer(source, 0, &buffer, region.start, bytes);
-            }
-        }
-        queue.submit([encoder.finish()]);
-        let mapped: MapState = Arc::new(Mutex::new(None));
-        let done = Arc::clone(&mapped);
-        buffer.map_async(wgpu::MapMode::Read, .., move |result| {
-            if let Ok(mut slot) = done.lock() {
-                *slot = Some(result);
-            }
-        });
         Self {
             buffer,
             regions,
-            mapped,
+            mapped: Arc::new(Mutex::new(None)),
         }
+    }
+
+    /// The buffer copies go into, and where region `k` lies in it.
+    pub(crate) fn region(&self, k: usize) -> (&wgpu::Buffer, u64) {
+        (&self.buffer, self.regions[k].start)
+    }
+
+    /// Requests the mapping, after the submissions that write the buffer.
+    pub(crate) fn request_map(&self) {
+        let done = Arc::clone(&self.mapped);
+        self.buffer
+            .map_async(wgpu::MapMode::Read, .., move |result| {
+                if let Ok(mut slot) = done.lock() {
+                    *slot = Some(result);
+                }
+            });
     }
 
     /// `read` applied to the copies (in source order) once the mapping has completed; `None`

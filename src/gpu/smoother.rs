@@ -2,7 +2,9 @@
 //! (every iteration's dispatches in one compute pass, no readback in between, the reference
 //! vertices drifting along), and the surface passes on a run's result (normals, measures).
 
-use super::layout::{dispatch_size, StepParams, HAS_BOUND, HAS_WEIGHTS, MAX_STEP_SLOTS};
+use super::layout::{
+    dispatch_size, MeasurePartial, StepParams, HAS_BOUND, HAS_WEIGHTS, MAX_STEP_SLOTS,
+};
 use super::measures::MeasureReadback;
 use super::mesh_buffers::{GpuMesh, Slot};
 use super::pipelines::{Layouts, Pipelines};
@@ -16,6 +18,7 @@ use crate::smooth::{sinc_coefficients, Filter, Params};
 /// float rounding; on a mesh uploaded with its measures, also the CPU's drifting reference,
 /// vertex normals and measure pass. Needs WebGPU's default limits (8 storage buffers per
 /// shader stage), which eframe requests on WebGPU.
+#[derive(Clone)]
 pub struct GpuSmoother {
     layouts: Layouts,
     pipelines: Pipelines,
@@ -70,6 +73,53 @@ impl GpuSmoother {
         mesh: &mut GpuMesh,
         params: &Params,
     ) -> Result<wgpu::SubmissionIndex, GpuError> {
+        let segment = Segment {
+            from: 0,
+            to: params.iterations,
+            measure_at: &[],
+            into: None,
+        };
+        self.submit(device, queue, mesh, params, &segment)
+    }
+
+    /// Part of a run, measured on the way: iterations `segment.from + 1 ..= segment.to` of
+    /// `params` (whose `iterations` field is ignored), continuing from the state the previous
+    /// segment left in `mesh` (`from == 0` starts from the original). After each iteration
+    /// count in `segment.measure_at` the measure pass runs and its per-workgroup sums are
+    /// copied into the next region of `segment.into`. Windowed sinc is one piece: `from` must
+    /// be 0 and `to` its degree. Submits and returns without waiting. Needs a mesh with
+    /// measures when anything is measured, and nothing run on `mesh` between segments.
+    pub(crate) fn smooth_segment(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &mut GpuMesh,
+        params: &Params,
+        segment: &Segment<'_>,
+    ) -> Result<wgpu::SubmissionIndex, GpuError> {
+        if !segment.measure_at.is_empty() {
+            mesh.surface()?;
+        }
+        let sinc_in_pieces = params.filter == Filter::Sinc && segment.from != 0;
+        if sinc_in_pieces || segment.from > segment.to {
+            return Err(GpuError::Device(format!(
+                "no run segment from iteration {} to {} of {}",
+                segment.from, segment.to, params.filter
+            )));
+        }
+        let mut run = *params;
+        run.iterations = segment.to;
+        self.submit(device, queue, mesh, &run, segment)
+    }
+
+    fn submit(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &mut GpuMesh,
+        params: &Params,
+        segment: &Segment<'_>,
+    ) -> Result<wgpu::SubmissionIndex, GpuError> {
         params.validate()?;
         let steps = step_records(mesh, params);
         if steps.len() > MAX_STEP_SLOTS {
@@ -94,7 +144,7 @@ impl GpuSmoother {
         let n = mesh.vertex_count;
         let grid = dispatch_size(n, device.limits().max_compute_workgroups_per_dimension);
         let result = match grid {
-            Some(grid) if n > 0 => self.record(&mut encoder, mesh, params, grid),
+            Some(grid) if n > 0 => self.record(&mut encoder, mesh, params, grid, segment),
             // Nothing to smooth (grid == None cannot happen: upload checked the limits).
             _ => Slot::Original,
         };
@@ -102,47 +152,52 @@ impl GpuSmoother {
         Ok(queue.submit([encoder.finish()]))
     }
 
-    /// Records one run; returns where its result lies.
+    /// Records one run (or a segment of one); returns where its result lies.
     fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         mesh: &GpuMesh,
         params: &Params,
         grid: (u32, u32),
+        segment: &Segment<'_>,
     ) -> Slot {
         let p = &self.pipelines;
         let g = &mesh.groups;
-        if params.filter != Filter::Sinc {
+        let fresh = segment.from == 0;
+        if fresh && params.filter != Filter::Sinc {
             // Laplace, Taubin and HC iterate on `a`, starting from the original.
             encoder.copy_buffer_to_buffer(&mesh.original, 0, &mesh.a, 0, mesh.original.size());
         }
-        let pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("meshsmooth smoothing"),
-            timestamp_writes: None,
-        });
         let mut run = Recorder {
-            pass,
+            encoder,
+            pass: None,
             mesh,
             pipelines: p,
             grid,
+            segment,
+            measured: 0,
         };
-        run.reset_reference();
+        if fresh {
+            run.reset_reference();
+        }
         let iterations = params.iterations;
-        match params.filter {
+        let result = match params.filter {
             Filter::Laplace | Filter::Taubin => {
                 let factors = if params.filter == Filter::Laplace {
                     1
                 } else {
                     2
                 };
-                let mut in_a = true;
-                for _ in 0..iterations {
+                // A later segment goes on from where the previous one left the positions.
+                let mut in_a = fresh || mesh.result != Slot::B;
+                for iteration in segment.from + 1..=iterations {
                     for slot in 0..factors {
                         let group = if in_a { &g.a_to_b } else { &g.b_to_a };
                         run.step(&p.umbrella_step, slot, group);
                         in_a = !in_a;
                         run.drift(if in_a { Slot::A } else { Slot::B });
                     }
+                    run.after_iteration(iteration, if in_a { Slot::A } else { Slot::B });
                 }
                 if in_a {
                     Slot::A
@@ -151,10 +206,11 @@ impl GpuSmoother {
                 }
             }
             Filter::Hc => {
-                for _ in 0..iterations {
+                for iteration in segment.from + 1..=iterations {
                     run.step(&p.hc_differences, 0, &g.a_to_aux);
                     run.step(&p.hc_correct, 0, &g.aux_to_a);
                     run.drift(Slot::A);
+                    run.after_iteration(iteration, Slot::A);
                 }
                 Slot::A
             }
@@ -178,42 +234,79 @@ impl GpuSmoother {
                 for _ in 0..iterations {
                     run.drift(Slot::Aux);
                 }
+                run.after_iteration(iterations, Slot::Aux);
                 Slot::Aux
             }
-        }
+        };
+        run.pass = None;
+        result
     }
 }
 
-/// Records the dispatches of one run into one compute pass.
-struct Recorder<'p, 'm> {
-    pass: wgpu::ComputePass<'p>,
+/// Which iterations of a run one submission records, and where the measures taken on the way
+/// go (see [`GpuSmoother::smooth_segment`]).
+pub(crate) struct Segment<'a> {
+    /// Iterations already run (0: start from the original).
+    pub from: u32,
+    /// Iterations run once this segment is done.
+    pub to: u32,
+    /// Iteration counts in `from + 1 ..= to` to measure after, ascending.
+    pub measure_at: &'a [u32],
+    /// Where the k-th measure's per-workgroup sums go: region `first + k` of the staging.
+    pub into: Option<(&'a super::readback::Staging, usize)>,
+}
+
+/// Records the dispatches of one run: compute passes, broken where a measure's sums are
+/// copied out.
+struct Recorder<'e, 'm> {
+    encoder: &'e mut wgpu::CommandEncoder,
+    pass: Option<wgpu::ComputePass<'static>>,
     mesh: &'m GpuMesh,
     pipelines: &'m Pipelines,
     grid: (u32, u32),
+    segment: &'m Segment<'m>,
+    /// Measures taken so far in this segment.
+    measured: usize,
 }
 
 impl Recorder<'_, '_> {
+    /// The open compute pass (a new one after a copy).
+    fn pass(&mut self) -> &mut wgpu::ComputePass<'static> {
+        let encoder = &mut *self.encoder;
+        self.pass.get_or_insert_with(|| {
+            encoder
+                .begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("meshsmooth smoothing"),
+                    timestamp_writes: None,
+                })
+                .forget_lifetime()
+        })
+    }
+
     fn dispatch(&mut self) {
-        self.pass.dispatch_workgroups(self.grid.0, self.grid.1, 1);
+        let (x, y) = self.grid;
+        self.pass().dispatch_workgroups(x, y, 1);
     }
 
     /// One smoothing kernel with the step record in `slot` and the position group `group`.
     fn step(&mut self, pipeline: &wgpu::ComputePipeline, slot: u32, group: &wgpu::BindGroup) {
         let stride = self.mesh.step_stride as u32;
-        self.pass.set_pipeline(pipeline);
-        self.pass
-            .set_bind_group(0, &self.mesh.mesh_group, &[slot * stride]);
-        self.pass.set_bind_group(1, group, &[]);
+        let mesh_group = &self.mesh.mesh_group;
+        let pass = self.pass();
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, mesh_group, &[slot * stride]);
+        pass.set_bind_group(1, group, &[]);
         self.dispatch();
     }
 
     /// Every vertex its own reference, when the mesh has one.
     fn reset_reference(&mut self) {
         if let Some(surface) = &self.mesh.surface {
-            self.pass.set_pipeline(&self.pipelines.reference_reset);
-            self.pass.set_bind_group(0, &surface.drift_group, &[]);
-            self.pass
-                .set_bind_group(1, surface.looked_at(Slot::Original), &[]);
+            let pipelines = self.pipelines;
+            let pass = self.pass();
+            pass.set_pipeline(&pipelines.reference_reset);
+            pass.set_bind_group(0, &surface.drift_group, &[]);
+            pass.set_bind_group(1, surface.looked_at(Slot::Original), &[]);
             self.dispatch();
         }
     }
@@ -223,10 +316,36 @@ impl Recorder<'_, '_> {
         let Some(surface) = self.mesh.surface.as_ref().filter(|s| s.track_reference) else {
             return;
         };
-        self.pass.set_pipeline(&self.pipelines.reference_drift);
-        self.pass.set_bind_group(0, &surface.drift_group, &[]);
-        self.pass.set_bind_group(1, surface.looked_at(towards), &[]);
+        let pipelines = self.pipelines;
+        let pass = self.pass();
+        pass.set_pipeline(&pipelines.reference_drift);
+        pass.set_bind_group(0, &surface.drift_group, &[]);
+        pass.set_bind_group(1, surface.looked_at(towards), &[]);
         self.dispatch();
+    }
+
+    /// After `iteration`, with the positions in `slot`: the measure pass, its sums copied out,
+    /// when the segment measures there.
+    fn after_iteration(&mut self, iteration: u32, slot: Slot) {
+        let segment = self.segment;
+        if segment.measure_at.get(self.measured) != Some(&iteration) {
+            return;
+        }
+        let (Some(surface), Some((staging, first))) = (&self.mesh.surface, segment.into) else {
+            return;
+        };
+        let pipelines = self.pipelines;
+        let pass = self.pass();
+        pass.set_pipeline(&pipelines.measure_vertices);
+        pass.set_bind_group(0, &surface.measure_group, &[]);
+        pass.set_bind_group(1, surface.looked_at(slot), &[]);
+        self.dispatch();
+        self.pass = None;
+        let bytes = u64::from(surface.partial_count) * std::mem::size_of::<MeasurePartial>() as u64;
+        let (buffer, offset) = staging.region(first + self.measured);
+        self.encoder
+            .copy_buffer_to_buffer(&surface.partials, 0, buffer, offset, bytes);
+        self.measured += 1;
     }
 }
 

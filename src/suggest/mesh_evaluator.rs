@@ -63,10 +63,7 @@ impl<'a> MeshEvaluator<'a> {
 
     /// The terms of the unchanged mesh (no volume term when it is open).
     pub(crate) fn unchanged(&self) -> Terms {
-        Terms {
-            volume_change: self.original.volume().map(|_| 0.0),
-            ..Terms::UNCHANGED
-        }
+        super::unchanged_terms(self.original)
     }
 
     pub(crate) fn measure_positions(&self, positions: &[[f32; 3]], reference: &[u32]) -> Terms {
