@@ -324,3 +324,77 @@ fn bench_runs_on_the_gpu_backend() {
     assert!(v["gpu_measure_seconds"].as_f64().unwrap() > 0.0);
     assert!(v["gpu_drift_seconds"].as_f64().unwrap() >= 0.0);
 }
+
+/// `cmd` with `--backend gpu --json` and with the CPU, or `None` (with a notice) when this
+/// machine has no adapter and REQUIRE_GPU is not set.
+fn on_both_backends(cmd: &[&str]) -> Option<[serde_json::Value; 2]> {
+    let mut args = cmd.to_vec();
+    args.extend(["--json", "--backend", "gpu"]);
+    let gpu = meshsmooth(&args);
+    if !gpu.status.success() && std::env::var_os("REQUIRE_GPU").is_none() {
+        eprintln!(
+            "NOTICE: no GPU adapter, {} --backend gpu not run: {}",
+            cmd[0],
+            String::from_utf8_lossy(&gpu.stderr)
+        );
+        return None;
+    }
+    args.truncate(args.len() - 2);
+    Some([json(&meshsmooth(&args)), json(&gpu)])
+}
+
+fn assert_close(cpu: &serde_json::Value, gpu: &serde_json::Value, what: &str) {
+    let (c, g) = (cpu.as_f64().unwrap(), gpu.as_f64().unwrap());
+    assert!(
+        (c - g).abs() <= 1e-4 * c.abs().max(g.abs()).max(1e-6),
+        "{what}: cpu {c}, gpu {g}"
+    );
+}
+
+#[test]
+fn smooth_sweep_and_suggest_run_on_the_gpu_backend() {
+    let input = data("synthetic/synthetic_bent_tube_r3.5.ply");
+    let input = input.to_str().unwrap();
+    let out = tmp("gpu-smoothed.ply");
+    let out = out.to_str().unwrap();
+
+    let Some([cpu, gpu]) = on_both_backends(&["smooth", input, "-o", out, "--filter", "taubin"])
+    else {
+        return;
+    };
+    assert_eq!(
+        (cpu["backend"].as_str(), gpu["backend"].as_str()),
+        (Some("cpu"), Some("gpu"))
+    );
+    for key in ["volume", "curvature", "mean_error", "max_error", "score"] {
+        assert_close(&cpu["metrics"][key], &gpu["metrics"][key], key);
+    }
+
+    let suggest = [
+        "suggest", input, "--filter", "hc", "--search", "local", "--tau", "0.6",
+    ];
+    let [cpu, gpu] = on_both_backends(&suggest).expect("the adapter found above");
+    assert_eq!(cpu["params"], gpu["params"]);
+    assert_close(&cpu["score"], &gpu["score"], "suggest score");
+
+    let auto = [
+        "smooth", input, "-o", out, "--auto", "--search", "local", "--filter", "laplace",
+    ];
+    let [cpu, gpu] = on_both_backends(&auto).expect("the adapter found above");
+    assert_eq!(cpu["params"], gpu["params"]);
+    assert_eq!(cpu["suggestion"], gpu["suggestion"]);
+
+    let [cpu, gpu] = on_both_backends(&["sweep", input, "--filter", "laplace"])
+        .expect("the adapter found above");
+    let curves = |v: &serde_json::Value| v["curves"].as_array().unwrap().clone();
+    assert_eq!(curves(&cpu).len(), 2);
+    for (c, g) in curves(&cpu).iter().zip(curves(&gpu).iter()) {
+        assert_eq!(c["best"], g["best"], "{}", c["param"]);
+        let samples = |v: &serde_json::Value| v["samples"].as_array().unwrap().clone();
+        assert_eq!(samples(c).len(), samples(g).len());
+        for (cs, gs) in samples(c).iter().zip(samples(g).iter()) {
+            assert_eq!(cs["value"], gs["value"]);
+            assert_close(&cs["score"], &gs["score"], "sweep sample score");
+        }
+    }
+}

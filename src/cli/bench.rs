@@ -4,6 +4,7 @@
 //! drifting reference are timed too (the CPU's columns stay for comparison).
 //! Speed is reported, never asserted: machines are shared and noisy.
 
+use super::backend::{Backend, GpuEngine};
 use super::params::filter;
 use crate::gpu;
 use crate::mesh::Topology;
@@ -38,21 +39,6 @@ struct BenchResult {
     /// `--backend gpu`: extra time the drifting reference adds to a GPU smoothing run.
     #[serde(skip_serializing_if = "Option::is_none")]
     gpu_drift_seconds: Option<f64>,
-}
-
-/// Which engine smooths.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Backend {
-    Cpu,
-    Gpu,
-}
-
-pub(super) fn parse_backend(name: &str) -> Result<Backend, String> {
-    match name {
-        "cpu" => Ok(Backend::Cpu),
-        "gpu" => Ok(Backend::Gpu),
-        other => Err(format!("unknown backend '{other}': use cpu or gpu")),
-    }
 }
 
 pub(super) fn run(
@@ -190,25 +176,22 @@ fn best_of(repeat: usize, mut f: impl FnMut()) -> f64 {
 /// The GPU engine with the mesh (and its measures) uploaded once; each timing is submission to
 /// completion.
 struct GpuBench {
-    context: gpu::GpuContext,
-    smoother: gpu::GpuSmoother,
+    engine: GpuEngine,
     mesh: gpu::GpuMesh,
     adapter: String,
 }
 
 impl GpuBench {
     fn new(original: &Original) -> Result<Self, String> {
-        let context = gpu::request_native_device().map_err(|e| e.to_string())?;
-        let smoother = gpu::GpuSmoother::new(&context.device);
-        let uploaded = smoother
-            .upload_with_measures(&context.device, original)
+        let engine = GpuEngine::open()?;
+        let mesh = engine
+            .smoother
+            .upload_with_measures(&engine.context.device, original)
             .map_err(|e| e.to_string())?;
-        let info = &context.adapter_info;
-        let adapter = format!("{} ({:?}, {:?})", info.name, info.device_type, info.backend);
+        let adapter = engine.adapter();
         Ok(Self {
-            context,
-            smoother,
-            mesh: uploaded,
+            engine,
+            mesh,
             adapter,
         })
     }
@@ -221,9 +204,9 @@ impl GpuBench {
         let mut best = f64::INFINITY;
         for _ in 0..repeat {
             let t = gpu::time_smoothing(
-                &self.smoother,
-                &self.context.device,
-                &self.context.queue,
+                &self.engine.smoother,
+                &self.engine.context.device,
+                &self.engine.context.queue,
                 &mut self.mesh,
                 params,
             )
@@ -238,9 +221,9 @@ impl GpuBench {
         let mut best = f64::INFINITY;
         for _ in 0..repeat {
             let t = gpu::time_measures(
-                &self.smoother,
-                &self.context.device,
-                &self.context.queue,
+                &self.engine.smoother,
+                &self.engine.context.device,
+                &self.engine.context.queue,
                 &self.mesh,
                 original,
             )

@@ -1,6 +1,7 @@
 //! The native command-line tool: fixed pipelines (e.g. CFD preparation) on the same engine as
 //! the web app. Every error goes to stderr with a non-zero exit code.
 
+mod backend;
 mod bench;
 mod bench_load;
 mod convert;
@@ -54,6 +55,9 @@ enum Command {
         /// With --auto: grid or local search.
         #[arg(long, default_value = "grid", value_parser = suggest::parse_search)]
         search: crate::suggest::SearchMethod,
+        /// cpu, or gpu (the native wgpu engine smooths, measures and searches).
+        #[arg(long, default_value = "cpu", value_parser = backend::parse_backend)]
+        backend: backend::Backend,
         #[arg(long)]
         json: bool,
     },
@@ -78,9 +82,9 @@ enum Command {
         iterations: Option<u32>,
         #[arg(long, default_value_t = 5)]
         repeat: usize,
-        /// cpu, or gpu (the native wgpu engine; measures stay on the cpu).
-        #[arg(long, default_value = "cpu", value_parser = bench::parse_backend)]
-        backend: bench::Backend,
+        /// cpu, or gpu (the native wgpu engine; the cpu's measure columns stay for comparison).
+        #[arg(long, default_value = "cpu", value_parser = backend::parse_backend)]
+        backend: backend::Backend,
         #[arg(long)]
         json: bool,
     },
@@ -112,8 +116,17 @@ pub fn main() -> ExitCode {
             tau,
             auto,
             search,
+            backend,
             json,
-        } => smooth::run(&file, &output, &params, tau, auto.then_some(search), json),
+        } => {
+            let how = smooth::How {
+                tau,
+                auto: auto.then_some(search),
+                backend,
+                json,
+            };
+            smooth::run(&file, &output, &params, &how)
+        }
         Command::Measure {
             original,
             smoothed,

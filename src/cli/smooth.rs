@@ -1,22 +1,27 @@
 //! `meshsmooth smooth FILE -o OUT [filter flags] [--json]`: smooth, write, print the measures.
 
+use super::backend::{smooth_and_measure, with_evaluator, Backend};
 use super::params::FilterArgs;
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh, Topology};
-use crate::metrics::{self, Metrics, Original};
+use crate::metrics::{Metrics, Original};
 use crate::smooth::Params;
-use crate::suggest::{suggest, SearchMethod};
+use crate::suggest::{suggest_on, SearchMethod};
 use std::path::Path;
 use std::time::Instant;
 
-pub(super) fn run(
-    file: &Path,
-    output: &Path,
-    args: &FilterArgs,
-    tau: f64,
-    auto: Option<SearchMethod>,
-    json: bool,
-) -> Result<(), String> {
+/// How `smooth` goes about it.
+pub(super) struct How {
+    /// The score's weight of smoothness, for the report and `--auto`.
+    pub tau: f64,
+    /// `--auto`: suggest the parameters first, by this search.
+    pub auto: Option<SearchMethod>,
+    pub backend: Backend,
+    pub json: bool,
+}
+
+pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> Result<(), String> {
+    let (tau, json) = (how.tau, how.json);
     super::check_tau(tau)?;
     let format = super::convert::output_format(output)?;
     let mut params = args.params()?;
@@ -25,10 +30,12 @@ pub(super) fn run(
     let original = Original::new(&mesh, &topology);
     // The fixed-pipeline mode: the suggestion's parameters replace the given ones (the given
     // displacement bound is kept in every trial run and in the final one).
-    let suggestion = match auto {
+    let suggestion = match how.auto {
         Some(method) => {
-            let s = suggest(&original, None, &params, tau, method, &mut |_| true)
-                .map_err(|e| e.to_string())?;
+            let s = with_evaluator(how.backend, &original, |ev| {
+                suggest_on(ev, &params, tau, method, &mut |_| true)
+            })?
+            .map_err(|e| e.to_string())?;
             params = s.params;
             Some(s)
         }
@@ -36,7 +43,7 @@ pub(super) fn run(
     };
 
     let start = Instant::now();
-    let (positions, metrics) = smooth_and_measure(&original, &params, tau);
+    let (positions, metrics) = smooth_and_measure(how.backend, &original, &params, tau)?;
     let seconds = start.elapsed().as_secs_f64();
 
     let smoothed = Mesh::new(positions, mesh.triangles.clone());
@@ -53,6 +60,7 @@ pub(super) fn run(
 
     if json {
         let mut report = report_json(&params, &metrics, seconds);
+        report["backend"] = serde_json::json!(how.backend.name());
         if let Some(s) = &suggestion {
             report["suggestion"] = serde_json::json!({
                 "search": s.search.name(),
@@ -81,17 +89,6 @@ pub(super) fn run(
         print!("{}", super::measure::text(&metrics));
     }
     Ok(())
-}
-
-/// Smooths from the original with the drifting reference watching, then measures.
-pub(crate) fn smooth_and_measure(
-    original: &Original,
-    params: &Params,
-    tau: f64,
-) -> (Vec<[f32; 3]>, Metrics) {
-    let (positions, reference) = metrics::smooth_drifting(original, params, None);
-    let metrics = metrics::measure(original, &positions, &reference, tau);
-    (positions, metrics)
 }
 
 fn report_json(params: &Params, metrics: &Metrics, seconds: f64) -> serde_json::Value {

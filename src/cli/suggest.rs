@@ -1,11 +1,12 @@
 //! `meshsmooth suggest FILE --filter F [--tau T] [--search grid|local] [--json]`: the suggested
 //! parameters for one filter at a target smoothness.
 
+use super::backend::{parse_backend, with_evaluator, Backend};
 use super::params::filter as parse_filter;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::{Filter, Params};
-use crate::suggest::{suggest, SearchMethod, Suggestion};
+use crate::suggest::{suggest_on, SearchMethod, Suggestion};
 use std::path::PathBuf;
 
 /// Parses a search method for clap.
@@ -31,6 +32,9 @@ pub(super) struct SuggestArgs {
     /// Bound on each vertex's displacement from its original position (mm), kept in every run.
     #[arg(long = "max-displacement")]
     pub max_displacement: Option<f32>,
+    /// cpu, or gpu (the native wgpu engine smooths and measures every parameter set).
+    #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+    pub backend: Backend,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
@@ -45,8 +49,13 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
     let topology = Topology::build(&mesh);
     let original = Original::new(&mesh, &topology);
-    let s = suggest(&original, None, &base, args.tau, args.search, &mut |_| true)
-        .map_err(|e| e.to_string())?;
+    if original.mesh().vertex_count() == 0 {
+        return Err(format!("{}: the mesh has no vertices", args.file.display()));
+    }
+    let s = with_evaluator(args.backend, &original, |ev| {
+        suggest_on(ev, &base, args.tau, args.search, &mut |_| true)
+    })?
+    .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
         println!("{}", super::to_json(&s.to_json(seconds))?);
@@ -100,6 +109,7 @@ mod tests {
             tau: 0.5,
             search: SearchMethod::Local,
             max_displacement: Some(0.5),
+            backend: Backend::Cpu,
             json: true,
         };
         run(&args).unwrap();

@@ -3,11 +3,12 @@
 
 mod plot;
 
+use super::backend::{parse_backend, with_evaluator, Backend};
 use super::params::FilterArgs;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::Filter;
-use crate::suggest::{quality_graphs, QualityGraphs};
+use crate::suggest::{quality_graphs_on, QualityGraphs};
 use std::path::{Path, PathBuf};
 
 /// The arguments of `meshsmooth sweep`.
@@ -33,6 +34,9 @@ pub(super) struct SweepArgs {
     /// Voxel edge length (mm) of the segmentation: draws half the voxel diagonal on the error axis.
     #[arg(long)]
     pub voxel_size: Option<f64>,
+    /// cpu, or gpu (the native wgpu engine smooths and measures every sample).
+    #[arg(long, default_value = "cpu", value_parser = parse_backend)]
+    pub backend: Backend,
 }
 
 pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
@@ -47,8 +51,10 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
     let topology = Topology::build(&mesh);
     let original = Original::new(&mesh, &topology);
-    let graphs = quality_graphs(&original, None, &current, args.tau, &mut |_| true)
-        .map_err(|e| e.to_string())?;
+    let graphs = with_evaluator(args.backend, &original, |ev| {
+        quality_graphs_on(ev, &current, args.tau, &mut |_| true)
+    })?
+    .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     if let Some(path) = &args.plot {
         let title = format!(
@@ -172,6 +178,7 @@ mod tests {
             csv: true,
             plot: Some(png.clone()),
             voxel_size: Some(1.0),
+            backend: Backend::Cpu,
         };
         run(&args).unwrap();
         let bytes = std::fs::read(&png).unwrap();

@@ -3,8 +3,8 @@
 
 use super::mesh_evaluator::{MeshEvaluator, WeightsError};
 use super::{
-    run, Cancelled, GridSearch, LocalSearch, Progress, QualityGraphs, QualitySweep, SearchMethod,
-    Suggestion,
+    run, Cancelled, Evaluator, GridSearch, LocalSearch, Progress, QualityGraphs, QualitySweep,
+    SearchMethod, Suggestion,
 };
 use crate::mesh::{Mesh, Topology};
 use crate::metrics::Original;
@@ -39,7 +39,7 @@ fn check_tau(tau: f64) -> Result<(), SuggestError> {
     }
 }
 
-/// The quality graphs of `current.filter` around `current`, on the real engine.
+/// The quality graphs of `current.filter` around `current`, on the CPU engine.
 pub fn quality_graphs(
     original: &Original,
     weights: Option<&[f32]>,
@@ -47,14 +47,24 @@ pub fn quality_graphs(
     tau: f64,
     on_progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<QualityGraphs, SuggestError> {
-    check_tau(tau)?;
     let mut evaluator = MeshEvaluator::new(original, weights)?;
-    let task = QualitySweep::new(current, tau)?;
-    Ok(run(task, &mut evaluator, on_progress)?)
+    quality_graphs_on(&mut evaluator, current, tau, on_progress)
 }
 
-/// The suggested parameters for `base.filter` at target smoothness `tau`. `base` carries the
-/// displacement bound; `weights` (one per vertex) are passed to every run.
+/// [`quality_graphs`] on any evaluator (the GPU's, say).
+pub fn quality_graphs_on(
+    evaluator: &mut dyn Evaluator,
+    current: &Params,
+    tau: f64,
+    on_progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<QualityGraphs, SuggestError> {
+    check_tau(tau)?;
+    let task = QualitySweep::new(current, tau)?;
+    Ok(run(task, evaluator, on_progress)?)
+}
+
+/// The suggested parameters for `base.filter` at target smoothness `tau`, on the CPU engine.
+/// `base` carries the displacement bound; `weights` (one per vertex) are passed to every run.
 pub fn suggest(
     original: &Original,
     weights: Option<&[f32]>,
@@ -63,19 +73,30 @@ pub fn suggest(
     method: SearchMethod,
     on_progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Suggestion, SuggestError> {
-    check_tau(tau)?;
     if original.mesh().vertex_count() == 0 {
         return Err(SuggestError::Empty);
     }
     let mut evaluator = MeshEvaluator::new(original, weights)?;
+    suggest_on(&mut evaluator, base, tau, method, on_progress)
+}
+
+/// [`suggest`] on any evaluator (the GPU's, say) of a mesh with vertices.
+pub fn suggest_on(
+    evaluator: &mut dyn Evaluator,
+    base: &Params,
+    tau: f64,
+    method: SearchMethod,
+    on_progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<Suggestion, SuggestError> {
+    check_tau(tau)?;
     let suggestion = match method {
         SearchMethod::Grid => {
             let task = GridSearch::new(base.filter, base)?;
-            run(task, &mut evaluator, on_progress)?.best(tau)
+            run(task, evaluator, on_progress)?.best(tau)
         }
         SearchMethod::Local => {
             let task = LocalSearch::new(base.filter, base, tau)?;
-            Some(run(task, &mut evaluator, on_progress)?.suggestion)
+            Some(run(task, evaluator, on_progress)?.suggestion)
         }
     };
     suggestion.ok_or(SuggestError::Empty)

@@ -19,7 +19,9 @@ mod sliced;
 mod space;
 mod sweep;
 
-pub use auto::{quality_graphs, suggest, suggest_for_mesh, SuggestError};
+pub use auto::{
+    quality_graphs, quality_graphs_on, suggest, suggest_for_mesh, suggest_on, SuggestError,
+};
 pub use grid::{EvaluatedGrid, GridSearch};
 pub use local::{LocalOutcome, LocalSearch};
 pub use mesh_evaluator::{check_weights, terms_of, MeshEvaluator, WeightsError};
