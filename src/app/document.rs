@@ -5,6 +5,7 @@
 //! (so an API call never blocks the page inside a frame), then answers the waiting calls.
 
 use crate::session::{Session, Timings};
+use crate::suggest::Offload;
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -85,6 +86,8 @@ pub struct Document {
     waiting_for: Vec<(Ready, Waiter)>,
     /// Set by the API's `gallery()`: the page shows the gallery tab.
     pub show_gallery: bool,
+    /// Whether the background's runs went to the GPU engine in the latest frame.
+    pub guidance_on_gpu: bool,
 }
 
 /// The handle the shell and the API hold.
@@ -101,6 +104,7 @@ impl Document {
             waiting: Vec::new(),
             waiting_for: Vec::new(),
             show_gallery: false,
+            guidance_on_gpu: false,
         }
     }
 
@@ -177,13 +181,14 @@ impl Document {
     }
 
     /// The background work's share of this frame (graphs, suggestions, the gallery):
-    /// `budget_ms` of CPU time. With the CPU engine it waits until the current parameters'
+    /// `budget_ms` of CPU time, or on the GPU engine's evaluator when one is lent (a run per
+    /// frame goes to the device). With the CPU engine it waits until the current parameters'
     /// result is there: what the user is looking at comes first.
-    pub fn compute_guidance(&mut self, budget_ms: f64) {
+    pub fn compute_guidance(&mut self, budget_ms: f64, offload: Option<&mut dyn Offload>) {
         if self.backend == Backend::Cpu && self.busy() {
             return;
         }
-        self.session.step_guidance(&now_ms, budget_ms);
+        self.session.step_guidance_on(&now_ms, budget_ms, offload);
     }
 
     /// What the API's `state()` returns.
@@ -191,6 +196,11 @@ impl Document {
         let mut state = self.session.state_json(self.busy());
         state["guidance"] = self.session.guidance_json();
         state["backend"] = serde_json::json!(self.backend.name());
+        state["guidance"]["engine"] = serde_json::json!(if self.guidance_on_gpu {
+            "webgpu"
+        } else {
+            "cpu"
+        });
         state["timings"] = match self.timings {
             Some(EngineTimings::Cpu(t)) => {
                 serde_json::json!({"smooth_ms": t.smooth_ms, "measure_ms": t.measure_ms})

@@ -4,7 +4,8 @@
 //! a frame never waits for the GPU.
 
 use super::document::{now_ms, Document, EngineTimings};
-use crate::gpu::{GpuMesh, GpuSmoother, MeasureReadback, ResultReadback};
+use crate::gpu::{GpuEvaluator, GpuMesh, GpuSmoother, MeasureReadback, ResultReadback};
+use crate::suggest::Offload;
 
 /// A run submitted for one session revision, its results still on the way back.
 struct InFlight {
@@ -15,6 +16,41 @@ struct InFlight {
     positions: ResultReadback,
     measures: MeasureReadback,
     result: Option<Vec<[f32; 3]>>,
+}
+
+/// Meshes from this many vertices have the background's runs on the GPU by default. Below it
+/// the CPU, sliced into the frame budget, finishes sooner: a GPU request's results come back a
+/// frame or more later, while the CPU does a whole run of a small mesh in a millisecond or two
+/// (the 2,296-vertex sample's local search: 0.24 s on the CPU natively; on SwiftShader WebGPU
+/// at 5 frames/s, one request in three frames).
+const GPU_GUIDANCE_MIN_VERTICES: usize = 50_000;
+
+/// Where the background's runs go: `?guidance=gpu` or `?guidance=cpu` in the page's query
+/// decides, else the mesh size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GuidancePolicy {
+    BySize,
+    Gpu,
+    Cpu,
+}
+
+impl GuidancePolicy {
+    pub fn from_query() -> Self {
+        match super::page::query_value("guidance").as_deref() {
+            Some("gpu") => GuidancePolicy::Gpu,
+            Some("cpu") => GuidancePolicy::Cpu,
+            _ => GuidancePolicy::BySize,
+        }
+    }
+
+    /// Whether a mesh of `vertices` has its background runs on the GPU.
+    pub fn on_gpu(self, vertices: usize) -> bool {
+        match self {
+            GuidancePolicy::BySize => vertices >= GPU_GUIDANCE_MIN_VERTICES,
+            GuidancePolicy::Gpu => true,
+            GuidancePolicy::Cpu => false,
+        }
+    }
 }
 
 pub struct GpuEngine {
@@ -28,19 +64,42 @@ pub struct GpuEngine {
     submitted: Option<u64>,
     /// The session's weights version the mesh's weight buffer holds: uploaded once per change.
     weights_uploaded: Option<u64>,
+    /// The background's runs (graphs, suggestions): its own copy of the model on the device,
+    /// so they never disturb what is drawn. `None` once it has failed.
+    evaluator: Option<GpuEvaluator>,
+    policy: GuidancePolicy,
 }
 
 impl GpuEngine {
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        let smoother = GpuSmoother::new(device);
         Self {
             device: device.clone(),
             queue: queue.clone(),
-            smoother: GpuSmoother::new(device),
             mesh: None,
             in_flight: None,
             submitted: None,
             weights_uploaded: None,
+            evaluator: Some(GpuEvaluator::new(device, queue, &smoother)),
+            policy: GuidancePolicy::from_query(),
+            smoother,
         }
+    }
+
+    /// The evaluator for the background's runs on a mesh of `vertices`, while it works and
+    /// when the policy puts them on the GPU.
+    pub fn evaluator(&mut self, vertices: usize) -> Option<&mut dyn Offload> {
+        if !self.policy.on_gpu(vertices) {
+            return None;
+        }
+        self.evaluator.as_mut().map(|e| e as &mut dyn Offload)
+    }
+
+    /// Why the background's evaluator failed (it is dropped then: the CPU takes over).
+    pub fn take_evaluator_failure(&mut self) -> Option<String> {
+        let why = self.evaluator.as_ref()?.failure()?;
+        self.evaluator = None;
+        Some(why)
     }
 
     /// The revision whose run the buffers hold (submitted; maybe not finished yet).

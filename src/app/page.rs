@@ -62,6 +62,14 @@ pub fn query_flag(name: &str) -> bool {
     query_has_flag(&search, name)
 }
 
+/// The value of the query parameter `name` (the first one), if any.
+pub fn query_value(name: &str) -> Option<String> {
+    let search = web_sys::window()?.location().search().ok()?;
+    web_sys::UrlSearchParams::new_with_str(&search)
+        .ok()?
+        .get(name)
+}
+
 fn query_has_flag(search: &str, name: &str) -> bool {
     search
         .trim_start_matches('?')

@@ -502,7 +502,16 @@ impl eframe::App for Shell {
         let budget = self
             .draw_ms
             .clamp(*GUIDANCE_BUDGET_MS.start(), *GUIDANCE_BUDGET_MS.end());
-        self.doc.borrow_mut().compute_guidance(budget);
+        {
+            let mut doc = self.doc.borrow_mut();
+            let vertices = doc.session.model().map_or(0, |m| m.mesh().vertex_count());
+            let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
+            doc.guidance_on_gpu = offload.is_some();
+            doc.compute_guidance(budget, offload);
+            if let Some(why) = self.gpu.as_mut().and_then(|g| g.take_evaluator_failure()) {
+                doc.session.guidance_engine_failed(&why);
+            }
+        }
         self.compute_ms = now_ms() - start;
         self.bottom.update(&ctx, &mut self.doc.borrow_mut());
         self.sync_view();

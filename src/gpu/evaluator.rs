@@ -17,8 +17,13 @@ use crate::suggest::{
     failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Terms,
 };
 
-/// Vertex-iterations in a segment at first, and the bounds the adaptation keeps to.
+/// Vertex-iterations in a segment at first, and the bounds the adaptation keeps to. Results
+/// come back two or three calls (frames) after their submission however small the work (the
+/// browser maps buffers between frames), so the size only shrinks when a segment keeps many
+/// frames waiting, and never below the floor: about 20 ms on a software adapter (SwiftShader,
+/// some 50 M vertex-iterations/s) and well under a millisecond on a real GPU.
 const FIRST_SEGMENT: u64 = 4_000_000;
+const MIN_SEGMENT: u64 = 1_000_000;
 const MAX_SEGMENT: u64 = 1 << 31;
 
 /// A request under way: its parameters, what is measured so far, and the segment in flight.
@@ -195,12 +200,13 @@ impl GpuEvaluator {
         if !is_cumulative(job.params.filter) {
             self.runs += 1;
         }
-        // Back by the next call: segments may grow; a segment that kept frames waiting shrinks.
+        // Back within the usual latency: segments may grow; one that kept many frames waiting
+        // shrinks, down to the floor.
         if let Some(s) = self.segment.as_mut() {
             *s = match polls {
-                0 => (*s * 2).min(MAX_SEGMENT),
-                1 => *s,
-                _ => (*s / 2).max(1),
+                0..=2 => (*s * 2).min(MAX_SEGMENT),
+                3..=5 => *s,
+                _ => (*s / 2).max(MIN_SEGMENT.min(*s)),
             };
         }
         Ok(true)

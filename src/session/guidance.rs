@@ -3,18 +3,20 @@
 //! smoothness tau (grid or local search), and a gallery of the model smoothed as suggested at
 //! several tau values.
 //!
-//! Every job runs on [`Sliced`] evaluators: a call to [`Session::step_guidance`] works for about
-//! the budget it is given and the job goes on at the next call, so the page never blocks. A job
+//! Every job runs on [`Sliced`] evaluators (the CPU engine: a call to [`Session::step_guidance`]
+//! works for about the budget it is given and the job goes on at the next call) or, when the
+//! caller lends one, on an [`Offload`] (the GPU engine: a run goes to the device and its
+//! measures come back by a later call), so the page never blocks. A job
 //! belongs to the model, filter, weights and displacement bound it was started for: when one of
 //! them changes it is dropped (the graphs also when any parameter changes) and its result no
 //! longer shown as current.
 
 use super::Session;
-use crate::metrics;
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
-    EvaluatedGrid, GridSearch, LocalOutcome, LocalSearch, Progress, QualityGraphs, QualitySweep,
-    SearchMethod, Sliced, SlicedRuns, Suggestion, Task,
+    EvaluatedGrid, Evaluator, GridSearch, LocalOutcome, LocalSearch, ModelRef, Offload, Offloaded,
+    Progress, QualityGraphs, QualitySweep, SearchMethod, Sliced, SlicedRuns, Suggestion, Task,
+    Terms,
 };
 
 /// The tau values of the gallery, from accuracy to smoothness.
@@ -47,17 +49,52 @@ impl<T> Running<T> {
         }
     }
 
-    /// A sliced evaluator for this job's next piece of work.
+    /// The evaluator for this job's next piece of work: the offload when one is lent, else
+    /// the CPU engine sliced to the budget.
     fn evaluator<'a>(
         &'a mut self,
-        original: &'a metrics::Original,
-        weights: Option<&'a [f32]>,
-        clock: &'a dyn Fn() -> f64,
-        budget_ms: f64,
-    ) -> Option<(&'a mut T, Sliced<'a>)> {
-        self.started_ms.get_or_insert_with(clock);
-        let ev = Sliced::new(original, weights, &mut self.runs, clock, budget_ms).ok()?;
+        engine: &'a mut Engine<'_, '_>,
+    ) -> Option<(&'a mut T, JobEvaluator<'a>)> {
+        self.started_ms.get_or_insert_with(engine.clock);
+        let model = engine.model;
+        let ev = match engine.offload.as_deref_mut() {
+            Some(offload) => JobEvaluator::Offload(Offloaded { offload, model }),
+            None => JobEvaluator::Cpu(
+                Sliced::new(
+                    model.original,
+                    model.weights,
+                    &mut self.runs,
+                    engine.clock,
+                    engine.budget_ms,
+                )
+                .ok()?,
+            ),
+        };
         Some((&mut self.task, ev))
+    }
+}
+
+/// What one call's work runs on: the model, the clock and budget (CPU), and the offload when
+/// the caller lends one.
+pub(super) struct Engine<'m, 'o> {
+    pub(super) model: ModelRef<'m>,
+    pub(super) clock: &'m dyn Fn() -> f64,
+    pub(super) budget_ms: f64,
+    pub(super) offload: Option<&'o mut dyn Offload>,
+}
+
+/// A job's evaluator for one call.
+pub(super) enum JobEvaluator<'a> {
+    Cpu(Sliced<'a>),
+    Offload(Offloaded<'a>),
+}
+
+impl Evaluator for JobEvaluator<'_> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        match self {
+            JobEvaluator::Cpu(ev) => ev.measure(params, at),
+            JobEvaluator::Offload(ev) => ev.measure(params, at),
+        }
     }
 }
 
@@ -368,6 +405,24 @@ impl Session {
         out
     }
 
+    /// The engine the background ran on failed (`why`): the jobs under way start again (on the
+    /// CPU engine, which the caller turns to) and the problem is shown.
+    pub fn guidance_engine_failed(&mut self, why: &str) {
+        let search = self.guidance.search.take().map(|j| j.method);
+        let gallery = self.guidance.gallery_job.take().is_some();
+        self.guidance.sweep = None;
+        self.guidance.graphs = None;
+        if let Some(method) = search {
+            self.start_suggest(method);
+        }
+        if gallery {
+            self.start_gallery();
+        }
+        self.guidance.problem = Some(format!(
+            "The GPU engine failed ({why}); guidance goes on on the CPU"
+        ));
+    }
+
     /// Whether any background job is under way or due.
     pub fn guidance_busy(&self) -> bool {
         self.guidance.search.is_some()
@@ -380,22 +435,44 @@ impl Session {
         self.guidance.graphs_wanted && self.model.is_some() && !self.graphs_current()
     }
 
-    /// Works on the background jobs for about `budget_ms`: the suggestion first (the user
-    /// asked and waits), then the gallery, then the graphs. Returns whether a job finished.
+    /// Works on the background jobs for about `budget_ms` on the CPU engine: the suggestion
+    /// first (the user asked and waits), then the gallery, then the graphs. Returns whether a
+    /// job finished.
     pub fn step_guidance(&mut self, clock: &dyn Fn() -> f64, budget_ms: f64) -> bool {
+        self.step_guidance_on(clock, budget_ms, None)
+    }
+
+    /// [`Self::step_guidance`] with the smoothing runs of the searches and graphs on `offload`
+    /// when given (the GPU engine): this returns as soon as a run is on the device, and the
+    /// next call collects it. The gallery's final smoothings stay on the CPU.
+    pub fn step_guidance_on(
+        &mut self,
+        clock: &dyn Fn() -> f64,
+        budget_ms: f64,
+        mut offload: Option<&mut dyn Offload>,
+    ) -> bool {
         let deadline = clock() + budget_ms;
         let mut finished = false;
         // A task step is at most one smoothing run: on a small mesh many fit in the budget.
         loop {
-            finished |= self.step_guidance_once(clock, deadline - clock());
-            if !self.guidance_busy() || clock() >= deadline {
+            // Reborrowed for this call only (a `dyn` object's lifetime shortens here, not
+            // inside an Option).
+            let lent = offload.as_mut().map(|o| &mut **o as &mut dyn Offload);
+            finished |= self.step_guidance_once(clock, deadline - clock(), lent);
+            let waiting = offload.as_deref().is_some_and(|o| o.waiting());
+            if waiting || !self.guidance_busy() || clock() >= deadline {
                 return finished;
             }
         }
     }
 
     /// One task step within `budget_ms`.
-    fn step_guidance_once(&mut self, clock: &dyn Fn() -> f64, budget_ms: f64) -> bool {
+    fn step_guidance_once(
+        &mut self,
+        clock: &dyn Fn() -> f64,
+        budget_ms: f64,
+        offload: Option<&mut dyn Offload>,
+    ) -> bool {
         let key = self.search_key();
         let params = *self.params();
         // Jobs for another model, filter, weights or bound are dropped.
@@ -421,13 +498,21 @@ impl Session {
         let Some(model) = self.model.as_ref() else {
             return false;
         };
-        let original = &model.original;
-        let weights = self.weights.as_deref();
+        let mut engine = Engine {
+            model: ModelRef {
+                original: &model.original,
+                id: self.model_id,
+                weights: self.weights.as_deref(),
+                weights_version: self.weights_version,
+            },
+            clock,
+            budget_ms,
+            offload,
+        };
         let guidance = &mut self.guidance;
 
         if let Some(job) = guidance.search.as_mut() {
-            let Some((task, mut ev)) = job.running.evaluator(original, weights, clock, budget_ms)
-            else {
+            let Some((task, mut ev)) = job.running.evaluator(&mut engine) else {
                 guidance.search = None;
                 return false;
             };
@@ -462,7 +547,7 @@ impl Session {
         }
 
         if let Some(job) = guidance.gallery_job.as_mut() {
-            let finished = step_gallery(job, original, weights, clock, budget_ms);
+            let finished = step_gallery(job, &mut engine);
             if finished {
                 if let Some(job) = guidance.gallery_job.take() {
                     guidance.problem = job.problem;
@@ -497,7 +582,7 @@ impl Session {
         let Some((_, _, running)) = guidance.sweep.as_mut() else {
             return false;
         };
-        let Some((task, mut ev)) = running.evaluator(original, weights, clock, budget_ms) else {
+        let Some((task, mut ev)) = running.evaluator(&mut engine) else {
             guidance.sweep = None;
             return false;
         };

@@ -60,6 +60,21 @@ test("G1 suggest() equals the CLI's suggest --json for the same mesh, filter and
     });
 });
 
+test("G1b on WebGPU with ?guidance=gpu, suggest() runs on the GPU engine and equals the CLI's", { timeout: TIMEOUT, skip: MODE !== "webgpu" && "WebGPU mode only" }, async () => {
+    await withApp(async (app) => {
+        await app.call("setFilter", "laplace");
+        for (const search of ["local", "grid"]) {
+            const got = await app.call("suggest", { tau: 0.6, search });
+            assert.equal((await state(app)).guidance.engine, "webgpu", "the background ran on the GPU");
+            const want = await cli.cliJson("suggest", SAMPLE, "--filter", "laplace", "--tau", "0.6", "--search", search, "--json");
+            assert.deepEqual(got.params, want.params, `${search}: parameters`);
+            // f32 WGSL against the CLI's f64 sums, as metrics() on WebGPU.
+            assert.deepEqual(jsonDifferences(got.terms, want.terms, 1e-4), [], `${search}: terms`);
+            console.log(`GPU suggest ${search}: ${JSON.stringify(got.params)}, ${got.evaluations} sets in ${got.seconds.toFixed(2)} s (CLI on the CPU: ${want.evaluations} sets, ${want.seconds.toFixed(2)} s)`);
+        }
+    }, { query: "?guidance=gpu" });
+});
+
 test("G2 sweep() equals the CLI's sweep --json; a click in a graph sets the parameter", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         const got = await app.call("sweep");

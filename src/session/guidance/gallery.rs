@@ -1,10 +1,10 @@
 //! The gallery job: the suggested parameters for each of [`GALLERY_TAUS`] (local searches, or
 //! an evaluated grid's answers), then the model smoothed and measured with each.
 
-use super::{Running, SearchKey, GALLERY_TAUS};
+use super::{Engine, Running, SearchKey, GALLERY_TAUS};
 use crate::metrics::{self, VertexMeasures};
 use crate::smooth::Params;
-use crate::suggest::{LocalSearch, Task, Terms};
+use crate::suggest::{LocalSearch, Sliced, Task, Terms};
 
 /// The model smoothed as suggested for one tau, with its measures.
 #[derive(Clone, Debug)]
@@ -34,13 +34,7 @@ pub(super) fn with_bound(mut params: Params, bound: Option<f32>) -> Params {
 
 /// One call's work on the gallery: the next tau's local search until every tau has
 /// parameters, then the next smoothing. Returns whether the gallery is complete.
-pub(super) fn step_gallery(
-    job: &mut GalleryJob,
-    original: &metrics::Original,
-    weights: Option<&[f32]>,
-    clock: &dyn Fn() -> f64,
-    budget_ms: f64,
-) -> bool {
+pub(super) fn step_gallery(job: &mut GalleryJob, engine: &mut Engine<'_, '_>) -> bool {
     let n = GALLERY_TAUS.len();
     if job.suggested.len() < n {
         let tau = GALLERY_TAUS[job.suggested.len()];
@@ -57,7 +51,7 @@ pub(super) fn step_gallery(
         let Some(running) = job.search.as_mut() else {
             return true;
         };
-        let Some((task, mut ev)) = running.evaluator(original, weights, clock, budget_ms) else {
+        let Some((task, mut ev)) = running.evaluator(engine) else {
             return true;
         };
         if task.step(&mut ev) {
@@ -75,7 +69,15 @@ pub(super) fn step_gallery(
         return true;
     };
     let tau = GALLERY_TAUS[job.picks.len()];
-    let Some((_, mut ev)) = job.smoothing.evaluator(original, weights, clock, budget_ms) else {
+    // The pick's positions and per-vertex measures are wanted here: a CPU run, sliced.
+    let original = engine.model.original;
+    let Ok(mut ev) = Sliced::new(
+        original,
+        engine.model.weights,
+        &mut job.smoothing.runs,
+        engine.clock,
+        engine.budget_ms,
+    ) else {
         return true;
     };
     let Some((positions, reference)) = ev.smoothed(&params) else {

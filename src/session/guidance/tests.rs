@@ -1,5 +1,6 @@
 use super::*;
-use crate::suggest::{quality_graphs, suggest};
+use crate::metrics;
+use crate::suggest::{quality_graphs, suggest, Evaluator};
 use std::cell::Cell;
 
 const SAMPLE: &[u8] = include_bytes!("../../../web/sample/bent_tube_staircase.ply");
@@ -167,4 +168,65 @@ fn a_search_for_another_filter_or_model_is_dropped() {
         "only the new model's suggestion: {:?}",
         s.activities()
     );
+}
+
+/// An offload that answers each request one call after it was made (as the GPU does between
+/// frames), from the CPU engine, for the model it is lent; it counts the requests per model.
+#[derive(Default)]
+struct Deferred {
+    asked: Option<(u64, Params, Vec<u32>)>,
+    requests: Vec<u64>,
+}
+
+impl Offload for Deferred {
+    fn measure(&mut self, model: &ModelRef<'_>, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        let request = (model.id, *params, at.to_vec());
+        if self.asked.as_ref() != Some(&request) {
+            self.asked = Some(request);
+            self.requests.push(model.id);
+            return None;
+        }
+        self.asked = None;
+        let mut ev = crate::suggest::MeshEvaluator::new(model.original, model.weights).ok()?;
+        ev.measure(params, at)
+    }
+
+    fn waiting(&self) -> bool {
+        self.asked.is_some()
+    }
+
+    fn failure(&self) -> Option<String> {
+        None
+    }
+}
+
+#[test]
+fn an_offload_runs_the_searches_and_graphs_with_the_same_results() {
+    let mut s = session("taubin");
+    let mut offload = Deferred::default();
+    let clock = || 0.0;
+    s.start_suggest(SearchMethod::Local);
+    s.set_graphs_wanted(true);
+    let mut calls = 0;
+    while s.guidance_busy() {
+        s.step_guidance_on(&clock, 1e9, Some(&mut offload));
+        calls += 1;
+        assert!(calls < 100_000, "the background never settles");
+    }
+    // One request per call at most: a call returns once its run is on the device.
+    assert!(calls >= offload.requests.len(), "{calls} calls");
+    let original = model_original(&s);
+    let expected = suggest(
+        &original,
+        None,
+        s.params(),
+        s.tau(),
+        SearchMethod::Local,
+        &mut |_| true,
+    )
+    .unwrap();
+    assert_eq!(s.suggestion().unwrap().suggestion, expected);
+    let graphs = quality_graphs(&original, None, s.params(), s.tau(), &mut |_| true).unwrap();
+    assert_eq!(s.graphs().unwrap(), graphs);
+    assert!(offload.requests.iter().all(|&id| id == s.model_id));
 }

@@ -12,7 +12,8 @@ import { serveDirectory } from "./server.mjs";
 
 /**
  * Registers the file's before/after hooks; returns `{MODE, OUT, withApp}`, where
- * `withApp(body)` runs `body(app)` on a freshly opened page (its API ready) and closes it.
+ * `withApp(body, {query})` runs `body(app)` on a freshly opened page (its API ready; `query`
+ * appended to its URL) and closes it.
  */
 export function appSuite({ beforeAll = () => {} } = {}) {
     const MODE = modeFromEnv();
@@ -31,8 +32,8 @@ export function appSuite({ beforeAll = () => {} } = {}) {
         await browser?.close();
         await server?.close();
     });
-    async function withApp(body) {
-        const app = await AppPage.open(browser, server, OUT);
+    async function withApp(body, { query = "" } = {}) {
+        const app = await AppPage.open(browser, server, OUT, { query });
         try {
             await app.api();
             const result = await body(app);
