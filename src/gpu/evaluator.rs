@@ -17,13 +17,12 @@ use crate::suggest::{
     failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Terms,
 };
 
-/// Vertex-iterations in a segment at first, and the bounds the adaptation keeps to. Results
-/// come back two or three calls (frames) after their submission however small the work (the
-/// browser maps buffers between frames), so the size only shrinks when a segment keeps many
-/// frames waiting, and never below the floor: about 20 ms on a software adapter (SwiftShader,
-/// some 50 M vertex-iterations/s) and well under a millisecond on a real GPU.
-const FIRST_SEGMENT: u64 = 4_000_000;
-const MIN_SEGMENT: u64 = 1_000_000;
+/// Vertex-iterations in a segment at first (five iterations of a 206k-vertex mesh), and the
+/// largest. Results come back two or three calls (frames) after their submission however small
+/// the work (the browser maps buffers between frames), so the size grows while results come
+/// back that soon and only shrinks when a segment keeps many frames waiting (a software adapter
+/// such as SwiftShader), down to one iteration.
+const FIRST_SEGMENT: u64 = 1_000_000;
 const MAX_SEGMENT: u64 = 1 << 31;
 
 /// A request under way: its parameters, what is measured so far, and the segment in flight.
@@ -206,7 +205,7 @@ impl GpuEvaluator {
             *s = match polls {
                 0..=2 => (*s * 2).min(MAX_SEGMENT),
                 3..=5 => *s,
-                _ => (*s / 2).max(MIN_SEGMENT.min(*s)),
+                _ => (*s / 2).max(1),
             };
         }
         Ok(true)
