@@ -26,7 +26,7 @@ use meshsmooth::metrics::Original;
 use meshsmooth::smooth::{Filter, Params};
 use meshsmooth::suggest::{
     run, Evaluator, GridSearch, LocalSearch, MeshEvaluator, ModelRef, Offload, Offloaded,
-    SearchMethod, Suggestion, Terms,
+    SearchMethod, Suggestion, Task, Terms,
 };
 
 const TUBE: &str = "synthetic/synthetic_bent_tube_r3.5.ply";
@@ -234,5 +234,83 @@ fn suggestions_equal_the_cpu_on_small_meshes() {
                 assert_terms_close(&gpu.terms, &cpu.terms, &name);
             }
         }
+    }
+}
+
+/// Steps `task` on a non-blocking GPU evaluator as the web app does: each frame steps until
+/// the evaluator waits on the device, which is polled between frames. Returns the output and
+/// the frames it took.
+fn stepped<T: Task>(mut task: T, evaluator: &mut Offloaded<'_>) -> (T::Output, usize) {
+    let g = gpu().expect("checked by the caller");
+    let mut frames = 0;
+    loop {
+        frames += 1;
+        loop {
+            if task.step(evaluator) {
+                return (task.into_output().expect("finished"), frames);
+            }
+            if evaluator.offload.waiting() {
+                break;
+            }
+        }
+        g.ctx
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("device alive");
+        assert!(frames < 100_000, "no end after {frames} frames");
+    }
+}
+
+#[test]
+fn prefetched_runs_batch_and_change_nothing() {
+    let Some(g) = gpu() else { return };
+    let (device, queue) = (&g.ctx.device, &g.ctx.queue);
+    let (mesh, topology) = data::load(TUBE);
+    let original = Original::new(&mesh, &topology);
+    for filter in Filter::ALL {
+        let base = Params::defaults(filter);
+        let mut blocking = GpuEvaluator::blocking(device, queue, &g.smoother);
+        let mut whole = Offloaded {
+            offload: &mut blocking,
+            model: model(&original, None, 3),
+        };
+        let grid = GridSearch::new(filter, &base).unwrap();
+        let expected = run(grid, &mut whole, &mut |_| true).unwrap();
+        let requests = blocking.runs;
+
+        let mut frames = GpuEvaluator::new(device, queue, &g.smoother);
+        let mut lent = Offloaded {
+            offload: &mut frames,
+            model: model(&original, None, 3),
+        };
+        let (got, frames) = stepped(GridSearch::new(filter, &base).unwrap(), &mut lent);
+        // Bit for bit; diverging settings (Taubin with mu far below -lambda) give NaN, which
+        // only the printed form holds equal.
+        assert!(
+            format!("{got:?}") == format!("{expected:?}"),
+            "{filter}: the grid's terms differ"
+        );
+        eprintln!("{filter} grid: {requests} runs in {frames} frames");
+        // Without batching every run takes a frame of its own.
+        assert!(
+            2 * frames < requests,
+            "{filter}: {frames} frames for {requests} runs: not batched"
+        );
+
+        let (local, _) = stepped(LocalSearch::new(filter, &base, 0.5).unwrap(), &mut lent);
+        let mut blocking = GpuEvaluator::blocking(device, queue, &g.smoother);
+        let expected = run(
+            LocalSearch::new(filter, &base, 0.5).unwrap(),
+            &mut Offloaded {
+                offload: &mut blocking,
+                model: model(&original, None, 3),
+            },
+            &mut |_| true,
+        )
+        .unwrap();
+        assert_eq!(
+            local.suggestion, expected.suggestion,
+            "{filter}: local search"
+        );
     }
 }

@@ -14,7 +14,7 @@ use super::{GpuError, GpuMesh, GpuSmoother};
 use crate::metrics::{metrics_from_sums, Original};
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
-    failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Terms,
+    failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Request, Terms,
 };
 
 /// Vertex-iterations in a segment at first (five iterations of a 206k-vertex mesh), and the
@@ -25,16 +25,57 @@ use crate::suggest::{
 const FIRST_SEGMENT: u64 = 1_000_000;
 const MAX_SEGMENT: u64 = 1 << 31;
 
-/// A request under way: its parameters, what is measured so far, and the segment in flight.
+/// A request under way or answered but not yet asked for: its parameters, what is measured so
+/// far, and the segment in flight.
 struct Job {
     model: u64,
     weights_version: u64,
-    params: Params,
-    at: Vec<u32>,
+    request: Request,
     terms: Vec<Terms>,
     /// Iterations of the current run done (cumulative filters).
     done: u32,
     in_flight: Option<InFlight>,
+}
+
+impl Job {
+    fn new(model: &ModelRef<'_>, request: Request) -> Self {
+        // Zero iterations is the original mesh, whose terms are known exactly.
+        let zeros = request.1.iter().take_while(|&&k| k == 0).count();
+        Self {
+            model: model.id,
+            weights_version: model.weights_version,
+            terms: vec![unchanged_terms(model.original); zeros],
+            request,
+            done: 0,
+            in_flight: None,
+        }
+    }
+
+    fn is(&self, model: &ModelRef<'_>, params: &Params, at: &[u32]) -> bool {
+        self.model == model.id
+            && self.weights_version == model.weights_version
+            && self.request.0 == *params
+            && self.request.1 == at
+    }
+
+    fn answered(&self) -> bool {
+        self.terms.len() == self.request.1.len()
+    }
+
+    /// Vertex-iterations of what is left of its run (windowed sinc: of its next count).
+    fn cost(&self, vertices: u64) -> u64 {
+        let (params, at) = &self.request;
+        let steps = if params.filter == Filter::Taubin {
+            2
+        } else {
+            1
+        };
+        let last = match is_cumulative(params.filter) {
+            true => at.last().map_or(0, |&k| k - self.done),
+            false => at.get(self.terms.len()).copied().unwrap_or(0),
+        };
+        vertices * steps * u64::from(last)
+    }
 }
 
 /// A submitted segment: where its measures come back, and how long they are taking.
@@ -54,7 +95,13 @@ pub struct GpuEvaluator {
     smoother: GpuSmoother,
     mesh: Option<(u64, GpuMesh)>,
     weights_version: Option<u64>,
-    job: Option<Job>,
+    /// The request asked for, and the requests prefetched with it (several whole runs go to
+    /// the device at once when they fit a segment).
+    jobs: Vec<Job>,
+    /// The requests the task said will follow.
+    upcoming: Vec<Request>,
+    /// The model and request whose run was submitted last (its state is on the device).
+    last_run: Option<(u64, Request)>,
     blocking: bool,
     /// Vertex-iterations per submission; `None`: whole runs.
     segment: Option<u64>,
@@ -73,7 +120,9 @@ impl GpuEvaluator {
             smoother: smoother.clone(),
             mesh: None,
             weights_version: None,
-            job: None,
+            jobs: Vec::new(),
+            upcoming: Vec::new(),
+            last_run: None,
             blocking: false,
             segment: Some(FIRST_SEGMENT),
             failure: None,
@@ -101,7 +150,7 @@ impl GpuEvaluator {
     fn prepare(&mut self, model: &ModelRef<'_>) -> Result<(), GpuError> {
         if self.mesh.as_ref().map(|m| m.0) != Some(model.id) {
             self.mesh = None;
-            self.job = None;
+            self.jobs.clear();
             let uploaded = self
                 .smoother
                 .upload_with_measures(&self.device, model.original)?;
@@ -119,33 +168,38 @@ impl GpuEvaluator {
 
     fn fail(&mut self, e: GpuError, count: usize) -> Option<Vec<Terms>> {
         self.failure = Some(e);
-        self.job = None;
+        self.jobs.clear();
         Some(failed_terms(count))
     }
 
-    /// Submits the job's next segment: cumulative filters up to the next counts that fit the
-    /// segment size; windowed sinc one count (one whole run).
-    fn submit_next(&mut self, vertices: u64) -> Result<(), GpuError> {
-        let (Some(job), Some((_, mesh))) = (self.job.as_mut(), self.mesh.as_mut()) else {
+    /// Submits job `j`'s next segment: cumulative filters up to the next counts that fit the
+    /// segment size (`budget`, vertex-iterations; `None`: the whole run); windowed sinc one
+    /// count (one whole run).
+    fn submit_next(&mut self, j: usize, budget: Option<u64>) -> Result<(), GpuError> {
+        let (Some(job), Some((_, mesh))) = (self.jobs.get_mut(j), self.mesh.as_mut()) else {
             return Ok(());
         };
-        let remaining = &job.at[job.terms.len()..];
+        let vertices = mesh.vertex_count() as u64;
+        let (params, at) = &job.request;
+        let remaining = &at[job.terms.len()..];
         let Some(&last) = remaining.last() else {
             return Ok(());
         };
-        let (from, to, measure_at) = if is_cumulative(job.params.filter) {
-            let steps = if job.params.filter == Filter::Taubin {
+        let (from, to, measure_at) = if is_cumulative(params.filter) {
+            let steps = if params.filter == Filter::Taubin {
                 2
             } else {
                 1
             };
             let per_iteration = (vertices * steps).max(1);
-            let most = self
-                .segment
-                .map_or(u64::from(last), |s| (s / per_iteration).max(1));
+            let most = budget.map_or(u64::from(last), |s| (s / per_iteration).max(1));
             let to = (u64::from(job.done) + most).min(u64::from(last)) as u32;
             let upto = remaining.iter().take_while(|&&k| k <= to).count();
-            (job.done, to, &remaining[..upto])
+            // Another run since this one's last segment left other positions on the device:
+            // run again from the original (measuring only what is missing).
+            let resumes = self.last_run.as_ref() == Some(&(job.model, job.request.clone()));
+            let from = if resumes { job.done } else { 0 };
+            (from, to, &remaining[..upto])
         } else {
             (0, remaining[0], &remaining[..1])
         };
@@ -160,8 +214,9 @@ impl GpuEvaluator {
             into: Some((&staging, 0)),
         };
         self.smoother
-            .smooth_segment(&self.device, &self.queue, mesh, &job.params, &segment)?;
+            .smooth_segment(&self.device, &self.queue, mesh, params, &segment)?;
         staging.request_map();
+        self.last_run = Some((job.model, job.request.clone()));
         job.in_flight = Some(InFlight {
             staging,
             to,
@@ -170,37 +225,86 @@ impl GpuEvaluator {
         Ok(())
     }
 
-    /// Collects the segment in flight when it is back; `Ok(false)` while it is not.
-    fn collect(&mut self, original: &Original) -> Result<bool, GpuError> {
-        let Some(job) = self.job.as_mut() else {
-            return Ok(true);
+    /// Submits job `asked`'s next segment and, when it finishes its run, whole runs of the
+    /// upcoming requests while they fit the rest of the segment size.
+    fn submit(&mut self, asked: usize, model: &ModelRef<'_>) -> Result<(), GpuError> {
+        let vertices = model.original.mesh().vertex_count() as u64;
+        let cost = self.jobs[asked].cost(vertices);
+        self.submit_next(asked, self.segment)?;
+        let Some(mut left) = self.segment.map(|s| s.saturating_sub(cost)) else {
+            return Ok(());
         };
-        let Some(flight) = job.in_flight.as_mut() else {
-            return Ok(true);
-        };
-        let read = flight.staging.try_read(|parts| {
-            Ok(parts
-                .iter()
-                .map(|bytes| {
-                    let partials: Vec<MeasurePartial> = bytemuck::pod_collect_to_vec(bytes);
-                    terms_of(&metrics_from_sums(original, &totals(&partials), 0.5))
-                })
-                .collect::<Vec<Terms>>())
-        });
-        let Some(terms) = read else {
-            flight.polls += 1;
-            return Ok(false);
-        };
-        let terms = terms?;
-        let (to, polls) = (flight.to, flight.polls);
-        job.in_flight = None;
-        job.terms.extend(terms);
-        job.done = to;
-        if !is_cumulative(job.params.filter) {
-            self.runs += 1;
+        // Other runs may follow only once this one is complete: a later segment goes on from
+        // the state it leaves on the device.
+        let job = &self.jobs[asked];
+        let to = job.in_flight.as_ref().map(|f| f.to);
+        if is_cumulative(job.request.0.filter) && to != job.request.1.last().copied() {
+            return Ok(());
         }
-        // Back within the usual latency: segments may grow; one that kept many frames waiting
-        // shrinks, down to the floor.
+        for request in std::mem::take(&mut self.upcoming) {
+            let known = self
+                .jobs
+                .iter()
+                .any(|j| j.is(model, &request.0, &request.1));
+            if known {
+                continue;
+            }
+            let job = Job::new(model, request);
+            let cost = job.cost(vertices);
+            if job.answered() {
+                self.jobs.push(job);
+                continue;
+            }
+            if cost > left || !(is_cumulative(job.request.0.filter) || job.request.1.len() == 1) {
+                break;
+            }
+            left -= cost;
+            self.jobs.push(job);
+            let j = self.jobs.len() - 1;
+            self.submit_next(j, None)?;
+        }
+        Ok(())
+    }
+
+    /// Collects every segment that is back; returns the polls of job `asked`'s segment when it
+    /// came back in this call.
+    fn collect(&mut self, original: &Original, asked: usize) -> Result<Option<u32>, GpuError> {
+        let mut asked_back = None;
+        for (j, job) in self.jobs.iter_mut().enumerate() {
+            let Some(flight) = job.in_flight.as_mut() else {
+                continue;
+            };
+            let read = flight.staging.try_read(|parts| {
+                Ok(parts
+                    .iter()
+                    .map(|bytes| {
+                        let partials: Vec<MeasurePartial> = bytemuck::pod_collect_to_vec(bytes);
+                        terms_of(&metrics_from_sums(original, &totals(&partials), 0.5))
+                    })
+                    .collect::<Vec<Terms>>())
+            });
+            let Some(terms) = read else {
+                flight.polls += 1;
+                continue;
+            };
+            let terms = terms?;
+            let (to, polls) = (flight.to, flight.polls);
+            job.in_flight = None;
+            job.terms.extend(terms);
+            job.done = to;
+            if !is_cumulative(job.request.0.filter) || job.answered() {
+                self.runs += 1;
+            }
+            if j == asked {
+                asked_back = Some(polls);
+            }
+        }
+        Ok(asked_back)
+    }
+
+    /// Adapts the segment size to how soon job results come back: within the usual latency
+    /// it may grow; a segment that kept many frames waiting shrinks, down to one iteration.
+    fn adapt(&mut self, polls: u32) {
         if let Some(s) = self.segment.as_mut() {
             *s = match polls {
                 0..=2 => (*s * 2).min(MAX_SEGMENT),
@@ -208,7 +312,6 @@ impl GpuEvaluator {
                 _ => (*s / 2).max(1),
             };
         }
-        Ok(true)
     }
 
     #[cfg(not(target_arch = "wasm32"))]
@@ -233,57 +336,55 @@ impl Offload for GpuEvaluator {
         if let Err(e) = self.prepare(model) {
             return self.fail(e, at.len());
         }
-        let same = self.job.as_ref().is_some_and(|j| {
-            j.model == model.id
-                && j.weights_version == model.weights_version
-                && j.params == *params
-                && j.at == at
+        // Keep what is asked, prefetched or on the device; forget the rest.
+        let upcoming = &self.upcoming;
+        self.jobs.retain(|j| {
+            j.in_flight.is_some()
+                || j.is(model, params, at)
+                || upcoming.iter().any(|(p, a)| j.is(model, p, a))
         });
-        if !same {
-            // Zero iterations is the original mesh, whose terms are known exactly.
-            let zeros = at.iter().take_while(|&&k| k == 0).count();
-            self.job = Some(Job {
-                model: model.id,
-                weights_version: model.weights_version,
-                params: *params,
-                at: at.to_vec(),
-                terms: vec![unchanged_terms(model.original); zeros],
-                done: 0,
-                in_flight: None,
-            });
-        }
-        let vertices = model.original.mesh().vertex_count() as u64;
-        loop {
-            match self.collect(model.original) {
-                Err(e) => return self.fail(e, at.len()),
-                Ok(false) if self.blocking => {
-                    if let Err(e) = self.wait() {
-                        return self.fail(e, at.len());
-                    }
-                    continue;
-                }
-                Ok(false) => return None,
-                Ok(true) => {}
+        let asked = match self.jobs.iter().position(|j| j.is(model, params, at)) {
+            Some(j) => j,
+            None => {
+                self.jobs.push(Job::new(model, (*params, at.to_vec())));
+                self.jobs.len() - 1
             }
-            let job = self.job.as_ref()?;
-            if job.terms.len() == at.len() {
-                let job = self.job.take()?;
-                if is_cumulative(params.filter) && job.done > 0 {
-                    self.runs += 1;
-                }
+        };
+        loop {
+            match self.collect(model.original, asked) {
+                Err(e) => return self.fail(e, at.len()),
+                Ok(Some(polls)) => self.adapt(polls),
+                Ok(None) => {}
+            }
+            let job = &self.jobs[asked];
+            if job.answered() {
+                let job = self.jobs.remove(asked);
                 return Some(job.terms);
             }
-            if let Err(e) = self.submit_next(vertices) {
-                return self.fail(e, at.len());
+            if job.in_flight.is_none() {
+                if let Err(e) = self.submit(asked, model) {
+                    return self.fail(e, at.len());
+                }
             }
             if !self.blocking {
                 return None;
             }
+            if let Err(e) = self.wait() {
+                return self.fail(e, at.len());
+            }
         }
     }
 
+    fn wants_prefetch(&self) -> bool {
+        !self.blocking
+    }
+
+    fn prefetch(&mut self, _model: &ModelRef<'_>, requests: &[Request]) {
+        self.upcoming = requests.to_vec();
+    }
+
     fn waiting(&self) -> bool {
-        !self.blocking && self.job.as_ref().is_some_and(|j| j.in_flight.is_some())
+        !self.blocking && self.jobs.iter().any(|j| j.in_flight.is_some())
     }
 
     fn failure(&self) -> Option<String> {

@@ -15,8 +15,8 @@ use super::Session;
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
     EvaluatedGrid, Evaluator, GridSearch, LocalOutcome, LocalSearch, ModelRef, Offload, Offloaded,
-    Progress, QualityGraphs, QualitySweep, SearchMethod, Sliced, SlicedRuns, Suggestion, Task,
-    Terms,
+    Progress, QualityGraphs, QualitySweep, Request, SearchMethod, Sliced, SlicedRuns, Suggestion,
+    Task, Terms,
 };
 
 /// The tau values of the gallery, from accuracy to smoothness.
@@ -94,6 +94,20 @@ impl Evaluator for JobEvaluator<'_> {
         match self {
             JobEvaluator::Cpu(ev) => ev.measure(params, at),
             JobEvaluator::Offload(ev) => ev.measure(params, at),
+        }
+    }
+
+    fn wants_prefetch(&self) -> bool {
+        match self {
+            JobEvaluator::Cpu(ev) => ev.wants_prefetch(),
+            JobEvaluator::Offload(ev) => ev.wants_prefetch(),
+        }
+    }
+
+    fn prefetch(&mut self, requests: &[Request]) {
+        match self {
+            JobEvaluator::Cpu(ev) => ev.prefetch(requests),
+            JobEvaluator::Offload(ev) => ev.prefetch(requests),
         }
     }
 }

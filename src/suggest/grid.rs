@@ -3,7 +3,7 @@
 //! For cumulative filters each weight setting is one run to the largest iteration count,
 //! measured at every grid count on the way (11 parameter sets per run).
 
-use super::points::{plan_runs, Measured, Run};
+use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
 use super::{score_order, Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
@@ -62,6 +62,8 @@ impl Task for GridSearch {
     type Output = EvaluatedGrid;
 
     fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
+        let later = self.runs.iter().skip(self.next + 1);
+        prefetch(evaluator, &self.space, &self.base, later);
         if let Some(run) = self.runs.get(self.next) {
             if self
                 .measured

@@ -5,7 +5,7 @@
 //! and the evaluation count is the number of distinct parameter sets measured.
 
 use super::grid::{check_base, lowest};
-use super::points::{plan_runs, Measured, Run};
+use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
 use super::{score_order, Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
@@ -115,6 +115,8 @@ impl Task for LocalSearch {
 
     fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
         self.advance();
+        let later = self.pending.iter().skip(1);
+        prefetch(evaluator, &self.space, &self.base, later);
         if let Some(run) = self.pending.front() {
             if self
                 .measured

@@ -82,7 +82,20 @@ pub trait Evaluator {
     /// request, later. Evaluators that spread a run over several calls (the web app's frames)
     /// use it; the others always answer.
     fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>>;
+
+    /// Whether this evaluator does better knowing the requests to come ([`Self::prefetch`]):
+    /// one that answers a frame later (the GPU's) batches them.
+    fn wants_prefetch(&self) -> bool {
+        false
+    }
+
+    /// The requests the caller will make after the next one, in order, as far as it knows
+    /// them. Only a hint: what is asked later is answered either way.
+    fn prefetch(&mut self, _requests: &[Request]) {}
 }
+
+/// One [`Evaluator::measure`] request: parameters and iteration counts.
+pub type Request = (Params, Vec<u32>);
 
 /// Whether the k-iteration result of `filter` is the state after k iterations of a longer run.
 /// Windowed sinc's iteration count is the degree of its polynomial, so each count is its own run.

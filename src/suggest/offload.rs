@@ -2,7 +2,7 @@
 //! its runs in flight between the web app's frames. The guidance lends one the model of the
 //! moment with every request ([`Offloaded`]), so one evaluator serves every job and model.
 
-use super::{Evaluator, Terms};
+use super::{Evaluator, Request, Terms};
 use crate::metrics::Original;
 use crate::smooth::Params;
 
@@ -24,6 +24,14 @@ pub trait Offload {
     /// last, and [`Offload::failure`] says why.
     fn measure(&mut self, model: &ModelRef<'_>, params: &Params, at: &[u32]) -> Option<Vec<Terms>>;
 
+    /// The requests that will follow the next one for `model` (see [`Evaluator::prefetch`]).
+    fn prefetch(&mut self, _model: &ModelRef<'_>, _requests: &[Request]) {}
+
+    /// Whether [`Offload::prefetch`] is of use.
+    fn wants_prefetch(&self) -> bool {
+        false
+    }
+
     /// Whether a run is on the device and this thread has nothing to do for it until the next
     /// call (the browser delivers the results between frames).
     fn waiting(&self) -> bool;
@@ -41,6 +49,14 @@ pub struct Offloaded<'a> {
 impl Evaluator for Offloaded<'_> {
     fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
         self.offload.measure(&self.model, params, at)
+    }
+
+    fn wants_prefetch(&self) -> bool {
+        self.offload.wants_prefetch()
+    }
+
+    fn prefetch(&mut self, requests: &[Request]) {
+        self.offload.prefetch(&self.model, requests);
     }
 }
 

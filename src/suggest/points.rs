@@ -2,7 +2,7 @@
 //! weights in one smoothing run (iterations are cumulative for all filters but windowed sinc).
 
 use super::space::{GridPoint, ParamSpace};
-use super::{is_cumulative, Evaluator, Terms};
+use super::{is_cumulative, Evaluator, Request, Terms};
 use crate::smooth::Params;
 use std::collections::BTreeMap;
 
@@ -10,6 +10,35 @@ use std::collections::BTreeMap;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) struct Run {
     pub points: Vec<GridPoint>,
+}
+
+impl Run {
+    /// The evaluator request that measures this run's points.
+    pub fn request(&self, space: &ParamSpace, base: &Params) -> Option<Request> {
+        let &first = self.points.first()?;
+        let at = self
+            .points
+            .iter()
+            .map(|&p| space.params_at(base, p).iterations)
+            .collect();
+        Some((space.params_at(base, first), at))
+    }
+}
+
+/// Tells `evaluator` the requests of `runs` when it wants to know them.
+pub(crate) fn prefetch<'r>(
+    evaluator: &mut dyn Evaluator,
+    space: &ParamSpace,
+    base: &Params,
+    runs: impl IntoIterator<Item = &'r Run>,
+) {
+    if evaluator.wants_prefetch() {
+        let requests: Vec<Request> = runs
+            .into_iter()
+            .filter_map(|r| r.request(space, base))
+            .collect();
+        evaluator.prefetch(&requests);
+    }
 }
 
 /// Groups `points` into runs: one per weight setting for cumulative filters, one per point for
@@ -72,15 +101,9 @@ impl Measured {
         evaluator: &mut dyn Evaluator,
         run: &Run,
     ) -> bool {
-        let Some(&first) = run.points.first() else {
+        let Some((params, at)) = run.request(space, base) else {
             return true;
         };
-        let params = space.params_at(base, first);
-        let at: Vec<u32> = run
-            .points
-            .iter()
-            .map(|&p| space.params_at(base, p).iterations)
-            .collect();
         let Some(terms) = evaluator.measure(&params, &at) else {
             return false;
         };

@@ -4,7 +4,7 @@
 //! since its k-iteration result is not a prefix of a longer run).
 
 use super::space::{Param, ParamSpace};
-use super::{is_cumulative, score_order, Evaluator, Progress, Task, Terms};
+use super::{is_cumulative, score_order, Evaluator, Progress, Request, Task, Terms};
 use crate::smooth::{ParamError, Params};
 use serde::{Deserialize, Serialize};
 
@@ -180,6 +180,15 @@ impl Task for QualitySweep {
     type Output = QualityGraphs;
 
     fn step(&mut self, evaluator: &mut dyn Evaluator) -> bool {
+        if evaluator.wants_prefetch() {
+            let later: Vec<Request> = self
+                .jobs
+                .iter()
+                .skip(self.next + 1)
+                .map(|job| (job.params, job.at.iter().map(|&(_, k)| k).collect()))
+                .collect();
+            evaluator.prefetch(&later);
+        }
         if let Some(job) = self.jobs.get(self.next) {
             let counts: Vec<u32> = job.at.iter().map(|&(_, k)| k).collect();
             let Some(terms) = evaluator.measure(&job.params, &counts) else {
