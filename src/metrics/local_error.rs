@@ -66,6 +66,9 @@ fn prism_height(e1: [f64; 3], e2: [f64; 3], d: [f64; 3]) -> Option<f64> {
         .then(|| dot(d, m).abs() / m2.sqrt())
 }
 
+/// Vertices per parallel task of a drift step.
+const DRIFT_CHUNK: usize = 2048;
+
 /// The drifting reference neighbourhood: after every smoothing step, each vertex's reference moves
 /// to whichever of the reference and its 1-ring on the original mesh is closest to the vertex's
 /// current position (one hop per step). Use it as the smoothing run's [`StepObserver`].
@@ -115,29 +118,31 @@ impl<'a> DriftingReference<'a> {
         let original = self.original.mesh();
         let topology = self.original.topology();
         let stay = self.original.stay_radius2();
+        // Plain loops over runs of vertices: rayon's per-item closures cost more than the work.
         self.reference
-            .par_iter_mut()
-            .zip(positions.par_iter())
-            .with_min_len(2048)
-            .for_each(|(r, q)| {
-                let d2 = |p: [f32; 3]| {
-                    let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-                };
-                // Ties keep the current reference, so a vertex that did not move stays put.
-                let mut best = *r;
-                let mut best_d2 = d2(original.positions[best as usize]);
-                // Within the stay radius no neighbour can be closer (see `Original`).
-                if best_d2 <= stay[best as usize] {
-                    return;
+            .par_chunks_mut(DRIFT_CHUNK)
+            .zip(positions.par_chunks(DRIFT_CHUNK))
+            .for_each(|(references, positions)| {
+                for (r, q) in references.iter_mut().zip(positions) {
+                    let d2 = |p: [f32; 3]| {
+                        let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+                        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+                    };
+                    // Ties keep the current reference, so a vertex that did not move stays put.
+                    let mut best = *r;
+                    let mut best_d2 = d2(original.positions[best as usize]);
+                    // Within the stay radius no neighbour can be closer (see `Original`).
+                    if best_d2 <= stay[best as usize] {
+                        continue;
+                    }
+                    for &j in topology.neighbors_of(*r as usize) {
+                        let dj = d2(original.positions[j as usize]);
+                        let closer = dj < best_d2;
+                        best = if closer { j } else { best };
+                        best_d2 = if closer { dj } else { best_d2 };
+                    }
+                    *r = best;
                 }
-                for &j in topology.neighbors_of(*r as usize) {
-                    let dj = d2(original.positions[j as usize]);
-                    let closer = dj < best_d2;
-                    best = if closer { j } else { best };
-                    best_d2 = if closer { dj } else { best_d2 };
-                }
-                *r = best;
             });
     }
 

@@ -111,9 +111,10 @@ fn run(
     let Some(rings) = Rings::new(topology, original.len()) else {
         return resume.map_or_else(|| original.clone(), |r| r.0);
     };
+    // `None`: the run starts from the original positions, read in place.
     let (start, span) = match resume {
-        Some((current, done, more)) => (current, (done, more)),
-        None => (original.clone(), (0, params.iterations)),
+        Some((current, done, more)) => (Some(current), (done, more)),
+        None => (None, (0, params.iterations)),
     };
     match Limits::new(weights, params.max_displacement, original) {
         None => run_filter(rings, original, start, span, params, &Free, observer),
@@ -124,20 +125,28 @@ fn run(
 fn run_filter<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
-    start: Vec<[f32; 3]>,
+    start: Option<Vec<[f32; 3]>>,
     span: (u32, u32),
     p: &Params,
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
     match p.filter {
-        Filter::Laplace => umbrella::run(rings, start, &[p.lambda], span, constraint, observer),
-        Filter::Taubin => {
-            umbrella::run(rings, start, &[p.lambda, p.mu], span, constraint, observer)
+        Filter::Laplace => {
+            let factors = [p.lambda];
+            umbrella::run(rings, original, start, &factors, span, constraint, observer)
         }
-        Filter::Hc => hc::run(
-            rings, original, start, p.alpha, p.beta, span, constraint, observer,
-        ),
+        Filter::Taubin => {
+            let factors = [p.lambda, p.mu];
+            umbrella::run(rings, original, start, &factors, span, constraint, observer)
+        }
+        Filter::Hc => {
+            // HC updates its positions in place, so it starts from a copy.
+            let start = start.unwrap_or_else(|| original.to_vec());
+            hc::run(
+                rings, original, start, p.alpha, p.beta, span, constraint, observer,
+            )
+        }
         Filter::Sinc => sinc::run(
             rings,
             original,

@@ -7,25 +7,32 @@ use super::rings::{ring_mean, Rings, CHUNK};
 use super::StepObserver;
 
 /// Runs iterations `done + 1 ..= done + more` of the umbrella steps `factors` (Laplace:
-/// `[lambda]`; Taubin: `[lambda, mu]`) from `start` (the original positions, or the result of
-/// `done` iterations), reporting after every step and every iteration.
+/// `[lambda]`; Taubin: `[lambda, mu]`) from `start` (the result of `done` iterations; `None`:
+/// `original`, read in place rather than copied), reporting after every step and iteration.
 pub(crate) fn run<C: Constrain>(
     rings: Rings,
-    start: Vec<[f32; 3]>,
+    original: &[[f32; 3]],
+    start: Option<Vec<[f32; 3]>>,
     factors: &[f32],
     (done, more): (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
-    let mut q = start;
     if more == 0 || factors.is_empty() {
-        return q;
+        return start.unwrap_or_else(|| original.to_vec());
     }
-    // The second buffer of the ping-pong pair; the only allocation of the run besides `q`.
-    let mut next = vec![[0.0f32; 3]; q.len()];
+    let n = original.len();
+    // The ping-pong pair, allocated once per run. Without a `start`, `q` stays empty until the
+    // first step, which reads the original.
+    let mut next = vec![[0.0f32; 3]; n];
+    let mut q = start.unwrap_or_default();
     for iteration in done + 1..=done + more {
         for &factor in factors {
-            step(rings, factor, &q, &mut next, constraint);
+            let src = if q.len() == n { &q[..] } else { original };
+            step(rings, factor, src, &mut next, constraint);
+            if q.len() != n {
+                q = vec![[0.0f32; 3]; n];
+            }
             std::mem::swap(&mut q, &mut next);
             observer.after_step(&q);
         }
