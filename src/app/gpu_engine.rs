@@ -80,7 +80,7 @@ impl GpuEngine {
             in_flight: None,
             submitted: None,
             weights_uploaded: None,
-            evaluator: Some(GpuEvaluator::new(device, queue, &smoother)),
+            evaluator: Some(GpuEvaluator::new(device, queue, &smoother, now_ms)),
             policy: GuidancePolicy::from_query(),
             smoother,
         }

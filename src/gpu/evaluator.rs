@@ -17,13 +17,14 @@ use crate::suggest::{
     failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Request, Terms,
 };
 
-/// Vertex-iterations in a segment at first (five iterations of a 206k-vertex mesh), and the
-/// largest. Results come back two or three calls (frames) after their submission however small
-/// the work (the browser maps buffers between frames), so the size grows while results come
-/// back that soon and only shrinks when a segment keeps many frames waiting (a software adapter
-/// such as SwiftShader), down to one iteration.
-const FIRST_SEGMENT: u64 = 1_000_000;
+/// Vertex-iterations in a segment at first (about one iteration of a 206k-vertex mesh), and
+/// the largest.
+const FIRST_SEGMENT: u64 = 200_000;
 const MAX_SEGMENT: u64 = 1 << 31;
+/// The device time a segment should take (ms). Results come back some frames after their
+/// submission however small the work (the browser maps buffers between frames): the shortest
+/// round trip seen stands for that latency, and what a segment takes beyond it for its work.
+const TARGET_WORK_MS: f64 = 30.0;
 
 /// A request under way or answered but not yet asked for: its parameters, what is measured so
 /// far, and the segment in flight.
@@ -78,12 +79,11 @@ impl Job {
     }
 }
 
-/// A submitted segment: where its measures come back, and how long they are taking.
+/// A submitted segment: where its measures come back, and when it went out (ms).
 struct InFlight {
     staging: Staging,
     to: u32,
-    /// Calls that found it unfinished.
-    polls: u32,
+    submitted_ms: f64,
 }
 
 /// The GPU engine as an evaluator for [`crate::suggest`]'s tasks, on the device handed in. It
@@ -105,15 +105,24 @@ pub struct GpuEvaluator {
     blocking: bool,
     /// Vertex-iterations per submission; `None`: whole runs.
     segment: Option<u64>,
+    /// The caller's clock (ms) and the shortest round trip seen.
+    clock: fn() -> f64,
+    latency_ms: Option<f64>,
     failure: Option<GpuError>,
     /// Smoothing runs finished (windowed sinc: one per count).
     pub runs: usize,
 }
 
 impl GpuEvaluator {
-    /// An evaluator that never waits: runs go out in segments and [`Offload::measure`] answers
-    /// `None` until the results are back (poll it once per frame).
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, smoother: &GpuSmoother) -> Self {
+    /// An evaluator that never waits: runs go out in segments sized by `clock` (milliseconds)
+    /// and [`Offload::measure`] answers `None` until the results are back (poll it once per
+    /// frame).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        smoother: &GpuSmoother,
+        clock: fn() -> f64,
+    ) -> Self {
         Self {
             device: device.clone(),
             queue: queue.clone(),
@@ -125,6 +134,8 @@ impl GpuEvaluator {
             last_run: None,
             blocking: false,
             segment: Some(FIRST_SEGMENT),
+            clock,
+            latency_ms: None,
             failure: None,
             runs: 0,
         }
@@ -136,7 +147,7 @@ impl GpuEvaluator {
         Self {
             blocking: true,
             segment: None,
-            ..Self::new(device, queue, smoother)
+            ..Self::new(device, queue, smoother, || 0.0)
         }
     }
 
@@ -220,7 +231,7 @@ impl GpuEvaluator {
         job.in_flight = Some(InFlight {
             staging,
             to,
-            polls: 0,
+            submitted_ms: (self.clock)(),
         });
         Ok(())
     }
@@ -266,9 +277,10 @@ impl GpuEvaluator {
         Ok(())
     }
 
-    /// Collects every segment that is back; returns the polls of job `asked`'s segment when it
-    /// came back in this call.
-    fn collect(&mut self, original: &Original, asked: usize) -> Result<Option<u32>, GpuError> {
+    /// Collects every segment that is back; returns the round trip (ms) of job `asked`'s
+    /// segment when it came back in this call.
+    fn collect(&mut self, original: &Original, asked: usize) -> Result<Option<f64>, GpuError> {
+        let now = (self.clock)();
         let mut asked_back = None;
         for (j, job) in self.jobs.iter_mut().enumerate() {
             let Some(flight) = job.in_flight.as_mut() else {
@@ -284,11 +296,10 @@ impl GpuEvaluator {
                     .collect::<Vec<Terms>>())
             });
             let Some(terms) = read else {
-                flight.polls += 1;
                 continue;
             };
             let terms = terms?;
-            let (to, polls) = (flight.to, flight.polls);
+            let (to, round_trip) = (flight.to, now - flight.submitted_ms);
             job.in_flight = None;
             job.terms.extend(terms);
             job.done = to;
@@ -296,21 +307,27 @@ impl GpuEvaluator {
                 self.runs += 1;
             }
             if j == asked {
-                asked_back = Some(polls);
+                asked_back = Some(round_trip);
             }
         }
         Ok(asked_back)
     }
 
-    /// Adapts the segment size to how soon job results come back: within the usual latency
-    /// it may grow; a segment that kept many frames waiting shrinks, down to one iteration.
-    fn adapt(&mut self, polls: u32) {
+    /// Sizes the next segments from a round trip of `round_trip_ms`: twice as large while the
+    /// work in it (beyond the shortest round trip seen) stays well under [`TARGET_WORK_MS`],
+    /// half as large when it is well over, down to one iteration.
+    fn adapt(&mut self, round_trip_ms: f64) {
+        let latency = self
+            .latency_ms
+            .map_or(round_trip_ms, |l| l.min(round_trip_ms));
+        self.latency_ms = Some(latency);
+        let work = round_trip_ms - latency;
         if let Some(s) = self.segment.as_mut() {
-            *s = match polls {
-                0..=2 => (*s * 2).min(MAX_SEGMENT),
-                3..=5 => *s,
-                _ => (*s / 2).max(1),
-            };
+            if work < TARGET_WORK_MS / 2.0 {
+                *s = (*s * 2).min(MAX_SEGMENT);
+            } else if work > 2.0 * TARGET_WORK_MS {
+                *s = (*s / 2).max(1);
+            }
         }
     }
 
@@ -353,7 +370,7 @@ impl Offload for GpuEvaluator {
         loop {
             match self.collect(model.original, asked) {
                 Err(e) => return self.fail(e, at.len()),
-                Ok(Some(polls)) => self.adapt(polls),
+                Ok(Some(round_trip)) => self.adapt(round_trip),
                 Ok(None) => {}
             }
             let job = &self.jobs[asked];
