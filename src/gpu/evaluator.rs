@@ -17,9 +17,12 @@ use crate::suggest::{
     failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Request, Terms,
 };
 
-/// Vertex-iterations in a segment at first (about one iteration of a 206k-vertex mesh), and
-/// the largest.
-const FIRST_SEGMENT: u64 = 200_000;
+/// Vertex-iterations in a segment at first and at least (about one iteration of a 206k-vertex
+/// mesh, two whole 50-iteration runs of the 2,296-vertex sample), and at most. The floor
+/// matters where round trips are long and noisy for reasons other than the work (SwiftShader's
+/// slow frames): shrinking to single iterations of a small mesh would only multiply the trips.
+const FIRST_SEGMENT: u64 = 250_000;
+const MIN_SEGMENT: u64 = 250_000;
 const MAX_SEGMENT: u64 = 1 << 31;
 /// The device time a segment should take (ms). Results come back some frames after their
 /// submission however small the work (the browser maps buffers between frames): the shortest
@@ -315,7 +318,8 @@ impl GpuEvaluator {
 
     /// Sizes the next segments from a round trip of `round_trip_ms`: twice as large while the
     /// work in it (beyond the shortest round trip seen) stays well under [`TARGET_WORK_MS`],
-    /// half as large when it is well over, down to one iteration.
+    /// half as large when it is well over, down to [`MIN_SEGMENT`] (or the size set, when
+    /// smaller).
     fn adapt(&mut self, round_trip_ms: f64) {
         let latency = self
             .latency_ms
@@ -326,7 +330,7 @@ impl GpuEvaluator {
             if work < TARGET_WORK_MS / 2.0 {
                 *s = (*s * 2).min(MAX_SEGMENT);
             } else if work > 2.0 * TARGET_WORK_MS {
-                *s = (*s / 2).max(1);
+                *s = (*s / 2).max(MIN_SEGMENT.min(*s));
             }
         }
     }
