@@ -51,71 +51,92 @@ impl GpuEngine {
     }
 }
 
-/// Runs `work` (a sweep, a search) with an evaluator of `original` on `backend`.
-pub(super) fn with_evaluator<R>(
-    backend: Backend,
-    original: &Original,
-    work: impl FnOnce(&mut dyn Evaluator) -> R,
-) -> Result<R, String> {
-    match backend {
-        Backend::Cpu => {
-            let mut evaluator = MeshEvaluator::new(original, None).map_err(|e| e.to_string())?;
-            Ok(work(&mut evaluator))
+/// The engine one command works on: the CPU, or the GPU engine opened once for it.
+pub(super) enum Engine {
+    Cpu,
+    Gpu(Box<GpuEngine>),
+}
+
+impl Engine {
+    pub(super) fn open(backend: Backend) -> Result<Self, String> {
+        Ok(match backend {
+            Backend::Cpu => Engine::Cpu,
+            Backend::Gpu => Engine::Gpu(Box::new(GpuEngine::open()?)),
+        })
+    }
+
+    pub(super) fn backend(&self) -> Backend {
+        match self {
+            Engine::Cpu => Backend::Cpu,
+            Engine::Gpu(_) => Backend::Gpu,
         }
-        Backend::Gpu => {
-            let engine = GpuEngine::open()?;
-            let (device, queue) = (&engine.context.device, &engine.context.queue);
-            let mut gpu_evaluator = GpuEvaluator::blocking(device, queue, &engine.smoother);
-            let result = work(&mut Offloaded {
-                offload: &mut gpu_evaluator,
-                model: ModelRef {
-                    original,
-                    id: 0,
-                    weights: None,
-                    weights_version: 0,
-                },
-            });
-            match gpu_evaluator.failure() {
-                Some(why) => Err(format!("the GPU engine failed: {why}")),
-                None => Ok(result),
+    }
+
+    /// Runs `work` (a sweep, a search) with an evaluator of `original`.
+    pub(super) fn with_evaluator<R>(
+        &self,
+        original: &Original,
+        work: impl FnOnce(&mut dyn Evaluator) -> R,
+    ) -> Result<R, String> {
+        match self {
+            Engine::Cpu => {
+                let mut evaluator =
+                    MeshEvaluator::new(original, None).map_err(|e| e.to_string())?;
+                Ok(work(&mut evaluator))
+            }
+            Engine::Gpu(engine) => {
+                let (device, queue) = (&engine.context.device, &engine.context.queue);
+                let mut gpu_evaluator = GpuEvaluator::blocking(device, queue, &engine.smoother);
+                let result = work(&mut Offloaded {
+                    offload: &mut gpu_evaluator,
+                    model: ModelRef {
+                        original,
+                        id: 0,
+                        weights: None,
+                        weights_version: 0,
+                    },
+                });
+                match gpu_evaluator.failure() {
+                    Some(why) => Err(format!("the GPU engine failed: {why}")),
+                    None => Ok(result),
+                }
             }
         }
     }
-}
 
-/// Smooths from the original with the drifting reference, then measures, on `backend`.
-pub(super) fn smooth_and_measure(
-    backend: Backend,
-    original: &Original,
-    params: &Params,
-    tau: f64,
-) -> Result<(Vec<[f32; 3]>, Metrics), String> {
-    match backend {
-        Backend::Cpu => {
-            let (positions, reference) = metrics::smooth_drifting(original, params, None);
-            let metrics = metrics::measure(original, &positions, &reference, tau);
-            Ok((positions, metrics))
-        }
-        Backend::Gpu => {
-            let engine = GpuEngine::open()?;
-            let (device, queue) = (&engine.context.device, &engine.context.queue);
-            let e = |e: gpu::GpuError| format!("the GPU engine failed: {e}");
-            let mut mesh = engine
-                .smoother
-                .upload_with_measures(device, original)
-                .map_err(e)?;
-            engine
-                .smoother
-                .smooth(device, queue, &mut mesh, params)
-                .map_err(e)?;
-            let measured = engine
-                .smoother
-                .measure(device, queue, &mesh, false)
-                .map_err(e)?
-                .wait(device, original, tau)
-                .map_err(e)?;
-            let positions = gpu::read_positions(device, queue, &mesh).map_err(e)?;
-            Ok((positions, measured.metrics))
+    /// Smooths from the original with the drifting reference, then measures.
+    pub(super) fn smooth_and_measure(
+        &self,
+        original: &Original,
+        params: &Params,
+        tau: f64,
+    ) -> Result<(Vec<[f32; 3]>, Metrics), String> {
+        match self {
+            Engine::Cpu => {
+                let (positions, reference) = metrics::smooth_drifting(original, params, None);
+                let metrics = metrics::measure(original, &positions, &reference, tau);
+                Ok((positions, metrics))
+            }
+            Engine::Gpu(engine) => {
+                let (device, queue) = (&engine.context.device, &engine.context.queue);
+                let e = |e: gpu::GpuError| format!("the GPU engine failed: {e}");
+                let mut mesh = engine
+                    .smoother
+                    .upload_with_measures(device, original)
+                    .map_err(e)?;
+                engine
+                    .smoother
+                    .smooth(device, queue, &mut mesh, params)
+                    .map_err(e)?;
+                let measured = engine
+                    .smoother
+                    .measure(device, queue, &mesh, false)
+                    .map_err(e)?
+                    .wait(device, original, tau)
+                    .map_err(e)?;
+                let positions = gpu::read_positions(device, queue, &mesh).map_err(e)?;
+                Ok((positions, measured.metrics))
+            }
         }
     }
 }

@@ -1,6 +1,6 @@
 //! `meshsmooth smooth FILE -o OUT [filter flags] [--json]`: smooth, write, print the measures.
 
-use super::backend::{smooth_and_measure, with_evaluator, Backend};
+use super::backend::{Backend, Engine};
 use super::params::FilterArgs;
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh, Topology};
@@ -30,12 +30,14 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
     let original = Original::new(&mesh, &topology);
     // The fixed-pipeline mode: the suggestion's parameters replace the given ones (the given
     // displacement bound is kept in every trial run and in the final one).
+    let engine = Engine::open(how.backend)?;
     let suggestion = match how.auto {
         Some(method) => {
-            let s = with_evaluator(how.backend, &original, |ev| {
-                suggest_on(ev, &params, tau, method, &mut |_| true)
-            })?
-            .map_err(|e| e.to_string())?;
+            let s = engine
+                .with_evaluator(&original, |ev| {
+                    suggest_on(ev, &params, tau, method, &mut |_| true)
+                })?
+                .map_err(|e| e.to_string())?;
             params = s.params;
             Some(s)
         }
@@ -43,7 +45,7 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
     };
 
     let start = Instant::now();
-    let (positions, metrics) = smooth_and_measure(how.backend, &original, &params, tau)?;
+    let (positions, metrics) = engine.smooth_and_measure(&original, &params, tau)?;
     let seconds = start.elapsed().as_secs_f64();
 
     let smoothed = Mesh::new(positions, mesh.triangles.clone());
@@ -60,7 +62,7 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
 
     if json {
         let mut report = report_json(&params, &metrics, seconds);
-        report["backend"] = serde_json::json!(how.backend.name());
+        report["backend"] = serde_json::json!(engine.backend().name());
         if let Some(s) = &suggestion {
             report["suggestion"] = serde_json::json!({
                 "search": s.search.name(),

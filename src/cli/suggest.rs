@@ -1,7 +1,7 @@
 //! `meshsmooth suggest FILE --filter F [--tau T] [--search grid|local] [--json]`: the suggested
 //! parameters for one filter at a target smoothness.
 
-use super::backend::{parse_backend, with_evaluator, Backend};
+use super::backend::{parse_backend, Backend, Engine};
 use super::params::filter as parse_filter;
 use crate::mesh::Topology;
 use crate::metrics::Original;
@@ -52,10 +52,11 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
     if original.mesh().vertex_count() == 0 {
         return Err(format!("{}: the mesh has no vertices", args.file.display()));
     }
-    let s = with_evaluator(args.backend, &original, |ev| {
-        suggest_on(ev, &base, args.tau, args.search, &mut |_| true)
-    })?
-    .map_err(|e| e.to_string())?;
+    let s = Engine::open(args.backend)?
+        .with_evaluator(&original, |ev| {
+            suggest_on(ev, &base, args.tau, args.search, &mut |_| true)
+        })?
+        .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
         println!("{}", super::to_json(&s.to_json(seconds))?);

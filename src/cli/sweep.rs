@@ -3,7 +3,7 @@
 
 mod plot;
 
-use super::backend::{parse_backend, with_evaluator, Backend};
+use super::backend::{parse_backend, Backend, Engine};
 use super::params::FilterArgs;
 use crate::mesh::Topology;
 use crate::metrics::Original;
@@ -51,10 +51,11 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
     let topology = Topology::build(&mesh);
     let original = Original::new(&mesh, &topology);
-    let graphs = with_evaluator(args.backend, &original, |ev| {
-        quality_graphs_on(ev, &current, args.tau, &mut |_| true)
-    })?
-    .map_err(|e| e.to_string())?;
+    let graphs = Engine::open(args.backend)?
+        .with_evaluator(&original, |ev| {
+            quality_graphs_on(ev, &current, args.tau, &mut |_| true)
+        })?
+        .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     if let Some(path) = &args.plot {
         let title = format!(

@@ -69,16 +69,21 @@ impl Job {
     /// Vertex-iterations of what is left of its run (windowed sinc: of its next count).
     fn cost(&self, vertices: u64) -> u64 {
         let (params, at) = &self.request;
-        let steps = if params.filter == Filter::Taubin {
-            2
-        } else {
-            1
-        };
         let last = match is_cumulative(params.filter) {
             true => at.last().map_or(0, |&k| k - self.done),
             false => at.get(self.terms.len()).copied().unwrap_or(0),
         };
-        vertices * steps * u64::from(last)
+        vertices * steps_per_iteration(params.filter) * u64::from(last)
+    }
+}
+
+/// Smoothing steps in one iteration: Taubin's lambda and mu steps, one for the others (the
+/// unit of a segment's size).
+fn steps_per_iteration(filter: Filter) -> u64 {
+    if filter == Filter::Taubin {
+        2
+    } else {
+        1
     }
 }
 
@@ -200,12 +205,7 @@ impl GpuEvaluator {
             return Ok(());
         };
         let (from, to, measure_at) = if is_cumulative(params.filter) {
-            let steps = if params.filter == Filter::Taubin {
-                2
-            } else {
-                1
-            };
-            let per_iteration = (vertices * steps).max(1);
+            let per_iteration = (vertices * steps_per_iteration(params.filter)).max(1);
             let most = budget.map_or(u64::from(last), |s| (s / per_iteration).max(1));
             let to = (u64::from(job.done) + most).min(u64::from(last)) as u32;
             let upto = remaining.iter().take_while(|&&k| k <= to).count();
