@@ -147,34 +147,34 @@ fn show_card(
         let weak = visuals.weak_text_color();
         let top = picture.bottom() + CAPTION_GAP;
         let (left, right) = (picture.left(), picture.right());
-        painter.text(
-            egui::pos2(left, top),
-            egui::Align2::LEFT_TOP,
-            &tau,
-            font.clone(),
-            visuals.strong_text_color(),
-        );
-        painter.text(
-            egui::pos2(right, top),
-            egui::Align2::RIGHT_TOP,
-            format!("K/K0 {:.3}", item.curvature_ratio),
-            font.clone(),
-            text,
-        );
-        painter.text(
-            egui::pos2(left, top + line),
-            egui::Align2::LEFT_TOP,
-            format!("{:.3} mm", item.mean_error),
-            font.clone(),
-            text,
-        );
-        painter.text(
-            egui::pos2(right, top + line),
-            egui::Align2::RIGHT_TOP,
-            format!("ΔV {}", format_volume(item.volume_change)),
-            font.clone(),
-            weak,
-        );
+        let (left_top, right_top) = (egui::Align2::LEFT_TOP, egui::Align2::RIGHT_TOP);
+        let captions = [
+            (left, top, left_top, tau, visuals.strong_text_color()),
+            (
+                right,
+                top,
+                right_top,
+                format!("K/K0 {:.3}", item.curvature_ratio),
+                text,
+            ),
+            (
+                left,
+                top + line,
+                left_top,
+                format!("{:.3} mm", item.mean_error),
+                text,
+            ),
+            (
+                right,
+                top + line,
+                right_top,
+                format!("ΔV {}", format_volume(item.volume_change)),
+                weak,
+            ),
+        ];
+        for (x, y, align, caption, color) in captions {
+            painter.text(egui::pos2(x, y), align, caption, font.clone(), color);
+        }
     }
     response
         .on_hover_cursor(egui::CursorIcon::PointingHand)

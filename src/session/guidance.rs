@@ -3,7 +3,7 @@
 //! smoothness tau (grid or local search), and a gallery of the model smoothed as suggested at
 //! several tau values.
 //!
-//! Every job runs on [`Sliced`] evaluators (the CPU engine: a call to [`Session::step_guidance`]
+//! Every job runs on [`Sliced`](crate::suggest::Sliced) evaluators (the CPU engine: a call to [`Session::step_guidance`]
 //! works for about the budget it is given and the job goes on at the next call) or, when the
 //! caller lends one, on an [`Offload`] (the GPU engine: a run goes to the device and its
 //! measures come back by a later call), so the page never blocks. A job
@@ -14,9 +14,8 @@
 use super::Session;
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
-    EvaluatedGrid, Evaluator, GridSearch, LocalOutcome, LocalSearch, ModelRef, Offload, Offloaded,
-    Progress, QualityGraphs, QualitySweep, Request, SearchMethod, Sliced, SlicedRuns, Suggestion,
-    Task, Terms,
+    EvaluatedGrid, GridSearch, LocalOutcome, LocalSearch, ModelRef, Offload, Progress,
+    QualityGraphs, QualitySweep, SearchMethod, Suggestion, Task,
 };
 
 /// The tau values of the gallery, from accuracy to smoothness.
@@ -30,86 +29,6 @@ pub struct SearchKey {
     weights: u64,
     filter: Filter,
     bound: Option<f32>,
-}
-
-/// A job under way with the sliced-run state it keeps between calls.
-struct Running<T> {
-    task: T,
-    runs: SlicedRuns,
-    /// When the first piece of work began (ms).
-    started_ms: Option<f64>,
-}
-
-impl<T> Running<T> {
-    fn new(task: T) -> Self {
-        Self {
-            task,
-            runs: SlicedRuns::default(),
-            started_ms: None,
-        }
-    }
-
-    /// The evaluator for this job's next piece of work: the offload when one is lent, else
-    /// the CPU engine sliced to the budget.
-    fn evaluator<'a>(
-        &'a mut self,
-        engine: &'a mut Engine<'_, '_>,
-    ) -> Option<(&'a mut T, JobEvaluator<'a>)> {
-        self.started_ms.get_or_insert_with(engine.clock);
-        let model = engine.model;
-        let ev = match engine.offload.as_deref_mut() {
-            Some(offload) => JobEvaluator::Offload(Offloaded { offload, model }),
-            None => JobEvaluator::Cpu(
-                Sliced::new(
-                    model.original,
-                    model.weights,
-                    &mut self.runs,
-                    engine.clock,
-                    engine.budget_ms,
-                )
-                .ok()?,
-            ),
-        };
-        Some((&mut self.task, ev))
-    }
-}
-
-/// What one call's work runs on: the model, the clock and budget (CPU), and the offload when
-/// the caller lends one.
-pub(super) struct Engine<'m, 'o> {
-    pub(super) model: ModelRef<'m>,
-    pub(super) clock: &'m dyn Fn() -> f64,
-    pub(super) budget_ms: f64,
-    pub(super) offload: Option<&'o mut dyn Offload>,
-}
-
-/// A job's evaluator for one call.
-pub(super) enum JobEvaluator<'a> {
-    Cpu(Sliced<'a>),
-    Offload(Offloaded<'a>),
-}
-
-impl Evaluator for JobEvaluator<'_> {
-    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
-        match self {
-            JobEvaluator::Cpu(ev) => ev.measure(params, at),
-            JobEvaluator::Offload(ev) => ev.measure(params, at),
-        }
-    }
-
-    fn wants_prefetch(&self) -> bool {
-        match self {
-            JobEvaluator::Cpu(ev) => ev.wants_prefetch(),
-            JobEvaluator::Offload(ev) => ev.wants_prefetch(),
-        }
-    }
-
-    fn prefetch(&mut self, requests: &[Request]) {
-        match self {
-            JobEvaluator::Cpu(ev) => ev.prefetch(requests),
-            JobEvaluator::Offload(ev) => ev.prefetch(requests),
-        }
-    }
 }
 
 enum Search {
@@ -613,9 +532,11 @@ impl Session {
     }
 }
 
+mod engine;
 mod gallery;
 #[cfg(test)]
 mod tests;
 
+use engine::{Engine, Running};
 pub use gallery::GalleryPick;
 use gallery::{step_gallery, with_bound, GalleryJob};

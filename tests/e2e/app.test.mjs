@@ -5,23 +5,33 @@
 // `webgpu`: WebGPU on SwiftShader, the app smooths on its GPU engine. `cpu`: no WebGPU, eframe
 // draws with WebGL2 and the app smooths with its CPU engine. The native CLI is the reference for
 // every number. Screenshots go to target/e2e/<mode>/.
-import { after, before, test } from "node:test";
+import { test } from "node:test";
 import assert from "node:assert/strict";
-import { appendFileSync, existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { appendFileSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
-import { AppPage } from "./lib/app.mjs";
-import { MODES, launchBrowser, modeFromEnv } from "./lib/browser.mjs";
+import { MODES } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
 import { jsonDifferences, metricDifferences, relativeDifference } from "./lib/compare.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
 import { colourHistogram, flatBoxes } from "./lib/png.mjs";
-import { DIST, E2E_OUT, meshPath, outputDir } from "./lib/paths.mjs";
-import { serveDirectory } from "./lib/server.mjs";
+import { E2E_OUT, meshPath } from "./lib/paths.mjs";
+import { appSuite } from "./lib/suite.mjs";
 
-const MODE = modeFromEnv();
-const OUT = outputDir(MODE);
+let tmp;
+
+// The start itself is under test here: pages are handed over before their API is up.
+const { MODE, OUT, withApp } = appSuite({
+    beforeAll: () => {
+        cli.requireCli();
+        tmp = mkdtempSync(join(tmpdir(), "meshsmooth-e2e-"));
+    },
+    afterAll: () => {
+        if (tmp) rmSync(tmp, { recursive: true, force: true });
+    },
+    waitForApi: false,
+});
 
 const SAMPLE = { name: "bent_tube_staircase.ply", vertices: 2296, faces: 4588 };
 const TORUS = meshPath("synthetic/synthetic_torus_R24_r8.ply");
@@ -63,43 +73,6 @@ const FILTER_CASES = {
 };
 
 const API_TIMEOUT = 5 * 60_000;
-
-let server;
-let browser;
-let tmp;
-
-before(async () => {
-    if (!existsSync(join(DIST, "index.html"))) {
-        throw new Error(`${DIST}/index.html is missing: build the page first (trunk build --release)`);
-    }
-    cli.requireCli();
-    tmp = mkdtempSync(join(tmpdir(), "meshsmooth-e2e-"));
-    server = await serveDirectory(DIST);
-    browser = await launchBrowser(MODE);
-    console.log(`e2e: mode ${MODE}, Chromium ${browser.version()}, serving ${DIST} at ${server.url}`);
-});
-
-after(async () => {
-    await browser?.close();
-    await server?.close();
-    if (tmp) rmSync(tmp, { recursive: true, force: true });
-});
-
-/**
- * Runs `body` with a freshly opened page, closes it after, and checks that the page asked
- * nothing of any origin but its own while it was open.
- */
-async function withApp(body, options = {}) {
-    const app = await AppPage.open(browser, server, OUT, options);
-    try {
-        const result = await body(app);
-        assert.deepEqual(app.foreignRequests(), [], "the page requested something outside its own origin");
-        assert.deepEqual(app.pageErrors.map(String), [], "uncaught errors in the page");
-        return result;
-    } finally {
-        await app.close();
-    }
-}
 
 /** Opens the app and loads `file` through the API. */
 async function withLoaded(file, body) {

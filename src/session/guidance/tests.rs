@@ -1,6 +1,6 @@
 use super::*;
 use crate::metrics;
-use crate::suggest::{quality_graphs, suggest, Evaluator};
+use crate::suggest::{quality_graphs, suggest, Evaluator, Terms};
 use std::cell::Cell;
 
 const SAMPLE: &[u8] = include_bytes!("../../../web/sample/bent_tube_staircase.ply");
@@ -15,6 +15,11 @@ fn session(filter: &str) -> Session {
 /// Steps the background until nothing is left, on a clock that ticks 1 ms per reading;
 /// returns the calls it took.
 fn settle(s: &mut Session) -> usize {
+    settle_on(s, None)
+}
+
+/// [`settle`] with the runs on `offload` when given.
+fn settle_on(s: &mut Session, mut offload: Option<&mut dyn Offload>) -> usize {
     let ticks = Cell::new(0.0);
     let clock = || {
         ticks.set(ticks.get() + 1.0);
@@ -22,7 +27,8 @@ fn settle(s: &mut Session) -> usize {
     };
     let mut calls = 0;
     while s.guidance_busy() {
-        s.step_guidance(&clock, 20.0);
+        let lent = offload.as_mut().map(|o| &mut **o as &mut dyn Offload);
+        s.step_guidance_on(&clock, 20.0, lent);
         calls += 1;
         assert!(calls < 1_000_000, "the background never settles");
     }
@@ -204,15 +210,9 @@ impl Offload for Deferred {
 fn an_offload_runs_the_searches_and_graphs_with_the_same_results() {
     let mut s = session("taubin");
     let mut offload = Deferred::default();
-    let clock = || 0.0;
     s.start_suggest(SearchMethod::Local);
     s.set_graphs_wanted(true);
-    let mut calls = 0;
-    while s.guidance_busy() {
-        s.step_guidance_on(&clock, 1e9, Some(&mut offload));
-        calls += 1;
-        assert!(calls < 100_000, "the background never settles");
-    }
+    let calls = settle_on(&mut s, Some(&mut offload));
     // One request per call at most: a call returns once its run is on the device.
     assert!(calls >= offload.requests.len(), "{calls} calls");
     let original = model_original(&s);

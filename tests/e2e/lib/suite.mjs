@@ -11,11 +11,13 @@ import { DIST, outputDir } from "./paths.mjs";
 import { serveDirectory } from "./server.mjs";
 
 /**
- * Registers the file's before/after hooks; returns `{MODE, OUT, withApp}`, where
- * `withApp(body, {query})` runs `body(app)` on a freshly opened page (its API ready; `query`
- * appended to its URL) and closes it.
+ * Registers the file's before/after hooks (`beforeAll`/`afterAll` run with them); returns
+ * `{MODE, OUT, withApp}`, where `withApp(body, options)` runs `body(app)` on a freshly opened
+ * page and closes it. `options` go to `AppPage.open` (`query`, `startTimeoutMs`); the page's
+ * API is awaited first unless the suite was made with `waitForApi: false` (tests of the start
+ * itself).
  */
-export function appSuite({ beforeAll = () => {} } = {}) {
+export function appSuite({ beforeAll = () => {}, afterAll = () => {}, waitForApi = true } = {}) {
     const MODE = modeFromEnv();
     const OUT = outputDir(MODE);
     let server;
@@ -27,15 +29,17 @@ export function appSuite({ beforeAll = () => {} } = {}) {
         beforeAll();
         server = await serveDirectory(DIST);
         browser = await launchBrowser(MODE);
+        console.log(`e2e: mode ${MODE}, Chromium ${browser.version()}, serving ${DIST} at ${server.url}`);
     });
     after(async () => {
         await browser?.close();
         await server?.close();
+        afterAll();
     });
-    async function withApp(body, { query = "" } = {}) {
-        const app = await AppPage.open(browser, server, OUT, { query });
+    async function withApp(body, options = {}) {
+        const app = await AppPage.open(browser, server, OUT, options);
         try {
-            await app.api();
+            if (waitForApi) await app.api();
             const result = await body(app);
             assert.deepEqual(app.foreignRequests(), [], "the page requested something outside its own origin");
             assert.deepEqual(app.pageErrors.map(String), [], "uncaught errors in the page");
