@@ -10,7 +10,7 @@ mod shapes;
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::metrics::{
     exact_distances, exact_error, identity, measure, measure_vertices, point_triangle_distance2,
-    vertex_curvatures, DriftingReference, Original, TriangleBvh,
+    vertex_curvatures, DriftingReference, MeasureInParts, Original, TriangleBvh,
 };
 use meshsmooth::smooth::{self, Filter, NoObserver, Params};
 use std::f64::consts::PI;
@@ -189,6 +189,31 @@ fn nothing_moved_means_no_error_and_no_change() {
         let mut drift = DriftingReference::new(&o);
         drift.update(&mesh.positions);
         assert_eq!(drift.reference(), &identity(mesh.vertex_count())[..]);
+    }
+}
+
+#[test]
+fn a_measure_pass_in_parts_equals_the_pass_in_one_call() {
+    // The pial surface (10,242 vertices: six chunks) after 10 HC iterations.
+    let (mesh, topology) = data::load(data::CLOSED_MESHES[0].0);
+    assert!(mesh.vertex_count() > 5 * 2048);
+    let o = Original::new(&mesh, &topology);
+    let params = Params::defaults(Filter::Hc);
+    let (positions, reference) = meshsmooth::metrics::smooth_drifting(&o, &params, None);
+    let whole = measure_vertices(&o, &positions, &reference, 0.3);
+    assert_eq!(whole.0, measure(&o, &positions, &reference, 0.3));
+    let n = mesh.vertex_count();
+    for part in [1, 2048, 5000, n] {
+        let mut pass = MeasureInParts::new(&o, &positions, &reference);
+        let mut calls = 0;
+        while !pass.advance(&o, &positions, &reference, part) {
+            calls += 1;
+            let (done, total) = pass.progress();
+            assert!(done < total && calls <= n, "part {part}: {done}/{total}");
+        }
+        let expected_calls = n.div_ceil(part.div_ceil(2048) * 2048);
+        assert_eq!(calls + 1, expected_calls, "part {part}");
+        assert_eq!(pass.finish(&o, 0.3), whole, "part {part}");
     }
 }
 

@@ -387,11 +387,11 @@ impl Shell {
                 ui.colored_label(ui.visuals().warn_fg_color, "CPU fallback")
                     .on_hover_text(why);
             }
-            if let Some((done, total)) = doc.session.progress() {
+            if let Some(p) = doc.session.progress() {
                 ui.add(
-                    egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                    egui::ProgressBar::new(p.fraction())
                         .desired_width(160.0)
-                        .text(format!("smoothing {done}/{total}")),
+                        .text(p.describe()),
                 );
             } else if doc.busy() || self.files.reading() > 0 {
                 ui.spinner();

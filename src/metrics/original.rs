@@ -44,7 +44,7 @@ impl Original {
             curvature: 0.0,
             referenced,
         };
-        let sums: Sums = measure_pass(&original, &mesh.positions, None, None);
+        let sums: Sums = measure_pass(&original, &mesh.positions, None);
         original.volume = original.is_closed().then(|| sums.volume());
         original.curvature = sums.curvature();
         original

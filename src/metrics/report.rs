@@ -86,7 +86,7 @@ pub fn measure(
     reference: &[u32],
     tau: f64,
 ) -> Metrics {
-    let sums = measure_pass(original, positions, Some(reference), None);
+    let sums = measure_pass(original, positions, Some(reference));
     metrics(original, &sums, tau)
 }
 
@@ -97,18 +97,85 @@ pub fn measure_vertices(
     reference: &[u32],
     tau: f64,
 ) -> (Metrics, VertexMeasures) {
-    let n = original.mesh().vertex_count();
-    let mut vertex = VertexMeasures {
-        local_error: vec![0.0; n],
-        gaussian_curvature: vec![0.0; n],
-    };
-    let sums = measure_pass(
-        original,
-        positions,
-        Some(reference),
-        Some((&mut vertex.local_error, &mut vertex.gaussian_curvature)),
-    );
-    (metrics(original, &sums, tau), vertex)
+    let mut pass = MeasureInParts::new(original, positions, reference);
+    pass.advance(original, positions, reference, usize::MAX);
+    pass.finish(original, tau)
+}
+
+/// [`measure_vertices`] spread over calls, for a caller that must return between them (the
+/// browser's one thread, which has a frame to draw): the triangle areas when created, then
+/// [`Self::advance`] by runs of vertices. The result is the one-call pass's, bit for bit.
+#[derive(Clone, Debug)]
+pub struct MeasureInParts {
+    areas: Vec<TriangleArea>,
+    volume6: f64,
+    /// One entry per chunk of vertices measured so far, added in chunk order at the end.
+    partial: Vec<Sums>,
+    vertex: VertexMeasures,
+}
+
+impl MeasureInParts {
+    /// Checks the arrays against the original and computes the triangle areas and the volume.
+    /// `positions` and `reference` must stay the same through [`Self::advance`].
+    pub fn new(original: &Original, positions: &[[f32; 3]], reference: &[u32]) -> Self {
+        let n = check_arrays(original, positions, Some(reference));
+        let (areas, volume6) = triangle_areas(positions, &original.mesh().triangles);
+        Self {
+            areas,
+            volume6,
+            partial: Vec::with_capacity(n.div_ceil(CHUNK)),
+            vertex: VertexMeasures {
+                local_error: vec![0.0; n],
+                gaussian_curvature: vec![0.0; n],
+            },
+        }
+    }
+
+    /// Measures up to `vertices` more vertices (rounded up to whole chunks of [`CHUNK`]);
+    /// returns whether every vertex is measured.
+    pub fn advance(
+        &mut self,
+        original: &Original,
+        positions: &[[f32; 3]],
+        reference: &[u32],
+        vertices: usize,
+    ) -> bool {
+        let pass = Pass {
+            original,
+            positions,
+            reference: Some(reference),
+            areas: &self.areas,
+        };
+        let (done, total) = self.progress();
+        let end = total.min(done + vertices.div_ceil(CHUNK).max(1));
+        let error = &mut self.vertex.local_error[done * CHUNK..];
+        let curvature = &mut self.vertex.gaussian_curvature[done * CHUNK..];
+        let sums: Vec<Sums> = error
+            .par_chunks_mut(CHUNK)
+            .zip(curvature.par_chunks_mut(CHUNK))
+            .take(end - done)
+            .enumerate()
+            .map(|(c, (e, k))| pass.chunk((done + c) * CHUNK, Some((e, k))))
+            .collect();
+        self.partial.extend(sums);
+        self.partial.len() == total
+    }
+
+    /// `(chunks measured, chunks)`.
+    pub fn progress(&self) -> (usize, usize) {
+        (
+            self.partial.len(),
+            self.vertex.local_error.len().div_ceil(CHUNK),
+        )
+    }
+
+    /// The report and the per-vertex arrays, once [`Self::advance`] returned true.
+    pub fn finish(self, original: &Original, tau: f64) -> (Metrics, VertexMeasures) {
+        let (done, total) = self.progress();
+        assert_eq!(done, total, "finish before every vertex is measured");
+        let sums = total_of(self.volume6, &self.partial);
+        (metrics(original, &sums, tau), self.vertex)
+    }
 }
 
 /// Exact distance from each vertex of `positions` to the original mesh, summarised over the same
@@ -241,13 +308,30 @@ impl Sums {
 }
 
 /// Volume, curvature and local error in one pass over the vertices (`reference`: `None` = every
-/// vertex its own reference). Writes per-vertex local error and `K_G` into `out` when given.
+/// vertex its own reference), without per-vertex arrays ([`MeasureInParts`] fills those).
 pub(crate) fn measure_pass(
     original: &Original,
     positions: &[[f32; 3]],
     reference: Option<&[u32]>,
-    out: Option<(&mut [f32], &mut [f32])>,
 ) -> Sums {
+    let n = check_arrays(original, positions, reference);
+    let (areas, volume6) = triangle_areas(positions, &original.mesh().triangles);
+    let pass = Pass {
+        original,
+        positions,
+        reference,
+        areas: &areas,
+    };
+    let partial: Vec<Sums> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| pass.chunk(c * CHUNK, None))
+        .collect();
+    total_of(volume6, &partial)
+}
+
+/// The vertex count, after checking that `positions` (and `reference`) have one entry per
+/// vertex of the original.
+fn check_arrays(original: &Original, positions: &[[f32; 3]], reference: Option<&[u32]>) -> usize {
     let n = original.mesh().vertex_count();
     assert_eq!(
         positions.len(),
@@ -257,30 +341,17 @@ pub(crate) fn measure_pass(
     if let Some(r) = reference {
         assert_eq!(r.len(), n, "one reference vertex per vertex");
     }
-    let (areas, volume6) = triangle_areas(positions, &original.mesh().triangles);
-    let pass = Pass {
-        original,
-        positions,
-        reference,
-        areas: &areas,
-    };
-    let partial: Vec<Sums> = match out {
-        Some((error, curvature)) => error
-            .par_chunks_mut(CHUNK)
-            .zip(curvature.par_chunks_mut(CHUNK))
-            .enumerate()
-            .map(|(c, (e, k))| pass.chunk(c * CHUNK, Some((e, k))))
-            .collect(),
-        None => (0..n.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|c| pass.chunk(c * CHUNK, None))
-            .collect(),
-    };
+    n
+}
+
+/// The volume plus the chunks' partial sums, added in chunk order (the same bit for bit
+/// whatever the thread count or the number of calls).
+fn total_of(volume6: f64, partial: &[Sums]) -> Sums {
     let mut total = Sums {
         volume6,
         ..Sums::default()
     };
-    for p in &partial {
+    for p in partial {
         total.add(p);
     }
     total

@@ -7,18 +7,22 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod colors;
+mod cpu_job;
 mod guidance;
 mod weights;
 
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
+pub use cpu_job::CpuProgress;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use weights::WeightsSummary;
+
+use cpu_job::CpuJob;
 
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::io;
 use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
-use crate::metrics::{self, DriftingReference, Metrics, Original, VertexMeasures};
-use crate::smooth::{self, Filter, Params};
+use crate::metrics::{Metrics, Original, VertexMeasures};
+use crate::smooth::{Filter, Params};
 
 /// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
 pub const DEFAULT_TAU: f64 = 0.5;
@@ -82,15 +86,6 @@ pub struct Timings {
     pub smooth_ms: f64,
     /// The measure pass with the per-vertex measures.
     pub measure_ms: f64,
-}
-
-/// A CPU run in progress, kept between frames.
-struct CpuJob {
-    revision: u64,
-    positions: Vec<[f32; 3]>,
-    reference: Vec<u32>,
-    done: u32,
-    smooth_ms: f64,
 }
 
 /// The open model, the filter settings and the latest result.
@@ -303,83 +298,33 @@ impl Session {
             return None;
         }
         let model = self.model.as_ref()?;
-        let params = *self.params();
-        let weights = self.weights.as_deref();
-        let start = clock();
-        let mut job = match self.job.take() {
+        let job = match self.job.take() {
             Some(job) if job.revision == self.revision => job,
-            _ => CpuJob {
-                revision: self.revision,
-                positions: model.mesh().positions.clone(),
-                reference: metrics::identity(model.mesh().vertex_count()),
-                done: 0,
-                smooth_ms: 0.0,
-            },
+            _ => CpuJob::new(self.revision, model),
         };
-        if params.filter == Filter::Sinc {
-            // Its terms are not shorter filters' results: one piece.
-            (job.positions, job.reference) =
-                metrics::smooth_drifting(&model.original, &params, weights);
-            job.done = params.iterations;
-        }
-        // Iterations per call: one at first, then as many as the time per iteration so far
-        // lets fit in what is left of the budget (each call re-checks the rings and allocates
-        // its second buffer, so fewer, longer calls cost less).
-        let mut chunk = 1;
-        while job.done < params.iterations {
-            let chunk_start = clock();
-            let mut drift = DriftingReference::resume(&model.original, job.reference);
-            let positions = std::mem::take(&mut job.positions);
-            job.positions = smooth::resume(
-                model.mesh(),
-                model.topology(),
-                &params,
-                weights,
-                positions,
-                job.done,
-                chunk,
-                &mut drift,
-            )
-            .unwrap_or_default();
-            job.reference = drift.into_reference();
-            job.done += chunk;
-            let now = clock();
-            let left = budget_ms - (now - start);
-            if left <= 0.0 {
-                break;
-            }
-            let per_iteration = ((now - chunk_start) / chunk as f64).max(1e-3);
-            let remaining = params.iterations - job.done;
-            chunk = ((left / per_iteration).floor() as u32).clamp(1, remaining.max(1));
-        }
-        let smoothed = clock();
-        job.smooth_ms += smoothed - start;
-        if job.done < params.iterations {
-            self.job = Some(job);
-            return None;
-        }
-        let result = measured(
-            model,
-            self.revision,
-            params,
+        let settings = (
+            &self.params[slot(self.filter)],
+            self.weights.as_deref(),
             self.tau,
-            job.positions,
-            &job.reference,
         );
-        self.result = Some(result);
-        Some(Timings {
-            smooth_ms: job.smooth_ms,
-            measure_ms: clock() - smoothed,
-        })
+        match job.step(model, settings, clock, budget_ms) {
+            Ok((result, timings)) => {
+                self.result = Some(result);
+                Some(timings)
+            }
+            Err(job) => {
+                self.job = Some(job);
+                None
+            }
+        }
     }
 
-    /// How far the CPU engine got with the current revision: `(iterations done, iterations)`,
-    /// while a run is under way.
-    pub fn progress(&self) -> Option<(u32, u32)> {
+    /// How far the CPU engine got with the current revision, while a run is under way.
+    pub fn progress(&self) -> Option<CpuProgress> {
         self.job
             .as_ref()
             .filter(|j| j.revision == self.revision && self.needs_smoothing())
-            .map(|j| (j.done, self.params().iterations))
+            .map(|j| j.progress(self.params()))
     }
 
     /// Accepts a result measured elsewhere (the GPU engine's smoothing and measure pass) for
@@ -482,25 +427,6 @@ impl Session {
             "busy": busy,
             "weights": self.weights_summary(),
         })
-    }
-}
-
-/// Measures `positions` (with their drifted references) against the model's original.
-fn measured(
-    model: &Model,
-    revision: u64,
-    params: Params,
-    tau: f64,
-    positions: Vec<[f32; 3]>,
-    reference: &[u32],
-) -> Smoothed {
-    let (metrics, vertex) = metrics::measure_vertices(&model.original, &positions, reference, tau);
-    Smoothed {
-        revision,
-        params,
-        positions,
-        metrics,
-        vertex,
     }
 }
 

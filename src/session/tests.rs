@@ -1,5 +1,5 @@
 use super::*;
-use crate::metrics::DriftingReference;
+use crate::metrics::{self, DriftingReference};
 
 const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
 
@@ -196,22 +196,37 @@ fn a_run_spread_over_steps_equals_the_run_in_one_go() {
             t.set(t.get() + 1.0);
             t.get()
         };
-        let mut calls = 0;
+        // Smoothing one iteration per call, then the measure pass one part per call.
+        let (mut smoothing, mut measuring) = (0, 0);
         while steps.step_cpu(&clock, 0.0).is_none() {
-            calls += 1;
-            let (done, total) = steps.progress().expect("under way");
-            assert_eq!(
-                (done, total),
-                (calls, steps.params().iterations),
-                "{filter}"
-            );
+            match steps.progress().expect("under way") {
+                CpuProgress::Smoothing { done, total } => {
+                    assert_eq!(measuring, 0, "{filter}: smoothing after measuring");
+                    smoothing += 1;
+                    let iterations = steps.params().iterations;
+                    // Sinc runs in one piece.
+                    let want = if filter == "sinc" {
+                        iterations
+                    } else {
+                        smoothing
+                    };
+                    assert_eq!((done, total), (want, iterations), "{filter}");
+                }
+                CpuProgress::Measuring { done, total } => {
+                    measuring += 1;
+                    assert!(done < total, "{filter}: {done}/{total}");
+                }
+            }
         }
         let expected = if filter == "sinc" {
-            0
+            1
         } else {
-            steps.params().iterations - 1
+            steps.params().iterations
         };
-        assert_eq!(calls, expected, "{filter}");
+        assert_eq!(smoothing, expected, "{filter}");
+        // The sample's 2296 vertices are two parts of the measure pass: the first call
+        // measures one, the call that measures the other returns the result.
+        assert_eq!(measuring, 1, "{filter}");
         assert_eq!(steps.progress(), None);
         let (a, b) = (whole.result().unwrap(), steps.result().unwrap());
         assert_eq!(a.positions, b.positions, "{filter}");
@@ -224,12 +239,18 @@ fn a_change_mid_run_starts_over() {
     let mut s = sample_session();
     let clock = || 0.0;
     assert!(s.step_cpu(&clock, -1.0).is_none());
-    assert_eq!(s.progress(), Some((1, 10)));
+    assert_eq!(
+        s.progress(),
+        Some(CpuProgress::Smoothing { done: 1, total: 10 })
+    );
     s.set_params_json(&serde_json::json!({"iterations": 4}))
         .unwrap();
     assert_eq!(s.progress(), None, "the old run is for other parameters");
     assert!(s.step_cpu(&clock, -1.0).is_none());
-    assert_eq!(s.progress(), Some((1, 4)));
+    assert_eq!(
+        s.progress(),
+        Some(CpuProgress::Smoothing { done: 1, total: 4 })
+    );
 }
 
 #[test]

@@ -1,0 +1,190 @@
+//! The CPU engine's run for the current parameters, spread over calls so a page without threads
+//! keeps drawing frames: the smoothing a few iterations at a time, then the measure pass a run
+//! of vertices at a time, each call within a time budget.
+
+use super::{Model, Smoothed, Timings};
+use crate::metrics::{self, DriftingReference, MeasureInParts};
+use crate::smooth::{self, Filter, Params};
+
+/// How far a run got (see [`super::Session::progress`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CpuProgress {
+    /// Iterations done of the run's iterations.
+    Smoothing { done: u32, total: u32 },
+    /// Parts of the measure pass done of all parts (runs of vertices).
+    Measuring { done: usize, total: usize },
+}
+
+impl CpuProgress {
+    /// Done as a fraction of the whole run, counting the measure pass as one iteration more
+    /// (about what it costs).
+    pub fn fraction(&self) -> f32 {
+        match *self {
+            CpuProgress::Smoothing { done, total } => done as f32 / (total + 1) as f32,
+            CpuProgress::Measuring { done, total } => {
+                let iterations_share = 1.0 - 1.0 / (total.max(1) as f32 + 1.0);
+                iterations_share.max(done as f32 / total.max(1) as f32)
+            }
+        }
+    }
+
+    /// What the progress bar says.
+    pub fn describe(&self) -> String {
+        match *self {
+            CpuProgress::Smoothing { done, total } => format!("smoothing {done}/{total}"),
+            CpuProgress::Measuring { .. } => "measuring".to_string(),
+        }
+    }
+}
+
+/// A CPU run in progress, kept between calls.
+pub(super) struct CpuJob {
+    pub revision: u64,
+    positions: Vec<[f32; 3]>,
+    reference: Vec<u32>,
+    done: u32,
+    smooth_ms: f64,
+    /// The measure pass, once the smoothing is done.
+    measure: Option<MeasureInParts>,
+    measure_ms: f64,
+}
+
+/// Vertices of the first part of a measure pass, before its speed is known.
+const FIRST_MEASURE_PART: usize = 2048;
+
+impl CpuJob {
+    pub fn new(revision: u64, model: &Model) -> Self {
+        Self {
+            revision,
+            positions: model.mesh().positions.clone(),
+            reference: metrics::identity(model.mesh().vertex_count()),
+            done: 0,
+            smooth_ms: 0.0,
+            measure: None,
+            measure_ms: 0.0,
+        }
+    }
+
+    pub fn progress(&self, params: &Params) -> CpuProgress {
+        match &self.measure {
+            Some(m) => {
+                let (done, total) = m.progress();
+                CpuProgress::Measuring { done, total }
+            }
+            None => CpuProgress::Smoothing {
+                done: self.done,
+                total: params.iterations,
+            },
+        }
+    }
+
+    /// Works for about `budget_ms` (at least one iteration, or one part of the measure pass);
+    /// the result and its timings once the run is measured.
+    pub fn step(
+        mut self,
+        model: &Model,
+        (params, weights, tau): (&Params, Option<&[f32]>, f64),
+        clock: &dyn Fn() -> f64,
+        budget_ms: f64,
+    ) -> Result<(Smoothed, Timings), Self> {
+        let start = clock();
+        if self.done < params.iterations {
+            self.smooth(model, params, weights, clock, start + budget_ms);
+            self.smooth_ms += clock() - start;
+            if self.done < params.iterations || clock() - start >= budget_ms {
+                return Err(self);
+            }
+        }
+        let measure_start = clock();
+        let finished = self.measure(model, clock, start + budget_ms);
+        self.measure_ms += clock() - measure_start;
+        if !finished {
+            return Err(self);
+        }
+        let measure = self.measure.take().expect("measured");
+        let (metrics, vertex) = measure.finish(&model.original, tau);
+        let timings = Timings {
+            smooth_ms: self.smooth_ms,
+            measure_ms: self.measure_ms,
+        };
+        let smoothed = Smoothed {
+            revision: self.revision,
+            params: *params,
+            positions: self.positions,
+            metrics,
+            vertex,
+        };
+        Ok((smoothed, timings))
+    }
+
+    /// Iterations until `deadline` (at least one). Iterations per call: one at first, then as
+    /// many as the time per iteration so far lets fit before the deadline (each call re-checks
+    /// the rings and allocates its second buffer, so fewer, longer calls cost less).
+    fn smooth(
+        &mut self,
+        model: &Model,
+        params: &Params,
+        weights: Option<&[f32]>,
+        clock: &dyn Fn() -> f64,
+        deadline: f64,
+    ) {
+        if params.filter == Filter::Sinc {
+            // Its terms are not shorter filters' results: one piece.
+            (self.positions, self.reference) =
+                metrics::smooth_drifting(&model.original, params, weights);
+            self.done = params.iterations;
+            return;
+        }
+        let mut chunk = 1;
+        while self.done < params.iterations {
+            let chunk_start = clock();
+            let mut drift =
+                DriftingReference::resume(&model.original, std::mem::take(&mut self.reference));
+            let positions = std::mem::take(&mut self.positions);
+            self.positions = smooth::resume(
+                model.mesh(),
+                model.topology(),
+                params,
+                weights,
+                positions,
+                self.done,
+                chunk,
+                &mut drift,
+            )
+            .unwrap_or_default();
+            self.reference = drift.into_reference();
+            self.done += chunk;
+            let now = clock();
+            let left = deadline - now;
+            if left <= 0.0 {
+                break;
+            }
+            let per_iteration = ((now - chunk_start) / chunk as f64).max(1e-3);
+            let remaining = params.iterations - self.done;
+            chunk = ((left / per_iteration).floor() as u32).clamp(1, remaining.max(1));
+        }
+    }
+
+    /// Parts of the measure pass until `deadline` (at least one); whether it is complete.
+    fn measure(&mut self, model: &Model, clock: &dyn Fn() -> f64, deadline: f64) -> bool {
+        let original = &model.original;
+        let (positions, reference) = (&self.positions, &self.reference);
+        let pass = self
+            .measure
+            .get_or_insert_with(|| MeasureInParts::new(original, positions, reference));
+        let mut part = FIRST_MEASURE_PART;
+        loop {
+            let part_start = clock();
+            if pass.advance(original, positions, reference, part) {
+                return true;
+            }
+            let now = clock();
+            let left = deadline - now;
+            if left <= 0.0 {
+                return false;
+            }
+            let per_vertex = ((now - part_start) / part as f64).max(1e-6);
+            part = ((left / per_vertex) as usize).max(1);
+        }
+    }
+}
