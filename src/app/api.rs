@@ -1,7 +1,9 @@
 //! The embedding API, `window.meshsmooth`, for the authoring page and for tests. Installed when
 //! the app has started, announced by a `meshsmooth-ready` event on `window`.
 //!
-//! - `loadMesh(bytes: Uint8Array, name): Promise<info>` (the CLI's `info --json` keys)
+//! - `loadMesh(bytes: Uint8Array, name): Promise<info>` (the CLI's `info --json` keys), once the
+//!   mesh is open: it opens a stage per frame (`state().loading`), the current model staying open
+//!   until then; a later `loadMesh` before it is open replaces it (its promise rejects)
 //! - `setFilter(name)`, `setParams(object)` (keys `lambda mu alpha beta passband iterations
 //!   max_displacement`); both throw with the engine's message on a bad name or value
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
@@ -15,8 +17,10 @@
 //! - `sweep(): Promise<object>`: the quality graphs of the active filter around the current
 //!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
-//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, backend,
-//!   timings, brush, view, guidance}` (`timings`: the last result's `smooth_ms` and `measure_ms`
+//! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, loading,
+//!   open_stages, backend, timings, brush, view, guidance}` (`loading`: `{name, stage, stages,
+//!   doing}` while a file opens, else null; `open_stages`: `[{doing, ms}]`, the latest opening's
+//!   stages and their times; `timings`: the last result's `smooth_ms` and `measure_ms`
 //!   of the CPU engine's own work, or `gpu_run_ms` from submitting a GPU run to having its
 //!   results back; `weights`: `{painted, locked, min, mean}` of the painted weights, or null;
 //!   `brush`: `{on, pick_ms}`, whether the weight brush is on and how long its latest pick took;
@@ -190,15 +194,28 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                     ));
                 };
                 let name = name.as_string().unwrap_or_else(|| "mesh.ply".into());
-                let result = d.borrow_mut().open(&name, &bytes.to_vec());
-                c.request_repaint();
-                settled(result.and_then(|()| {
-                    d.borrow()
-                        .session
-                        .info_json()
-                        .map(|v| to_js(&v))
-                        .ok_or_else(|| "no report".to_string())
-                }))
+                let bytes = bytes.to_vec();
+                let (d, c) = (d.clone(), c.clone());
+                let mut bytes = Some(bytes);
+                // Opened a stage per frame; the promise settles once it is open (or not).
+                Promise::new(&mut |resolve: Function, reject: Function| {
+                    let Some(bytes) = bytes.take() else { return };
+                    let waiter =
+                        Box::new(move |outcome: Result<&crate::session::Session, String>| {
+                            let info = outcome.and_then(|session| {
+                                session
+                                    .info_json()
+                                    .map(|v| to_js(&v))
+                                    .ok_or_else(|| "no report".to_string())
+                            });
+                            let _ = match info {
+                                Ok(v) => resolve.call1(&JsValue::NULL, &v),
+                                Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
+                            };
+                        });
+                    d.borrow_mut().begin_open(&name, bytes, Some(waiter));
+                    c.request_repaint();
+                })
             },
         ),
     )?;

@@ -13,6 +13,10 @@ use std::rc::Rc;
 /// `exportMesh()`); it receives the session once that result is there.
 pub type Waiter = Box<dyn FnOnce(&Session)>;
 
+/// A call waiting for a file being opened (the API's `loadMesh`): the session once the file is
+/// open, or why it is not.
+pub type LoadWaiter = Box<dyn FnOnce(Result<&Session, String>)>;
+
 /// Which engine smooths.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Backend {
@@ -88,6 +92,8 @@ pub struct Document {
     pub show_gallery: bool,
     /// Whether the background's runs went to the GPU engine in the latest frame.
     pub guidance_on_gpu: bool,
+    /// Calls waiting for the file being opened.
+    waiting_for_load: Vec<LoadWaiter>,
 }
 
 /// The handle the shell and the API hold.
@@ -105,20 +111,16 @@ impl Document {
             waiting_for: Vec::new(),
             show_gallery: false,
             guidance_on_gpu: false,
+            waiting_for_load: Vec::new(),
         }
     }
 
-    /// Opens a file's bytes; on failure the current model stays and the error is kept.
+    /// Opens a file's bytes at once (the bundled sample at start); on failure the current
+    /// model stays and the error is kept.
     pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
         match self.session.open(name, bytes) {
-            Ok(model) => {
-                log::info!(
-                    "opened {name}: {} vertices, {} faces",
-                    model.report.vertices,
-                    model.report.faces
-                );
-                self.model_generation += 1;
-                self.timings = None;
+            Ok(_) => {
+                self.opened();
                 Ok(())
             }
             Err(message) => {
@@ -126,6 +128,52 @@ impl Document {
                 Err(message)
             }
         }
+    }
+
+    /// Starts opening a file's bytes, a stage per frame ([`Self::step_loading`]); the current
+    /// model stays until it is open. `waiter`, when given, hears how it ended. A file still
+    /// opening is dropped for this one, and its waiters hear so.
+    pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>, waiter: Option<LoadWaiter>) {
+        if let Some(replaced) = self.session.begin_open(name, bytes) {
+            let why = format!("{replaced} was not opened: {name} was opened before it finished");
+            for w in std::mem::take(&mut self.waiting_for_load) {
+                w(Err(why.clone()));
+            }
+        }
+        self.waiting_for_load.extend(waiter);
+    }
+
+    /// This frame's work on the file being opened, if one is; returns whether there was one
+    /// (the frame then has no time for other work).
+    pub fn step_loading(&mut self) -> bool {
+        if self.session.loading().is_none() {
+            return false;
+        }
+        let Some(outcome) = self.session.step_loading(&now_ms, FRAME_BUDGET_MS) else {
+            return true;
+        };
+        match &outcome {
+            Ok(()) => self.opened(),
+            Err(message) => log::warn!("{message}"),
+        }
+        for w in std::mem::take(&mut self.waiting_for_load) {
+            w(outcome.clone().map(|()| &self.session));
+        }
+        true
+    }
+
+    /// What a newly opened model needs.
+    fn opened(&mut self) {
+        if let Some(model) = self.session.model() {
+            log::info!(
+                "opened {}: {} vertices, {} faces",
+                model.name,
+                model.report.vertices,
+                model.report.faces
+            );
+        }
+        self.model_generation += 1;
+        self.timings = None;
     }
 
     /// Whether work for the current parameters is still to do.
@@ -169,7 +217,7 @@ impl Document {
     /// Whether anything is computing (the current result or background work), so the page
     /// keeps drawing frames.
     pub fn working(&self) -> bool {
-        self.busy() || self.session.guidance_busy()
+        self.busy() || self.session.guidance_busy() || self.session.loading().is_some()
     }
 
     /// The CPU engine's share of this frame: works on the current parameters' result for

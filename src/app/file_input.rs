@@ -7,6 +7,7 @@ use eframe::egui;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
+use super::read_bytes::{self, OnProgress};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsCast;
 
@@ -19,20 +20,70 @@ pub struct ArrivedFile {
     pub bytes: Result<Vec<u8>, String>,
 }
 
+/// A file being read: bytes so far, and the total when known.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reading {
+    pub name: String,
+    pub read: u64,
+    pub total: Option<u64>,
+}
+
+impl Reading {
+    /// What the page says about it.
+    pub fn describe(&self) -> String {
+        let mb = |b: u64| b as f64 / 1e6;
+        match self.total {
+            Some(t) if t > 0 => format!(
+                "Reading {}: {:.1} of {:.1} MB",
+                self.name,
+                mb(self.read),
+                mb(t)
+            ),
+            _ => format!("Reading {}: {:.1} MB", self.name, mb(self.read)),
+        }
+    }
+
+    /// The fraction read, when the total is known.
+    pub fn fraction(&self) -> Option<f32> {
+        self.total
+            .filter(|&t| t > 0)
+            .map(|t| (self.read as f64 / t as f64).min(1.0) as f32)
+    }
+}
+
 /// Shared between the app and the reads in flight.
 #[derive(Clone, Default)]
 struct Inbox {
     arrived: Rc<RefCell<Vec<ArrivedFile>>>,
-    reading: Rc<Cell<usize>>,
+    /// The reads in flight, by number.
+    reading: Rc<RefCell<Vec<(u64, Reading)>>>,
+    next: Rc<Cell<u64>>,
 }
 
 impl Inbox {
-    fn begin(&self) {
-        self.reading.set(self.reading.get() + 1);
+    /// Registers a read of `name`; the returned callback reports its progress.
+    fn begin(&self, name: &str, ctx: &egui::Context) -> (u64, OnProgress) {
+        let id = self.next.get();
+        self.next.set(id + 1);
+        let reading = Reading {
+            name: name.to_string(),
+            read: 0,
+            total: None,
+        };
+        self.reading.borrow_mut().push((id, reading));
+        let (list, ctx) = (self.reading.clone(), ctx.clone());
+        let progress = Box::new(move |read, total| {
+            if let Some((_, r)) = list.borrow_mut().iter_mut().find(|(i, _)| *i == id) {
+                r.read = read;
+                r.total = total;
+            }
+            ctx.request_repaint();
+        });
+        (id, progress)
     }
 
-    fn deliver(&self, file: ArrivedFile, ctx: &egui::Context) {
-        self.reading.set(self.reading.get().saturating_sub(1));
+    fn deliver(&self, id: u64, file: ArrivedFile, ctx: &egui::Context) {
+        self.reading.borrow_mut().retain(|(i, _)| *i != id);
         self.arrived.borrow_mut().push(file);
         ctx.request_repaint();
     }
@@ -92,10 +143,13 @@ impl FileInput {
             .unwrap_or_else(|| file.path().to_string_lossy().into_owned());
         let inbox = self.inbox.clone();
         let ctx = ctx.clone();
-        inbox.begin();
+        let (id, progress) = inbox.begin(&name, &ctx);
         wasm_bindgen_futures::spawn_local(async move {
-            let bytes = file.bytes_async().await;
-            inbox.deliver(ArrivedFile { name, bytes }, &ctx);
+            let bytes = match file.web_file() {
+                Some(web_file) => read_bytes::read_file(web_file, progress).await,
+                None => file.bytes_async().await,
+            };
+            inbox.deliver(id, ArrivedFile { name, bytes }, &ctx);
         });
     }
 
@@ -103,10 +157,10 @@ impl FileInput {
     pub fn fetch(&self, url: String, name: String, ctx: &egui::Context) {
         let inbox = self.inbox.clone();
         let ctx = ctx.clone();
-        inbox.begin();
+        let (id, progress) = inbox.begin(&name, &ctx);
         wasm_bindgen_futures::spawn_local(async move {
-            let bytes = super::query::fetch(&url).await;
-            inbox.deliver(ArrivedFile { name, bytes }, &ctx);
+            let bytes = read_bytes::fetch(&url, progress).await;
+            inbox.deliver(id, ArrivedFile { name, bytes }, &ctx);
         });
     }
 
@@ -115,9 +169,14 @@ impl FileInput {
         std::mem::take(&mut *self.inbox.arrived.borrow_mut())
     }
 
-    /// Number of files still being read.
-    pub fn reading(&self) -> usize {
-        self.inbox.reading.get()
+    /// The files still being read, oldest first.
+    pub fn reading(&self) -> Vec<Reading> {
+        self.inbox
+            .reading
+            .borrow()
+            .iter()
+            .map(|(_, r)| r.clone())
+            .collect()
     }
 }
 
@@ -151,33 +210,14 @@ fn create_picker(
             };
             let inbox = inbox.clone();
             let ctx = ctx.clone();
-            inbox.begin();
+            let name = file.name();
+            let (id, progress) = inbox.begin(&name, &ctx);
             wasm_bindgen_futures::spawn_local(async move {
-                let name = file.name();
-                let bytes = read_file(&file).await;
-                inbox.deliver(ArrivedFile { name, bytes }, &ctx);
+                let bytes = read_bytes::read_file(&file, progress).await;
+                inbox.deliver(id, ArrivedFile { name, bytes }, &ctx);
             });
         })
     };
     input.set_onchange(Some(on_change.as_ref().unchecked_ref()));
     Ok((input, on_change))
-}
-
-async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
-    // Wasm32 memory is 4 GiB at most; refuse early rather than fail inside the copy.
-    if file.size() > f64::from(u32::MAX) {
-        return Err(format!(
-            "the file is too large ({:.1} GB) to read in the browser",
-            file.size() / 1e9
-        ));
-    }
-    let buffer = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
-        .await
-        .map_err(|e| {
-            format!(
-                "the browser could not read it: {}",
-                super::page::js_error_text(&e)
-            )
-        })?;
-    Ok(js_sys::Uint8Array::new(&buffer).to_vec())
 }

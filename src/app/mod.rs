@@ -28,6 +28,7 @@ mod guide;
 mod legend;
 mod page;
 mod query;
+mod read_bytes;
 mod report_view;
 mod shell;
 mod shortcuts;

@@ -1,17 +1,11 @@
 //! `?model=URL`: open a mesh from the page's own origin at start. Any other origin is refused,
 //! so the page never sends a request beyond loading itself (patient data stays here).
 
-use wasm_bindgen::JsCast;
-
 /// A model named in the page's query: its absolute URL and a file name for the format.
 #[derive(Debug)]
 pub struct ModelUrl {
     pub url: String,
     pub name: String,
-}
-
-fn text(e: wasm_bindgen::JsValue) -> String {
-    super::page::js_error_text(&e)
 }
 
 /// The `model` query parameter, if there is one; an error when it names another origin.
@@ -49,23 +43,6 @@ fn resolve(wanted: &str, page: &str, origin: &str) -> Result<ModelUrl, String> {
         url: url.href(),
         name,
     })
-}
-
-/// Fetches `url`'s bytes (same origin, checked by [`model_url`]).
-pub async fn fetch(url: &str) -> Result<Vec<u8>, String> {
-    let window = web_sys::window().ok_or("no window")?;
-    let response = wasm_bindgen_futures::JsFuture::from(window.fetch_with_str(url))
-        .await
-        .map_err(|e| format!("cannot fetch it: {}", text(e)))?
-        .dyn_into::<web_sys::Response>()
-        .map_err(|_| "the fetch did not give a response")?;
-    if !response.ok() {
-        return Err(format!("the server answered {}", response.status()));
-    }
-    let buffer = wasm_bindgen_futures::JsFuture::from(response.array_buffer().map_err(text)?)
-        .await
-        .map_err(|e| format!("cannot read it: {}", text(e)))?;
-    Ok(js_sys::Uint8Array::new(&buffer).to_vec())
 }
 
 #[cfg(test)]

@@ -217,9 +217,7 @@ impl Shell {
         for file in self.files.take_arrived() {
             let mut doc = self.doc.borrow_mut();
             match file.bytes {
-                Ok(bytes) => {
-                    let _ = doc.open(&file.name, &bytes);
-                }
+                Ok(bytes) => doc.begin_open(&file.name, bytes, None),
                 Err(reason) => {
                     doc.session.fail(&file.name, &reason);
                 }
@@ -387,13 +385,31 @@ impl Shell {
                 ui.colored_label(ui.visuals().warn_fg_color, "CPU fallback")
                     .on_hover_text(why);
             }
-            if let Some(p) = doc.session.progress() {
+            let reading = self.files.reading();
+            if let Some(l) = doc.session.loading() {
+                ui.add(
+                    egui::ProgressBar::new(l.stage as f32 / l.total as f32)
+                        .desired_width(220.0)
+                        .text(format!(
+                            "opening: {} ({}/{})",
+                            l.doing,
+                            l.stage + 1,
+                            l.total
+                        )),
+                );
+            } else if let Some(fraction) = reading.first().and_then(|r| r.fraction()) {
+                ui.add(
+                    egui::ProgressBar::new(fraction)
+                        .desired_width(220.0)
+                        .text(format!("reading {:.0}%", 100.0 * fraction)),
+                );
+            } else if let Some(p) = doc.session.progress() {
                 ui.add(
                     egui::ProgressBar::new(p.fraction())
                         .desired_width(160.0)
                         .text(p.describe()),
                 );
-            } else if doc.busy() || self.files.reading() > 0 {
+            } else if doc.busy() || !reading.is_empty() {
                 ui.spinner();
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
@@ -440,8 +456,12 @@ impl Shell {
         if let Some(error) = doc.session.error().or(self.export_error.as_deref()) {
             lines.push((error.to_string(), ui.visuals().error_fg_color));
         }
-        if self.files.reading() > 0 {
-            lines.push(("Reading file…".to_string(), egui::Color32::WHITE));
+        for r in self.files.reading() {
+            lines.push((format!("{}…", r.describe()), egui::Color32::WHITE));
+        }
+        if let Some(l) = doc.session.loading() {
+            let text = format!("Opening {}: {}…", l.name, l.doing);
+            lines.push((text, egui::Color32::WHITE));
         }
         if self.show_original {
             lines.push((
@@ -498,11 +518,15 @@ impl eframe::App for Shell {
             self.draw_ms = 0.8 * self.draw_ms + 0.2 * other;
         }
         self.frame_start_ms = start;
-        self.compute();
+        // A file being opened takes the frame: the model it replaces needs no more work.
+        let loading = self.doc.borrow_mut().step_loading();
+        if !loading {
+            self.compute();
+        }
         let budget = self
             .draw_ms
             .clamp(*GUIDANCE_BUDGET_MS.start(), *GUIDANCE_BUDGET_MS.end());
-        {
+        if !loading {
             let mut doc = self.doc.borrow_mut();
             let vertices = doc.session.model().map_or(0, |m| m.mesh().vertex_count());
             let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));

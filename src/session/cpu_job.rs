@@ -79,29 +79,29 @@ impl CpuJob {
     }
 
     /// Works for about `budget_ms` (at least one iteration, or one part of the measure pass);
-    /// the result and its timings once the run is measured.
+    /// the result and its timings once the run is measured (the job is spent then).
     pub fn step(
-        mut self,
+        &mut self,
         model: &Model,
         (params, weights, tau): (&Params, Option<&[f32]>, f64),
         clock: &dyn Fn() -> f64,
         budget_ms: f64,
-    ) -> Result<(Smoothed, Timings), Self> {
+    ) -> Option<(Smoothed, Timings)> {
         let start = clock();
         if self.done < params.iterations {
             self.smooth(model, params, weights, clock, start + budget_ms);
             self.smooth_ms += clock() - start;
             if self.done < params.iterations || clock() - start >= budget_ms {
-                return Err(self);
+                return None;
             }
         }
         let measure_start = clock();
         let finished = self.measure(model, clock, start + budget_ms);
         self.measure_ms += clock() - measure_start;
         if !finished {
-            return Err(self);
+            return None;
         }
-        let measure = self.measure.take().expect("measured");
+        let measure = self.measure.take()?;
         let (metrics, vertex) = measure.finish(&model.original, tau);
         let timings = Timings {
             smooth_ms: self.smooth_ms,
@@ -110,11 +110,11 @@ impl CpuJob {
         let smoothed = Smoothed {
             revision: self.revision,
             params: *params,
-            positions: self.positions,
+            positions: std::mem::take(&mut self.positions),
             metrics,
             vertex,
         };
-        Ok((smoothed, timings))
+        Some((smoothed, timings))
     }
 
     /// Iterations until `deadline` (at least one). Iterations per call: one at first, then as

@@ -9,11 +9,13 @@
 mod colors;
 mod cpu_job;
 mod guidance;
+mod loading;
 mod weights;
 
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use cpu_job::CpuProgress;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
+pub use loading::{LoadProgress, Loaded, Loading};
 pub use weights::WeightsSummary;
 
 use cpu_job::CpuJob;
@@ -40,23 +42,9 @@ pub struct Model {
 
 impl Model {
     /// Parses `bytes` (the format chosen by `name`'s extension), builds topology, report and
-    /// the original's measures.
+    /// the original's measures (every stage of [`Loading`] in one call).
     pub fn load(name: &str, bytes: &[u8]) -> Result<Self, io::LoadError> {
-        Ok(Self::from_mesh(name, io::load(bytes, name)?))
-    }
-
-    pub fn from_mesh(name: &str, mesh: Mesh) -> Self {
-        let topology = Topology::build(&mesh);
-        let report = MeshReport::new(&mesh, &topology);
-        let warnings = report.warnings();
-        let edges = topology.edges();
-        Self {
-            name: name.to_string(),
-            original: Original::new(&mesh, &topology),
-            report,
-            warnings,
-            edges,
-        }
+        Loading::new(name, bytes.to_vec()).finish()
     }
 
     pub fn mesh(&self) -> &Mesh {
@@ -110,6 +98,10 @@ pub struct Session {
     /// Counts changes of `weights`.
     weights_version: u64,
     guidance: guidance::Guidance,
+    /// A file being opened, a stage per [`Self::step_loading`] call.
+    loading: Option<Loading>,
+    /// How long each stage of the latest opening took (ms), in order.
+    open_stages: Vec<(&'static str, f64)>,
 }
 
 impl Default for Session {
@@ -128,6 +120,8 @@ impl Default for Session {
             weights: None,
             weights_version: 0,
             guidance: guidance::Guidance::default(),
+            loading: None,
+            open_stages: Vec::new(),
         }
     }
 }
@@ -201,6 +195,56 @@ impl Session {
             Ok(model) => Ok(self.set_model(model)),
             Err(e) => Err(self.fail(name, &e.to_string())),
         }
+    }
+
+    /// Starts opening a file's bytes in stages ([`Self::step_loading`] does the work); the
+    /// current model stays open meanwhile. Returns the name of an opening this one replaces.
+    pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>) -> Option<String> {
+        let replaced = self.loading.take().map(|l| l.name().to_string());
+        self.loading = Some(Loading::new(name, bytes));
+        self.open_stages.clear();
+        replaced
+    }
+
+    /// Works on the file being opened for about `budget_ms` (at least one stage). Once it is
+    /// done: `Ok` with the model open, or the error (as [`Self::open`] reports it) with the
+    /// previous model still open. `None` while stages remain, or when nothing is being opened.
+    pub fn step_loading(
+        &mut self,
+        clock: &dyn Fn() -> f64,
+        budget_ms: f64,
+    ) -> Option<Result<(), String>> {
+        let start = clock();
+        while let Some(loading) = self.loading.take() {
+            let name = loading.name().to_string();
+            let doing = loading.progress().doing;
+            let stage_start = clock();
+            let step = loading.step();
+            self.open_stages.push((doing, clock() - stage_start));
+            match step {
+                Loaded::Pending(next) => self.loading = Some(*next),
+                Loaded::Done(model) => {
+                    self.set_model(*model);
+                    return Some(Ok(()));
+                }
+                Loaded::Failed(e) => return Some(Err(self.fail(&name, &e.to_string()))),
+            }
+            if clock() - start >= budget_ms {
+                break;
+            }
+        }
+        None
+    }
+
+    /// How long each stage of the latest opening took (ms), in order: the longest is the
+    /// longest the page could not draw while a file opened.
+    pub fn open_stages(&self) -> &[(&'static str, f64)] {
+        &self.open_stages
+    }
+
+    /// How far the file being opened got, while one is.
+    pub fn loading(&self) -> Option<LoadProgress> {
+        self.loading.as_ref().map(Loading::progress)
     }
 
     /// Makes `model` the open model (the previous result is dropped).
@@ -298,7 +342,7 @@ impl Session {
             return None;
         }
         let model = self.model.as_ref()?;
-        let job = match self.job.take() {
+        let mut job = match self.job.take() {
             Some(job) if job.revision == self.revision => job,
             _ => CpuJob::new(self.revision, model),
         };
@@ -307,16 +351,15 @@ impl Session {
             self.weights.as_deref(),
             self.tau,
         );
-        match job.step(model, settings, clock, budget_ms) {
-            Ok((result, timings)) => {
-                self.result = Some(result);
-                Some(timings)
-            }
-            Err(job) => {
+        let (result, timings) = match job.step(model, settings, clock, budget_ms) {
+            Some(done) => done,
+            None => {
                 self.job = Some(job);
-                None
+                return None;
             }
-        }
+        };
+        self.result = Some(result);
+        Some(timings)
     }
 
     /// How far the CPU engine got with the current revision, while a run is under way.
@@ -426,6 +469,12 @@ impl Session {
             "tau": self.tau,
             "busy": busy,
             "weights": self.weights_summary(),
+            "loading": self.loading().map(|l| serde_json::json!({
+                "name": l.name, "stage": l.stage, "stages": l.total, "doing": l.doing,
+            })),
+            "open_stages": self.open_stages.iter()
+                .map(|(doing, ms)| serde_json::json!({"doing": doing, "ms": ms}))
+                .collect::<Vec<_>>(),
         })
     }
 }

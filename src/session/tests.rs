@@ -282,3 +282,71 @@ fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
         serde_json::to_value(&r.metrics).unwrap()
     );
 }
+
+#[test]
+fn opening_in_stages_equals_opening_at_once_and_keeps_the_model_until_done() {
+    let mut s = Session::default();
+    s.open("first.ply", SAMPLE).unwrap();
+    let at_once = Model::load("second.ply", SAMPLE).unwrap();
+    assert_eq!(s.begin_open("second.ply", SAMPLE.to_vec()), None);
+    // A budget of 0 ms: one stage per call, the progress moving through every stage in order.
+    let mut stages = Vec::new();
+    let outcome = loop {
+        let p = s.loading().expect("opening");
+        assert_eq!((p.name.as_str(), p.total), ("second.ply", 4));
+        stages.push(p.stage);
+        assert_eq!(
+            s.model().unwrap().name,
+            "first.ply",
+            "the open model stays meanwhile"
+        );
+        assert_eq!(s.state_json(false)["loading"]["doing"], p.doing);
+        if let Some(outcome) = s.step_loading(&|| 0.0, 0.0) {
+            break outcome;
+        }
+    };
+    assert_eq!(outcome, Ok(()));
+    assert_eq!(stages, [0, 1, 2, 3]);
+    let timed: Vec<&str> = s.open_stages().iter().map(|(doing, _)| *doing).collect();
+    let named: Vec<String> = (0..4)
+        .map(|k| {
+            s.state_json(false)["open_stages"][k]["doing"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(timed, named);
+    assert_eq!(timed.len(), 4);
+    assert!(s.loading().is_none() && s.state_json(false)["loading"].is_null());
+    let model = s.model().unwrap();
+    assert_eq!(model.name, "second.ply");
+    assert_eq!(model.report, at_once.report);
+    assert_eq!(model.edges, at_once.edges);
+    assert_eq!(model.original.curvature(), at_once.original.curvature());
+    assert_eq!(model.original.volume(), at_once.original.volume());
+    assert_eq!(s.step_loading(&|| 0.0, 0.0), None, "nothing left to open");
+}
+
+#[test]
+fn a_bad_file_opened_in_stages_keeps_the_model_and_a_later_file_replaces_an_earlier() {
+    let mut s = sample_session();
+    let revision = s.revision();
+    s.begin_open(
+        "broken.ply",
+        b"ply\nformat ascii 1.0\nelement vertex 99\n".to_vec(),
+    );
+    let e = s.step_loading(&|| 0.0, f64::INFINITY).unwrap().unwrap_err();
+    assert!(e.starts_with("Cannot open broken.ply: "), "{e}");
+    assert_eq!(s.error(), Some(e.as_str()));
+    assert_eq!(s.model().unwrap().name, "bent_tube_staircase.ply");
+    assert_eq!(s.revision(), revision, "nothing changed");
+
+    s.begin_open("first.ply", SAMPLE.to_vec());
+    assert_eq!(s.step_loading(&|| 0.0, 0.0), None);
+    let replaced = s.begin_open("second.ply", SAMPLE.to_vec());
+    assert_eq!(replaced.as_deref(), Some("first.ply"));
+    assert_eq!(s.step_loading(&|| 0.0, f64::INFINITY), Some(Ok(())));
+    assert_eq!(s.model().unwrap().name, "second.ply");
+    assert_eq!(s.error(), None);
+}

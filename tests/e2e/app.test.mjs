@@ -462,3 +462,64 @@ test("9 benchmark: HC, 20 iterations, on the 206k-vertex segmentation (printed)"
         await app.screenshot("09-brain-smoothed-hc");
     });
 });
+
+// --- 10: a large mesh opens over several frames ---
+
+test("10 the 206k-vertex mesh opens over several frames: state() shows the stages, the old model stays meanwhile (stage times printed)", { timeout: API_TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.api();
+        const before = (await app.state()).model;
+        const name = "seg_mni152_gm_plus_wm_p0.5_1mm.ply";
+        const run = await app.page.evaluate(
+            async ([base64, name]) => {
+                const text = atob(base64);
+                const bytes = new Uint8Array(text.length);
+                for (let i = 0; i < text.length; i++) {
+                    bytes[i] = text.charCodeAt(i);
+                }
+                // What state() says at every animation frame (the app works a stage per frame).
+                const seen = [];
+                let running = true;
+                const look = () => {
+                    const s = window.meshsmooth.state();
+                    if (s.loading) seen.push({ stage: s.loading.stage, doing: s.loading.doing, model: s.model });
+                    if (running) requestAnimationFrame(look);
+                };
+                requestAnimationFrame(look);
+                const start = performance.now();
+                const info = await window.meshsmooth.loadMesh(bytes, name);
+                const seconds = (performance.now() - start) / 1000;
+                running = false;
+                return { info, seen, seconds, after: window.meshsmooth.state() };
+            },
+            [readFileSync(BRAIN).toString("base64"), name],
+        );
+        assert.equal(run.info.vertices, 206512);
+        assert.equal(run.after.model, name);
+        assert.equal(run.after.loading, null, "state().loading clears once the mesh is open");
+        const stages = [...new Set(run.seen.map((s) => s.stage))];
+        // Stages shorter than a frame's budget share a frame (reading and the topology do), so
+        // not every stage shows; two or more mean the opening took three frames or more.
+        assert.ok(stages.length >= 2, `state() showed only stages ${JSON.stringify(stages)} between frames`);
+        assert.deepEqual(stages, [...stages].sort((a, b) => a - b), "stages go forward");
+        for (const s of run.seen) {
+            assert.equal(s.model, before, "the previous model stays open while the new one opens");
+            assert.ok(s.doing.length > 0);
+        }
+        const stageMs = run.after.open_stages;
+        assert.equal(stageMs.length, 4, "every stage is timed");
+        const line = {
+            bench: "open-large-mesh",
+            mode: MODE,
+            backend: await app.backend(),
+            mesh: name,
+            seconds: run.seconds,
+            stage_ms: Object.fromEntries(stageMs.map((s) => [s.doing, Math.round(s.ms)])),
+            longest_stage_ms: Math.max(...stageMs.map((s) => s.ms)),
+            stages_seen_between_frames: run.seen.map((s) => s.doing).filter((d, i, a) => a.indexOf(d) === i),
+        };
+        console.log(JSON.stringify(line));
+        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
+        await app.screenshot("10-brain-opened");
+    });
+});

@@ -1,0 +1,120 @@
+//! Opening a file in stages (parse, topology, checks, the original's measures), so a page
+//! without threads can draw a frame with the progress between them instead of freezing while a
+//! large mesh opens. [`Loading::finish`] runs every stage in one call; the stages are the same.
+
+use super::Model;
+use crate::io::{self, LoadError};
+use crate::mesh::{Mesh, MeshReport, Topology};
+use crate::metrics::Original;
+
+/// What is left to do, with what the done stages produced.
+enum Stage {
+    Parse(Vec<u8>),
+    Topology(Mesh),
+    Check(Mesh, Topology),
+    Measure(Mesh, Topology, MeshReport, Vec<[u32; 2]>),
+}
+
+/// Stage names, in order, as the progress bar shows them.
+const STAGES: [&str; 4] = [
+    "reading the file",
+    "building the topology",
+    "checking the mesh",
+    "measuring the original",
+];
+
+/// How far an opening got: the stage under way (0-based) of [`LoadProgress::total`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoadProgress {
+    pub name: String,
+    pub stage: usize,
+    pub total: usize,
+    /// What the stage under way does.
+    pub doing: &'static str,
+}
+
+/// A file being opened.
+pub struct Loading {
+    name: String,
+    stage: Stage,
+}
+
+/// What one stage left.
+pub enum Loaded {
+    /// More stages to go.
+    Pending(Box<Loading>),
+    Done(Box<Model>),
+    Failed(LoadError),
+}
+
+impl Loading {
+    /// Opens `bytes` (the format from `name`'s extension).
+    pub fn new(name: &str, bytes: Vec<u8>) -> Self {
+        Self {
+            name: name.to_string(),
+            stage: Stage::Parse(bytes),
+        }
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn progress(&self) -> LoadProgress {
+        let stage = match self.stage {
+            Stage::Parse(_) => 0,
+            Stage::Topology(_) => 1,
+            Stage::Check(..) => 2,
+            Stage::Measure(..) => 3,
+        };
+        LoadProgress {
+            name: self.name.clone(),
+            stage,
+            total: STAGES.len(),
+            doing: STAGES[stage],
+        }
+    }
+
+    /// Runs the next stage.
+    pub fn step(self) -> Loaded {
+        let Self { name, stage } = self;
+        let next = match stage {
+            Stage::Parse(bytes) => match io::load(&bytes, &name) {
+                Ok(mesh) => Stage::Topology(mesh),
+                Err(e) => return Loaded::Failed(e),
+            },
+            Stage::Topology(mesh) => {
+                let topology = Topology::build(&mesh);
+                Stage::Check(mesh, topology)
+            }
+            Stage::Check(mesh, topology) => {
+                let report = MeshReport::new(&mesh, &topology);
+                let edges = topology.edges();
+                Stage::Measure(mesh, topology, report, edges)
+            }
+            Stage::Measure(mesh, topology, report, edges) => {
+                let original = Original::new(&mesh, &topology);
+                return Loaded::Done(Box::new(Model {
+                    name,
+                    warnings: report.warnings(),
+                    original,
+                    report,
+                    edges,
+                }));
+            }
+        };
+        Loaded::Pending(Box::new(Self { name, stage: next }))
+    }
+
+    /// Every stage left, in one call.
+    pub fn finish(self) -> Result<Model, LoadError> {
+        let mut loading = self;
+        loop {
+            match loading.step() {
+                Loaded::Pending(next) => loading = *next,
+                Loaded::Done(model) => return Ok(*model),
+                Loaded::Failed(e) => return Err(e),
+            }
+        }
+    }
+}
