@@ -143,8 +143,9 @@ impl Document {
         self.waiting_for_load.extend(waiter);
     }
 
-    /// This frame's work on the file being opened, if one is; returns whether there was one
-    /// (the frame then has no time for other work).
+    /// This frame's work on the file being opened, if one is; returns whether it is still
+    /// opening (the frame then has no time for other work). The frame that opens it goes on to
+    /// the engines' work as usual, so they take up the new model before the view is updated.
     pub fn step_loading(&mut self) -> bool {
         if self.session.loading().is_none() {
             return false;
@@ -159,7 +160,7 @@ impl Document {
         for w in std::mem::take(&mut self.waiting_for_load) {
             w(outcome.clone().map(|()| &self.session));
         }
-        true
+        false
     }
 
     /// What a newly opened model needs.

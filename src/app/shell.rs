@@ -518,7 +518,7 @@ impl eframe::App for Shell {
             self.draw_ms = 0.8 * self.draw_ms + 0.2 * other;
         }
         self.frame_start_ms = start;
-        // A file being opened takes the frame: the model it replaces needs no more work.
+        // A file still opening takes the frame: the model it replaces needs no more work.
         let loading = self.doc.borrow_mut().step_loading();
         if !loading {
             self.compute();

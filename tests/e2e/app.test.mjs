@@ -520,6 +520,10 @@ test("10 the 206k-vertex mesh opens over several frames: state() shows the stage
         };
         console.log(JSON.stringify(line));
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
-        await app.screenshot("10-brain-opened");
+        // The view follows: the new mesh drawn and colour-coded once measured, and no error
+        // text (red) over it.
+        await app.metrics();
+        const image = await app.screenshotWhen("10-brain-opened", middleShowsSomething, "the opened mesh in the middle of the page", 60_000);
+        assert.ok(redPixels(image) < 50, `red (error) text over the view after opening: ${redPixels(image)} red pixels`);
     });
 });
