@@ -459,6 +459,35 @@ test("9 benchmark: HC, 20 iterations, on the 206k-vertex segmentation (printed)"
             iterations: 20,
             seconds_set_params_and_metrics: seconds,
         });
+        if (MODE === "cpu") {
+            // The wasm CPU engine against the native one on one thread, each its best of 3:
+            // state().timings counts the engine's own work (smoothing with the drift, and the
+            // measure pass), not the frames drawn between its slices. Beta moves by 0.01 between
+            // runs so each is a new run of the same work.
+            let wasm = null;
+            for (const beta of [0.51, 0.5, 0.51]) {
+                await app.setParams({ beta });
+                await app.metrics();
+                const t = (await app.state()).timings;
+                wasm = wasm ? { smooth_ms: Math.min(wasm.smooth_ms, t.smooth_ms), measure_ms: Math.min(wasm.measure_ms, t.measure_ms) } : t;
+            }
+            const one = await cli.cliWithEnv({ RAYON_NUM_THREADS: "1" }, "bench", BRAIN, "--filter", "hc", "--iterations", "20", "--repeat", "3", "--json").then(JSON.parse);
+            const nativeSmoothMs = (one.seconds + one.drift_seconds) * 1e3;
+            const nativeMeasureMs = one.measure_seconds * 1e3;
+            emit({
+                bench: "wasm-vs-native-one-thread",
+                mesh: "seg_mni152_gm_plus_wm_p0.5_1mm.ply",
+                filter: "hc",
+                iterations: 20,
+                native_threads: one.threads,
+                native_smooth_and_drift_ms: nativeSmoothMs,
+                wasm_smooth_and_drift_ms: wasm.smooth_ms,
+                native_measure_ms: nativeMeasureMs,
+                wasm_measure_ms: wasm.measure_ms,
+                wasm_speed_vs_native_smoothing: nativeSmoothMs / wasm.smooth_ms,
+                wasm_speed_vs_native_measure: nativeMeasureMs / wasm.measure_ms,
+            });
+        }
         await app.screenshot("09-brain-smoothed-hc");
     });
 });

@@ -26,9 +26,15 @@ export function requireCli() {
 }
 
 /** Runs the CLI; resolves with stdout, rejects with an Error carrying its stderr. */
-export async function cli(...args) {
+export function cli(...args) {
+    return cliWithEnv({}, ...args);
+}
+
+/** `cli` with environment variables added (e.g. `RAYON_NUM_THREADS`). */
+export async function cliWithEnv(env, ...args) {
     try {
-        const { stdout } = await run(requireCli(), args, { maxBuffer: 64 << 20 });
+        const options = { maxBuffer: 64 << 20, env: { ...process.env, ...env } };
+        const { stdout } = await run(requireCli(), args, options);
         return stdout;
     } catch (e) {
         const error = new Error(`meshsmooth ${args.join(" ")} failed (exit ${e.code}): ${String(e.stderr).trim()}`);
