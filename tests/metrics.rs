@@ -10,7 +10,7 @@ mod shapes;
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::metrics::{
     exact_distances, exact_error, identity, measure, measure_vertices, point_triangle_distance2,
-    vertex_curvatures, DriftingReference, MeasureInParts, Original, TriangleBvh,
+    vertex_curvatures, DriftingReference, MeasureInParts, Original, OriginalInParts, TriangleBvh,
 };
 use meshsmooth::smooth::{self, Filter, NoObserver, Params};
 use std::f64::consts::PI;
@@ -214,6 +214,30 @@ fn a_measure_pass_in_parts_equals_the_pass_in_one_call() {
         let expected_calls = n.div_ceil(part.div_ceil(2048) * 2048);
         assert_eq!(calls + 1, expected_calls, "part {part}");
         assert_eq!(pass.finish(&o, 0.3), whole, "part {part}");
+    }
+}
+
+#[test]
+fn the_original_measured_in_parts_equals_the_original_at_once() {
+    for (name, _) in [data::CLOSED_MESHES[0], data::CLOSED_MESHES[6]] {
+        let (mesh, topology) = data::load(name);
+        let at_once = Original::new(&mesh, &topology);
+        for part in [1, 3000, usize::MAX] {
+            let mut parts = OriginalInParts::new(mesh.clone(), topology.clone());
+            let mut fraction = parts.fraction();
+            assert_eq!(fraction, 0.0);
+            while !parts.advance(part) {
+                assert!(
+                    parts.fraction() > fraction && parts.fraction() < 1.0,
+                    "{name}"
+                );
+                fraction = parts.fraction();
+            }
+            let o = parts.finish();
+            assert_eq!(o.volume(), at_once.volume(), "{name} part {part}");
+            assert_eq!(o.curvature(), at_once.curvature(), "{name} part {part}");
+            assert_eq!(o.referenced_vertices(), at_once.referenced_vertices());
+        }
     }
 }
 

@@ -388,7 +388,7 @@ impl Shell {
             let reading = self.files.reading();
             if let Some(l) = doc.session.loading() {
                 ui.add(
-                    egui::ProgressBar::new(l.stage as f32 / l.total as f32)
+                    egui::ProgressBar::new(l.fraction)
                         .desired_width(220.0)
                         .text(format!(
                             "opening: {} ({}/{})",

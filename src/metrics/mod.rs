@@ -16,7 +16,7 @@ mod score;
 pub use curvature::{vertex_curvature, vertex_curvatures, VertexCurvature};
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
 pub use local_error::{identity, smooth_drifting, DriftingReference};
-pub use original::Original;
+pub use original::{Original, OriginalInParts};
 pub use report::{
     exact_distances, exact_error, measure, measure_vertices, ErrorSummary, MeasureInParts, Metrics,
     VertexMeasures,

@@ -2,7 +2,7 @@
 //! over a smoothed mesh only reads what stays fixed.
 
 use super::curvature::fan_corners;
-use super::report::{measure_pass, Sums};
+use super::report::MeasureInParts;
 use crate::mesh::{Mesh, Topology};
 
 /// The original mesh with what the measures precompute from it: the triangle fans in the order
@@ -27,6 +27,13 @@ pub struct Original {
 impl Original {
     /// Precomputes the original's measures. `topology` must be `Topology::build(mesh)`.
     pub fn new(mesh: &Mesh, topology: &Topology) -> Self {
+        let mut parts = OriginalInParts::new(mesh.clone(), topology.clone());
+        while !parts.advance(usize::MAX) {}
+        parts.finish()
+    }
+
+    /// The original without its measures yet (see [`OriginalInParts`]).
+    fn unmeasured(mesh: Mesh, topology: Topology) -> Self {
         assert_eq!(
             topology.vertex_count(),
             mesh.vertex_count(),
@@ -35,19 +42,15 @@ impl Original {
         let referenced = (0..mesh.vertex_count())
             .filter(|&i| !topology.triangles_of(i).is_empty())
             .count();
-        let mut original = Self {
-            mesh: mesh.clone(),
-            topology: topology.clone(),
-            fan_corners: fan_corners(&mesh.triangles, topology),
-            stay_radius2: stay_radius2(&mesh.positions, topology),
+        Self {
+            fan_corners: fan_corners(&mesh.triangles, &topology),
+            stay_radius2: stay_radius2(&mesh.positions, &topology),
+            mesh,
+            topology,
             volume: None,
             curvature: 0.0,
             referenced,
-        };
-        let sums: Sums = measure_pass(&original, &mesh.positions, None);
-        original.volume = original.is_closed().then(|| sums.volume());
-        original.curvature = sums.curvature();
-        original
+        }
     }
 
     /// V0, by the divergence theorem; `None` for an open mesh (or one without triangles), where
@@ -119,4 +122,52 @@ fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
             }
         })
         .collect()
+}
+
+/// [`Original::new`] spread over calls, for a caller that must return between them (the
+/// browser's one thread opening a large mesh): the precomputation when created, then the
+/// measure pass of the original ([`MeasureInParts`], every vertex its own reference) a run of
+/// vertices at a time. The result is [`Original::new`]'s, bit for bit.
+pub struct OriginalInParts {
+    original: Original,
+    reference: Vec<u32>,
+    pass: MeasureInParts,
+}
+
+impl OriginalInParts {
+    /// `topology` must be `Topology::build(&mesh)`.
+    pub fn new(mesh: Mesh, topology: Topology) -> Self {
+        let original = Original::unmeasured(mesh, topology);
+        let reference = super::identity(original.mesh.vertex_count());
+        let pass = MeasureInParts::new(&original, &original.mesh.positions, &reference);
+        Self {
+            original,
+            reference,
+            pass,
+        }
+    }
+
+    /// Measures up to `vertices` more vertices; returns whether every vertex is measured.
+    pub fn advance(&mut self, vertices: usize) -> bool {
+        let o = &self.original;
+        self.pass
+            .advance(o, &o.mesh.positions, &self.reference, vertices)
+    }
+
+    /// The fraction of the vertices measured.
+    pub fn fraction(&self) -> f32 {
+        let (done, total) = self.pass.progress();
+        done as f32 / total.max(1) as f32
+    }
+
+    /// The original with its measures, once [`Self::advance`] returned true.
+    pub fn finish(self) -> Original {
+        let Self {
+            mut original, pass, ..
+        } = self;
+        let sums = pass.sums();
+        original.volume = original.is_closed().then(|| sums.volume());
+        original.curvature = sums.curvature();
+        original
+    }
 }

@@ -171,10 +171,14 @@ impl MeasureInParts {
 
     /// The report and the per-vertex arrays, once [`Self::advance`] returned true.
     pub fn finish(self, original: &Original, tau: f64) -> (Metrics, VertexMeasures) {
+        (metrics(original, &self.sums(), tau), self.vertex)
+    }
+
+    /// The pass's totals, once [`Self::advance`] returned true.
+    pub(crate) fn sums(&self) -> Sums {
         let (done, total) = self.progress();
         assert_eq!(done, total, "finish before every vertex is measured");
-        let sums = total_of(self.volume6, &self.partial);
-        (metrics(original, &sums, tau), self.vertex)
+        total_of(self.volume6, &self.partial)
     }
 }
 

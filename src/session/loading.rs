@@ -1,36 +1,44 @@
-//! Opening a file in stages (parse, topology, checks, the original's measures), so a page
-//! without threads can draw a frame with the progress between them instead of freezing while a
+//! Opening a file in stages (parse, topology, checks, the original's measures a part at a time),
+//! so a page without threads can draw a frame with the progress between them instead of freezing while a
 //! large mesh opens. [`Loading::finish`] runs every stage in one call; the stages are the same.
 
 use super::Model;
 use crate::io::{self, LoadError};
 use crate::mesh::{Mesh, MeshReport, Topology};
-use crate::metrics::Original;
+use crate::metrics::OriginalInParts;
 
 /// What is left to do, with what the done stages produced.
 enum Stage {
     Parse(Vec<u8>),
     Topology(Mesh),
     Check(Mesh, Topology),
-    Measure(Mesh, Topology, MeshReport, Vec<[u32; 2]>),
+    Prepare(Mesh, Topology, MeshReport, Vec<[u32; 2]>),
+    /// The original's measures, a part per step.
+    Measure(Box<OriginalInParts>, MeshReport, Vec<[u32; 2]>),
 }
 
+/// Vertices of the original measured per step (about 10 ms in the browser).
+const MEASURE_PART: usize = 32 * 1024;
+
 /// Stage names, in order, as the progress bar shows them.
-const STAGES: [&str; 4] = [
+const STAGES: [&str; 5] = [
     "reading the file",
     "building the topology",
     "checking the mesh",
+    "preparing the measures",
     "measuring the original",
 ];
 
 /// How far an opening got: the stage under way (0-based) of [`LoadProgress::total`].
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct LoadProgress {
     pub name: String,
     pub stage: usize,
     pub total: usize,
     /// What the stage under way does.
     pub doing: &'static str,
+    /// The whole opening's part done, in [0, 1].
+    pub fraction: f32,
 }
 
 /// A file being opened.
@@ -61,17 +69,19 @@ impl Loading {
     }
 
     pub fn progress(&self) -> LoadProgress {
-        let stage = match self.stage {
-            Stage::Parse(_) => 0,
-            Stage::Topology(_) => 1,
-            Stage::Check(..) => 2,
-            Stage::Measure(..) => 3,
+        let (stage, within) = match &self.stage {
+            Stage::Parse(_) => (0, 0.0),
+            Stage::Topology(_) => (1, 0.0),
+            Stage::Check(..) => (2, 0.0),
+            Stage::Prepare(..) => (3, 0.0),
+            Stage::Measure(original, ..) => (4, original.fraction()),
         };
         LoadProgress {
             name: self.name.clone(),
             stage,
             total: STAGES.len(),
             doing: STAGES[stage],
+            fraction: (stage as f32 + within) / STAGES.len() as f32,
         }
     }
 
@@ -90,14 +100,21 @@ impl Loading {
             Stage::Check(mesh, topology) => {
                 let report = MeshReport::new(&mesh, &topology);
                 let edges = topology.edges();
-                Stage::Measure(mesh, topology, report, edges)
+                Stage::Prepare(mesh, topology, report, edges)
             }
-            Stage::Measure(mesh, topology, report, edges) => {
-                let original = Original::new(&mesh, &topology);
+            Stage::Prepare(mesh, topology, report, edges) => {
+                let original = Box::new(OriginalInParts::new(mesh, topology));
+                Stage::Measure(original, report, edges)
+            }
+            Stage::Measure(mut original, report, edges) => {
+                if !original.advance(MEASURE_PART) {
+                    let stage = Stage::Measure(original, report, edges);
+                    return Loaded::Pending(Box::new(Self { name, stage }));
+                }
                 return Loaded::Done(Box::new(Model {
                     name,
                     warnings: report.warnings(),
-                    original,
+                    original: original.finish(),
                     report,
                     edges,
                 }));

@@ -293,7 +293,7 @@ fn opening_in_stages_equals_opening_at_once_and_keeps_the_model_until_done() {
     let mut stages = Vec::new();
     let outcome = loop {
         let p = s.loading().expect("opening");
-        assert_eq!((p.name.as_str(), p.total), ("second.ply", 4));
+        assert_eq!((p.name.as_str(), p.total), ("second.ply", 5));
         stages.push(p.stage);
         assert_eq!(
             s.model().unwrap().name,
@@ -306,9 +306,9 @@ fn opening_in_stages_equals_opening_at_once_and_keeps_the_model_until_done() {
         }
     };
     assert_eq!(outcome, Ok(()));
-    assert_eq!(stages, [0, 1, 2, 3]);
+    assert_eq!(stages, [0, 1, 2, 3, 4]);
     let timed: Vec<&str> = s.open_stages().iter().map(|(doing, _)| *doing).collect();
-    let named: Vec<String> = (0..4)
+    let named: Vec<String> = (0..5)
         .map(|k| {
             s.state_json(false)["open_stages"][k]["doing"]
                 .as_str()
@@ -317,7 +317,7 @@ fn opening_in_stages_equals_opening_at_once_and_keeps_the_model_until_done() {
         })
         .collect();
     assert_eq!(timed, named);
-    assert_eq!(timed.len(), 4);
+    assert_eq!(timed.len(), 5);
     assert!(s.loading().is_none() && s.state_json(false)["loading"].is_null());
     let model = s.model().unwrap();
     assert_eq!(model.name, "second.ply");

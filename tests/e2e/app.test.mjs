@@ -535,16 +535,20 @@ test("10 the 206k-vertex mesh opens over several frames: state() shows the stage
             assert.equal(s.model, before, "the previous model stays open while the new one opens");
             assert.ok(s.doing.length > 0);
         }
+        // One entry per step: the original's measures take several.
         const stageMs = run.after.open_stages;
-        assert.equal(stageMs.length, 4, "every stage is timed");
+        const perStage = {};
+        for (const s of stageMs) perStage[s.doing] = (perStage[s.doing] ?? 0) + s.ms;
+        assert.equal(Object.keys(perStage).length, 5, `every stage is timed: ${JSON.stringify(stageMs)}`);
         const line = {
             bench: "open-large-mesh",
             mode: MODE,
             backend: await app.backend(),
             mesh: name,
             seconds: run.seconds,
-            stage_ms: Object.fromEntries(stageMs.map((s) => [s.doing, Math.round(s.ms)])),
-            longest_stage_ms: Math.max(...stageMs.map((s) => s.ms)),
+            stage_ms: Object.fromEntries(Object.entries(perStage).map(([k, v]) => [k, Math.round(v)])),
+            steps: stageMs.length,
+            longest_step_ms: Math.max(...stageMs.map((s) => s.ms)),
             stages_seen_between_frames: run.seen.map((s) => s.doing).filter((d, i, a) => a.indexOf(d) === i),
         };
         console.log(JSON.stringify(line));
