@@ -4,7 +4,7 @@
 
 use super::{Model, Smoothed, Timings};
 use crate::metrics::{self, DriftingReference, MeasureInParts};
-use crate::smooth::{self, Filter, Params};
+use crate::smooth::{self, Filter, Params, SincInParts};
 
 /// How far a run got (see [`super::Session::progress`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,6 +44,10 @@ pub(super) struct CpuJob {
     reference: Vec<u32>,
     done: u32,
     smooth_ms: f64,
+    /// Windowed sinc's recurrence under way (its terms are not shorter runs' results).
+    sinc: Option<SincInParts>,
+    /// Windowed sinc's result is in `positions`; the drift's steps towards it left to take.
+    sinc_drift_left: Option<u32>,
     /// The measure pass, once the smoothing is done.
     measure: Option<MeasureInParts>,
     measure_ms: f64,
@@ -60,6 +64,8 @@ impl CpuJob {
             reference: metrics::identity(model.mesh().vertex_count()),
             done: 0,
             smooth_ms: 0.0,
+            sinc: None,
+            sinc_drift_left: None,
             measure: None,
             measure_ms: 0.0,
         }
@@ -72,7 +78,11 @@ impl CpuJob {
                 CpuProgress::Measuring { done, total }
             }
             None => CpuProgress::Smoothing {
-                done: self.done,
+                done: match &self.sinc {
+                    Some(sinc) => sinc.progress().0,
+                    None if self.sinc_drift_left.is_some() => params.iterations,
+                    None => self.done,
+                },
                 total: params.iterations,
             },
         }
@@ -129,10 +139,7 @@ impl CpuJob {
         deadline: f64,
     ) {
         if params.filter == Filter::Sinc {
-            // Its terms are not shorter filters' results: one piece.
-            (self.positions, self.reference) =
-                metrics::smooth_drifting(&model.original, params, weights);
-            self.done = params.iterations;
+            self.smooth_sinc(model, params, weights, clock, deadline);
             return;
         }
         let mut chunk = 1;
@@ -162,6 +169,56 @@ impl CpuJob {
             let per_iteration = ((now - chunk_start) / chunk as f64).max(1e-3);
             let remaining = params.iterations - self.done;
             chunk = ((left / per_iteration).floor() as u32).clamp(1, remaining.max(1));
+        }
+    }
+
+    /// Windowed sinc until `deadline` (at least one neighbour pass or drift step): its terms,
+    /// then the drifting reference's steps towards the result (one per degree, as
+    /// [`metrics::smooth_drifting`] takes them).
+    fn smooth_sinc(
+        &mut self,
+        model: &Model,
+        params: &Params,
+        weights: Option<&[f32]>,
+        clock: &dyn Fn() -> f64,
+        deadline: f64,
+    ) {
+        let (mesh, topology) = (model.mesh(), model.topology());
+        if self.sinc_drift_left.is_none() {
+            let sinc = match self.sinc.take() {
+                Some(sinc) => Some(sinc),
+                None => SincInParts::new(mesh, topology, params),
+            };
+            let Some(mut sinc) = sinc else { return };
+            let mut more = 1;
+            loop {
+                let part_start = clock();
+                if sinc.advance(mesh, topology, more) {
+                    self.positions = sinc.finish(mesh, params, weights);
+                    self.sinc_drift_left = Some(params.iterations);
+                    break;
+                }
+                let now = clock();
+                if now >= deadline {
+                    self.sinc = Some(sinc);
+                    return;
+                }
+                let per_pass = ((now - part_start) / more as f64).max(1e-3);
+                more = ((deadline - now) / per_pass).max(1.0) as u32;
+            }
+        }
+        let mut drift =
+            DriftingReference::resume(&model.original, std::mem::take(&mut self.reference));
+        while let Some(left) = self.sinc_drift_left.filter(|&n| n > 0) {
+            drift.update(&self.positions);
+            self.sinc_drift_left = Some(left - 1);
+            if clock() >= deadline {
+                break;
+            }
+        }
+        self.reference = drift.into_reference();
+        if self.sinc_drift_left == Some(0) {
+            self.done = params.iterations;
         }
     }
 

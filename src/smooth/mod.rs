@@ -16,9 +16,11 @@ mod params;
 mod rings;
 mod sinc;
 mod sinc_coefficients;
+mod sinc_parts;
 mod umbrella;
 
 pub use params::{shortest, Filter, ParamError, Params};
+pub use sinc_parts::SincInParts;
 // The GPU engine evaluates the same windowed-sinc series.
 pub(crate) use sinc_coefficients::sinc_coefficients;
 
@@ -172,6 +174,43 @@ mod tests {
         fn after_iteration(&mut self, k: u32, _: &[[f32; 3]]) {
             self.1.push(k);
         }
+    }
+
+    #[test]
+    fn windowed_sinc_in_parts_equals_the_whole_run() {
+        let mesh = crate::io::load(
+            include_bytes!("../../web/sample/bent_tube_staircase.ply"),
+            "tube.ply",
+        )
+        .unwrap();
+        let topology = Topology::build(&mesh);
+        let weights: Vec<f32> = (0..mesh.vertex_count())
+            .map(|i| (i % 3) as f32 / 2.0)
+            .collect();
+        let mut p = Params::defaults(Filter::Sinc);
+        for (iterations, bound, w) in [(20, None, None), (7, Some(0.4), Some(&weights[..]))] {
+            p.iterations = iterations;
+            p.max_displacement = bound;
+            let expected = smooth(&mesh, &topology, &p, w, &mut NoObserver);
+            for more in [1, 3, u32::MAX] {
+                let mut parts = SincInParts::new(&mesh, &topology, &p).expect("sinc");
+                assert_eq!(parts.progress(), (1, iterations));
+                let mut calls = 0;
+                while !parts.advance(&mesh, &topology, more) {
+                    calls += 1;
+                    assert!(parts.progress().0 < iterations);
+                }
+                assert_eq!(calls, (iterations - 1).div_ceil(more.min(iterations)) - 1);
+                assert_eq!(parts.progress(), (iterations, iterations));
+                let got = parts.finish(&mesh, &p, w);
+                assert_eq!(got, expected, "{iterations} iterations, {more} per call");
+            }
+        }
+        p.iterations = 0;
+        let nothing = SincInParts::new(&mesh, &topology, &p).expect("sinc");
+        assert_eq!(nothing.finish(&mesh, &p, None), mesh.positions);
+        let laplace = Params::defaults(Filter::Laplace);
+        assert!(SincInParts::new(&mesh, &topology, &laplace).is_none());
     }
 
     #[test]

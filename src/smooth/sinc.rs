@@ -41,41 +41,99 @@ pub(crate) fn run<C: Constrain>(
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
-    let n = original.len();
-    let Some((lo, hi)) = bounding_box(original).filter(|_| iterations > 0) else {
+    let Some(mut terms) = Terms::start(rings, original, passband, iterations) else {
         return original.to_vec();
     };
-    assert!(n == rings.vertex_count());
-    let centre: [f32; 3] = std::array::from_fn(|k| ((lo[k] as f64 + hi[k] as f64) * 0.5) as f32);
-    let c: Vec<f32> = sinc_coefficients(iterations, passband)
-        .into_iter()
-        .map(|x| x as f32)
-        .collect();
-
-    // T_{k-1} x and T_k x (centred), and the estimate; allocated once for the whole run.
-    let mut previous = vec![[0.0f32; 3]; n];
-    let mut current = vec![[0.0f32; 3]; n];
-    let mut estimate = vec![[0.0f32; 3]; n];
-    first_term(
-        rings,
-        original,
-        centre,
-        [c[0], c[1]],
-        &mut previous,
-        &mut current,
-        &mut estimate,
-    );
-    for &ck in &c[2..] {
-        // `previous` becomes T_{k+1} x in place, then the pair swaps roles.
-        next_term(rings, ck, &current, &mut previous, &mut estimate);
-        std::mem::swap(&mut previous, &mut current);
-    }
-    let result = constrain(original, estimate, constraint);
+    while !terms.advance(rings, u32::MAX) {}
+    let result = terms.finish(original, constraint);
     for _ in 0..iterations {
         observer.after_step(&result);
     }
     observer.after_iteration(iterations, &result);
     result
+}
+
+/// The recurrence under way: the terms so far summed into the estimate. Advancing it a few
+/// terms at a time gives the same result, bit for bit, as running it through.
+pub(crate) struct Terms {
+    /// The series' coefficients, `c_0 ..= c_iterations`.
+    c: Vec<f32>,
+    /// The highest term summed so far.
+    k: usize,
+    /// T_{k-1} x and T_k x (centred), and the estimate; allocated once for the whole run.
+    previous: Vec<[f32; 3]>,
+    current: Vec<[f32; 3]>,
+    estimate: Vec<[f32; 3]>,
+}
+
+impl Terms {
+    /// The first two terms; `None` when nothing moves (no iterations, or no vertices).
+    pub(crate) fn start(
+        rings: Rings,
+        original: &[[f32; 3]],
+        passband: f32,
+        iterations: u32,
+    ) -> Option<Self> {
+        let n = original.len();
+        let (lo, hi) = bounding_box(original).filter(|_| iterations > 0)?;
+        assert!(n == rings.vertex_count());
+        let centre: [f32; 3] =
+            std::array::from_fn(|k| ((lo[k] as f64 + hi[k] as f64) * 0.5) as f32);
+        let c: Vec<f32> = sinc_coefficients(iterations, passband)
+            .into_iter()
+            .map(|x| x as f32)
+            .collect();
+        let mut t = Self {
+            k: 1,
+            previous: vec![[0.0f32; 3]; n],
+            current: vec![[0.0f32; 3]; n],
+            estimate: vec![[0.0f32; 3]; n],
+            c,
+        };
+        first_term(
+            rings,
+            original,
+            centre,
+            [t.c[0], t.c[1]],
+            &mut t.previous,
+            &mut t.current,
+            &mut t.estimate,
+        );
+        Some(t)
+    }
+
+    /// Sums up to `more` further terms; returns whether every term is summed.
+    pub(crate) fn advance(&mut self, rings: Rings, more: u32) -> bool {
+        let last = self.c.len() - 1;
+        let end = last.min(self.k.saturating_add(more as usize));
+        while self.k < end {
+            self.k += 1;
+            // `previous` becomes T_{k+1} x in place, then the pair swaps roles.
+            next_term(
+                rings,
+                self.c[self.k],
+                &self.current,
+                &mut self.previous,
+                &mut self.estimate,
+            );
+            std::mem::swap(&mut self.previous, &mut self.current);
+        }
+        self.k == last
+    }
+
+    /// `(terms summed, terms)`, counting the first two as one neighbour pass.
+    pub(crate) fn progress(&self) -> (u32, u32) {
+        (self.k as u32, (self.c.len() - 1) as u32)
+    }
+
+    /// The estimate through the weights and the bound, once every term is summed.
+    pub(crate) fn finish<C: Constrain>(
+        self,
+        original: &[[f32; 3]],
+        constraint: &C,
+    ) -> Vec<[f32; 3]> {
+        constrain(original, self.estimate, constraint)
+    }
 }
 
 /// `previous = x - centre`, `current = T_1 (x - centre)`,
