@@ -12,6 +12,7 @@ mod local_error;
 mod original;
 mod report;
 mod score;
+mod sinc_drifting;
 
 pub use curvature::{vertex_curvature, vertex_curvatures, VertexCurvature};
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
@@ -22,6 +23,7 @@ pub use report::{
     VertexMeasures,
 };
 pub use score::ScoreTerms;
+pub use sinc_drifting::SincDrifting;
 
 // What the GPU engine's measure pass shares with the CPU's.
 pub(crate) use report::{metrics as metrics_from_sums, Sums};

@@ -3,8 +3,8 @@
 //! of vertices at a time, each call within a time budget.
 
 use super::{Model, Smoothed, Timings};
-use crate::metrics::{self, DriftingReference, MeasureInParts};
-use crate::smooth::{self, Filter, Params, SincInParts};
+use crate::metrics::{self, DriftingReference, MeasureInParts, SincDrifting};
+use crate::smooth::{self, Filter, Params};
 
 /// How far a run got (see [`super::Session::progress`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,10 +44,9 @@ pub(super) struct CpuJob {
     reference: Vec<u32>,
     done: u32,
     smooth_ms: f64,
-    /// Windowed sinc's recurrence under way (its terms are not shorter runs' results).
-    sinc: Option<SincInParts>,
-    /// Windowed sinc's result is in `positions`; the drift's steps towards it left to take.
-    sinc_drift_left: Option<u32>,
+    /// Windowed sinc under way (its terms are not shorter runs' results, so it cannot be
+    /// resumed like the others).
+    sinc: Option<SincDrifting>,
     /// The measure pass, once the smoothing is done.
     measure: Option<MeasureInParts>,
     measure_ms: f64,
@@ -65,7 +64,6 @@ impl CpuJob {
             done: 0,
             smooth_ms: 0.0,
             sinc: None,
-            sinc_drift_left: None,
             measure: None,
             measure_ms: 0.0,
         }
@@ -79,8 +77,12 @@ impl CpuJob {
             }
             None => CpuProgress::Smoothing {
                 done: match &self.sinc {
-                    Some(sinc) => sinc.progress().0,
-                    None if self.sinc_drift_left.is_some() => params.iterations,
+                    // Its passes and drift steps, as a share of the iterations.
+                    Some(sinc) => {
+                        let (done, pieces) = sinc.progress();
+                        (u64::from(done) * u64::from(params.iterations) / u64::from(pieces.max(1)))
+                            as u32
+                    }
                     None => self.done,
                 },
                 total: params.iterations,
@@ -172,9 +174,8 @@ impl CpuJob {
         }
     }
 
-    /// Windowed sinc until `deadline` (at least one neighbour pass or drift step): its terms,
-    /// then the drifting reference's steps towards the result (one per degree, as
-    /// [`metrics::smooth_drifting`] takes them).
+    /// Windowed sinc until `deadline` (at least one neighbour pass or drift step), as many
+    /// pieces per call as the time per piece so far lets fit.
     fn smooth_sinc(
         &mut self,
         model: &Model,
@@ -183,42 +184,29 @@ impl CpuJob {
         clock: &dyn Fn() -> f64,
         deadline: f64,
     ) {
-        let (mesh, topology) = (model.mesh(), model.topology());
-        if self.sinc_drift_left.is_none() {
-            let sinc = match self.sinc.take() {
-                Some(sinc) => Some(sinc),
-                None => SincInParts::new(mesh, topology, params),
-            };
-            let Some(mut sinc) = sinc else { return };
-            let mut more = 1;
-            loop {
-                let part_start = clock();
-                if sinc.advance(mesh, topology, more) {
-                    self.positions = sinc.finish(mesh, params, weights);
-                    self.sinc_drift_left = Some(params.iterations);
-                    break;
-                }
-                let now = clock();
-                if now >= deadline {
-                    self.sinc = Some(sinc);
-                    return;
-                }
-                let per_pass = ((now - part_start) / more as f64).max(1e-3);
-                more = ((deadline - now) / per_pass).max(1.0) as u32;
+        let original = &model.original;
+        let Some(mut sinc) = self
+            .sinc
+            .take()
+            .or_else(|| SincDrifting::new(original, params))
+        else {
+            return;
+        };
+        let mut pieces = 1;
+        loop {
+            let piece_start = clock();
+            if sinc.advance(original, params, weights, pieces) {
+                (self.positions, self.reference) = sinc.into_result();
+                self.done = params.iterations;
+                return;
             }
-        }
-        let mut drift =
-            DriftingReference::resume(&model.original, std::mem::take(&mut self.reference));
-        while let Some(left) = self.sinc_drift_left.filter(|&n| n > 0) {
-            drift.update(&self.positions);
-            self.sinc_drift_left = Some(left - 1);
-            if clock() >= deadline {
-                break;
+            let now = clock();
+            if now >= deadline {
+                self.sinc = Some(sinc);
+                return;
             }
-        }
-        self.reference = drift.into_reference();
-        if self.sinc_drift_left == Some(0) {
-            self.done = params.iterations;
+            let per_piece = ((now - piece_start) / f64::from(pieces)).max(1e-3);
+            pieces = ((deadline - now) / per_piece).max(1.0) as u32;
         }
     }
 

@@ -1,11 +1,12 @@
 //! An evaluator that spreads each smoothing run over several calls, each within a time budget,
 //! so the web app (one thread on wasm32) can compute quality graphs and suggestions between
 //! frames. Its results are those of [`MeshEvaluator`], bit for bit: the run is the same
-//! iterations resumed in chunks ([`crate::smooth::resume`]), measured at the same counts.
+//! iterations resumed in chunks ([`crate::smooth::resume`]; windowed sinc a few neighbour passes
+//! and drift steps at a time, [`SincDrifting`]), measured at the same counts.
 
 use super::mesh_evaluator::{MeshEvaluator, WeightsError};
 use super::{is_cumulative, Evaluator, Terms};
-use crate::metrics::{self, DriftingReference, Original};
+use crate::metrics::{self, DriftingReference, Original, SincDrifting};
 use crate::smooth::{self, Params};
 
 /// A run under way between calls.
@@ -16,6 +17,8 @@ struct Partial {
     reference: Vec<u32>,
     done: u32,
     terms: Vec<Terms>,
+    /// Windowed sinc's run towards the next count, under way.
+    sinc: Option<SincDrifting>,
 }
 
 /// What a sliced evaluation keeps between calls: the run under way and how long work took so
@@ -54,7 +57,7 @@ pub struct Sliced<'a> {
 impl<'a> Sliced<'a> {
     /// Work started by this evaluator ends near `clock() + budget_ms`: a piece of work is
     /// started only when its estimated time fits (or nothing was done yet in this call). One
-    /// measure pass or one windowed-sinc run is the smallest piece.
+    /// measure pass is the smallest piece.
     pub fn new(
         original: &'a Original,
         weights: Option<&'a [f32]>,
@@ -91,6 +94,7 @@ impl<'a> Sliced<'a> {
             reference: metrics::identity(self.original.mesh().vertex_count()),
             done: 0,
             terms: Vec::with_capacity(at.len()),
+            sinc: None,
         }
     }
 
@@ -108,25 +112,22 @@ impl<'a> Sliced<'a> {
     }
 
     /// Smooths `partial` towards `target` iterations, as many as fit in the budget (at least
-    /// one). Windowed sinc, whose k-iteration result is no prefix of a longer run, is one piece.
+    /// one). Windowed sinc, whose k-iteration result is no prefix of a longer run, runs from the
+    /// original for each count, a few neighbour passes or drift steps per call.
     fn advance(&mut self, partial: &mut Partial, target: u32) {
         let t0 = (self.clock)();
+        let left = self.deadline - t0;
+        let fit = match self.runs.iteration_ms {
+            Some(ms) if ms > 0.0 => (left / ms).floor().max(1.0) as u32,
+            _ => 1,
+        };
         let mut params = partial.params;
         let chunk = if is_cumulative(params.filter) {
-            let left = self.deadline - t0;
-            let fit = match self.runs.iteration_ms {
-                Some(ms) if ms > 0.0 => (left / ms).floor().max(1.0) as u32,
-                _ => 1,
-            };
-            fit.clamp(1, target - partial.done)
-        } else {
-            target - partial.done
-        };
-        let positions = std::mem::take(&mut partial.positions);
-        let reference = std::mem::take(&mut partial.reference);
-        let mut drift = DriftingReference::resume(self.original, reference);
-        partial.positions = if is_cumulative(params.filter) {
-            smooth::resume(
+            let chunk = fit.clamp(1, target - partial.done);
+            let positions = std::mem::take(&mut partial.positions);
+            let reference = std::mem::take(&mut partial.reference);
+            let mut drift = DriftingReference::resume(self.original, reference);
+            partial.positions = smooth::resume(
                 self.original.mesh(),
                 self.original.topology(),
                 &params,
@@ -136,19 +137,26 @@ impl<'a> Sliced<'a> {
                 chunk,
                 &mut drift,
             )
-            .unwrap_or_default()
+            .unwrap_or_default();
+            partial.reference = drift.into_reference();
+            partial.done += chunk;
+            chunk
         } else {
             params.iterations = target;
-            smooth::smooth(
-                self.original.mesh(),
-                self.original.topology(),
-                &params,
-                self.weights,
-                &mut drift,
-            )
+            let sinc = partial.sinc.take();
+            match sinc.or_else(|| SincDrifting::new(self.original, &params)) {
+                Some(mut sinc) => {
+                    if sinc.advance(self.original, &params, self.weights, fit) {
+                        (partial.positions, partial.reference) = sinc.into_result();
+                        partial.done = target;
+                    } else {
+                        partial.sinc = Some(sinc);
+                    }
+                }
+                None => partial.done = target,
+            }
+            fit
         };
-        partial.reference = drift.into_reference();
-        partial.done += chunk;
         self.runs.iteration_ms = Some(((self.clock)() - t0) / f64::from(chunk.max(1)));
         self.worked = true;
     }
