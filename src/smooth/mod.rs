@@ -176,17 +176,23 @@ mod tests {
         }
     }
 
-    #[test]
-    fn windowed_sinc_in_parts_equals_the_whole_run() {
+    /// The bundled sample, its topology and uneven weights (0, 0.5, 1 in turn).
+    fn sample_with_weights() -> (Mesh, Topology, Vec<f32>) {
         let mesh = crate::io::load(
             include_bytes!("../../web/sample/bent_tube_staircase.ply"),
             "tube.ply",
         )
         .unwrap();
         let topology = Topology::build(&mesh);
-        let weights: Vec<f32> = (0..mesh.vertex_count())
+        let weights = (0..mesh.vertex_count())
             .map(|i| (i % 3) as f32 / 2.0)
             .collect();
+        (mesh, topology, weights)
+    }
+
+    #[test]
+    fn windowed_sinc_in_parts_equals_the_whole_run() {
+        let (mesh, topology, weights) = sample_with_weights();
         let mut p = Params::defaults(Filter::Sinc);
         for (iterations, bound, w) in [(20, None, None), (7, Some(0.4), Some(&weights[..]))] {
             p.iterations = iterations;
@@ -215,15 +221,7 @@ mod tests {
 
     #[test]
     fn a_resumed_run_equals_the_whole_run() {
-        let mesh = crate::io::load(
-            include_bytes!("../../web/sample/bent_tube_staircase.ply"),
-            "tube.ply",
-        )
-        .unwrap();
-        let topology = Topology::build(&mesh);
-        let weights: Vec<f32> = (0..mesh.vertex_count())
-            .map(|i| (i % 3) as f32 / 2.0)
-            .collect();
+        let (mesh, topology, weights) = sample_with_weights();
         for filter in [Filter::Laplace, Filter::Taubin, Filter::Hc] {
             let mut p = Params::defaults(filter);
             p.iterations = 7;
