@@ -43,17 +43,7 @@ fn a_loaded_model_gets_the_local_search_suggestion() {
     let calls = settle(&mut s);
     assert!(calls > 10, "spread over {calls} calls");
     let got = s.suggestion().expect("a suggestion").suggestion;
-    let model = s.model().unwrap();
-    let expected = suggest(
-        &model.original,
-        None,
-        s.params(),
-        s.tau(),
-        SearchMethod::Local,
-        &mut |_| true,
-    )
-    .unwrap();
-    assert_eq!(got, expected);
+    assert_eq!(got, local_suggestion(&s.model().unwrap().original, &s));
 }
 
 #[test]
@@ -82,6 +72,13 @@ fn a_grid_suggestion_follows_tau_without_smoothing_again() {
     // Another filter: the grid is not for it.
     s.set_filter_name("hc").unwrap();
     assert!(s.suggestion().is_none());
+}
+
+/// The one-shot engine's local-search suggestion for `original` at the session's parameters
+/// and tau, unweighted: what the background must arrive at.
+fn local_suggestion(original: &metrics::Original, s: &Session) -> crate::suggest::Suggestion {
+    let method = SearchMethod::Local;
+    suggest(original, None, s.params(), s.tau(), method, &mut |_| true).unwrap()
 }
 
 fn model_original(s: &Session) -> metrics::Original {
@@ -216,15 +213,7 @@ fn an_offload_runs_the_searches_and_graphs_with_the_same_results() {
     // One request per call at most: a call returns once its run is on the device.
     assert!(calls >= offload.requests.len(), "{calls} calls");
     let original = model_original(&s);
-    let expected = suggest(
-        &original,
-        None,
-        s.params(),
-        s.tau(),
-        SearchMethod::Local,
-        &mut |_| true,
-    )
-    .unwrap();
+    let expected = local_suggestion(&original, &s);
     assert_eq!(s.suggestion().unwrap().suggestion, expected);
     let graphs = quality_graphs(&original, None, s.params(), s.tau(), &mut |_| true).unwrap();
     assert_eq!(s.graphs().unwrap(), graphs);
