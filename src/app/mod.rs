@@ -32,6 +32,7 @@ mod read_bytes;
 mod report_view;
 mod shell;
 mod shortcuts;
+mod status;
 pub mod viewer;
 
 pub use document::{Backend, Document};

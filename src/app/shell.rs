@@ -12,7 +12,7 @@ use super::gpu_engine::GpuEngine;
 use super::guide::Guide;
 use super::shortcuts::{self, Action};
 use super::viewer::Viewer;
-use super::{api, download, legend, page, query, report_view, SAMPLE_BYTES, SAMPLE_NAME};
+use super::{api, download, legend, page, query, report_view, status, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
 use crate::session::{ColorField, Legend};
 use crate::smooth::Filter;
@@ -385,33 +385,7 @@ impl Shell {
                 ui.colored_label(ui.visuals().warn_fg_color, "CPU fallback")
                     .on_hover_text(why);
             }
-            let reading = self.files.reading();
-            if let Some(l) = doc.session.loading() {
-                ui.add(
-                    egui::ProgressBar::new(l.fraction)
-                        .desired_width(220.0)
-                        .text(format!(
-                            "opening: {} ({}/{})",
-                            l.doing,
-                            l.stage + 1,
-                            l.total
-                        )),
-                );
-            } else if let Some(fraction) = reading.first().and_then(|r| r.fraction()) {
-                ui.add(
-                    egui::ProgressBar::new(fraction)
-                        .desired_width(220.0)
-                        .text(format!("reading {:.0}%", 100.0 * fraction)),
-                );
-            } else if let Some(p) = doc.session.progress() {
-                ui.add(
-                    egui::ProgressBar::new(p.fraction())
-                        .desired_width(160.0)
-                        .text(p.describe()),
-                );
-            } else if doc.busy() || !reading.is_empty() {
-                ui.spinner();
-            }
+            status::progress(ui, &doc, &self.files.reading());
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                 ui.small("Files are read inside this browser tab; nothing is uploaded.");
             });
@@ -452,41 +426,10 @@ impl Shell {
         }
         // Messages over the view's top-left corner.
         let doc = self.doc.borrow();
-        let mut lines = Vec::new();
-        if let Some(error) = doc.session.error().or(self.export_error.as_deref()) {
-            lines.push((error.to_string(), ui.visuals().error_fg_color));
-        }
-        for r in self.files.reading() {
-            lines.push((format!("{}…", r.describe()), egui::Color32::WHITE));
-        }
-        if let Some(l) = doc.session.loading() {
-            let text = format!("Opening {}: {}…", l.name, l.doing);
-            lines.push((text, egui::Color32::WHITE));
-        }
-        if self.show_original {
-            lines.push((
-                "Showing the original mesh (B to go back)".to_string(),
-                egui::Color32::WHITE,
-            ));
-        }
-        let painter = ui.painter_at(rect);
-        let mut y = rect.top() + 10.0;
-        for (text, color) in lines {
-            let galley = painter.layout(
-                text,
-                egui::FontId::proportional(15.0),
-                color,
-                rect.width() * 0.6,
-            );
-            let at = egui::pos2(rect.left() + 12.0, y);
-            painter.rect_filled(
-                egui::Rect::from_min_size(at, galley.size()).expand(6.0),
-                4.0,
-                egui::Color32::from_black_alpha(170),
-            );
-            y += galley.size().y + 16.0;
-            painter.galley(at, galley, color);
-        }
+        let reading = self.files.reading();
+        let error = self.export_error.as_deref();
+        let lines = status::view_messages(ui, &doc, error, &reading, self.show_original);
+        status::paint_messages(ui, rect, lines);
     }
 }
 
