@@ -129,9 +129,8 @@ impl CpuJob {
         Some((smoothed, timings))
     }
 
-    /// Iterations until `deadline` (at least one). Iterations per call: one at first, then as
-    /// many as the time per iteration so far lets fit before the deadline (each call re-checks
-    /// the rings and allocates its second buffer, so fewer, longer calls cost less).
+    /// Iterations until `deadline` (at least one; each call of `smooth::resume` re-checks the
+    /// rings and allocates its second buffer, so fewer, longer calls cost less).
     fn smooth(
         &mut self,
         model: &Model,
@@ -144,9 +143,8 @@ impl CpuJob {
             self.smooth_sinc(model, params, weights, clock, deadline);
             return;
         }
-        let mut chunk = 1;
-        while self.done < params.iterations {
-            let chunk_start = clock();
+        in_pieces(clock, deadline, 1, |n| {
+            let chunk = (params.iterations - self.done).min(n.try_into().unwrap_or(u32::MAX));
             let mut drift =
                 DriftingReference::resume(&model.original, std::mem::take(&mut self.reference));
             let positions = std::mem::take(&mut self.positions);
@@ -163,19 +161,12 @@ impl CpuJob {
             .unwrap_or_default();
             self.reference = drift.into_reference();
             self.done += chunk;
-            let now = clock();
-            let left = deadline - now;
-            if left <= 0.0 {
-                break;
-            }
-            let per_iteration = ((now - chunk_start) / chunk as f64).max(1e-3);
-            let remaining = params.iterations - self.done;
-            chunk = ((left / per_iteration).floor() as u32).clamp(1, remaining.max(1));
-        }
+            self.done >= params.iterations
+        });
     }
 
-    /// Windowed sinc until `deadline` (at least one neighbour pass or drift step), as many
-    /// pieces per call as the time per piece so far lets fit.
+    /// Windowed sinc until `deadline`: its neighbour passes, then the drift's steps (at least
+    /// one piece).
     fn smooth_sinc(
         &mut self,
         model: &Model,
@@ -192,21 +183,14 @@ impl CpuJob {
         else {
             return;
         };
-        let mut pieces = 1;
-        loop {
-            let piece_start = clock();
-            if sinc.advance(original, params, weights, pieces) {
-                (self.positions, self.reference) = sinc.into_result();
-                self.done = params.iterations;
-                return;
-            }
-            let now = clock();
-            if now >= deadline {
-                self.sinc = Some(sinc);
-                return;
-            }
-            let per_piece = ((now - piece_start) / f64::from(pieces)).max(1e-3);
-            pieces = ((deadline - now) / per_piece).max(1.0) as u32;
+        let finished = in_pieces(clock, deadline, 1, |n| {
+            sinc.advance(original, params, weights, n.try_into().unwrap_or(u32::MAX))
+        });
+        if finished {
+            (self.positions, self.reference) = sinc.into_result();
+            self.done = params.iterations;
+        } else {
+            self.sinc = Some(sinc);
         }
     }
 
@@ -217,19 +201,32 @@ impl CpuJob {
         let pass = self
             .measure
             .get_or_insert_with(|| MeasureInParts::new(original, positions, reference));
-        let mut part = FIRST_MEASURE_PART;
-        loop {
-            let part_start = clock();
-            if pass.advance(original, positions, reference, part) {
-                return true;
-            }
-            let now = clock();
-            let left = deadline - now;
-            if left <= 0.0 {
-                return false;
-            }
-            let per_vertex = ((now - part_start) / part as f64).max(1e-6);
-            part = ((left / per_vertex) as usize).max(1);
+        in_pieces(clock, deadline, FIRST_MEASURE_PART, |vertices| {
+            pass.advance(original, positions, reference, vertices)
+        })
+    }
+}
+
+/// Runs `work(n)` (`n` pieces of work; whether everything is done) until everything is done
+/// or `deadline` has passed, at least once: `first` pieces, then as many as the time per piece
+/// so far lets fit. Returns whether everything is done.
+fn in_pieces(
+    clock: &dyn Fn() -> f64,
+    deadline: f64,
+    first: usize,
+    mut work: impl FnMut(usize) -> bool,
+) -> bool {
+    let mut n = first.max(1);
+    loop {
+        let start = clock();
+        if work(n) {
+            return true;
         }
+        let now = clock();
+        if now >= deadline {
+            return false;
+        }
+        let per_piece = ((now - start) / n as f64).max(1e-9);
+        n = ((deadline - now) / per_piece).max(1.0) as usize;
     }
 }
