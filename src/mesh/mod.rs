@@ -5,11 +5,16 @@
 
 mod normals;
 mod report;
+mod report_parts;
 mod topology;
+mod topology_parts;
 
 pub use normals::vertex_normals;
 pub use report::MeshReport;
+pub use report_parts::ReportInParts;
 pub use topology::Topology;
+pub(crate) use topology_parts::by_blocks;
+pub use topology_parts::TopologyInParts;
 
 /// "No such index" in flat `u32` arrays.
 pub const NONE: u32 = u32::MAX;
@@ -134,6 +139,31 @@ pub(crate) mod fixtures {
             ],
             vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
         )
+    }
+
+    /// An open, wavy height field of `cols` by `rows` quads, each split into two triangles
+    /// along alternating diagonals.
+    pub(crate) fn grid(cols: u32, rows: u32) -> Mesh {
+        let mut positions = Vec::new();
+        for y in 0..=rows {
+            for x in 0..=cols {
+                let h = ((x as f32) * 0.7).sin() * ((y as f32) * 0.4).cos();
+                positions.push([x as f32, y as f32, h]);
+            }
+        }
+        let at = |x: u32, y: u32| y * (cols + 1) + x;
+        let mut triangles = Vec::new();
+        for y in 0..rows {
+            for x in 0..cols {
+                let (a, b, c, d) = (at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y + 1));
+                if (x + y) % 2 == 0 {
+                    triangles.extend([[a, b, c], [a, c, d]]);
+                } else {
+                    triangles.extend([[a, b, d], [b, c, d]]);
+                }
+            }
+        }
+        Mesh::new(positions, triangles)
     }
 }
 

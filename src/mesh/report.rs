@@ -2,8 +2,8 @@
 //!
 //! Odd meshes (open, several components, non-manifold, degenerate faces) are reported, never refused.
 
-use super::{cross, sub, to_f64, Mesh, Topology};
-use rayon::prelude::*;
+use super::report_parts::ReportInParts;
+use super::{Mesh, Topology};
 use serde::Serialize;
 
 /// Counts and flags that describe a mesh. Serialises to the `meshsmooth info --json` keys.
@@ -36,52 +36,12 @@ pub struct MeshReport {
 }
 
 impl MeshReport {
+    /// The report of `mesh`; `topology` must be `Topology::build(mesh)`. The steps of
+    /// [`ReportInParts`] in one call.
     pub fn new(mesh: &Mesh, topology: &Topology) -> Self {
-        let n = mesh.vertex_count();
-        let referenced = (0..n)
-            .filter(|&i| topology.triangle_offsets[i] != topology.triangle_offsets[i + 1])
-            .count();
-        let boundary_edges = topology
-            .edge_triangle_counts
-            .iter()
-            .filter(|&&c| c == 1)
-            .count()
-            / 2;
-        let nonmanifold_edges = topology
-            .edge_triangle_counts
-            .iter()
-            .filter(|&&c| c >= 3)
-            .count()
-            / 2;
-        let nonmanifold_vertices = (0..n)
-            .into_par_iter()
-            .with_min_len(4096)
-            .filter(|&i| fan_count(mesh, topology, i) > 1)
-            .count();
-        let components = component_count(mesh, topology);
-        let euler = referenced as i64 - topology.edge_count() as i64 + mesh.triangle_count() as i64;
-        let closed = boundary_edges == 0 && mesh.triangle_count() > 0;
-        let manifold = nonmanifold_edges == 0 && nonmanifold_vertices == 0;
-        let genus = (closed && manifold && (2 * components as i64 - euler) % 2 == 0)
-            .then(|| (2 * components as i64 - euler) / 2);
-        let (bbox_min, bbox_max) = mesh.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
-        Self {
-            vertices: n,
-            faces: mesh.triangle_count(),
-            unreferenced_vertices: n - referenced,
-            degenerate_faces: degenerate_count(mesh),
-            duplicate_faces: duplicate_count(mesh),
-            boundary_edges,
-            nonmanifold_edges,
-            nonmanifold_vertices,
-            components,
-            euler,
-            genus,
-            closed,
-            volume: closed.then(|| mesh.signed_volume()),
-            bbox_min,
-            bbox_max,
-        }
+        let mut parts = ReportInParts::new(mesh);
+        while !parts.advance(mesh, topology, usize::MAX) {}
+        parts.finish(mesh, topology)
     }
 
     /// Human-readable warnings for whatever is odd about the mesh (empty when nothing is).
@@ -117,96 +77,6 @@ impl MeshReport {
         }
         w
     }
-}
-
-fn degenerate_count(mesh: &Mesh) -> usize {
-    mesh.triangles
-        .par_iter()
-        .with_min_len(4096)
-        .filter(|t| {
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                return true;
-            }
-            let a = to_f64(mesh.positions[t[0] as usize]);
-            let b = to_f64(mesh.positions[t[1] as usize]);
-            let c = to_f64(mesh.positions[t[2] as usize]);
-            cross(sub(b, a), sub(c, a)) == [0.0; 3]
-        })
-        .count()
-}
-
-fn duplicate_count(mesh: &Mesh) -> usize {
-    let mut keys: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let mut k = *t;
-            k.sort_unstable();
-            k
-        })
-        .collect();
-    keys.par_sort_unstable();
-    keys.windows(2).filter(|w| w[0] == w[1]).count()
-}
-
-/// Number of edge-connected fans of triangles around vertex `i` (1 for a manifold vertex).
-fn fan_count(mesh: &Mesh, topology: &Topology, i: usize) -> usize {
-    let fan = topology.triangles_of(i);
-    if fan.len() <= 1 {
-        return fan.len();
-    }
-    // Tiny union-find over the fan; two triangles join when they share an edge through `i`.
-    let mut parent: Vec<usize> = (0..fan.len()).collect();
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    let mut seen: Vec<(u32, usize)> = Vec::with_capacity(fan.len() * 2);
-    for (k, &ti) in fan.iter().enumerate() {
-        for &v in &mesh.triangles[ti as usize] {
-            if v as usize == i {
-                continue;
-            }
-            match seen.iter().find(|(u, _)| *u == v) {
-                Some(&(_, other)) => {
-                    let (a, b) = (find(&mut parent, other), find(&mut parent, k));
-                    parent[a] = b;
-                }
-                None => seen.push((v, k)),
-            }
-        }
-    }
-    (0..fan.len())
-        .filter(|&k| find(&mut parent, k) == k)
-        .count()
-}
-
-fn component_count(mesh: &Mesh, topology: &Topology) -> usize {
-    let n = mesh.vertex_count();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            let p = parent[parent[x as usize] as usize];
-            parent[x as usize] = p;
-            x = p;
-        }
-        x
-    }
-    for t in &mesh.triangles {
-        for (a, b) in [(t[0], t[1]), (t[1], t[2])] {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            if ra != rb {
-                parent[ra as usize] = rb;
-            }
-        }
-    }
-    (0..n)
-        .filter(|&i| topology.triangle_offsets[i] != topology.triangle_offsets[i + 1])
-        .filter(|&i| find(&mut parent, i as u32) == i as u32)
-        .count()
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 //! Built in linear time by counting sorts; every array is `u32` so the GPU engine uploads it as-is.
 //! `offsets[i]..offsets[i + 1]` indexes vertex `i`'s entries (the paper's "lookup table").
 
+use super::topology_parts::TopologyInParts;
 use super::Mesh;
 use rayon::prelude::*;
 
@@ -30,38 +31,22 @@ pub struct Topology {
 
 impl Topology {
     /// Builds the CSR arrays for `mesh`. Triangles with repeated indices contribute only their
-    /// distinct edges; indices must be in range (the parsers guarantee it).
+    /// distinct edges; indices must be in range (the parsers guarantee it). The steps of
+    /// [`TopologyInParts`] in one call.
     pub fn build(mesh: &Mesh) -> Self {
-        let n = mesh.positions.len();
-        let tris = &mesh.triangles;
-        debug_assert!(tris.iter().flatten().all(|&v| (v as usize) < n));
+        let mut parts = TopologyInParts::new(mesh);
+        while !parts.advance(mesh, usize::MAX) {}
+        parts.finish()
+    }
 
-        // Vertex -> triangle incidence by counting sort (ascending triangle order for free).
-        let mut triangle_offsets = vec![0u32; n + 1];
-        for t in tris {
-            for (k, &v) in t.iter().enumerate() {
-                if !t[..k].contains(&v) {
-                    triangle_offsets[v as usize + 1] += 1;
-                }
-            }
-        }
-        prefix_sum(&mut triangle_offsets);
-        let mut cursor: Vec<u32> = triangle_offsets[..n].to_vec();
-        let mut vertex_triangles = vec![0u32; triangle_offsets[n] as usize];
-        for (ti, t) in tris.iter().enumerate() {
-            for (k, &v) in t.iter().enumerate() {
-                if !t[..k].contains(&v) {
-                    let c = &mut cursor[v as usize];
-                    vertex_triangles[*c as usize] = ti as u32;
-                    *c += 1;
-                }
-            }
-        }
-
-        let (neighbor_offsets, neighbors, edge_triangle_counts) =
-            build_rings(tris, &triangle_offsets, &vertex_triangles);
-        let total = neighbors.len();
-
+    /// The topology from its 1-rings and incidence; derives the boundary flags and the
+    /// smoothing neighbourhood.
+    pub(super) fn from_rings(
+        (neighbor_offsets, neighbors, edge_triangle_counts): (Vec<u32>, Vec<u32>, Vec<u32>),
+        triangle_offsets: Vec<u32>,
+        vertex_triangles: Vec<u32>,
+    ) -> Self {
+        let n = neighbor_offsets.len().saturating_sub(1);
         let is_boundary: Vec<bool> = (0..n)
             .into_par_iter()
             .with_min_len(4096)
@@ -73,7 +58,7 @@ impl Topology {
 
         let boundary_ring = is_boundary.iter().any(|&b| b).then(|| {
             let mut offsets = vec![0u32; n + 1];
-            let mut ring = Vec::with_capacity(total);
+            let mut ring = Vec::with_capacity(neighbors.len());
             for i in 0..n {
                 let range = neighbor_offsets[i] as usize..neighbor_offsets[i + 1] as usize;
                 if is_boundary[i] {
@@ -151,113 +136,6 @@ impl Topology {
             );
         }
         edges
-    }
-}
-
-/// Vertices per parallel work item when building the rings.
-const BLOCK: usize = 2048;
-
-/// The 1-ring CSR with edge multiplicities, without per-vertex allocations: every vertex's raw
-/// list (two entries per incident triangle) is written into one flat buffer at twice its
-/// triangle offset, sorted and deduplicated in place, then compacted.
-fn build_rings(
-    tris: &[[u32; 3]],
-    triangle_offsets: &[u32],
-    vertex_triangles: &[u32],
-) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
-    let n = triangle_offsets.len() - 1;
-    let raw_len = 2 * triangle_offsets[n] as usize;
-    let mut raw = vec![0u32; raw_len];
-    let mut counts = vec![0u32; raw_len];
-
-    // Per block: its vertices, and the slices of `raw` and `counts` it owns.
-    let mut jobs = Vec::with_capacity(n / BLOCK + 1);
-    {
-        let (mut raw_rest, mut counts_rest) = (&mut raw[..], &mut counts[..]);
-        for start in (0..n).step_by(BLOCK) {
-            let end = (start + BLOCK).min(n);
-            let len = 2 * (triangle_offsets[end] - triangle_offsets[start]) as usize;
-            let (r, rr) = std::mem::take(&mut raw_rest).split_at_mut(len);
-            let (c, cr) = std::mem::take(&mut counts_rest).split_at_mut(len);
-            (raw_rest, counts_rest) = (rr, cr);
-            jobs.push((start, end, r, c));
-        }
-    }
-    // Distinct neighbours per vertex, block by block.
-    let unique: Vec<u32> = jobs
-        .par_iter_mut()
-        .flat_map_iter(|(start, end, r, c)| {
-            let mut u = Vec::with_capacity(*end - *start);
-            let base = 2 * triangle_offsets[*start] as usize;
-            for i in *start..*end {
-                let lo = 2 * triangle_offsets[i] as usize - base;
-                let hi = 2 * triangle_offsets[i + 1] as usize - base;
-                let slot = &mut r[lo..hi];
-                let mut len = 0;
-                for &ti in &vertex_triangles
-                    [triangle_offsets[i] as usize..triangle_offsets[i + 1] as usize]
-                {
-                    for &v in &tris[ti as usize] {
-                        if v as usize != i {
-                            slot[len] = v;
-                            len += 1;
-                        }
-                    }
-                }
-                let slot = &mut slot[..len];
-                slot.sort_unstable();
-                let cnt = &mut c[lo..hi];
-                let mut k = 0;
-                for j in 0..len {
-                    if k > 0 && slot[k - 1] == slot[j] {
-                        cnt[k - 1] += 1;
-                    } else {
-                        slot[k] = slot[j];
-                        cnt[k] = 1;
-                        k += 1;
-                    }
-                }
-                u.push(k as u32);
-            }
-            u
-        })
-        .collect();
-
-    let mut offsets = vec![0u32; n + 1];
-    for i in 0..n {
-        offsets[i + 1] = offsets[i] + unique[i];
-    }
-    let total = offsets[n] as usize;
-    let mut neighbors = vec![0u32; total];
-    let mut edge_counts = vec![0u32; total];
-    {
-        let (mut nb_rest, mut ec_rest) = (&mut neighbors[..], &mut edge_counts[..]);
-        let mut out = Vec::with_capacity(jobs.len());
-        for (start, end, r, c) in jobs {
-            let len = (offsets[end] - offsets[start]) as usize;
-            let (nb, nr) = std::mem::take(&mut nb_rest).split_at_mut(len);
-            let (ec, er) = std::mem::take(&mut ec_rest).split_at_mut(len);
-            (nb_rest, ec_rest) = (nr, er);
-            out.push((start, end, r, c, nb, ec));
-        }
-        out.into_par_iter().for_each(|(start, end, r, c, nb, ec)| {
-            let base_raw = 2 * triangle_offsets[start] as usize;
-            let base_out = offsets[start] as usize;
-            for i in start..end {
-                let src = 2 * triangle_offsets[i] as usize - base_raw;
-                let dst = offsets[i] as usize - base_out;
-                let k = unique[i] as usize;
-                nb[dst..dst + k].copy_from_slice(&r[src..src + k]);
-                ec[dst..dst + k].copy_from_slice(&c[src..src + k]);
-            }
-        });
-    }
-    (offsets, neighbors, edge_counts)
-}
-
-fn prefix_sum(offsets: &mut [u32]) {
-    for i in 1..offsets.len() {
-        offsets[i] += offsets[i - 1];
     }
 }
 

@@ -1,7 +1,7 @@
 //! Discrete Gaussian curvature after Meyer, Desbrun, Schroeder and Barr (2003):
 //! `K_G(i) = (2 pi - sum of the angles at i) / A_mixed(i)`.
 
-use crate::mesh::{cross, dot, sub, to_f64, Topology};
+use crate::mesh::{by_blocks, cross, dot, sub, to_f64, Topology};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -139,16 +139,25 @@ pub(crate) fn triangle_areas(
 /// For every entry of the vertex->triangle incidence, the triangle's other two corners in winding
 /// order: the passes then read them in sequence instead of looking up every triangle.
 pub(crate) fn fan_corners(triangles: &[[u32; 3]], topology: &Topology) -> Vec<[u32; 2]> {
-    (0..topology.vertex_count())
+    let offsets = &topology.triangle_offsets;
+    let n = topology.vertex_count();
+    let mut corners = vec![[0u32; 2]; topology.vertex_triangles.len()];
+    // Filled in place, a block of vertices per task: no growing or joining of vectors.
+    by_blocks(&mut corners, offsets, 0..n, 1)
         .into_par_iter()
-        .with_min_len(1024)
-        .flat_map_iter(|i| {
-            topology.triangles_of(i).iter().map(move |&t| {
-                let (j, k) = other_corners(triangles[t as usize], i as u32);
-                [j, k]
-            })
-        })
-        .collect()
+        .for_each(|(vertices, out)| {
+            let base = offsets[vertices.start] as usize;
+            for i in vertices {
+                let range = offsets[i] as usize..offsets[i + 1] as usize;
+                let fan = &topology.vertex_triangles[range.clone()];
+                let out = &mut out[range.start - base..range.end - base];
+                for (o, &t) in out.iter_mut().zip(fan) {
+                    let (j, k) = other_corners(triangles[t as usize], i as u32);
+                    *o = [j, k];
+                }
+            }
+        });
+    corners
 }
 
 /// The corners of `tri` other than `i`, in winding order: `(i, j, k)` is a rotation of `tri`.

@@ -125,13 +125,14 @@ fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
 }
 
 /// [`Original::new`] spread over calls, for a caller that must return between them (the
-/// browser's one thread opening a large mesh): the precomputation when created, then the
-/// measure pass of the original ([`MeasureInParts`], every vertex its own reference) a run of
-/// vertices at a time. The result is [`Original::new`]'s, bit for bit.
+/// browser's one thread opening a large mesh): the precomputation when created, the triangle
+/// areas in the first [`Self::advance`], then the measure pass of the original
+/// ([`MeasureInParts`], every vertex its own reference) a run of vertices per call. The result
+/// is [`Original::new`]'s, bit for bit.
 pub struct OriginalInParts {
     original: Original,
     reference: Vec<u32>,
-    pass: MeasureInParts,
+    pass: Option<MeasureInParts>,
 }
 
 impl OriginalInParts {
@@ -139,24 +140,30 @@ impl OriginalInParts {
     pub fn new(mesh: Mesh, topology: Topology) -> Self {
         let original = Original::unmeasured(mesh, topology);
         let reference = super::identity(original.mesh.vertex_count());
-        let pass = MeasureInParts::new(&original, &original.mesh.positions, &reference);
         Self {
             original,
             reference,
-            pass,
+            pass: None,
         }
     }
 
-    /// Measures up to `vertices` more vertices; returns whether every vertex is measured.
+    /// Begins the measure pass, or measures up to `vertices` more vertices; returns whether
+    /// every vertex is measured.
     pub fn advance(&mut self, vertices: usize) -> bool {
         let o = &self.original;
-        self.pass
-            .advance(o, &o.mesh.positions, &self.reference, vertices)
+        let positions = &o.mesh.positions;
+        match &mut self.pass {
+            Some(pass) => pass.advance(o, positions, &self.reference, vertices),
+            None => {
+                self.pass = Some(MeasureInParts::new(o, positions, &self.reference));
+                false
+            }
+        }
     }
 
     /// The fraction of the vertices measured.
     pub fn fraction(&self) -> f32 {
-        let (done, total) = self.pass.progress();
+        let (done, total) = self.pass.as_ref().map_or((0, 1), |p| p.progress());
         done as f32 / total.max(1) as f32
     }
 
@@ -165,7 +172,7 @@ impl OriginalInParts {
         let Self {
             mut original, pass, ..
         } = self;
-        let sums = pass.sums();
+        let sums = pass.expect("finish after advance returned true").sums();
         original.volume = original.is_closed().then(|| sums.volume());
         original.curvature = sums.curvature();
         original

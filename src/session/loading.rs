@@ -1,24 +1,28 @@
-//! Opening a file in stages (parse, topology, checks, the original's measures a part at a time),
-//! so a page without threads can draw a frame with the progress between them instead of freezing while a
-//! large mesh opens. [`Loading::finish`] runs every stage in one call; the stages are the same.
+//! Opening a file in stages (parse, topology, checks, the original's measures; all but the
+//! parse a part at a time), so a page without threads can draw a frame with the progress between
+//! them instead of freezing while a large mesh opens. [`Loading::finish`] runs every stage in one
+//! call; the stages are the same.
 
 use super::Model;
 use crate::io::{self, LoadError};
-use crate::mesh::{Mesh, MeshReport, Topology};
+use crate::mesh::{Mesh, MeshReport, ReportInParts, Topology, TopologyInParts};
 use crate::metrics::OriginalInParts;
 
 /// What is left to do, with what the done stages produced.
 enum Stage {
     Parse(Vec<u8>),
-    Topology(Mesh),
-    Check(Mesh, Topology),
+    /// The incidence first (`None`), then the 1-rings a part per step.
+    Topology(Mesh, Option<Box<TopologyInParts>>),
+    /// The per-vertex checks, then the per-triangle checks, a part per step.
+    Check(Mesh, Topology, Box<ReportInParts>),
     Prepare(Mesh, Topology, MeshReport, Vec<[u32; 2]>),
-    /// The original's measures, a part per step.
+    /// The triangle areas first, then the original's measures a part per step.
     Measure(Box<OriginalInParts>, MeshReport, Vec<[u32; 2]>),
 }
 
-/// Vertices of the original measured per step (about 10 ms in the browser).
-const MEASURE_PART: usize = 32 * 1024;
+/// Vertices (or triangles) per step of the stages done in parts: each step of the 206k-vertex
+/// benchmark mesh takes about 10 ms or less in the browser.
+const PART: usize = 32 * 1024;
 
 /// Stage names, in order, as the progress bar shows them.
 const STAGES: [&str; 5] = [
@@ -71,8 +75,8 @@ impl Loading {
     pub fn progress(&self) -> LoadProgress {
         let (stage, within) = match &self.stage {
             Stage::Parse(_) => (0, 0.0),
-            Stage::Topology(_) => (1, 0.0),
-            Stage::Check(..) => (2, 0.0),
+            Stage::Topology(_, parts) => (1, parts.as_ref().map_or(0.0, |p| p.fraction())),
+            Stage::Check(.., parts) => (2, parts.fraction()),
             Stage::Prepare(..) => (3, 0.0),
             Stage::Measure(original, ..) => (4, original.fraction()),
         };
@@ -90,24 +94,37 @@ impl Loading {
         let Self { name, stage } = self;
         let next = match stage {
             Stage::Parse(bytes) => match io::load(&bytes, &name) {
-                Ok(mesh) => Stage::Topology(mesh),
+                Ok(mesh) => Stage::Topology(mesh, None),
                 Err(e) => return Loaded::Failed(e),
             },
-            Stage::Topology(mesh) => {
-                let topology = Topology::build(&mesh);
-                Stage::Check(mesh, topology)
+            Stage::Topology(mesh, None) => {
+                let parts = Box::new(TopologyInParts::new(&mesh));
+                Stage::Topology(mesh, Some(parts))
             }
-            Stage::Check(mesh, topology) => {
-                let report = MeshReport::new(&mesh, &topology);
-                let edges = topology.edges();
-                Stage::Prepare(mesh, topology, report, edges)
+            Stage::Topology(mesh, Some(mut parts)) => {
+                if parts.advance(&mesh, PART) {
+                    let topology = parts.finish();
+                    let report = Box::new(ReportInParts::new(&mesh));
+                    Stage::Check(mesh, topology, report)
+                } else {
+                    Stage::Topology(mesh, Some(parts))
+                }
+            }
+            Stage::Check(mesh, topology, mut parts) => {
+                if parts.advance(&mesh, &topology, PART) {
+                    let report = parts.finish(&mesh, &topology);
+                    let edges = topology.edges();
+                    Stage::Prepare(mesh, topology, report, edges)
+                } else {
+                    Stage::Check(mesh, topology, parts)
+                }
             }
             Stage::Prepare(mesh, topology, report, edges) => {
                 let original = Box::new(OriginalInParts::new(mesh, topology));
                 Stage::Measure(original, report, edges)
             }
             Stage::Measure(mut original, report, edges) => {
-                if !original.advance(MEASURE_PART) {
+                if !original.advance(PART) {
                     let stage = Stage::Measure(original, report, edges);
                     return Loaded::Pending(Box::new(Self { name, stage }));
                 }
