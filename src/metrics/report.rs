@@ -161,6 +161,11 @@ impl MeasureInParts {
         self.partial.len() == total
     }
 
+    /// Vertices measured so far.
+    pub fn measured(&self) -> usize {
+        (self.partial.len() * CHUNK).min(self.vertex.local_error.len())
+    }
+
     /// `(chunks measured, chunks)`.
     pub fn progress(&self) -> (usize, usize) {
         (

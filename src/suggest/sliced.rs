@@ -2,11 +2,12 @@
 //! so the web app (one thread on wasm32) can compute quality graphs and suggestions between
 //! frames. Its results are those of [`MeshEvaluator`], bit for bit: the run is the same
 //! iterations resumed in chunks ([`crate::smooth::resume`]; windowed sinc a few neighbour passes
-//! and drift steps at a time, [`SincDrifting`]), measured at the same counts.
+//! and drift steps at a time, [`SincDrifting`]), measured at the same counts, each measure pass
+//! a run of vertices at a time ([`MeasureInParts`]).
 
-use super::mesh_evaluator::{MeshEvaluator, WeightsError};
+use super::mesh_evaluator::{terms_of, MeshEvaluator, WeightsError};
 use super::{is_cumulative, Evaluator, Terms};
-use crate::metrics::{self, DriftingReference, Original, SincDrifting};
+use crate::metrics::{self, DriftingReference, MeasureInParts, Original, SincDrifting};
 use crate::smooth::{self, Params};
 
 /// A run under way between calls.
@@ -19,16 +20,24 @@ struct Partial {
     terms: Vec<Terms>,
     /// Windowed sinc's run towards the next count, under way.
     sinc: Option<SincDrifting>,
+    /// The measure pass at the count reached, under way.
+    measuring: Option<MeasureInParts>,
 }
+
+/// Vertices of the first part of a measure pass, before its speed is known.
+const FIRST_MEASURE_PART: usize = 2048;
+
+/// The triangle areas that begin a measure pass cost about this share of the whole pass.
+const AREAS_SHARE: f64 = 0.2;
 
 /// What a sliced evaluation keeps between calls: the run under way and how long work took so
 /// far (to size the next chunk). Belongs to one model: [`SlicedRuns::reset`] when it changes.
 #[derive(Default)]
 pub struct SlicedRuns {
     partial: Option<Partial>,
-    /// Milliseconds per smoothing iteration and per measure pass, as last seen.
+    /// Milliseconds per smoothing iteration and per vertex of a measure pass, as last seen.
     iteration_ms: Option<f64>,
-    measure_ms: Option<f64>,
+    vertex_ms: Option<f64>,
     /// Smoothing runs finished.
     pub runs: usize,
 }
@@ -57,7 +66,7 @@ pub struct Sliced<'a> {
 impl<'a> Sliced<'a> {
     /// Work started by this evaluator ends near `clock() + budget_ms`: a piece of work is
     /// started only when its estimated time fits (or nothing was done yet in this call). One
-    /// measure pass is the smallest piece.
+    /// part of a measure pass is the smallest piece.
     pub fn new(
         original: &'a Original,
         weights: Option<&'a [f32]>,
@@ -95,20 +104,51 @@ impl<'a> Sliced<'a> {
             done: 0,
             terms: Vec::with_capacity(at.len()),
             sinc: None,
+            measuring: None,
         }
     }
 
-    fn measure_now(&mut self, partial: &Partial) -> Terms {
-        let t0 = (self.clock)();
-        let terms = if partial.done == 0 {
-            self.evaluator.unchanged()
-        } else {
-            self.evaluator
-                .measure_positions(&partial.positions, &partial.reference)
-        };
-        self.runs.measure_ms = Some((self.clock)() - t0);
-        self.worked = true;
-        terms
+    /// Measures `partial`'s positions, a part at a time while the parts fit the budget: the
+    /// triangle areas, then runs of vertices sized by the speed seen so far. The terms once the
+    /// pass is complete, `None` when the budget ran out first.
+    fn measure_parts(&mut self, partial: &mut Partial) -> Option<Terms> {
+        if partial.done == 0 {
+            return Some(self.evaluator.unchanged());
+        }
+        let original = self.original;
+        let n = original.mesh().vertex_count();
+        loop {
+            let Some(pass) = partial.measuring.as_mut() else {
+                let areas = self.runs.vertex_ms.map(|ms| ms * n as f64 * AREAS_SHARE);
+                if !self.fits(areas) {
+                    return None;
+                }
+                let pass = MeasureInParts::new(original, &partial.positions, &partial.reference);
+                partial.measuring = Some(pass);
+                self.worked = true;
+                continue;
+            };
+            let now = (self.clock)();
+            let vertices = match self.runs.vertex_ms {
+                Some(ms) if ms > 0.0 => ((self.deadline - now) / ms).max(0.0) as usize,
+                // Work of unknown length comes first in a call or not at all.
+                _ if self.worked => 0,
+                _ => FIRST_MEASURE_PART,
+            };
+            // A part is whole chunks of vertices: less than one does not fit.
+            if self.worked && vertices < FIRST_MEASURE_PART {
+                return None;
+            }
+            let before = pass.measured();
+            let complete = pass.advance(original, &partial.positions, &partial.reference, vertices);
+            let measured = (pass.measured() - before).max(1);
+            self.runs.vertex_ms = Some(((self.clock)() - now) / measured as f64);
+            self.worked = true;
+            if complete {
+                let (metrics, _) = partial.measuring.take()?.finish(original, 0.5);
+                return Some(terms_of(&metrics));
+            }
+        }
     }
 
     /// Smooths `partial` towards `target` iterations, as many as fit in the budget (at least
@@ -198,11 +238,10 @@ impl Evaluator for Sliced<'_> {
                 return Some(partial.terms);
             };
             if partial.done >= next {
-                if !self.fits(self.runs.measure_ms) {
-                    break;
+                match self.measure_parts(&mut partial) {
+                    Some(t) => partial.terms.push(t),
+                    None => break,
                 }
-                let t = self.measure_now(&partial);
-                partial.terms.push(t);
             } else {
                 if !self.fits(self.runs.iteration_ms) {
                     break;
@@ -324,6 +363,32 @@ mod tests {
             let expected_calls = if filter == Filter::Sinc { 1 } else { 3 };
             assert!(calls >= expected_calls, "{filter:?}: {calls} calls");
         }
+    }
+
+    #[test]
+    fn a_measure_pass_is_spread_over_calls_too() {
+        let original = sample();
+        assert_eq!(original.mesh().vertex_count().div_ceil(2048), 2);
+        let ticks = Cell::new(0.0);
+        let clock = || {
+            ticks.set(ticks.get() + 1.0);
+            ticks.get()
+        };
+        let p = Params::defaults(Filter::Hc);
+        let mut runs = SlicedRuns::default();
+        let mut calls = 0;
+        let terms = loop {
+            calls += 1;
+            let mut ev = Sliced::new(&original, None, &mut runs, &clock, 0.0).unwrap();
+            if let Some(t) = ev.measure(&p, &[2]) {
+                break t;
+            }
+        };
+        // Without budget, one piece per call: two iterations, the triangle areas, then the
+        // measure pass's two runs of 2048 vertices.
+        assert_eq!(calls, 5);
+        let mut ev = MeshEvaluator::new(&original, None).unwrap();
+        assert_eq!(Some(terms), ev.measure(&p, &[2]));
     }
 
     #[test]
