@@ -125,20 +125,29 @@ pub(crate) fn wait_for<T>(
     device: &wgpu::Device,
     mut try_take: impl FnMut() -> Option<Result<T, GpuError>>,
 ) -> Result<T, GpuError> {
-    // Waiting on the latest submission runs the mapping callback; a second wait covers a
-    // submission made by another thread in between.
-    for _ in 0..2 {
+    // Waiting on the latest submission runs the mapping callback. When another thread polls
+    // the same device, it may have collected the callback and not yet called it when the
+    // device goes idle here: keep polling briefly until it has.
+    let deadline = std::time::Instant::now() + MAPPING_GRACE;
+    loop {
         device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| GpuError::Readback(e.to_string()))?;
         if let Some(result) = try_take() {
             return result;
         }
+        if std::time::Instant::now() >= deadline {
+            return Err(GpuError::Readback(
+                "the mapping did not complete after the device went idle".into(),
+            ));
+        }
+        std::thread::sleep(std::time::Duration::from_micros(200));
     }
-    Err(GpuError::Readback(
-        "the mapping did not complete after the device went idle".into(),
-    ))
 }
+
+/// How long a mapping may lag behind the device going idle (see [`wait_for`]).
+#[cfg(not(target_arch = "wasm32"))]
+const MAPPING_GRACE: std::time::Duration = std::time::Duration::from_secs(10);
 
 fn encoder(device: &wgpu::Device) -> wgpu::CommandEncoder {
     device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
