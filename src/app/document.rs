@@ -76,6 +76,17 @@ pub struct ViewReport {
     pub pick_ms: Option<f64>,
 }
 
+/// What a frame did for a file being opened (see [`Document::step_loading`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Opening {
+    /// Nothing is being opened.
+    Idle,
+    /// Still opening.
+    Working,
+    /// Opened, or failed, in this frame.
+    Done,
+}
+
 pub struct Document {
     pub session: Session,
     pub backend: Backend,
@@ -143,15 +154,15 @@ impl Document {
         self.waiting_for_load.extend(waiter);
     }
 
-    /// This frame's work on the file being opened, if one is; returns whether it is still
-    /// opening (the frame then has no time for other work). The frame that opens it goes on to
-    /// the engines' work as usual, so they take up the new model before the view is updated.
-    pub fn step_loading(&mut self) -> bool {
+    /// This frame's work on the file being opened, if one is: whether nothing is being opened,
+    /// it is still opening, or it opened (or failed) in this frame. Either of the last two takes
+    /// the frame: the engines take up a new model from the next frame on, before the view does.
+    pub fn step_loading(&mut self) -> Opening {
         if self.session.loading().is_none() {
-            return false;
+            return Opening::Idle;
         }
         let Some(outcome) = self.session.step_loading(&now_ms, FRAME_BUDGET_MS) else {
-            return true;
+            return Opening::Working;
         };
         match &outcome {
             Ok(()) => self.opened(),
@@ -160,7 +171,7 @@ impl Document {
         for w in std::mem::take(&mut self.waiting_for_load) {
             w(outcome.clone().map(|()| &self.session));
         }
-        false
+        Opening::Done
     }
 
     /// What a newly opened model needs.

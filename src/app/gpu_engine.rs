@@ -53,6 +53,16 @@ impl GuidancePolicy {
     }
 }
 
+/// What a frame sent to the device (see [`GpuEngine::step`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sent {
+    Nothing,
+    /// A newly opened model's buffers.
+    Model,
+    /// A smoothing run with its measures.
+    Run,
+}
+
 pub struct GpuEngine {
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -115,16 +125,17 @@ impl GpuEngine {
 
     /// One frame's work: collects a finished run into the session, and submits a run for the
     /// current parameters when the session needs one and none is in flight ([`Self::submitted`]
-    /// then names its revision: its positions and normals are in [`Self::buffers`]). An error (a mesh
+    /// then names its revision: its positions and normals are in [`Self::buffers`]); a new model
+    /// is uploaded in a frame of its own first. Returns what went to the device. An error (a mesh
     /// over the device's limits, a lost device) comes back for the caller to fall back to the
     /// CPU engine.
-    pub fn step(&mut self, doc: &mut Document) -> Result<(), String> {
+    pub fn step(&mut self, doc: &mut Document) -> Result<Sent, String> {
         self.collect(doc)?;
         if self.in_flight.is_some() || !doc.session.needs_smoothing() {
-            return Ok(());
+            return Ok(Sent::Nothing);
         }
         let Some(model) = doc.session.model() else {
-            return Ok(());
+            return Ok(Sent::Nothing);
         };
         let generation = doc.model_generation;
         if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
@@ -136,9 +147,11 @@ impl GpuEngine {
                 .upload_with_measures(&self.device, &model.original)
                 .map_err(|e| e.to_string())?;
             self.mesh = Some((generation, uploaded));
+            // A large model's upload fills a frame: its first run goes out with the next one.
+            return Ok(Sent::Model);
         }
         let Some((_, mesh)) = self.mesh.as_mut() else {
-            return Ok(());
+            return Ok(Sent::Nothing);
         };
         let params = *doc.session.params();
         let started_ms = now_ms();
@@ -169,7 +182,7 @@ impl GpuEngine {
             measures,
             result: None,
         });
-        Ok(())
+        Ok(Sent::Run)
     }
 
     /// Takes a finished run's results into the session (a run for an older revision is

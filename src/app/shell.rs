@@ -5,10 +5,12 @@
 use super::bottom_panel::BottomPanel;
 use super::brush::Brush;
 use super::controls::{self, Controls};
-use super::document::{now_ms, Backend, Document, SharedDocument, ViewReport, FRAME_BUDGET_MS};
+use super::document::{
+    now_ms, Backend, Document, Opening, SharedDocument, ViewReport, FRAME_BUDGET_MS,
+};
 use super::drag_params::DragParams;
 use super::file_input::FileInput;
-use super::gpu_engine::GpuEngine;
+use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
 use super::shortcuts::{self, Action};
 use super::viewer::Viewer;
@@ -196,11 +198,12 @@ impl Shell {
     }
 
     /// This frame's engine work: the GPU engine where there is one, else the CPU engine.
-    fn compute(&mut self) {
+    /// Returns whether it uploaded a new model to the GPU (the frame is full then).
+    fn compute(&mut self) -> bool {
         let mut doc = self.doc.borrow_mut();
         if let Some(gpu) = &mut self.gpu {
             match gpu.step(&mut doc) {
-                Ok(()) => return,
+                Ok(sent) => return sent == Sent::Model,
                 Err(why) => {
                     log::error!("GPU engine failed, using the CPU engine: {why}");
                     self.gpu = None;
@@ -210,6 +213,7 @@ impl Shell {
             }
         }
         doc.compute_on_cpu();
+        false
     }
 
     fn receive_files(&mut self, ctx: &egui::Context) {
@@ -461,15 +465,15 @@ impl eframe::App for Shell {
             self.draw_ms = 0.8 * self.draw_ms + 0.2 * other;
         }
         self.frame_start_ms = start;
-        // A file still opening takes the frame: the model it replaces needs no more work.
-        let loading = self.doc.borrow_mut().step_loading();
-        if !loading {
-            self.compute();
-        }
+        // A file still opening takes the frame (the model it replaces needs no more work), and
+        // so does the one that opens it; uploading it to the GPU takes the next.
+        let opening = self.doc.borrow_mut().step_loading();
+        let loading = opening != Opening::Idle;
+        let uploading = !loading && self.compute();
         let budget = self
             .draw_ms
             .clamp(*GUIDANCE_BUDGET_MS.start(), *GUIDANCE_BUDGET_MS.end());
-        if !loading {
+        if !loading && !uploading {
             let mut doc = self.doc.borrow_mut();
             let vertices = doc.session.model().map_or(0, |m| m.mesh().vertex_count());
             let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
@@ -481,7 +485,10 @@ impl eframe::App for Shell {
         }
         self.compute_ms = now_ms() - start;
         self.bottom.update(&ctx, &mut self.doc.borrow_mut());
-        self.sync_view();
+        // The view takes up a new model once the engines have (a frame later).
+        if opening != Opening::Done && !uploading {
+            self.sync_view();
+        }
         {
             let mut doc = self.doc.borrow_mut();
             doc.answer_waiting();
