@@ -43,8 +43,9 @@ struct Job {
 
 impl Job {
     fn new(model: &ModelRef<'_>, request: Request) -> Self {
-        // Zero iterations is the original mesh, whose terms are known exactly.
-        let zeros = request.1.iter().take_while(|&&k| k == 0).count();
+        // Zero iterations (or steps that move nothing) give the original mesh, whose terms are
+        // known exactly.
+        let zeros = request.0.unchanged_counts(&request.1);
         Self {
             model: model.id,
             weights_version: model.weights_version,

@@ -63,6 +63,16 @@ pub struct Params {
 }
 
 impl Params {
+    /// How many of the iteration counts `at` (ascending) leave the mesh as it is: the zeros, or
+    /// every count when no iteration moves a vertex (uniform Laplace with lambda 0), so a caller
+    /// can answer them without smoothing.
+    pub fn unchanged_counts(&self, at: &[u32]) -> usize {
+        if self.filter == Filter::Laplace && self.lambda == 0.0 {
+            return at.len();
+        }
+        at.iter().take_while(|&&k| k == 0).count()
+    }
+
     /// ALGORITHMS.md's defaults for `filter` (sinc runs 20 iterations, the others 10).
     pub fn defaults(filter: Filter) -> Self {
         Self {

@@ -99,8 +99,9 @@ impl Evaluator for MeshEvaluator<'_> {
         let mesh = self.original.mesh();
         let topology = self.original.topology();
         let mut out = Vec::with_capacity(at.len());
-        // Zero iterations is the original mesh, whose terms are known exactly.
-        let zeros = at.iter().take_while(|&&k| k == 0).count();
+        // Zero iterations (or steps that move nothing) give the original mesh, whose terms are
+        // known exactly.
+        let zeros = params.unchanged_counts(at);
         out.extend((0..zeros).map(|_| self.unchanged()));
         let rest = &at[zeros..];
         if rest.is_empty() {
@@ -141,6 +142,27 @@ impl Evaluator for MeshEvaluator<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::metrics::smooth_drifting;
+    use crate::smooth::Filter;
+
+    #[test]
+    fn a_run_that_moves_nothing_is_answered_without_smoothing_and_truthfully() {
+        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let mesh = crate::io::load(bytes, "sample.ply").unwrap();
+        let original = Original::new(&mesh, &crate::mesh::Topology::build(&mesh));
+        let mut params = Params::defaults(Filter::Laplace);
+        params.lambda = 0.0;
+        let at = [0, 5, 50];
+        let mut ev = MeshEvaluator::new(&original, None).unwrap();
+        let answered = ev.measure(&params, &at).unwrap();
+        assert_eq!(ev.runs, 0, "no smoothing run");
+        for (&k, terms) in at.iter().zip(&answered) {
+            params.iterations = k;
+            let (positions, reference) = smooth_drifting(&original, &params, None);
+            assert_eq!(positions, original.mesh().positions, "lambda 0 moves nothing");
+            assert_eq!(*terms, ev.measure_positions(&positions, &reference), "{k}");
+        }
+    }
 
     #[test]
     fn weights_must_fit_the_mesh() {

@@ -231,6 +231,9 @@ impl Sliced<'_> {
 
 impl Evaluator for Sliced<'_> {
     fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        if params.unchanged_counts(at) == at.len() {
+            return Some(vec![self.evaluator.unchanged(); at.len()]);
+        }
         let mut partial = self.resume(params, at);
         loop {
             let Some(&next) = partial.at.get(partial.terms.len()) else {
