@@ -159,7 +159,11 @@ mod tests {
         for (&k, terms) in at.iter().zip(&answered) {
             params.iterations = k;
             let (positions, reference) = smooth_drifting(&original, &params, None);
-            assert_eq!(positions, original.mesh().positions, "lambda 0 moves nothing");
+            assert_eq!(
+                positions,
+                original.mesh().positions,
+                "lambda 0 moves nothing"
+            );
             assert_eq!(*terms, ev.measure_positions(&positions, &reference), "{k}");
         }
     }
