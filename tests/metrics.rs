@@ -226,14 +226,25 @@ fn the_original_measured_in_parts_equals_the_original_at_once() {
             let mut parts = OriginalInParts::new(mesh.clone(), topology.clone());
             let mut fraction = parts.fraction();
             assert_eq!(fraction, 0.0);
-            // The first call computes the triangle areas; each later one measures vertices.
+            // Three precomputation steps (fan corners, stay radii, triangle areas), then the
+            // measure pass; the fraction grows within each.
+            let mut preparing = parts.preparing();
+            let mut calls = 0;
             while !parts.advance(part) {
+                calls += 1;
+                if parts.preparing() != preparing {
+                    (preparing, fraction) = (parts.preparing(), 0.0);
+                }
                 assert!(
                     parts.fraction() >= fraction && parts.fraction() < 1.0,
                     "{name}"
                 );
                 fraction = parts.fraction();
             }
+            assert!(
+                !preparing && calls >= 3,
+                "{name} part {part}: {calls} calls"
+            );
             let o = parts.finish();
             assert_eq!(o.volume(), at_once.volume(), "{name} part {part}");
             assert_eq!(o.curvature(), at_once.curvature(), "{name} part {part}");

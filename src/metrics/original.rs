@@ -32,8 +32,8 @@ impl Original {
         parts.finish()
     }
 
-    /// The original without its measures yet (see [`OriginalInParts`]).
-    fn unmeasured(mesh: Mesh, topology: Topology) -> Self {
+    /// The original with nothing precomputed yet (see [`OriginalInParts`]).
+    fn bare(mesh: Mesh, topology: Topology) -> Self {
         assert_eq!(
             topology.vertex_count(),
             mesh.vertex_count(),
@@ -43,8 +43,8 @@ impl Original {
             .filter(|&i| !topology.triangles_of(i).is_empty())
             .count();
         Self {
-            fan_corners: fan_corners(&mesh.triangles, &topology),
-            stay_radius2: stay_radius2(&mesh.positions, &topology),
+            fan_corners: Vec::new(),
+            stay_radius2: Vec::new(),
             mesh,
             topology,
             volume: None,
@@ -125,46 +125,70 @@ fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
 }
 
 /// [`Original::new`] spread over calls, for a caller that must return between them (the
-/// browser's one thread opening a large mesh): the precomputation when created, the triangle
-/// areas in the first [`Self::advance`], then the measure pass of the original
+/// browser's one thread opening a large mesh). Each [`Self::advance`] does one step: the fan
+/// corners, the drift's stay radii, the triangle areas, then the measure pass of the original
 /// ([`MeasureInParts`], every vertex its own reference) a run of vertices per call. The result
 /// is [`Original::new`]'s, bit for bit.
 pub struct OriginalInParts {
     original: Original,
+    /// Precomputation steps done, of [`PREPARATION_STEPS`].
+    prepared: usize,
     reference: Vec<u32>,
     pass: Option<MeasureInParts>,
 }
 
+/// The fan corners, the stay radii and the triangle areas.
+const PREPARATION_STEPS: usize = 3;
+
 impl OriginalInParts {
-    /// `topology` must be `Topology::build(&mesh)`.
+    /// `topology` must be `Topology::build(&mesh)`. Nothing is computed yet.
     pub fn new(mesh: Mesh, topology: Topology) -> Self {
-        let original = Original::unmeasured(mesh, topology);
-        let reference = super::identity(original.mesh.vertex_count());
         Self {
-            original,
-            reference,
+            original: Original::bare(mesh, topology),
+            prepared: 0,
+            reference: Vec::new(),
             pass: None,
         }
     }
 
-    /// Begins the measure pass, or measures up to `vertices` more vertices; returns whether
-    /// every vertex is measured.
+    /// Does the next precomputation step, or measures up to `vertices` more vertices; returns
+    /// whether every vertex is measured.
     pub fn advance(&mut self, vertices: usize) -> bool {
-        let o = &self.original;
-        let positions = &o.mesh.positions;
-        match &mut self.pass {
-            Some(pass) => pass.advance(o, positions, &self.reference, vertices),
-            None => {
-                self.pass = Some(MeasureInParts::new(o, positions, &self.reference));
-                false
+        let o = &mut self.original;
+        match self.prepared {
+            0 => o.fan_corners = fan_corners(&o.mesh.triangles, &o.topology),
+            1 => o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology),
+            2 => {
+                self.reference = super::identity(o.mesh.vertex_count());
+                self.pass = Some(MeasureInParts::new(o, &o.mesh.positions, &self.reference));
+            }
+            _ => {
+                let pass = self
+                    .pass
+                    .as_mut()
+                    .expect("begun in the last preparation step");
+                return pass.advance(o, &o.mesh.positions, &self.reference, vertices);
             }
         }
+        self.prepared += 1;
+        false
     }
 
-    /// The fraction of the vertices measured.
+    /// Whether the precomputation is still under way (the measure pass not begun).
+    pub fn preparing(&self) -> bool {
+        self.prepared < PREPARATION_STEPS
+    }
+
+    /// The fraction done of the precomputation while [`Self::preparing`], else of the
+    /// vertices measured.
     pub fn fraction(&self) -> f32 {
-        let (done, total) = self.pass.as_ref().map_or((0, 1), |p| p.progress());
-        done as f32 / total.max(1) as f32
+        match &self.pass {
+            Some(pass) => {
+                let (done, total) = pass.progress();
+                done as f32 / total.max(1) as f32
+            }
+            None => self.prepared as f32 / PREPARATION_STEPS as f32,
+        }
     }
 
     /// The original with its measures, once [`Self::advance`] returned true.

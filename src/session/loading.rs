@@ -15,8 +15,8 @@ enum Stage {
     Topology(Mesh, Option<Box<TopologyInParts>>),
     /// The per-vertex checks, then the per-triangle checks, a part per step.
     Check(Mesh, Topology, Box<ReportInParts>),
-    Prepare(Mesh, Topology, MeshReport, Vec<[u32; 2]>),
-    /// The triangle areas first, then the original's measures a part per step.
+    /// The original's precomputation (shown as preparing the measures) a step at a time, then
+    /// its measures a part per step.
     Measure(Box<OriginalInParts>, MeshReport, Vec<[u32; 2]>),
 }
 
@@ -77,7 +77,7 @@ impl Loading {
             Stage::Parse(_) => (0, 0.0),
             Stage::Topology(_, parts) => (1, parts.as_ref().map_or(0.0, |p| p.fraction())),
             Stage::Check(.., parts) => (2, parts.fraction()),
-            Stage::Prepare(..) => (3, 0.0),
+            Stage::Measure(original, ..) if original.preparing() => (3, original.fraction()),
             Stage::Measure(original, ..) => (4, original.fraction()),
         };
         LoadProgress {
@@ -114,14 +114,11 @@ impl Loading {
                 if parts.advance(&mesh, &topology, PART) {
                     let report = parts.finish(&mesh, &topology);
                     let edges = topology.edges();
-                    Stage::Prepare(mesh, topology, report, edges)
+                    let original = Box::new(OriginalInParts::new(mesh, topology));
+                    Stage::Measure(original, report, edges)
                 } else {
                     Stage::Check(mesh, topology, parts)
                 }
-            }
-            Stage::Prepare(mesh, topology, report, edges) => {
-                let original = Box::new(OriginalInParts::new(mesh, topology));
-                Stage::Measure(original, report, edges)
             }
             Stage::Measure(mut original, report, edges) => {
                 if !original.advance(PART) {
