@@ -115,6 +115,9 @@ pub struct MeasureInParts {
 }
 
 impl MeasureInParts {
+    /// The smallest part [`Self::advance`] measures (vertices): a part is whole chunks.
+    pub const SMALLEST_PART: usize = CHUNK;
+
     /// Checks the arrays against the original and computes the triangle areas and the volume.
     /// `positions` and `reference` must stay the same through [`Self::advance`].
     pub fn new(original: &Original, positions: &[[f32; 3]], reference: &[u32]) -> Self {

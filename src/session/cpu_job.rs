@@ -53,7 +53,7 @@ pub(super) struct CpuJob {
 }
 
 /// Vertices of the first part of a measure pass, before its speed is known.
-const FIRST_MEASURE_PART: usize = 2048;
+const FIRST_MEASURE_PART: usize = MeasureInParts::SMALLEST_PART;
 
 impl CpuJob {
     pub fn new(revision: u64, model: &Model) -> Self {

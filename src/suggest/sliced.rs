@@ -24,8 +24,8 @@ struct Partial {
     measuring: Option<MeasureInParts>,
 }
 
-/// Vertices of the first part of a measure pass, before its speed is known.
-const FIRST_MEASURE_PART: usize = 2048;
+/// Vertices of the first part of a measure pass, before its speed is known; also the smallest.
+const FIRST_MEASURE_PART: usize = MeasureInParts::SMALLEST_PART;
 
 /// The triangle areas that begin a measure pass cost about this share of the whole pass.
 const AREAS_SHARE: f64 = 0.2;
