@@ -13,18 +13,22 @@
 //!   `local`) for the active filter; resolves with the CLI's `suggest --json` keys (the
 //!   suggestion is shown, not applied)
 //! - `gallery(): Promise<array>`: makes the gallery of the active filter and shows it;
-//!   resolves with `{tau, params, terms}` per picture
+//!   resolves with `{tau, params, terms, volume_change}` per picture (`terms.volume_change` is
+//!   the size `|V - V0| / V0` the score uses; `volume_change` is signed, negative = shrunk)
 //! - `sweep(): Promise<object>`: the quality graphs of the active filter around the current
 //!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
 //! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, loading,
-//!   open_stages, backend, timings, brush, view, guidance}` (`loading`: `{name, stage, stages,
+//!   open_stages, backend, timings, brush, view, layout, guidance}` (`loading`: `{name, stage, stages,
 //!   doing}` while a file opens, else null; `open_stages`: `[{doing, ms}]`, the latest opening's
 //!   stages and their times; `timings`: the last result's `smooth_ms` and `measure_ms`
 //!   of the CPU engine's own work, or `gpu_run_ms` from submitting a GPU run to having its
 //!   results back; `weights`: `{painted, locked, min, mean}` of the painted weights, or null;
 //!   `brush`: `{on, pick_ms}`, whether the weight brush is on and how long its latest pick took;
-//!   `view`: `{x, y, width, height}`, the 3D view's rectangle in CSS pixels; `guidance`:
+//!   `view`: `{x, y, width, height}`, the 3D view's rectangle in CSS pixels; `layout`:
+//!   `{graphs: [{param, strips: [{x, y, width, height, x0, x1}]}], gallery: [{x, y, width,
+//!   height}]}`, where the graphs' plot areas (with the parameter values at their left and
+//!   right edges) and the gallery's visible cards were drawn; `guidance`:
 //!   background work under way, whether the graphs are current, the suggestion and the gallery)
 //! - `clearWeights()`: every vertex free again (undoes the weight brush)
 //!

@@ -1,7 +1,7 @@
 //! The panel under the view: the model quality graphs or the gallery, one at a time. The
 //! graphs are kept current in the background only while they are shown.
 
-use super::document::Document;
+use super::document::{Document, GraphColumn, PanelLayout};
 use super::gallery_view::GalleryView;
 use super::graphs;
 use crate::session::{Activity, Session};
@@ -36,7 +36,9 @@ impl BottomPanel {
         }
     }
 
-    pub fn show(&mut self, ui: &mut egui::Ui, session: &mut Session) {
+    /// The panel's contents; `layout` gets where its graphs or gallery cards were drawn.
+    pub fn show(&mut self, ui: &mut egui::Ui, session: &mut Session, layout: &mut PanelLayout) {
+        *layout = PanelLayout::default();
         ui.horizontal(|ui| {
             let mut gallery = self.gallery_tab;
             ui.selectable_value(
@@ -51,17 +53,23 @@ impl BottomPanel {
             }
         });
         if self.gallery_tab {
-            if let Some((tau, params)) = self.gallery.show(ui, session) {
+            let mut cards = Vec::new();
+            let picked = self.gallery.show(ui, session, &mut cards);
+            layout.gallery = cards
+                .iter()
+                .map(|r| [r.left(), r.top(), r.width(), r.height()])
+                .collect();
+            if let Some((tau, params)) = picked {
                 let _ = session.set_tau(tau);
                 let _ = session.set_params(params);
             }
         } else {
-            graphs_tab(ui, session);
+            graphs_tab(ui, session, &mut layout.graphs);
         }
     }
 }
 
-fn graphs_tab(ui: &mut egui::Ui, session: &mut Session) {
+fn graphs_tab(ui: &mut egui::Ui, session: &mut Session, layout: &mut Vec<GraphColumn>) {
     ui.horizontal(|ui| {
         let filter = session.filter();
         ui.label(format!("{filter} filter: each column varies one parameter"));
@@ -75,7 +83,7 @@ fn graphs_tab(ui: &mut egui::Ui, session: &mut Session) {
             }
         }
     });
-    if let Some(p) = graphs::show(ui, session) {
+    if let Some(p) = graphs::show(ui, session, layout) {
         let _ = session.set_params(p);
     }
 }

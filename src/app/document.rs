@@ -76,6 +76,44 @@ pub struct ViewReport {
     pub pick_ms: Option<f64>,
 }
 
+/// Where the bottom panel's clickable parts were drawn in the latest frame (points), for
+/// `state().layout`: egui draws on a canvas without a DOM, so tests find them here.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PanelLayout {
+    /// The quality graphs shown: one column per parameter.
+    pub graphs: Vec<GraphColumn>,
+    /// The gallery cards' visible rectangles (left, top, width, height), in gallery order.
+    pub gallery: Vec<[f32; 4]>,
+}
+
+/// One parameter's column of graphs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GraphColumn {
+    pub param: &'static str,
+    /// Each strip's plot area (left, top, width, height) and the parameter values at its left
+    /// and right edges: a value's x is `left + width * (value - x0) / (x1 - x0)`.
+    pub strips: Vec<([f32; 4], [f64; 2])>,
+}
+
+impl PanelLayout {
+    fn to_json(&self) -> serde_json::Value {
+        let rect =
+            |r: &[f32; 4]| serde_json::json!({"x": r[0], "y": r[1], "width": r[2], "height": r[3]});
+        serde_json::json!({
+            "graphs": self.graphs.iter().map(|c| serde_json::json!({
+                "param": c.param,
+                "strips": c.strips.iter().map(|(r, x)| {
+                    let mut s = rect(r);
+                    s["x0"] = serde_json::json!(x[0]);
+                    s["x1"] = serde_json::json!(x[1]);
+                    s
+                }).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+            "gallery": self.gallery.iter().map(rect).collect::<Vec<_>>(),
+        })
+    }
+}
+
 /// What a frame did for a file being opened (see [`Document::step_loading`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Opening {
@@ -96,6 +134,8 @@ pub struct Document {
     pub model_generation: u64,
     /// What the 3D view reports to `state()`.
     pub view: ViewReport,
+    /// Where the graphs and gallery cards are, for `state()`.
+    pub panel: PanelLayout,
     waiting: Vec<Waiter>,
     /// Calls waiting for background work (a suggestion, the graphs).
     waiting_for: Vec<(Ready, Waiter)>,
@@ -118,6 +158,7 @@ impl Document {
             timings: None,
             model_generation: 0,
             view: ViewReport::default(),
+            panel: PanelLayout::default(),
             waiting: Vec::new(),
             waiting_for: Vec::new(),
             show_gallery: false,
@@ -273,6 +314,7 @@ impl Document {
         state["view"] = serde_json::json!({
             "x": v.rect[0], "y": v.rect[1], "width": v.rect[2], "height": v.rect[3],
         });
+        state["layout"] = self.panel.to_json();
         state
     }
 }

@@ -29,7 +29,8 @@ pub struct GalleryItem {
     pub curvature_ratio: f64,
     /// Mean local distance of the vertices from the original surface, mm.
     pub mean_error: f64,
-    /// Change of the enclosed volume as a fraction (0.01 = +1 %); `None` for open meshes.
+    /// Signed change of the enclosed volume as a fraction (0.01 = +1 %, -0.01 = shrunk by 1 %);
+    /// `None` for open meshes.
     pub volume_change: Option<f64>,
     /// The result currently applied to the model.
     pub selected: bool,
@@ -56,8 +57,12 @@ pub fn texture(ctx: &egui::Context, name: &str, thumbnail: &Thumbnail) -> egui::
 }
 
 /// Shows `items` as cards in rows that fill the available width; returns the index of the card
-/// clicked this frame, if any.
-pub fn show(ui: &mut egui::Ui, items: &[GalleryItem]) -> Option<usize> {
+/// clicked this frame, if any. `cards` gets each card's visible part (empty when scrolled away).
+pub fn show(
+    ui: &mut egui::Ui,
+    items: &[GalleryItem],
+    cards: &mut Vec<egui::Rect>,
+) -> Option<usize> {
     let font = egui::FontId::proportional(CAPTION_SIZE);
     let line = ui.fonts_mut(|f| f.row_height(&font));
     // In a panel narrower than one card, the pictures shrink to fit.
@@ -78,7 +83,9 @@ pub fn show(ui: &mut egui::Ui, items: &[GalleryItem]) -> Option<usize> {
         for (row, chunk) in items.chunks(columns).enumerate() {
             ui.horizontal(|ui| {
                 for (column, item) in chunk.iter().enumerate() {
-                    if show_card(ui, item, card, image, &font, line).clicked() {
+                    let response = show_card(ui, item, card, image, &font, line);
+                    cards.push(response.rect.intersect(ui.clip_rect()));
+                    if response.clicked() {
                         clicked = Some(row * columns + column);
                     }
                 }

@@ -53,14 +53,20 @@ impl GalleryView {
             tau: pick.tau,
             curvature_ratio: pick.terms.curvature_ratio,
             mean_error: pick.terms.mean_error,
-            volume_change: pick.terms.volume_change,
+            volume_change: pick.volume_change,
             selected: false,
         });
         ctx.request_repaint();
     }
 
-    /// The tab's contents; returns the picked result's tau and parameters.
-    pub fn show(&mut self, ui: &mut egui::Ui, session: &mut Session) -> Option<(f64, Params)> {
+    /// The tab's contents; returns the picked result's tau and parameters. `cards` gets where
+    /// the cards were drawn.
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        session: &mut Session,
+        cards: &mut Vec<egui::Rect>,
+    ) -> Option<(f64, Params)> {
         ui.horizontal(|ui| {
             if session.making_gallery() {
                 if ui.button("Cancel").clicked() {
@@ -105,7 +111,7 @@ impl GalleryView {
             item.selected = pick.params == current;
         }
         let clicked = egui::ScrollArea::vertical()
-            .show(ui, |ui| gallery::show(ui, &self.items))
+            .show(ui, |ui| gallery::show(ui, &self.items, cards))
             .inner?;
         picks.get(clicked).map(|p| (p.tau, p.params))
     }

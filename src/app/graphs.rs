@@ -3,9 +3,11 @@
 //! The paper's users found three curves on one unlabelled axis confusing, so each measure has
 //! its own strip with its own labelled axis, in its own unit: smoothness (K/K0), accuracy (mean
 //! local error in mm, with half the voxel diagonal as a reference line when the voxel size is
-//! known), volume change (%), and the score S(tau) with its minimum marked. A dashed line marks
-//! the current value in every strip; clicking or dragging in any strip sets the parameter.
+//! known), the size of the volume change (%), and the score S(tau) with its minimum marked. A
+//! dashed line marks the current value in every strip; clicking or dragging in any strip sets
+//! the parameter.
 
+use super::document::GraphColumn;
 use crate::session::Session;
 use crate::smooth::Params;
 use crate::suggest::{Curve, Param};
@@ -43,8 +45,9 @@ const STRIPS: [Strip; 4] = [
         value: |s| Some(s.terms.mean_error),
     },
     Strip {
-        title: "Volume change (%)",
-        help: "Change of the enclosed volume against the original. Closer to 0 is better.",
+        title: "Volume change |ΔV| (%)",
+        help: "Size of the change of the enclosed volume against the original, shrinking and \
+               growing alike (the score counts both). Closer to 0 is better.",
         color: VOLUME,
         value: |s| s.terms.volume_change.map(|v| 100.0 * v),
     },
@@ -59,7 +62,8 @@ const STRIPS: [Strip; 4] = [
 ];
 
 /// Shows the graphs; returns new parameters when the user clicked or dragged in a strip.
-pub fn show(ui: &mut egui::Ui, session: &Session) -> Option<Params> {
+/// `layout` gets where each column's strips were drawn.
+pub fn show(ui: &mut egui::Ui, session: &Session, layout: &mut Vec<GraphColumn>) -> Option<Params> {
     let Some(graphs) = session.graphs() else {
         ui.label("The quality graphs are being computed…");
         return None;
@@ -70,7 +74,13 @@ pub fn show(ui: &mut egui::Ui, session: &Session) -> Option<Params> {
     let columns = graphs.curves.len().max(1);
     ui.columns(columns, |cols| {
         for (ui, curve) in cols.iter_mut().zip(&graphs.curves) {
-            if let Some(value) = column(ui, curve, half_vd, stale) {
+            let mut drawn = GraphColumn {
+                param: curve.param.name(),
+                strips: Vec::new(),
+            };
+            let value = column(ui, curve, half_vd, stale, &mut drawn);
+            layout.push(drawn);
+            if let Some(value) = value {
                 let mut p = *session.params();
                 curve.param.set(&mut p, value);
                 picked = Some(p);
@@ -80,8 +90,15 @@ pub fn show(ui: &mut egui::Ui, session: &Session) -> Option<Params> {
     picked.filter(|p| p.validate().is_ok() && p != session.params())
 }
 
-/// One parameter's strips; returns the sample value picked.
-fn column(ui: &mut egui::Ui, curve: &Curve, half_vd: Option<f64>, stale: bool) -> Option<f64> {
+/// One parameter's strips; returns the sample value picked. Each strip's plot area goes into
+/// `drawn`.
+fn column(
+    ui: &mut egui::Ui,
+    curve: &Curve,
+    half_vd: Option<f64>,
+    stale: bool,
+    drawn: &mut GraphColumn,
+) -> Option<f64> {
     let param = curve.param;
     let unit = param.unit();
     let mut heading = format!(
@@ -177,6 +194,12 @@ fn column(ui: &mut egui::Ui, curve: &Curve, half_vd: Option<f64>, stale: bool) -
                 .then(|| plot_ui.pointer_coordinate())
                 .flatten()
         });
+        let frame = *response.transform.frame();
+        let bounds = response.transform.bounds();
+        drawn.strips.push((
+            [frame.left(), frame.top(), frame.width(), frame.height()],
+            [bounds.min()[0], bounds.max()[0]],
+        ));
         // The measure's name inside its strip, top left: every axis says what it is.
         let rect = response.response.rect;
         ui.painter().text(

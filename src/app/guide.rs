@@ -105,7 +105,7 @@ impl Guide {
                 .volume_change
                 .map_or("n/a".to_string(), |v| format!("{:.2} %", 100.0 * v));
             ui.small(format!(
-                "K/K0 {:.3}, mean error {:.3} mm, volume {volume}, S {:.4}; {} sets in {:.1} s",
+                "K/K0 {:.3}, mean error {:.3} mm, |ΔV| {volume}, S {:.4}; {} sets in {:.1} s",
                 s.terms.curvature_ratio,
                 s.terms.mean_error,
                 s.score,

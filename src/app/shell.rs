@@ -512,8 +512,12 @@ impl eframe::App for Shell {
                 .default_size(330.0)
                 .min_size(240.0)
                 .show(ui, |ui| {
-                    self.bottom.show(ui, &mut self.doc.borrow_mut().session)
+                    let mut doc = self.doc.borrow_mut();
+                    let doc = &mut *doc;
+                    self.bottom.show(ui, &mut doc.session, &mut doc.panel)
                 });
+        } else {
+            self.doc.borrow_mut().panel = Default::default();
         }
         egui::Panel::right("report")
             .resizable(true)

@@ -248,6 +248,7 @@ impl Session {
                 "tau": p.tau,
                 "params": p.params.to_json(),
                 "terms": p.terms,
+                "volume_change": p.volume_change,
             })).collect::<Vec<_>>(),
             "problem": self.guidance_problem(),
         })

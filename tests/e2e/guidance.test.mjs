@@ -6,7 +6,6 @@ import { appendFileSync, mkdtempSync, readFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
-import { VIEWPORT } from "./lib/app.mjs";
 import * as cli from "./lib/cli.mjs";
 import { jsonDifferences, metricDifferences } from "./lib/compare.mjs";
 import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
@@ -23,6 +22,11 @@ const METRIC_RTOL = { cpu: 1e-9, webgpu: 1e-4 }[MODE];
 const TIMEOUT = 10 * 60_000;
 
 const state = (app) => app.page.evaluate(() => window.meshsmooth.state());
+
+/** The page x of `value` in a graph strip of `state().layout.graphs`. */
+function xOfValue(strip, value) {
+    return strip.x + (strip.width * (value - strip.x0)) / (strip.x1 - strip.x0);
+}
 
 function assertClose(actual, expected, what) {
     const diffs = jsonDifferences(actual, expected, RTOL);
@@ -45,7 +49,9 @@ test("G1 suggest() equals the CLI's suggest --json for the same mesh, filter and
         // The suggestion is shown, not applied, until the user takes it (key A).
         const suggested = (await state(app)).guidance.suggestion.params;
         assert.notDeepEqual((await state(app)).params, suggested);
-        await app.page.mouse.click(640, 200);
+        // A click on the view gives the canvas the keyboard.
+        const { view } = await state(app);
+        await app.page.mouse.click(view.x + view.width / 2, view.y + view.height / 2);
         await app.page.keyboard.press("a");
         await app.page.waitForFunction((p) => JSON.stringify(window.meshsmooth.state().params) === JSON.stringify(p), suggested);
         const metrics = await app.call("metrics");
@@ -90,13 +96,13 @@ test("G2 sweep() equals the CLI's sweep --json; a click in a graph sets the para
         const before = await state(app);
         const shot = await app.screenshot("guidance-graphs");
         console.log(`graphs screenshot: ${shot.path}`);
-        // The graphs fill the bottom panel right of the smoothing panel, one column per
-        // parameter (HC: alpha, beta, iterations). A click in the middle of the last column's
-        // second strip picks an iteration count from the middle of its range.
-        const left = 310;
-        const column = (VIEWPORT.width - left) / 3;
-        const x = left + 2 * column + 0.6 * column;
-        await app.page.mouse.click(x, VIEWPORT.height - 200);
+        // A click in the iterations column's error strip, at 30 iterations (from where the
+        // page says it drew the strip), sets the iterations to 30.
+        const column = before.layout.graphs.find((c) => c.param === "iterations");
+        assert.ok(column, `state().layout.graphs: ${JSON.stringify(before.layout.graphs)}`);
+        assert.equal(column.strips.length, 4);
+        const strip = column.strips[1];
+        await app.page.mouse.click(xOfValue(strip, 30), strip.y + strip.height / 2);
         await app.page.waitForFunction(
             (it) => window.meshsmooth.state().params.iterations !== it,
             before.params.iterations,
@@ -104,7 +110,7 @@ test("G2 sweep() equals the CLI's sweep --json; a click in a graph sets the para
         );
         const after = await state(app);
         assert.equal(after.params.alpha, before.params.alpha, "only the clicked parameter changes");
-        assert.ok(after.params.iterations >= 10 && after.params.iterations <= 45, `iterations ${after.params.iterations}`);
+        assert.equal(after.params.iterations, 30);
         await app.screenshotWhen(
             "guidance-graphs-after-click",
             () => true,
@@ -129,16 +135,26 @@ test("G3 the gallery shows five results; a click on one takes its tau and parame
         await app.page.waitForTimeout(1500);
         const shot = await app.screenshot("guidance-gallery");
         console.log(`gallery screenshot: ${shot.path}`);
-        // The cards sit in a row at the top of the bottom panel, right of the smoothing panel;
-        // the second is tau 0.3 (the first, tau 0.1, leaves this mesh unchanged).
-        const target = picks[1];
-        await app.page.mouse.click(580, VIEWPORT.height - 160);
-        await app.page.waitForFunction(
-            (p) => JSON.stringify(window.meshsmooth.state().params) === JSON.stringify(p),
-            target.params,
-            { timeout: 10_000 },
-        );
-        assert.equal((await state(app)).tau, target.tau);
+        // Laplace shrinks: the cards' volume changes are signed, the terms hold their size.
+        for (const p of picks) {
+            assert.ok(p.volume_change <= 0, `tau ${p.tau}: volume change ${p.volume_change}`);
+            assert.ok(Math.abs(Math.abs(p.volume_change) - p.terms.volume_change) < 1e-12, `tau ${p.tau}`);
+        }
+        // A click on each card, where the page says it drew it, takes that card's tau and
+        // parameters; the first (tau 0.1) leaves this mesh unchanged (no iterations).
+        const { layout } = await state(app);
+        assert.equal(layout.gallery.length, picks.length, `state().layout.gallery: ${JSON.stringify(layout.gallery)}`);
+        for (const k of [0, 2, 1]) {
+            const card = layout.gallery[k];
+            assert.ok(card.width > 50 && card.height > 50, `card ${k} is visible: ${JSON.stringify(card)}`);
+            await app.page.mouse.click(card.x + card.width / 2, card.y + card.height / 2);
+            await app.page.waitForFunction(
+                (p) => JSON.stringify(window.meshsmooth.state().params) === JSON.stringify(p),
+                picks[k].params,
+                { timeout: 10_000 },
+            );
+            assert.equal((await state(app)).tau, picks[k].tau);
+        }
     });
 });
 

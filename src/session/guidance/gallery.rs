@@ -12,6 +12,8 @@ pub struct GalleryPick {
     pub tau: f64,
     pub params: Params,
     pub terms: Terms,
+    /// Signed `(V - V0) / V0` of the result (the terms hold its size); `None` for open meshes.
+    pub volume_change: Option<f64>,
     pub positions: Vec<[f32; 3]>,
     pub vertex: VertexMeasures,
 }
@@ -83,11 +85,12 @@ pub(super) fn step_gallery(job: &mut GalleryJob, engine: &mut Engine<'_, '_>) ->
     let Some((positions, reference)) = ev.smoothed(&params) else {
         return false;
     };
-    let (_, vertex) = metrics::measure_vertices(original, &positions, &reference, tau);
+    let (measured, vertex) = metrics::measure_vertices(original, &positions, &reference, tau);
     job.picks.push(GalleryPick {
         tau,
         params,
         terms,
+        volume_change: measured.volume_change,
         positions,
         vertex,
     });
