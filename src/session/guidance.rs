@@ -15,7 +15,7 @@ use super::Session;
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
     EvaluatedGrid, GridSearch, LocalOutcome, LocalSearch, ModelRef, Offload, Progress,
-    QualityGraphs, QualitySweep, SearchMethod, Suggestion, Task,
+    QualityGraphs, QualitySweep, SearchMethod, Suggestion, Task, TermsMemo,
 };
 
 /// The tau values of the gallery, from accuracy to smoothness.
@@ -120,6 +120,10 @@ pub struct Guidance {
     gallery_job: Option<GalleryJob>,
     /// Why the last job gave no result.
     pub problem: Option<String>,
+    /// Terms every job measured, for the model, weights and engine of `memo_for`: searches at
+    /// other tau values and the graphs reuse them.
+    memo: TermsMemo,
+    memo_for: Option<(u64, u64, bool)>,
 }
 
 impl Session {
@@ -400,12 +404,32 @@ impl Session {
         }
     }
 
-    /// One task step within `budget_ms`.
+    /// One task step within `budget_ms`, with the memo of measured terms for this model,
+    /// weights and engine.
     fn step_guidance_once(
         &mut self,
         clock: &dyn Fn() -> f64,
         budget_ms: f64,
         offload: Option<&mut dyn Offload>,
+    ) -> bool {
+        let memo_for = Some((self.model_id, self.weights_version, offload.is_some()));
+        if self.guidance.memo_for != memo_for {
+            self.guidance.memo = TermsMemo::default();
+            self.guidance.memo_for = memo_for;
+        }
+        let mut memo = std::mem::take(&mut self.guidance.memo);
+        let finished = self.step_job(clock, budget_ms, offload, &mut memo);
+        self.guidance.memo = memo;
+        finished
+    }
+
+    /// One task step of the job due.
+    fn step_job(
+        &mut self,
+        clock: &dyn Fn() -> f64,
+        budget_ms: f64,
+        offload: Option<&mut dyn Offload>,
+        memo: &mut TermsMemo,
     ) -> bool {
         let key = self.search_key();
         let params = *self.params();
@@ -442,6 +466,7 @@ impl Session {
             clock,
             budget_ms,
             offload,
+            memo,
         };
         let guidance = &mut self.guidance;
 

@@ -12,6 +12,7 @@
 mod auto;
 mod grid;
 mod local;
+mod memo;
 mod mesh_evaluator;
 mod offload;
 mod points;
@@ -24,6 +25,7 @@ pub use auto::{
 };
 pub use grid::{EvaluatedGrid, GridSearch};
 pub use local::{LocalOutcome, LocalSearch};
+pub use memo::{Memoized, TermsMemo};
 pub use mesh_evaluator::{check_weights, terms_of, MeshEvaluator, WeightsError};
 pub use offload::{failed_terms, unchanged_terms, ModelRef, Offload, Offloaded};
 pub use sliced::{Sliced, SlicedRuns};
@@ -92,6 +94,21 @@ pub trait Evaluator {
     /// The requests the caller will make after the next one, in order, as far as it knows
     /// them. Only a hint: what is asked later is answered either way.
     fn prefetch(&mut self, _requests: &[Request]) {}
+}
+
+/// An evaluator lent by reference (to wrap it, as [`Memoized`] does).
+impl<E: Evaluator + ?Sized> Evaluator for &mut E {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        (**self).measure(params, at)
+    }
+
+    fn wants_prefetch(&self) -> bool {
+        (**self).wants_prefetch()
+    }
+
+    fn prefetch(&mut self, requests: &[Request]) {
+        (**self).prefetch(requests)
+    }
 }
 
 /// One [`Evaluator::measure`] request: parameters and iteration counts.

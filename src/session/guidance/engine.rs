@@ -2,7 +2,10 @@
 //! offload (the GPU engine) the caller lends.
 
 use crate::smooth::Params;
-use crate::suggest::{Evaluator, ModelRef, Offload, Offloaded, Request, Sliced, SlicedRuns, Terms};
+use crate::suggest::{
+    Evaluator, Memoized, ModelRef, Offload, Offloaded, Request, Sliced, SlicedRuns, Terms,
+    TermsMemo,
+};
 
 /// A job under way with the sliced-run state it keeps between calls.
 pub(super) struct Running<T> {
@@ -22,11 +25,12 @@ impl<T> Running<T> {
     }
 
     /// The evaluator for this job's next piece of work: the offload when one is lent, else
-    /// the CPU engine sliced to the budget.
+    /// the CPU engine sliced to the budget; either answers what the memo knows without
+    /// measuring.
     pub(super) fn evaluator<'a>(
         &'a mut self,
         engine: &'a mut Engine<'_, '_>,
-    ) -> Option<(&'a mut T, JobEvaluator<'a>)> {
+    ) -> Option<(&'a mut T, Memoized<'a, JobEvaluator<'a>>)> {
         self.started_ms.get_or_insert_with(engine.clock);
         let model = engine.model;
         let ev = match engine.offload.as_deref_mut() {
@@ -42,7 +46,13 @@ impl<T> Running<T> {
                 .ok()?,
             ),
         };
-        Some((&mut self.task, ev))
+        Some((
+            &mut self.task,
+            Memoized {
+                memo: &mut *engine.memo,
+                inner: ev,
+            },
+        ))
     }
 }
 
@@ -53,6 +63,8 @@ pub(super) struct Engine<'m, 'o> {
     pub(super) clock: &'m dyn Fn() -> f64,
     pub(super) budget_ms: f64,
     pub(super) offload: Option<&'o mut dyn Offload>,
+    /// Terms measured before, for this model, weights and engine.
+    pub(super) memo: &'m mut TermsMemo,
 }
 
 /// A job's evaluator for one call.

@@ -219,3 +219,39 @@ fn an_offload_runs_the_searches_and_graphs_with_the_same_results() {
     assert_eq!(s.graphs().unwrap(), graphs);
     assert!(offload.requests.iter().all(|&id| id == s.model_id));
 }
+
+#[test]
+fn searches_reuse_the_terms_measured_before_until_the_weights_change() {
+    let mut s = session("hc");
+    let mut offload = Deferred::default();
+    settle_on(&mut s, Some(&mut offload));
+    let suggestion = offload.requests.len();
+    assert!(suggestion > 0, "the suggestion made at opening measured");
+    s.start_gallery();
+    settle_on(&mut s, Some(&mut offload));
+    let gallery = offload.requests.len() - suggestion;
+    let picks: Vec<_> = s.gallery().iter().map(|p| (p.params, p.terms)).collect();
+    // Made again: every search is answered from what was measured, with the same picks.
+    s.start_gallery();
+    settle_on(&mut s, Some(&mut offload));
+    assert_eq!(offload.requests.len(), suggestion + gallery);
+    let again: Vec<_> = s.gallery().iter().map(|p| (p.params, p.terms)).collect();
+    assert_eq!(again, picks);
+    // The gallery's tau 0.5 search is the opening suggestion's: it measured nothing new, so
+    // the gallery asked for fewer runs than five searches alone would.
+    let mut alone = Deferred::default();
+    let mut fresh = session("hc");
+    fresh.cancel_suggest();
+    fresh.start_gallery();
+    settle_on(&mut fresh, Some(&mut alone));
+    assert!(
+        gallery < alone.requests.len(),
+        "{gallery} runs, {} alone",
+        alone.requests.len()
+    );
+    // Other weights: measured afresh.
+    assert!(s.paint_weights(&[(0, 1.0), (1, 1.0)], 0.0));
+    s.start_gallery();
+    settle_on(&mut s, Some(&mut offload));
+    assert!(offload.requests.len() > suggestion + gallery);
+}
