@@ -55,10 +55,7 @@ impl BottomPanel {
         if self.gallery_tab {
             let mut cards = Vec::new();
             let picked = self.gallery.show(ui, session, &mut cards);
-            layout.gallery = cards
-                .iter()
-                .map(|r| [r.left(), r.top(), r.width(), r.height()])
-                .collect();
+            layout.gallery = cards.into_iter().map(Into::into).collect();
             if let Some((tau, params)) = picked {
                 let _ = session.set_tau(tau);
                 let _ = session.set_params(params);

@@ -66,12 +66,37 @@ impl EngineTimings {
 /// When a waiting call is answered.
 pub type Ready = fn(&Session) -> bool;
 
+/// A rectangle on the page in points (CSS pixels at zoom 1), as `state()` reports it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PageRect {
+    pub left: f32,
+    pub top: f32,
+    pub width: f32,
+    pub height: f32,
+}
+
+impl PageRect {
+    fn to_json(self) -> serde_json::Value {
+        serde_json::json!({"x": self.left, "y": self.top, "width": self.width, "height": self.height})
+    }
+}
+
+impl From<eframe::egui::Rect> for PageRect {
+    fn from(r: eframe::egui::Rect) -> Self {
+        Self {
+            left: r.left(),
+            top: r.top(),
+            width: r.width(),
+            height: r.height(),
+        }
+    }
+}
+
 /// The 3D view's part of `state()`: where it is on the page, whether the weight brush is on
 /// and how long its latest pick took.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ViewReport {
-    /// Left, top, width, height in points (CSS pixels at zoom 1).
-    pub rect: [f32; 4],
+    pub rect: PageRect,
     pub brush_on: bool,
     pub pick_ms: Option<f64>,
 }
@@ -82,34 +107,32 @@ pub struct ViewReport {
 pub struct PanelLayout {
     /// The quality graphs shown: one column per parameter.
     pub graphs: Vec<GraphColumn>,
-    /// The gallery cards' visible rectangles (left, top, width, height), in gallery order.
-    pub gallery: Vec<[f32; 4]>,
+    /// The gallery cards' visible rectangles, in gallery order.
+    pub gallery: Vec<PageRect>,
 }
 
 /// One parameter's column of graphs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GraphColumn {
     pub param: &'static str,
-    /// Each strip's plot area (left, top, width, height) and the parameter values at its left
-    /// and right edges: a value's x is `left + width * (value - x0) / (x1 - x0)`.
-    pub strips: Vec<([f32; 4], [f64; 2])>,
+    /// Each strip's plot area and the parameter values at its left and right edges: a value's
+    /// x is `left + width * (value - x0) / (x1 - x0)`.
+    pub strips: Vec<(PageRect, [f64; 2])>,
 }
 
 impl PanelLayout {
     fn to_json(&self) -> serde_json::Value {
-        let rect =
-            |r: &[f32; 4]| serde_json::json!({"x": r[0], "y": r[1], "width": r[2], "height": r[3]});
         serde_json::json!({
             "graphs": self.graphs.iter().map(|c| serde_json::json!({
                 "param": c.param,
                 "strips": c.strips.iter().map(|(r, x)| {
-                    let mut s = rect(r);
+                    let mut s = r.to_json();
                     s["x0"] = serde_json::json!(x[0]);
                     s["x1"] = serde_json::json!(x[1]);
                     s
                 }).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
-            "gallery": self.gallery.iter().map(rect).collect::<Vec<_>>(),
+            "gallery": self.gallery.iter().map(|r| r.to_json()).collect::<Vec<_>>(),
         })
     }
 }
@@ -311,9 +334,7 @@ impl Document {
         };
         let v = &self.view;
         state["brush"] = serde_json::json!({"on": v.brush_on, "pick_ms": v.pick_ms});
-        state["view"] = serde_json::json!({
-            "x": v.rect[0], "y": v.rect[1], "width": v.rect[2], "height": v.rect[3],
-        });
+        state["view"] = v.rect.to_json();
         state["layout"] = self.panel.to_json();
         state
     }

@@ -194,10 +194,9 @@ fn column(
                 .then(|| plot_ui.pointer_coordinate())
                 .flatten()
         });
-        let frame = *response.transform.frame();
         let bounds = response.transform.bounds();
         drawn.strips.push((
-            [frame.left(), frame.top(), frame.width(), frame.height()],
+            (*response.transform.frame()).into(),
             [bounds.min()[0], bounds.max()[0]],
         ));
         // The measure's name inside its strip, top left: every axis says what it is.

@@ -412,9 +412,8 @@ impl Shell {
                 self.brush
                     .interact(ui, &response, camera, &mut doc.session, surface);
                 self.drag_params.interact(ui, &response, &mut doc.session);
-                let r = response.rect;
                 doc.view = ViewReport {
-                    rect: [r.left(), r.top(), r.width(), r.height()],
+                    rect: response.rect.into(),
                     brush_on: self.brush.active,
                     pick_ms: self.brush.pick_ms,
                 };
