@@ -4,12 +4,14 @@
 //! topology (`Topology`) and the validation report (`MeshReport`) are built on demand.
 
 mod normals;
+mod padded_ring;
 mod report;
 mod report_parts;
 mod topology;
 mod topology_parts;
 
 pub use normals::vertex_normals;
+pub use padded_ring::{PaddedRing, PADDED_WIDTH};
 pub use report::MeshReport;
 pub use report_parts::ReportInParts;
 pub use topology::Topology;

@@ -3,6 +3,7 @@
 //! Built in linear time by counting sorts; every array is `u32` so the GPU engine uploads it as-is.
 //! `offsets[i]..offsets[i + 1]` indexes vertex `i`'s entries (the paper's "lookup table").
 
+use super::padded_ring::PaddedRing;
 use super::topology_parts::TopologyInParts;
 use super::Mesh;
 use rayon::prelude::*;
@@ -27,6 +28,8 @@ pub struct Topology {
     /// boundary neighbours for boundary vertices (1-D smoothing along the boundary).
     /// `None` when the mesh has no boundary, in which case it equals the 1-ring.
     boundary_ring: Option<(Vec<u32>, Vec<u32>)>,
+    /// The smoothing neighbourhood in fixed rows, as the CPU kernels read it.
+    padded_ring: PaddedRing,
 }
 
 impl Topology {
@@ -74,6 +77,10 @@ impl Topology {
             }
             (offsets, ring)
         });
+        let padded_ring = match &boundary_ring {
+            Some((offsets, ring)) => PaddedRing::new(offsets, ring),
+            None => PaddedRing::new(&neighbor_offsets, &neighbors),
+        };
 
         Self {
             neighbor_offsets,
@@ -83,6 +90,7 @@ impl Topology {
             vertex_triangles,
             is_boundary,
             boundary_ring,
+            padded_ring,
         }
     }
 
@@ -115,6 +123,11 @@ impl Topology {
             Some((offsets, ring)) => (offsets, ring),
             None => (&self.neighbor_offsets, &self.neighbors),
         }
+    }
+
+    /// [`Self::smoothing_ring`] in fixed rows of eight slots (see [`PaddedRing`]).
+    pub fn padded_ring(&self) -> &PaddedRing {
+        &self.padded_ring
     }
 
     /// Number of distinct undirected edges.

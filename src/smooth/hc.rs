@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{ring_mean, Rings, CHUNK};
+use super::rings::{xyz, xyz0, Field, Rings, CHUNK};
 use super::StepObserver;
 
 /// Runs HC iterations `done + 1 ..= done + more` from `start` (the original positions, or the
@@ -26,42 +26,51 @@ pub(crate) fn run<C: Constrain>(
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
-    let mut q = start;
     if more == 0 {
-        return q;
+        return start;
     }
-    let n = q.len();
-    assert!(n == rings.vertex_count());
-    let mut b = vec![[0.0f32; 3]; n];
+    let n = start.len();
+    assert!(n == rings.vertex_count() && original.len() == n);
+    let mut q = Field::from_points(&start);
+    // `points` receives the 3-vectors the observer and the caller see.
+    let mut points = start;
+    let mut b = Field::zeros(n);
+    let watching = observer.watches();
     for iteration in done + 1..=done + more {
         differences(rings, original, &q, &mut b, alpha);
         correct(rings, original, &b, &mut q, alpha, beta, constraint);
-        observer.after_step(&q);
-        observer.after_iteration(iteration, &q);
+        if watching {
+            q.write_points(&mut points);
+            observer.after_step(&points);
+            observer.after_iteration(iteration, &points);
+        }
     }
-    q
+    if !watching {
+        q.write_points(&mut points);
+    }
+    points
 }
 
 /// Pass 1: `b_i = mean_{N(i)} q - (alpha o_i + (1 - alpha) q_i)`; 0 for isolated vertices
 /// (no ring reads them).
-fn differences(
-    rings: Rings,
-    original: &[[f32; 3]],
-    q: &[[f32; 3]],
-    b: &mut [[f32; 3]],
-    alpha: f32,
-) {
+fn differences(rings: Rings, original: &[[f32; 3]], q: &Field, b: &mut Field, alpha: f32) {
     let keep = 1.0 - alpha;
-    b.par_chunks_mut(CHUNK)
-        .zip(q.par_chunks(CHUNK).zip(original.par_chunks(CHUNK)))
+    b.vertices_mut()
+        .par_chunks_mut(CHUNK)
+        .zip(
+            q.vertices()
+                .par_chunks(CHUNK)
+                .zip(original.par_chunks(CHUNK)),
+        )
         .enumerate()
         .for_each(|(c, (b, (own, orig)))| {
             let rows = b.iter_mut().zip(own.iter().zip(orig)).zip(rings.chunk(c));
             for ((bi, (&qi, &oi)), ring) in rows {
                 *bi = if ring.is_empty() {
-                    [0.0; 3]
+                    [0.0; 4]
                 } else {
-                    let p = ring_mean(ring, q);
+                    let p = rings.mean(ring, q);
+                    let oi = xyz0(oi);
                     std::array::from_fn(|k| p[k] - (alpha * oi[k] + keep * qi[k]))
                 };
             }
@@ -72,30 +81,35 @@ fn differences(
 fn correct<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
-    b: &[[f32; 3]],
-    q: &mut [[f32; 3]],
+    b: &Field,
+    q: &mut Field,
     alpha: f32,
     beta: f32,
     constraint: &C,
 ) {
     let keep = 1.0 - alpha;
     let spread = 1.0 - beta;
-    q.par_chunks_mut(CHUNK)
-        .zip(b.par_chunks(CHUNK).zip(original.par_chunks(CHUNK)))
+    q.vertices_mut()
+        .par_chunks_mut(CHUNK)
+        .zip(
+            b.vertices()
+                .par_chunks(CHUNK)
+                .zip(original.par_chunks(CHUNK)),
+        )
         .enumerate()
         .for_each(|(c, (q, (own_b, orig)))| {
             let rows = q.iter_mut().zip(own_b.iter().zip(orig)).zip(rings.chunk(c));
             for (k, ((qi, (&bi, &oi)), ring)) in rows.enumerate() {
-                let i = c * CHUNK + k;
                 if ring.is_empty() {
                     continue;
                 }
-                let mb = ring_mean(ring, b);
-                let proposed = std::array::from_fn(|k| {
+                let mb = rings.mean(ring, b);
+                let oi = xyz0(oi);
+                let proposed: [f32; 4] = std::array::from_fn(|k| {
                     let p = bi[k] + alpha * oi[k] + keep * qi[k];
                     p - (beta * bi[k] + spread * mb[k])
                 });
-                *qi = constraint.apply(i, *qi, proposed);
+                *qi = xyz0(constraint.apply(c * CHUNK + k, xyz(*qi), xyz(proposed)));
             }
         });
 }

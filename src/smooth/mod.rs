@@ -39,11 +39,20 @@ pub trait StepObserver {
     /// of smoothing with k iterations (Laplace, Taubin, HC). Windowed sinc's intermediate terms
     /// are not a shorter filter's result, so it reports only its final iteration.
     fn after_iteration(&mut self, _iteration: u32, _positions: &[[f32; 3]]) {}
+    /// False when the observer ignores every call: the engine then skips laying out the
+    /// positions it would report (its kernels keep them in another layout).
+    fn watches(&self) -> bool {
+        true
+    }
 }
 
 /// An observer that watches nothing.
 pub struct NoObserver;
-impl StepObserver for NoObserver {}
+impl StepObserver for NoObserver {
+    fn watches(&self) -> bool {
+        false
+    }
+}
 
 /// Smooths `mesh` with `params` from its original positions and returns the new positions
 /// (same vertex order). `weights`, when given, has one entry in [0, 1] per vertex.
@@ -143,7 +152,7 @@ fn run_filter<C: Constrain>(
             umbrella::run(rings, original, start, &factors, span, constraint, observer)
         }
         Filter::Hc => {
-            // HC updates its positions in place, so it starts from a copy.
+            // HC starts from a copy (whose allocation receives the result).
             let start = start.unwrap_or_else(|| original.to_vec());
             hc::run(
                 rings, original, start, p.alpha, p.beta, span, constraint, observer,

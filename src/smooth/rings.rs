@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use crate::mesh::Topology;
+use crate::mesh::{PaddedRing, Topology, PADDED_WIDTH};
 
 /// Vertices per parallel task. Each task is a plain loop over a contiguous run of vertices
 /// (rayon's per-item closures cost ~15% more); 1024 is large enough that scheduling (a few
@@ -10,12 +10,15 @@ use crate::mesh::Topology;
 /// threads on meshes of ten thousand vertices and up.
 pub(crate) const CHUNK: usize = 1024;
 
-/// The smoothing neighbourhood (`Topology::smoothing_ring`) checked once against the vertex
-/// count, so every kernel can slice rings and gather neighbours without further checks failing.
+/// The smoothing neighbourhood (`Topology::smoothing_ring`, and its padded rows) checked once
+/// against the vertex count, so every kernel can slice rings and gather neighbours without
+/// further checks failing.
 #[derive(Clone, Copy)]
 pub(crate) struct Rings<'a> {
     offsets: &'a [u32],
     neighbors: &'a [u32],
+    rows: &'a [[u32; PADDED_WIDTH]],
+    inverse_sizes: &'a [f32],
 }
 
 impl<'a> Rings<'a> {
@@ -24,12 +27,20 @@ impl<'a> Rings<'a> {
     /// length, and every neighbour must be a vertex.
     pub(crate) fn new(topology: &'a Topology, vertex_count: usize) -> Option<Self> {
         let (offsets, neighbors) = topology.smoothing_ring();
+        let padded = topology.padded_ring();
         let consistent = offsets.len() == vertex_count + 1
             && offsets.first() == Some(&0)
             && offsets.last().map(|&e| e as usize) == Some(neighbors.len())
             && non_decreasing(offsets)
-            && neighbors_below(neighbors, vertex_count);
-        consistent.then_some(Self { offsets, neighbors })
+            && neighbors_below(neighbors, vertex_count)
+            && padded.rows.len() == vertex_count
+            && padded.inverse_sizes.len() == vertex_count;
+        consistent.then_some(Self {
+            offsets,
+            neighbors,
+            rows: &padded.rows,
+            inverse_sizes: &padded.inverse_sizes,
+        })
     }
 
     pub(crate) fn vertex_count(&self) -> usize {
@@ -37,16 +48,147 @@ impl<'a> Rings<'a> {
     }
 
     /// The rings of the vertices of chunk `c` (`c * CHUNK ..`, at most `CHUNK` of them), in
-    /// order. Walking the chunk's offsets pairwise saves the per-vertex offset checks.
+    /// order.
     #[inline(always)]
-    pub(crate) fn chunk(&self, c: usize) -> impl Iterator<Item = &'a [u32]> + 'a {
+    pub(crate) fn chunk(&self, c: usize) -> impl Iterator<Item = Ring<'a>> + 'a {
         let start = (c * CHUNK).min(self.vertex_count());
         let end = (start + CHUNK).min(self.vertex_count());
-        let neighbors = self.neighbors;
-        self.offsets[start..=end]
-            .windows(2)
-            .map(move |w| &neighbors[w[0] as usize..w[1] as usize])
+        self.rows[start..end]
+            .iter()
+            .zip(&self.inverse_sizes[start..end])
+            .enumerate()
+            .map(move |(k, (row, &inverse_size))| Ring {
+                row,
+                inverse_size,
+                vertex: start + k,
+            })
     }
+
+    /// Mean of `q` over `ring` (which must not be empty). `q` holds every vertex and the zero
+    /// entry after them ([`Field`]).
+    ///
+    /// A row's slots go into four sums of two: a fixed loop without branches, four independent
+    /// add chains, and a vertex's four lanes in one vector register.
+    #[inline(always)]
+    pub(crate) fn mean(&self, ring: Ring, q: &Field) -> [f32; 4] {
+        let q = &q.0[..];
+        if !PaddedRing::fits(ring.inverse_size) {
+            return self.csr_mean(ring.vertex, q);
+        }
+        let r = ring.row;
+        let mut sums = [[0.0f32; 4]; 4];
+        for (h, sum) in sums.iter_mut().enumerate() {
+            let (a, b) = (q[r[2 * h] as usize], q[r[2 * h + 1] as usize]);
+            for k in 0..4 {
+                sum[k] = a[k] + b[k];
+            }
+        }
+        let s = ring.inverse_size;
+        std::array::from_fn(|k| ((sums[0][k] + sums[1][k]) + (sums[2][k] + sums[3][k])) * s)
+    }
+
+    /// The mean over a ring larger than a row, from the CSR: neighbours go in pairs into two
+    /// sums (half the loop branches, two independent add chains).
+    #[inline(never)]
+    fn csr_mean(&self, i: usize, q: &[[f32; 4]]) -> [f32; 4] {
+        let ring = &self.neighbors[self.offsets[i] as usize..self.offsets[i + 1] as usize];
+        let mut even = [0.0f32; 4];
+        let mut odd = [0.0f32; 4];
+        let mut pairs = ring.chunks_exact(2);
+        for pair in &mut pairs {
+            let (a, b) = (q[pair[0] as usize], q[pair[1] as usize]);
+            for k in 0..4 {
+                even[k] += a[k];
+                odd[k] += b[k];
+            }
+        }
+        if let [j] = *pairs.remainder() {
+            let a = q[j as usize];
+            for k in 0..4 {
+                even[k] += a[k];
+            }
+        }
+        let inv = 1.0 / ring.len().max(1) as f32;
+        std::array::from_fn(|k| (even[k] + odd[k]) * inv)
+    }
+}
+
+/// One vertex's smoothing ring.
+#[derive(Clone, Copy)]
+pub(crate) struct Ring<'a> {
+    row: &'a [u32; PADDED_WIDTH],
+    inverse_size: f32,
+    vertex: usize,
+}
+
+impl Ring<'_> {
+    /// An isolated vertex: no neighbours to average.
+    #[inline(always)]
+    pub(crate) fn is_empty(&self) -> bool {
+        self.inverse_size == 0.0
+    }
+}
+
+/// Per-vertex 3-vectors as the kernels gather them: four lanes per vertex (the fourth 0, so a
+/// vertex is one aligned 16-byte load and its sums one vector add) and, after the last vertex,
+/// the zero entry that padded ring slots name. Only the vertices' entries can be changed.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Field(Vec<[f32; 4]>);
+
+impl Field {
+    /// Zeros for `n` vertices.
+    pub(crate) fn zeros(n: usize) -> Self {
+        Self(vec![[0.0; 4]; n + 1])
+    }
+
+    /// `points`, one per vertex.
+    pub(crate) fn from_points(points: &[[f32; 3]]) -> Self {
+        let mut field = Self::zeros(points.len());
+        field
+            .vertices_mut()
+            .par_chunks_mut(CHUNK)
+            .zip(points.par_chunks(CHUNK))
+            .for_each(|(out, points)| {
+                for (o, p) in out.iter_mut().zip(points) {
+                    *o = [p[0], p[1], p[2], 0.0];
+                }
+            });
+        field
+    }
+
+    /// The vertices' entries.
+    pub(crate) fn vertices(&self) -> &[[f32; 4]] {
+        &self.0[..self.0.len() - 1]
+    }
+
+    pub(crate) fn vertices_mut(&mut self) -> &mut [[f32; 4]] {
+        let n = self.0.len() - 1;
+        &mut self.0[..n]
+    }
+
+    /// The vertices' entries as 3-vectors, written into `out` (resized to fit).
+    pub(crate) fn write_points(&self, out: &mut Vec<[f32; 3]>) {
+        out.resize(self.0.len() - 1, [0.0; 3]);
+        out.par_chunks_mut(CHUNK)
+            .zip(self.vertices().par_chunks(CHUNK))
+            .for_each(|(out, field)| {
+                for (o, f) in out.iter_mut().zip(field) {
+                    *o = [f[0], f[1], f[2]];
+                }
+            });
+    }
+}
+
+/// The first three lanes.
+#[inline(always)]
+pub(crate) fn xyz(v: [f32; 4]) -> [f32; 3] {
+    [v[0], v[1], v[2]]
+}
+
+/// `v` with a zero fourth lane.
+#[inline(always)]
+pub(crate) fn xyz0(v: [f32; 3]) -> [f32; 4] {
+    [v[0], v[1], v[2], 0.0]
 }
 
 /// Entries checked per parallel task by the checks below: each task is a loop without an early
@@ -73,28 +215,68 @@ fn neighbors_below(neighbors: &[u32], vertex_count: usize) -> bool {
     })
 }
 
-/// Mean of `q` over a non-empty ring. `q` must hold every vertex the ring names.
-///
-/// Neighbours go in pairs into two sums: half the loop branches (whose trip count varies with
-/// the valence, so the exit is often mispredicted) and two independent add chains.
-#[inline(always)]
-pub(crate) fn ring_mean(ring: &[u32], q: &[[f32; 3]]) -> [f32; 3] {
-    let mut even = [0.0f32; 3];
-    let mut odd = [0.0f32; 3];
-    let mut pairs = ring.chunks_exact(2);
-    for pair in &mut pairs {
-        let (a, b) = (q[pair[0] as usize], q[pair[1] as usize]);
-        for k in 0..3 {
-            even[k] += a[k];
-            odd[k] += b[k];
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Mesh;
+
+    /// A closed double cone: two apexes with `k` neighbours each around a rim of `k` vertices
+    /// (valence 4 each), and an isolated vertex.
+    fn double_cone(k: u32) -> Mesh {
+        let mut positions = vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.3]];
+        for j in 0..k {
+            let a = j as f32 * std::f32::consts::TAU / k as f32;
+            positions.push([a.cos(), a.sin(), 0.1 * (j % 3) as f32]);
+        }
+        positions.push([5.0, 5.0, 5.0]);
+        let rim = |j: u32| 2 + j % k;
+        let triangles = (0..k)
+            .flat_map(|j| [[0, rim(j), rim(j + 1)], [1, rim(j + 1), rim(j)]])
+            .collect();
+        Mesh::new(positions, triangles)
+    }
+
+    #[test]
+    fn means_over_rows_and_larger_rings_equal_the_plain_mean() {
+        for k in [3, 8, 9, 12] {
+            let mesh = double_cone(k);
+            let topology = Topology::build(&mesh);
+            let n = mesh.vertex_count();
+            let rings = Rings::new(&topology, n).expect("built for this mesh");
+            let q = Field::from_points(&mesh.positions);
+            let means: Vec<Option<[f32; 4]>> = (0..n.div_ceil(CHUNK))
+                .flat_map(|c| rings.chunk(c).collect::<Vec<_>>())
+                .map(|ring| (!ring.is_empty()).then(|| rings.mean(ring, &q)))
+                .collect();
+            assert_eq!(means.len(), n);
+            for (i, m) in means.iter().enumerate() {
+                let ring = topology.neighbors_of(i);
+                let Some(m) = m else {
+                    assert!(ring.is_empty(), "vertex {i} of cone {k}");
+                    continue;
+                };
+                for (d, &got) in m[..3].iter().enumerate() {
+                    let plain = ring
+                        .iter()
+                        .map(|&j| mesh.positions[j as usize][d])
+                        .sum::<f32>()
+                        / ring.len() as f32;
+                    assert!((got - plain).abs() < 1e-6, "vertex {i} of cone {k}");
+                }
+                assert_eq!(m[3], 0.0);
+            }
+            assert!(means[n - 1].is_none(), "the isolated vertex");
         }
     }
-    if let [j] = *pairs.remainder() {
-        let a = q[j as usize];
-        for k in 0..3 {
-            even[k] += a[k];
-        }
+
+    #[test]
+    fn a_field_keeps_its_zero_entry_and_gives_back_its_points() {
+        let points = vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
+        let mut f = Field::from_points(&points);
+        f.vertices_mut().iter_mut().for_each(|v| v[0] += 1.0);
+        assert_eq!(f.0[2], [0.0; 4]);
+        let mut back = Vec::new();
+        f.write_points(&mut back);
+        assert_eq!(back, vec![[2.0, 2.0, 3.0], [5.0, 5.0, 6.0]]);
     }
-    let inv = 1.0 / ring.len() as f32;
-    std::array::from_fn(|k| (even[k] + odd[k]) * inv)
 }

@@ -26,7 +26,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{ring_mean, Rings, CHUNK};
+use super::rings::{xyz0, Field, Rings, CHUNK};
 use super::sinc_coefficients::sinc_coefficients;
 use super::StepObserver;
 use crate::mesh::bounding_box;
@@ -61,8 +61,8 @@ pub(crate) struct Terms {
     /// The highest term summed so far.
     k: usize,
     /// T_{k-1} x and T_k x (centred), and the estimate; allocated once for the whole run.
-    previous: Vec<[f32; 3]>,
-    current: Vec<[f32; 3]>,
+    previous: Field,
+    current: Field,
     estimate: Vec<[f32; 3]>,
 }
 
@@ -85,8 +85,8 @@ impl Terms {
             .collect();
         let mut t = Self {
             k: 1,
-            previous: vec![[0.0f32; 3]; n],
-            current: vec![[0.0f32; 3]; n],
+            previous: centred(original, centre),
+            current: Field::zeros(n),
             estimate: vec![[0.0f32; 3]; n],
             c,
         };
@@ -95,7 +95,7 @@ impl Terms {
             original,
             centre,
             [t.c[0], t.c[1]],
-            &mut t.previous,
+            &t.previous,
             &mut t.current,
             &mut t.estimate,
         );
@@ -136,36 +136,52 @@ impl Terms {
     }
 }
 
-/// `previous = x - centre`, `current = T_1 (x - centre)`,
-/// `estimate = centre + c0 (x - centre) + c1 T_1 (x - centre)`. Isolated vertices stay put.
+/// `x - centre`.
+fn centred(original: &[[f32; 3]], centre: [f32; 3]) -> Field {
+    let mut z = Field::zeros(original.len());
+    z.vertices_mut()
+        .par_chunks_mut(CHUNK)
+        .zip(original.par_chunks(CHUNK))
+        .for_each(|(z, orig)| {
+            for (z, o) in z.iter_mut().zip(orig) {
+                *z = xyz0(std::array::from_fn(|k| o[k] - centre[k]));
+            }
+        });
+    z
+}
+
+/// From `z0 = x - centre`: `current = T_1 z0`, `estimate = centre + c0 z0 + c1 T_1 z0`.
+/// Isolated vertices stay at `original`.
 fn first_term(
     rings: Rings,
     original: &[[f32; 3]],
     centre: [f32; 3],
     [c0, c1]: [f32; 2],
-    previous: &mut [[f32; 3]],
-    current: &mut [[f32; 3]],
+    z0: &Field,
+    current: &mut Field,
     estimate: &mut [[f32; 3]],
 ) {
-    previous
+    current
+        .vertices_mut()
         .par_chunks_mut(CHUNK)
-        .zip(current.par_chunks_mut(CHUNK))
         .zip(estimate.par_chunks_mut(CHUNK))
-        .zip(original.par_chunks(CHUNK))
+        .zip(
+            z0.vertices()
+                .par_chunks(CHUNK)
+                .zip(original.par_chunks(CHUNK)),
+        )
         .enumerate()
-        .for_each(|(c, (((t0, t1), e), orig))| {
-            let rows = t0.iter_mut().zip(t1.iter_mut()).zip(e.iter_mut()).zip(orig);
-            for ((((t0, t1), e), &o), ring) in rows.zip(rings.chunk(c)) {
-                let z0 = std::array::from_fn(|k| o[k] - centre[k]);
-                *t0 = z0;
+        .for_each(|(c, ((t1, e), (own, orig)))| {
+            let rows = t1.iter_mut().zip(e.iter_mut()).zip(own.iter().zip(orig));
+            for (((t1, e), (&z, &o)), ring) in rows.zip(rings.chunk(c)) {
                 if ring.is_empty() {
-                    *t1 = z0;
+                    *t1 = z;
                     *e = o;
                     continue;
                 }
-                let m = ring_mean(ring, original);
-                *t1 = std::array::from_fn(|k| 0.5 * (z0[k] + (m[k] - centre[k])));
-                *e = std::array::from_fn(|k| centre[k] + c0 * z0[k] + c1 * t1[k]);
+                let m = rings.mean(ring, z0);
+                *t1 = std::array::from_fn(|k| 0.5 * (z[k] + m[k]));
+                *e = std::array::from_fn(|k| centre[k] + c0 * z[k] + c1 * t1[k]);
             }
         });
 }
@@ -174,14 +190,15 @@ fn first_term(
 fn next_term(
     rings: Rings,
     ck: f32,
-    current: &[[f32; 3]],
-    previous: &mut [[f32; 3]],
+    current: &Field,
+    previous: &mut Field,
     estimate: &mut [[f32; 3]],
 ) {
     previous
+        .vertices_mut()
         .par_chunks_mut(CHUNK)
         .zip(estimate.par_chunks_mut(CHUNK))
-        .zip(current.par_chunks(CHUNK))
+        .zip(current.vertices().par_chunks(CHUNK))
         .enumerate()
         .for_each(|(c, ((t, e), own))| {
             let rows = t.iter_mut().zip(e.iter_mut()).zip(own).zip(rings.chunk(c));
@@ -191,9 +208,11 @@ fn next_term(
                     *t = tk;
                     continue;
                 }
-                let m = ring_mean(ring, current);
-                for k in 0..3 {
+                let m = rings.mean(ring, current);
+                for k in 0..4 {
                     t[k] = tk[k] + m[k] - t[k];
+                }
+                for k in 0..3 {
                     e[k] += ck * t[k];
                 }
             }

@@ -3,12 +3,12 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{ring_mean, Rings, CHUNK};
+use super::rings::{xyz, xyz0, Field, Rings, CHUNK};
 use super::StepObserver;
 
 /// Runs iterations `done + 1 ..= done + more` of the umbrella steps `factors` (Laplace:
 /// `[lambda]`; Taubin: `[lambda, mu]`) from `start` (the result of `done` iterations; `None`:
-/// `original`, read in place rather than copied), reporting after every step and iteration.
+/// `original`), reporting after every step and iteration.
 pub(crate) fn run<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
@@ -21,49 +21,49 @@ pub(crate) fn run<C: Constrain>(
     if more == 0 || factors.is_empty() {
         return start.unwrap_or_else(|| original.to_vec());
     }
-    let n = original.len();
-    // The ping-pong pair, allocated once per run. Without a `start`, `q` stays empty until the
-    // first step, which reads the original.
-    let mut next = vec![[0.0f32; 3]; n];
-    let mut q = start.unwrap_or_default();
+    // The ping-pong pair, allocated once per run; `points` receives the 3-vectors the observer
+    // and the caller see (the start's allocation, reused).
+    let mut q = Field::from_points(start.as_deref().unwrap_or(original));
+    let mut next = Field::zeros(original.len());
+    let mut points = start.unwrap_or_default();
+    let watching = observer.watches();
     for iteration in done + 1..=done + more {
         for &factor in factors {
-            let src = if q.len() == n { &q[..] } else { original };
-            step(rings, factor, src, &mut next, constraint);
-            if q.len() != n {
-                q = vec![[0.0f32; 3]; n];
-            }
+            step(rings, factor, &q, &mut next, constraint);
             std::mem::swap(&mut q, &mut next);
-            observer.after_step(&q);
+            if watching {
+                q.write_points(&mut points);
+                observer.after_step(&points);
+            }
         }
-        observer.after_iteration(iteration, &q);
+        if watching {
+            observer.after_iteration(iteration, &points);
+        }
     }
-    q
+    if !watching {
+        q.write_points(&mut points);
+    }
+    points
 }
 
 /// One Jacobi umbrella step: `dst_i = src_i + factor * (mean_{N(i)} src - src_i)`, constrained.
 /// Isolated vertices keep their position.
-fn step<C: Constrain>(
-    rings: Rings,
-    factor: f32,
-    src: &[[f32; 3]],
-    dst: &mut [[f32; 3]],
-    constraint: &C,
-) {
-    assert!(src.len() == rings.vertex_count() && dst.len() == src.len());
-    dst.par_chunks_mut(CHUNK)
-        .zip(src.par_chunks(CHUNK))
+fn step<C: Constrain>(rings: Rings, factor: f32, src: &Field, dst: &mut Field, constraint: &C) {
+    assert!(src.vertices().len() == rings.vertex_count());
+    assert!(dst.vertices().len() == rings.vertex_count());
+    dst.vertices_mut()
+        .par_chunks_mut(CHUNK)
+        .zip(src.vertices().par_chunks(CHUNK))
         .enumerate()
         .for_each(|(c, (dst, own))| {
             let rows = dst.iter_mut().zip(own).zip(rings.chunk(c)).enumerate();
             for (k, ((out, &q), ring)) in rows {
-                let i = c * CHUNK + k;
                 *out = if ring.is_empty() {
                     q
                 } else {
-                    let m = ring_mean(ring, src);
+                    let m = rings.mean(ring, src);
                     let proposed = std::array::from_fn(|k| q[k] + factor * (m[k] - q[k]));
-                    constraint.apply(i, q, proposed)
+                    xyz0(constraint.apply(c * CHUNK + k, xyz(q), xyz(proposed)))
                 };
             }
         });
