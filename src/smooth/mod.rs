@@ -8,7 +8,8 @@
 //! Layout: `umbrella` (Laplace, Taubin), `hc`, `sinc` with `sinc_coefficients`; the shared
 //! neighbourhood view and neighbour mean in `rings`; weights and the bound in `constraint`.
 //! Every pass runs in parallel over vertices (rayon; on wasm32 without threads it runs on the
-//! calling thread) on f32 buffers allocated once per run.
+//! calling thread) on f32 buffers allocated once per run, four lanes per vertex with a zero
+//! entry after the last (`rings::Field`), which the rings' unused slots name.
 
 mod constraint;
 mod hc;
