@@ -14,6 +14,9 @@ use rayon::prelude::*;
 /// Slots per row: rings up to this valence take the fixed loop.
 pub const PADDED_WIDTH: usize = 8;
 
+/// Rows filled per parallel task.
+const BLOCK: usize = 4096;
+
 /// Per vertex, its smoothing ring padded to [`PADDED_WIDTH`] slots, and the ring's inverse size.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PaddedRing {
@@ -28,18 +31,26 @@ impl PaddedRing {
     /// Rows for the CSR ring `(offsets, neighbors)` (offsets one longer than the vertex count).
     pub fn new(offsets: &[u32], neighbors: &[u32]) -> Self {
         let n = offsets.len().saturating_sub(1);
-        let pad = n as u32;
-        let row = |i: usize| -> ([u32; PADDED_WIDTH], f32) {
-            let ring = &neighbors[offsets[i] as usize..offsets[i + 1] as usize];
-            let row = std::array::from_fn(|k| ring.get(k).copied().unwrap_or(pad));
-            let inverse = if ring.is_empty() {
-                0.0
-            } else {
-                1.0 / ring.len() as f32
-            };
-            (row, inverse)
-        };
-        let (rows, inverse_sizes) = (0..n).into_par_iter().with_min_len(4096).map(row).unzip();
+        let mut rows = vec![[n as u32; PADDED_WIDTH]; n];
+        let mut inverse_sizes = vec![0.0f32; n];
+        // Filled in place, a block of rows per task: plain loops, no joining of vectors.
+        rows.par_chunks_mut(BLOCK)
+            .zip(inverse_sizes.par_chunks_mut(BLOCK))
+            .enumerate()
+            .for_each(|(b, (rows, inverse_sizes))| {
+                let first = b * BLOCK;
+                let offsets = &offsets[first..=first + rows.len()];
+                let rings = offsets
+                    .windows(2)
+                    .map(|w| &neighbors[w[0] as usize..w[1] as usize]);
+                for ((row, inverse), ring) in rows.iter_mut().zip(inverse_sizes).zip(rings) {
+                    let fits = ring.len().min(PADDED_WIDTH);
+                    row[..fits].copy_from_slice(&ring[..fits]);
+                    if !ring.is_empty() {
+                        *inverse = 1.0 / ring.len() as f32;
+                    }
+                }
+            });
         Self {
             rows,
             inverse_sizes,
