@@ -57,8 +57,8 @@ impl PaddedRing {
         }
     }
 
-    /// True when vertex `i`'s whole ring fits its row (an inverse size of at least 1/8; an
-    /// isolated vertex's 0 does not).
+    /// True when a ring of this inverse size fits a row whole (at least 1/8; an isolated
+    /// vertex's 0 does not: it has nothing to read).
     #[inline(always)]
     pub fn fits(inverse_size: f32) -> bool {
         inverse_size >= 1.0 / PADDED_WIDTH as f32

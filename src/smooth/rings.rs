@@ -143,6 +143,11 @@ impl Field {
 
     /// `points`, one per vertex.
     pub(crate) fn from_points(points: &[[f32; 3]]) -> Self {
+        Self::from_points_about(points, [0.0; 3])
+    }
+
+    /// `points - origin`, one per vertex (subtracting a zero origin changes no point).
+    pub(crate) fn from_points_about(points: &[[f32; 3]], origin: [f32; 3]) -> Self {
         let mut field = Self::zeros(points.len());
         field
             .vertices_mut()
@@ -150,7 +155,7 @@ impl Field {
             .zip(points.par_chunks(CHUNK))
             .for_each(|(out, points)| {
                 for (o, p) in out.iter_mut().zip(points) {
-                    *o = [p[0], p[1], p[2], 0.0];
+                    *o = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2], 0.0];
                 }
             });
         field

@@ -26,7 +26,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz0, Field, Rings, CHUNK};
+use super::rings::{Field, Rings, CHUNK};
 use super::sinc_coefficients::sinc_coefficients;
 use super::StepObserver;
 use crate::mesh::bounding_box;
@@ -85,7 +85,7 @@ impl Terms {
             .collect();
         let mut t = Self {
             k: 1,
-            previous: centred(original, centre),
+            previous: Field::from_points_about(original, centre),
             current: Field::zeros(n),
             estimate: vec![[0.0f32; 3]; n],
             c,
@@ -134,20 +134,6 @@ impl Terms {
     ) -> Vec<[f32; 3]> {
         constrain(original, self.estimate, constraint)
     }
-}
-
-/// `x - centre`.
-fn centred(original: &[[f32; 3]], centre: [f32; 3]) -> Field {
-    let mut z = Field::zeros(original.len());
-    z.vertices_mut()
-        .par_chunks_mut(CHUNK)
-        .zip(original.par_chunks(CHUNK))
-        .for_each(|(z, orig)| {
-            for (z, o) in z.iter_mut().zip(orig) {
-                *z = xyz0(std::array::from_fn(|k| o[k] - centre[k]));
-            }
-        });
-    z
 }
 
 /// From `z0 = x - centre`: `current = T_1 z0`, `estimate = centre + c0 z0 + c1 T_1 z0`.
