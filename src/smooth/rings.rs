@@ -16,9 +16,7 @@ pub(crate) const CHUNK: usize = 1024;
 #[derive(Clone, Copy)]
 pub(crate) struct Rings<'a> {
     offsets: &'a [u32],
-    neighbors: &'a [u32],
-    rows: &'a [[u32; PADDED_WIDTH]],
-    inverse_sizes: &'a [f32],
+    padded: &'a PaddedRing,
 }
 
 impl<'a> Rings<'a> {
@@ -35,12 +33,7 @@ impl<'a> Rings<'a> {
             && neighbors_below(neighbors, vertex_count)
             && padded.rows.len() == vertex_count
             && padded.inverse_sizes.len() == vertex_count;
-        consistent.then_some(Self {
-            offsets,
-            neighbors,
-            rows: &padded.rows,
-            inverse_sizes: &padded.inverse_sizes,
-        })
+        consistent.then_some(Self { offsets, padded })
     }
 
     pub(crate) fn vertex_count(&self) -> usize {
@@ -53,15 +46,10 @@ impl<'a> Rings<'a> {
     pub(crate) fn chunk(&self, c: usize) -> impl Iterator<Item = Ring<'a>> + 'a {
         let start = (c * CHUNK).min(self.vertex_count());
         let end = (start + CHUNK).min(self.vertex_count());
-        self.rows[start..end]
+        self.padded.rows[start..end]
             .iter()
-            .zip(&self.inverse_sizes[start..end])
-            .enumerate()
-            .map(move |(k, (row, &inverse_size))| Ring {
-                row,
-                inverse_size,
-                vertex: start + k,
-            })
+            .zip(&self.padded.inverse_sizes[start..end])
+            .map(|(row, &inverse_size)| Ring { row, inverse_size })
     }
 
     /// Mean of `q` over `ring` (which must not be empty). `q` holds every vertex and the zero
@@ -73,7 +61,7 @@ impl<'a> Rings<'a> {
     pub(crate) fn mean(&self, ring: Ring, q: &Field) -> [f32; 4] {
         let q = &q.0[..];
         if !PaddedRing::fits(ring.inverse_size) {
-            return self.csr_mean(ring.vertex, q);
+            return self.large_mean(ring.row, q);
         }
         let r = ring.row;
         let mut sums = [[0.0f32; 4]; 4];
@@ -87,11 +75,11 @@ impl<'a> Rings<'a> {
         std::array::from_fn(|k| ((sums[0][k] + sums[1][k]) + (sums[2][k] + sums[3][k])) * s)
     }
 
-    /// The mean over a ring larger than a row, from the CSR: neighbours go in pairs into two
-    /// sums (half the loop branches, two independent add chains).
+    /// The mean over a ring larger than a row, from the list of large rings: neighbours go in
+    /// pairs into two sums (half the loop branches, two independent add chains).
     #[inline(never)]
-    fn csr_mean(&self, i: usize, q: &[[f32; 4]]) -> [f32; 4] {
-        let ring = &self.neighbors[self.offsets[i] as usize..self.offsets[i + 1] as usize];
+    fn large_mean(&self, row: &[u32; PADDED_WIDTH], q: &[[f32; 4]]) -> [f32; 4] {
+        let ring = self.padded.large_ring(row);
         let mut even = [0.0f32; 4];
         let mut odd = [0.0f32; 4];
         let mut pairs = ring.chunks_exact(2);
@@ -118,7 +106,6 @@ impl<'a> Rings<'a> {
 pub(crate) struct Ring<'a> {
     row: &'a [u32; PADDED_WIDTH],
     inverse_size: f32,
-    vertex: usize,
 }
 
 impl Ring<'_> {
