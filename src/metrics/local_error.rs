@@ -72,19 +72,24 @@ const DRIFT_CHUNK: usize = 2048;
 /// The drifting reference neighbourhood: after every smoothing step, each vertex's reference moves
 /// to whichever of the reference and its 1-ring on the original mesh is closest to the vertex's
 /// current position (one hop per step). Use it as the smoothing run's [`StepObserver`].
+///
+/// Most vertices keep their reference from one step to the next, and a step moves them little, so
+/// each vertex also keeps an anchor: a point and a radius such that anywhere within the radius of
+/// the point, the reference is still strictly the closest of its ring. A vertex within its anchor's
+/// radius skips the ring. The anchors only save work: the references are those of checking every
+/// ring at every step.
 #[derive(Clone, Debug)]
 pub struct DriftingReference<'a> {
     original: &'a Original,
     reference: Vec<u32>,
+    /// Per vertex `[x, y, z, radius^2]` (see the type's notes).
+    anchors: Vec<[f32; 4]>,
 }
 
 impl<'a> DriftingReference<'a> {
     /// Every vertex starts at itself.
     pub fn new(original: &'a Original) -> Self {
-        Self {
-            original,
-            reference: identity(original.mesh().vertex_count()),
-        }
+        Self::resume(original, identity(original.mesh().vertex_count()))
     }
 
     /// Continues a drift from `reference` (an earlier state of one, one entry per vertex): a
@@ -95,16 +100,22 @@ impl<'a> DriftingReference<'a> {
             original.mesh().vertex_count(),
             "one reference per vertex"
         );
+        let anchors = reference
+            .iter()
+            .map(|&r| home_anchor(original, r as usize))
+            .collect();
         Self {
             original,
             reference,
+            anchors,
         }
     }
 
     /// Back to the start, for a new smoothing run from the original positions.
     pub fn reset(&mut self) {
-        for (i, r) in self.reference.iter_mut().enumerate() {
+        for (i, (r, a)) in self.reference.iter_mut().zip(&mut self.anchors).enumerate() {
             *r = i as u32;
+            *a = home_anchor(self.original, i);
         }
     }
 
@@ -115,33 +126,18 @@ impl<'a> DriftingReference<'a> {
             self.reference.len(),
             "positions must belong to the original mesh"
         );
-        let original = self.original.mesh();
-        let topology = self.original.topology();
-        let stay = self.original.stay_radius2();
+        let original = self.original;
         // Plain loops over runs of vertices: rayon's per-item closures cost more than the work.
         self.reference
             .par_chunks_mut(DRIFT_CHUNK)
+            .zip(self.anchors.par_chunks_mut(DRIFT_CHUNK))
             .zip(positions.par_chunks(DRIFT_CHUNK))
-            .for_each(|(references, positions)| {
-                for (r, q) in references.iter_mut().zip(positions) {
-                    let d2 = |p: [f32; 3]| {
-                        let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-                    };
-                    // Ties keep the current reference, so a vertex that did not move stays put.
-                    let mut best = *r;
-                    let mut best_d2 = d2(original.positions[best as usize]);
-                    // Within the stay radius no neighbour can be closer (see `Original`).
-                    if best_d2 <= stay[best as usize] {
+            .for_each(|((references, anchors), positions)| {
+                for ((r, a), q) in references.iter_mut().zip(anchors).zip(positions) {
+                    if distance2(*q, [a[0], a[1], a[2]]) <= a[3] {
                         continue;
                     }
-                    for &j in topology.neighbors_of(*r as usize) {
-                        let dj = d2(original.positions[j as usize]);
-                        let closer = dj < best_d2;
-                        best = if closer { j } else { best };
-                        best_d2 = if closer { dj } else { best_d2 };
-                    }
-                    *r = best;
+                    (*r, *a) = drift_step(original, *q, *r);
                 }
             });
     }
@@ -153,6 +149,53 @@ impl<'a> DriftingReference<'a> {
 
     pub fn into_reference(self) -> Vec<u32> {
         self.reference
+    }
+}
+
+/// The anchor of a vertex whose reference `r` may be anywhere: the reference's own position and
+/// its stay radius (see `Original`).
+fn home_anchor(original: &Original, r: usize) -> [f32; 4] {
+    let p = original.mesh().positions[r];
+    [p[0], p[1], p[2], original.stay_radius2()[r]]
+}
+
+#[inline]
+fn distance2(q: [f32; 3], p: [f32; 3]) -> f32 {
+    let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+}
+
+/// One step of the drift for a vertex at `q` with reference `r`, checking the whole ring: the new
+/// reference and its anchor.
+///
+/// If the reference stays, with `D_r` its distance and `D_min` the nearest neighbour's, then
+/// wherever `q` moves by less than `(D_min - D_r) / 2`, every neighbour stays farther than the
+/// reference (triangle inequality). The anchor at `q` takes 0.45 of that gap less `1e-4 D_min`:
+/// far more than the rounding of the f32 distances, so the comparisons the full check would
+/// make give the same answer within it. A new reference is anchored at home.
+#[inline]
+fn drift_step(original: &Original, q: [f32; 3], r: u32) -> (u32, [f32; 4]) {
+    let positions = &original.mesh().positions;
+    // Ties keep the current reference, so a vertex that did not move stays put.
+    let mut best = r;
+    let mut best_d2 = distance2(q, positions[r as usize]);
+    let mut nearest_other = f32::INFINITY;
+    for &j in original.topology().neighbors_of(r as usize) {
+        let dj = distance2(q, positions[j as usize]);
+        let closer = dj < best_d2;
+        best = if closer { j } else { best };
+        best_d2 = if closer { dj } else { best_d2 };
+        nearest_other = nearest_other.min(dj);
+    }
+    if best != r {
+        return (best, home_anchor(original, best as usize));
+    }
+    let (d_r, d_min) = (best_d2.sqrt(), nearest_other.sqrt());
+    let radius = 0.45 * (d_min - d_r) - 1e-4 * d_min;
+    if radius > 0.0 && radius.is_finite() {
+        (r, [q[0], q[1], q[2], radius * radius])
+    } else {
+        (r, home_anchor(original, r as usize))
     }
 }
 
