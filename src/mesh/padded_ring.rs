@@ -15,7 +15,7 @@ use rayon::prelude::*;
 /// Slots per row: rings up to this valence take the fixed loop.
 pub const PADDED_WIDTH: usize = 8;
 
-/// Rows filled per parallel task.
+/// Rows filled (or checked) per parallel task.
 const BLOCK: usize = 4096;
 
 /// Per vertex, its smoothing ring padded to [`PADDED_WIDTH`] slots, and the ring's inverse size.
@@ -79,6 +79,37 @@ impl PaddedRing {
         &self.large[row[0] as usize..row[1] as usize]
     }
 
+    /// Whether these rows describe `vertex_count` vertices, so a kernel gathering from a buffer of
+    /// `vertex_count + 1` entries (the zero entry last) reads nothing out of range: one row per
+    /// vertex, every slot of a row that fits at most `vertex_count`, every large ring's range
+    /// within the list and its entries below `vertex_count`. Checked once per smoothing run;
+    /// each task's loop has no early exit.
+    pub fn describes(&self, vertex_count: usize) -> bool {
+        let sized = self.rows.len() == vertex_count && self.inverse_sizes.len() == vertex_count;
+        let large = self.large.len();
+        sized
+            && self.large.iter().all(|&j| (j as usize) < vertex_count)
+            && self
+                .rows
+                .par_chunks(BLOCK)
+                .zip(self.inverse_sizes.par_chunks(BLOCK))
+                .all(|(rows, inverse_sizes)| {
+                    rows.iter()
+                        .zip(inverse_sizes)
+                        .fold(true, |ok, (row, &inv)| {
+                            let fine = if Self::fits(inv) {
+                                row.iter()
+                                    .fold(true, |ok, &j| ok & (j as usize <= vertex_count))
+                            } else if inv != 0.0 {
+                                row[0] <= row[1] && row[1] as usize <= large
+                            } else {
+                                true
+                            };
+                            ok & fine
+                        })
+                })
+    }
+
     /// True when a ring of this inverse size fits a row whole (at least 1/8; an isolated
     /// vertex's 0 does not: it has nothing to read).
     #[inline(always)]
@@ -107,5 +138,27 @@ mod tests {
         assert!(!PaddedRing::fits(p.inverse_sizes[1]));
         assert!(!PaddedRing::fits(p.inverse_sizes[2]));
         assert!(PaddedRing::fits(1.0 / 8.0) && !PaddedRing::fits(1.0 / 9.0));
+    }
+
+    #[test]
+    fn rows_describe_only_their_own_vertex_count() {
+        // Twelve vertices: 0 has two neighbours, 2 has ten (a large ring), the rest none.
+        let mut offsets = vec![0u32, 2, 2, 12];
+        offsets.resize(13, 12);
+        let neighbors = [7, 9, 0, 1, 3, 4, 5, 6, 7, 8, 9, 11];
+        let p = PaddedRing::new(&offsets, &neighbors);
+        assert!(p.describes(12));
+        assert!(!p.describes(11) && !p.describes(13));
+        // A slot past the zero entry, a large ring's range past the list, a neighbour that is
+        // no vertex: not these rows.
+        let mut past = p.clone();
+        past.rows[0][1] = 13;
+        let mut beyond = p.clone();
+        beyond.rows[2][1] = 11;
+        let mut foreign = p.clone();
+        foreign.large[3] = 12;
+        for broken in [past, beyond, foreign] {
+            assert!(!broken.describes(12));
+        }
     }
 }

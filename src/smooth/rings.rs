@@ -10,34 +10,28 @@ use crate::mesh::{PaddedRing, Topology, PADDED_WIDTH};
 /// threads on meshes of ten thousand vertices and up.
 pub(crate) const CHUNK: usize = 1024;
 
-/// The smoothing neighbourhood (`Topology::smoothing_ring`, and its padded rows) checked once
-/// against the vertex count, so every kernel can slice rings and gather neighbours without
-/// further checks failing.
+/// The smoothing neighbourhood as the kernels read it (`Topology::padded_ring`), checked once
+/// against the vertex count, so every kernel can gather neighbours without further checks
+/// failing.
 #[derive(Clone, Copy)]
 pub(crate) struct Rings<'a> {
-    offsets: &'a [u32],
     padded: &'a PaddedRing,
+    vertex_count: usize,
 }
 
 impl<'a> Rings<'a> {
     /// `None` when the topology does not describe `vertex_count` vertices (built for another
-    /// mesh): the CSR must have `vertex_count + 1` non-decreasing offsets ending at the list's
-    /// length, and every neighbour must be a vertex.
+    /// mesh; see [`PaddedRing::describes`]).
     pub(crate) fn new(topology: &'a Topology, vertex_count: usize) -> Option<Self> {
-        let (offsets, neighbors) = topology.smoothing_ring();
         let padded = topology.padded_ring();
-        let consistent = offsets.len() == vertex_count + 1
-            && offsets.first() == Some(&0)
-            && offsets.last().map(|&e| e as usize) == Some(neighbors.len())
-            && non_decreasing(offsets)
-            && neighbors_below(neighbors, vertex_count)
-            && padded.rows.len() == vertex_count
-            && padded.inverse_sizes.len() == vertex_count;
-        consistent.then_some(Self { offsets, padded })
+        padded.describes(vertex_count).then_some(Self {
+            padded,
+            vertex_count,
+        })
     }
 
     pub(crate) fn vertex_count(&self) -> usize {
-        self.offsets.len() - 1
+        self.vertex_count
     }
 
     /// The rings of the vertices of chunk `c` (`c * CHUNK ..`, at most `CHUNK` of them), in
@@ -181,30 +175,6 @@ pub(crate) fn xyz(v: [f32; 4]) -> [f32; 3] {
 #[inline(always)]
 pub(crate) fn xyz0(v: [f32; 3]) -> [f32; 4] {
     [v[0], v[1], v[2], 0.0]
-}
-
-/// Entries checked per parallel task by the checks below: each task is a loop without an early
-/// exit, which the compiler turns into vector instructions (the checks run once per smoothing
-/// run, over every neighbour entry: a few percent of a short run when done one by one).
-const CHECK_CHUNK: usize = 64 * 1024;
-
-/// `offsets[k] <= offsets[k + 1]` for every `k`.
-fn non_decreasing(offsets: &[u32]) -> bool {
-    let Some(tail) = offsets.get(1..) else {
-        return true;
-    };
-    offsets
-        .par_chunks(CHECK_CHUNK)
-        .zip(tail.par_chunks(CHECK_CHUNK))
-        .all(|(a, b)| a.iter().zip(b).fold(true, |ok, (x, y)| ok & (x <= y)))
-}
-
-/// Every entry of `neighbors` is below `vertex_count`.
-fn neighbors_below(neighbors: &[u32], vertex_count: usize) -> bool {
-    neighbors.par_chunks(CHECK_CHUNK).all(|c| {
-        let largest = c.iter().fold(0, |m, &j| m.max(j));
-        (largest as usize) < vertex_count
-    })
 }
 
 #[cfg(test)]
