@@ -22,6 +22,16 @@
 @group(0) @binding(6) var<storage, read_write> vertex_measures: array<vec2<f32>>;
 // One per workgroup, at its linear index.
 @group(0) @binding(7) var<storage, read_write> partials: array<Partial>;
+// The workgroups this dispatch covers: the pass runs as 1-D parts, each its own dispatch.
+@group(0) @binding(8) var<uniform> part: MeasurePart;
+
+// Mirrors `MeasurePart` in src/gpu/layout.rs (16 bytes).
+struct MeasurePart {
+    first_group: u32,
+    group_count: u32,
+    pad0: u32,
+    pad1: u32,
+}
 
 // Mirrors `MeasurePartial` in src/gpu/layout.rs (32 bytes).
 struct Partial {
@@ -252,12 +262,11 @@ fn combine(a: Partial, b: Partial) -> Partial {
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn measure_vertices(
-    @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
-    @builtin(workgroup_id) workgroup: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(workgroup_id) local_group: vec3<u32>,
 ) {
-    let i = vertex_index(id, groups);
+    let group = part.first_group + local_group.x;
+    let i = group * WORKGROUP_SIZE + lane;
     var s = empty_partial();
     if i < surface.vertex_count {
         s = measure_vertex(i);
@@ -272,6 +281,6 @@ fn measure_vertices(
         workgroupBarrier();
     }
     if lane == 0u {
-        partials[workgroup.x + workgroup.y * groups.x] = shared_partials[0];
+        partials[group] = shared_partials[0];
     }
 }

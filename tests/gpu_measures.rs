@@ -7,7 +7,7 @@
 //!   references: volume within 1e-6 relative, mean local error 1e-5, maximum 1e-4, every angle
 //!   defect within 1e-6 rad (f32 leaves a few 1e-7), hence K within 1e-6 times the mean of
 //!   1 / A_mixed.
-//! - The same numbers from a 2-D workgroup grid.
+//! - The same numbers from a 2-D workgroup grid, and from a run sent in pieces.
 //!
 //! Without an adapter these tests print a notice and pass, unless REQUIRE_GPU=1, where they fail.
 #![cfg(not(target_arch = "wasm32"))]
@@ -22,7 +22,7 @@ mod open_scalp;
 mod runs;
 
 use device::{gpu, Gpu};
-use meshsmooth::gpu::{read_normals, GpuMesh};
+use meshsmooth::gpu::{read_normals, read_result, GpuMesh, RunPieces};
 use meshsmooth::mesh::{vertex_normals, Mesh};
 use meshsmooth::metrics::{
     identity, measure_vertices, vertex_curvatures, Metrics, Original, VertexMeasures,
@@ -359,4 +359,64 @@ fn a_2d_grid_gives_the_same_drift_normals_and_measures() {
     assert!(relative(a.mean_error, b.mean_error) < 1e-6);
     assert!(relative(a.curvature, b.curvature) < 1e-6);
     assert!(relative(a.volume.expect("closed"), b.volume.expect("closed")) < 1e-6);
+}
+
+/// A run sent in pieces (as the web app sends one per frame: some iterations, the normals,
+/// parts of the measure pass) leaves the same positions, references, normals and measures as
+/// the whole run, bit for bit.
+#[test]
+fn a_run_in_pieces_equals_the_whole_run() {
+    let Some(gpu) = gpu() else { return };
+    let (device, queue) = (&gpu.ctx.device, &gpu.ctx.queue);
+    let original = original(SCALP);
+    let n = original.mesh().vertex_count() as u64;
+    for filter in Filter::ALL {
+        for iterations in [0, 7] {
+            let p = params(filter, iterations.max(u32::from(filter == Filter::Sinc)));
+            let mut mesh = gpu
+                .smoother
+                .upload_with_measures(device, &original)
+                .expect("fits");
+            let whole = run(gpu, &mut mesh, &p);
+            gpu.smoother
+                .compute_normals(device, queue, &mesh)
+                .expect("has measures");
+            let whole_normals = read_normals(device, queue, &mesh).expect("readback");
+            let whole_measures = gpu
+                .smoother
+                .measure(device, queue, &mesh, true)
+                .expect("has measures")
+                .wait(device, &original, 0.5)
+                .expect("readback");
+
+            let mut mesh = gpu
+                .smoother
+                .upload_with_measures(device, &original)
+                .expect("fits");
+            let mut pieces = RunPieces::new(&p);
+            let mut calls = 0;
+            while !pieces.done() {
+                // About one iteration (or a few parts of the measure) per call.
+                let sent = pieces
+                    .advance(&gpu.smoother, device, queue, &mut mesh, n)
+                    .expect("valid");
+                assert!(sent.spent > 0);
+                calls += 1;
+                assert!(calls < 100, "{filter}: no end");
+            }
+            let what = format!("{filter}, {iterations} iterations");
+            assert!(calls >= 4, "{what}: {calls} pieces");
+            let (positions, measures) = pieces.read_back(device, queue, &mesh).expect("done");
+            let in_pieces = positions.wait(device).expect("readback");
+            let normals = read_normals(device, queue, &mesh).expect("readback");
+            let measured = measures.wait(device, &original, 0.5).expect("readback");
+            assert_eq!(
+                in_pieces,
+                read_result(device, queue, &mesh).expect("readback")
+            );
+            assert_eq!(in_pieces, whole, "{what}: positions");
+            assert_eq!(normals, whole_normals, "{what}: normals");
+            assert_eq!(measured, whole_measures, "{what}: measures");
+        }
+    }
 }

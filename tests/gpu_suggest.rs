@@ -164,7 +164,8 @@ fn segmented_runs_equal_whole_runs() {
         let params = Params::defaults(filter);
         for at in requests(filter) {
             let expected = whole.measure(&model, &params, &at).expect("answers");
-            // Three iterations per submission at first; the size then adapts.
+            // At most three vertex-steps per vertex per submission: a measure (about six)
+            // runs in parts.
             pieces.set_segment(Some(3 * n));
             let mut calls = 0;
             let start = std::time::Instant::now();

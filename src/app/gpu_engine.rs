@@ -2,10 +2,26 @@
 //! compute on eframe's own device, so the view draws from the engine's buffers. Only the
 //! measures and the positions (for colours, exports and the API) come back, asynchronously:
 //! a frame never waits for the GPU.
+//!
+//! A run goes to the device in pieces (some iterations, the normals, parts of the measure), as
+//! much per frame as keeps the frame's own work near [`crate::gpu::FRAME_WORK_MS`] (the
+//! background's runs get what is left): the device runs its queue in order, so a frame drawn
+//! after a whole run on a slow (software) adapter would wait for all of it. On a fast one the
+//! pieces grow until a run fits a frame or two.
 
 use super::document::{now_ms, Document, EngineTimings};
-use crate::gpu::{GpuEvaluator, GpuMesh, GpuSmoother, MeasureReadback, ResultReadback};
+use crate::gpu::{
+    FrameWork, GpuEvaluator, GpuMesh, GpuSmoother, MeasureReadback, ResultReadback, RunPieces,
+};
 use crate::suggest::Offload;
+
+/// A run being sent to the device in pieces, for one session revision.
+struct Running {
+    generation: u64,
+    revision: u64,
+    started_ms: f64,
+    pieces: RunPieces,
+}
 
 /// A run submitted for one session revision, its results still on the way back.
 struct InFlight {
@@ -69,7 +85,10 @@ pub struct GpuEngine {
     smoother: GpuSmoother,
     /// The open model on the GPU, with the document's model generation it belongs to.
     mesh: Option<(u64, GpuMesh)>,
+    running: Option<Running>,
     in_flight: Option<InFlight>,
+    /// How much of a run goes out per frame.
+    frame_work: FrameWork,
     /// The revision of the latest run submitted (its positions are in the buffers).
     submitted: Option<u64>,
     /// The session's weights version the mesh's weight buffer holds: uploaded once per change.
@@ -87,7 +106,9 @@ impl GpuEngine {
             device: device.clone(),
             queue: queue.clone(),
             mesh: None,
+            running: None,
             in_flight: None,
+            frame_work: FrameWork::default(),
             submitted: None,
             weights_uploaded: None,
             evaluator: Some(GpuEvaluator::new(device, queue, &smoother, now_ms)),
@@ -97,12 +118,31 @@ impl GpuEngine {
     }
 
     /// The evaluator for the background's runs on a mesh of `vertices`, while it works and
-    /// when the policy puts them on the GPU.
+    /// when the policy puts them on the GPU, with what is left of this frame's device work
+    /// (report what it sent with [`Self::guidance_sent`]).
     pub fn evaluator(&mut self, vertices: usize) -> Option<&mut dyn Offload> {
         if !self.policy.on_gpu(vertices) {
             return None;
         }
-        self.evaluator.as_mut().map(|e| e as &mut dyn Offload)
+        // A run for the view waiting for room comes first: the background waits with it.
+        let left = match self.frame_work.holding() {
+            true => 0,
+            false => self.frame_work.left(),
+        };
+        let evaluator = self.evaluator.as_mut()?;
+        evaluator.share_frame(left);
+        Some(evaluator as &mut dyn Offload)
+    }
+
+    /// Counts what the evaluator sent in this frame into the frame's work.
+    pub fn guidance_sent(&mut self) {
+        if let Some(e) = &self.evaluator {
+            let (steps, full, held) = e.frame_spent();
+            self.frame_work.sent(steps, full);
+            if held > 0 {
+                self.frame_work.hold(held);
+            }
+        }
     }
 
     /// Why the background's evaluator failed (it is dropped then: the CPU takes over).
@@ -117,44 +157,65 @@ impl GpuEngine {
         self.submitted
     }
 
-    /// The buffers of the latest run: positions and normals, vec4 per vertex.
+    /// The buffers of the latest run: positions and normals, vec4 per vertex; `None` while
+    /// the next run is under way in them.
     pub fn buffers(&self) -> Option<(&wgpu::Buffer, &wgpu::Buffer)> {
+        if self.running.is_some() {
+            return None;
+        }
         let (_, mesh) = self.mesh.as_ref()?;
         Some((mesh.positions_buffer(), mesh.normals_buffer()?))
     }
 
-    /// One frame's work: collects a finished run into the session, and submits a run for the
-    /// current parameters when the session needs one and none is in flight ([`Self::submitted`]
-    /// then names its revision: its positions and normals are in [`Self::buffers`]); a new model
-    /// is uploaded in a frame of its own first. Returns what went to the device. An error (a mesh
-    /// over the device's limits, a lost device) comes back for the caller to fall back to the
-    /// CPU engine.
+    /// One frame's work: collects a finished run into the session, and sends the next pieces
+    /// of a run for the current parameters when the session needs one and no results are on
+    /// the way back ([`Self::submitted`] names the revision once its positions and normals
+    /// are in [`Self::buffers`]); a new model is uploaded in a frame of its own first. Returns
+    /// what went to the device. An error (a mesh over the device's limits, a lost device) comes
+    /// back for the caller to fall back to the CPU engine.
     pub fn step(&mut self, doc: &mut Document) -> Result<Sent, String> {
+        self.frame_work.begin_frame(now_ms());
         self.collect(doc)?;
-        if self.in_flight.is_some() || !doc.session.needs_smoothing() {
+        if self.in_flight.is_some() {
             return Ok(Sent::Nothing);
         }
-        let Some(model) = doc.session.model() else {
-            return Ok(Sent::Nothing);
-        };
         let generation = doc.model_generation;
-        if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
-            self.mesh = None;
-            self.submitted = None;
-            self.weights_uploaded = None;
-            let uploaded = self
-                .smoother
-                .upload_with_measures(&self.device, &model.original)
-                .map_err(|e| e.to_string())?;
-            self.mesh = Some((generation, uploaded));
-            // A large model's upload fills a frame: its first run goes out with the next one.
-            return Ok(Sent::Model);
+        if self
+            .running
+            .as_ref()
+            .is_some_and(|r| r.generation != generation)
+        {
+            self.running = None;
         }
-        let Some((_, mesh)) = self.mesh.as_mut() else {
+        if self.running.is_none() {
+            if !doc.session.needs_smoothing() {
+                return Ok(Sent::Nothing);
+            }
+            let Some(model) = doc.session.model() else {
+                return Ok(Sent::Nothing);
+            };
+            if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
+                self.mesh = None;
+                self.submitted = None;
+                self.weights_uploaded = None;
+                let uploaded = self
+                    .smoother
+                    .upload_with_measures(&self.device, &model.original)
+                    .map_err(|e| e.to_string())?;
+                self.mesh = Some((generation, uploaded));
+                // A large model's upload fills a frame: its first run goes out with the next one.
+                return Ok(Sent::Model);
+            }
+            self.running = Some(Running {
+                generation,
+                revision: doc.session.revision(),
+                started_ms: now_ms(),
+                pieces: RunPieces::new(doc.session.params()),
+            });
+        }
+        let (Some((_, mesh)), Some(run)) = (self.mesh.as_mut(), self.running.as_mut()) else {
             return Ok(Sent::Nothing);
         };
-        let params = *doc.session.params();
-        let started_ms = now_ms();
         let e = |e: crate::gpu::GpuError| e.to_string();
         let weights_version = doc.session.weights_version();
         if self.weights_uploaded != Some(weights_version) {
@@ -162,26 +223,44 @@ impl GpuEngine {
                 .map_err(e)?;
             self.weights_uploaded = Some(weights_version);
         }
-        self.smoother
-            .smooth(&self.device, &self.queue, mesh, &params)
+        let smallest = run.pieces.next_cost(mesh).map_err(e)?;
+        if self.frame_work.left() < smallest {
+            // Too large for this frame: the frames until there is room save up for it.
+            self.frame_work.hold(smallest);
+            return Ok(Sent::Nothing);
+        }
+        let advance = run
+            .pieces
+            .advance(
+                &self.smoother,
+                &self.device,
+                &self.queue,
+                mesh,
+                self.frame_work.left(),
+            )
             .map_err(e)?;
-        self.smoother
-            .compute_normals(&self.device, &self.queue, mesh)
-            .map_err(e)?;
-        let measures = self
-            .smoother
-            .measure(&self.device, &self.queue, mesh, true)
-            .map_err(e)?;
-        let positions = ResultReadback::start(&self.device, &self.queue, mesh).map_err(e)?;
-        self.submitted = Some(doc.session.revision());
-        self.in_flight = Some(InFlight {
-            generation,
-            revision: doc.session.revision(),
-            started_ms,
-            positions,
-            measures,
-            result: None,
-        });
+        self.frame_work.sent(advance.spent, advance.full);
+        let stale = run.revision != doc.session.revision();
+        if run.pieces.smoothed() && stale {
+            // The parameters moved on: show where these took the mesh, skip its measures.
+            self.submitted = Some(run.revision);
+            self.running = None;
+        } else if run.pieces.done() {
+            let (positions, measures) = run
+                .pieces
+                .read_back(&self.device, &self.queue, mesh)
+                .map_err(e)?;
+            self.submitted = Some(run.revision);
+            self.in_flight = Some(InFlight {
+                generation: run.generation,
+                revision: run.revision,
+                started_ms: run.started_ms,
+                positions,
+                measures,
+                result: None,
+            });
+            self.running = None;
+        }
         Ok(Sent::Run)
     }
 

@@ -161,25 +161,32 @@ impl Shell {
             result.map_or(Positions::Original, |r| Positions::Cpu(r.revision))
         };
         if self.shown.positions != Some(wanted) {
-            match wanted {
+            let shown = match wanted {
                 Positions::Original => {
                     let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
                     viewer.set_positions(rs, &mesh.positions, &normals);
+                    true
                 }
                 Positions::Cpu(_) => {
                     if let Some(r) = result {
                         let normals = crate::mesh::vertex_normals(&r.positions, &mesh.triangles);
                         viewer.set_positions(rs, &r.positions, &normals);
                     }
+                    true
                 }
-                Positions::Gpu(_) => {
-                    if let Some((positions, normals)) = self.gpu.as_ref().and_then(|g| g.buffers())
-                    {
+                // While a run is under way in the engine's buffers they hold none of its
+                // results: copy once it is done.
+                Positions::Gpu(_) => match self.gpu.as_ref().and_then(|g| g.buffers()) {
+                    Some((positions, normals)) => {
                         viewer.copy_positions_from(rs, positions, normals);
+                        true
                     }
-                }
+                    None => false,
+                },
+            };
+            if shown {
+                self.shown.positions = Some(wanted);
             }
-            self.shown.positions = Some(wanted);
         }
         // The brush shows what it paints; the weights' colours follow their own changes.
         let colors = if self.brush.active {
@@ -478,6 +485,9 @@ impl eframe::App for Shell {
             let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
             doc.guidance_on_gpu = offload.is_some();
             doc.compute_guidance(budget, offload);
+            if let Some(gpu) = self.gpu.as_mut() {
+                gpu.guidance_sent();
+            }
             if let Some(why) = self.gpu.as_mut().and_then(|g| g.take_evaluator_failure()) {
                 doc.session.guidance_engine_failed(&why);
             }

@@ -4,15 +4,17 @@
 //!
 //! A run may be split into segments of a bounded size, one submission each, so the web app's
 //! frames never queue behind a long run; the segment size adapts to how fast results come back.
+//! A measure that does not fit a segment runs in parts, over the next segments.
 //! Natively the evaluator can block instead ([`GpuEvaluator::blocking`]), for the CLI.
 
 use super::layout::MeasurePartial;
 use super::measures::totals;
 use super::readback::Staging;
 use super::smoother::Segment;
+use super::work::{iteration_cost, measure_part_cost, plan_segment, AdaptiveSize};
 use super::{GpuError, GpuMesh, GpuSmoother};
 use crate::metrics::{metrics_from_sums, Original};
-use crate::smooth::{Filter, Params};
+use crate::smooth::Params;
 use crate::suggest::{
     failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Request, Terms,
 };
@@ -23,7 +25,7 @@ use crate::suggest::{
 /// slow frames): shrinking to single iterations of a small mesh would only multiply the trips.
 const FIRST_SEGMENT: u64 = 250_000;
 const MIN_SEGMENT: u64 = 250_000;
-const MAX_SEGMENT: u64 = 1 << 31;
+const MAX_SEGMENT: u64 = 1 << 40;
 /// The device time a segment should take (ms). Results come back some frames after their
 /// submission however small the work (the browser maps buffers between frames): the shortest
 /// round trip seen stands for that latency, and what a segment takes beyond it for its work.
@@ -38,6 +40,8 @@ struct Job {
     terms: Vec<Terms>,
     /// Iterations of the current run done (cumulative filters).
     done: u32,
+    /// The measure after `done` iterations is under way in parts: the next part to run.
+    measuring: Option<usize>,
     in_flight: Option<InFlight>,
 }
 
@@ -52,6 +56,7 @@ impl Job {
             terms: vec![unchanged_terms(model.original); zeros],
             request,
             done: 0,
+            measuring: None,
             in_flight: None,
         }
     }
@@ -67,25 +72,48 @@ impl Job {
         self.terms.len() == self.request.1.len()
     }
 
-    /// Vertex-iterations of what is left of its run (windowed sinc: of its next count).
-    fn cost(&self, vertices: u64) -> u64 {
+    /// Vertex-steps of the smallest segment of its run that smooths: an iteration (windowed
+    /// sinc: the whole run to its next count).
+    fn smallest_piece(&self, vertices: u64) -> u64 {
         let (params, at) = &self.request;
-        let last = match is_cumulative(params.filter) {
-            true => at.last().map_or(0, |&k| k - self.done),
-            false => at.get(self.terms.len()).copied().unwrap_or(0),
+        let iteration = iteration_cost(params.filter, vertices);
+        match is_cumulative(params.filter) {
+            true => iteration,
+            false => iteration * u64::from(at.get(self.terms.len()).copied().unwrap_or(1)),
+        }
+    }
+
+    /// Vertex-steps of what is left of its run with its measures (windowed sinc: of its next
+    /// count), on a mesh of `vertices` whose measure pass has `parts` parts.
+    fn cost(&self, vertices: u64, parts: usize) -> u64 {
+        let (params, at) = &self.request;
+        let (last, measures) = match is_cumulative(params.filter) {
+            true => (
+                at.last().map_or(0, |&k| k - self.done),
+                at.len() - self.terms.len(),
+            ),
+            false => (at.get(self.terms.len()).copied().unwrap_or(0), 1),
         };
-        vertices * steps_per_iteration(params.filter) * u64::from(last)
+        iteration_cost(params.filter, vertices) * u64::from(last)
+            + measure_part_cost(vertices, parts) * (parts * measures) as u64
     }
 }
 
-/// Smoothing steps in one iteration: Taubin's lambda and mu steps, one for the others (the
-/// unit of a segment's size).
-fn steps_per_iteration(filter: Filter) -> u64 {
-    if filter == Filter::Taubin {
-        2
-    } else {
-        1
-    }
+/// What a submission sent: vertex-steps, and whether the segment size limited it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Sent {
+    steps: u64,
+    full: bool,
+}
+
+/// A frame's share of the device work (see [`GpuEvaluator::share_frame`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct FrameShare {
+    budget: u64,
+    spent: u64,
+    full: bool,
+    /// The piece held back (vertex-steps).
+    held: u64,
 }
 
 /// A submitted segment: where its measures come back, and when it went out (ms).
@@ -93,6 +121,8 @@ struct InFlight {
     staging: Staging,
     to: u32,
     submitted_ms: f64,
+    /// Whether the segment size limited what went out.
+    full: bool,
 }
 
 /// The GPU engine as an evaluator for [`crate::suggest`]'s tasks, on the device handed in. It
@@ -112,11 +142,15 @@ pub struct GpuEvaluator {
     /// The model and request whose run was submitted last (its state is on the device).
     last_run: Option<(u64, Request)>,
     blocking: bool,
-    /// Vertex-iterations per submission; `None`: whole runs.
-    segment: Option<u64>,
-    /// The caller's clock (ms) and the shortest round trip seen.
+    /// Vertex-steps per submission, adapting to the round trips; `None`: whole runs.
+    segment: Option<AdaptiveSize>,
+    /// This frame's share of the device work, when the caller shares it out (it then sizes
+    /// the segments instead of the round trips).
+    frame: Option<FrameShare>,
+    /// Whether this frame's share ran out with a segment still to submit.
+    held: bool,
+    /// The caller's clock (ms).
     clock: fn() -> f64,
-    latency_ms: Option<f64>,
     failure: Option<GpuError>,
     /// Smoothing runs finished (windowed sinc: one per count).
     pub runs: usize,
@@ -142,9 +176,10 @@ impl GpuEvaluator {
             upcoming: Vec::new(),
             last_run: None,
             blocking: false,
-            segment: Some(FIRST_SEGMENT),
+            segment: Some(Self::adaptive(FIRST_SEGMENT)),
+            frame: None,
+            held: false,
             clock,
-            latency_ms: None,
             failure: None,
             runs: 0,
         }
@@ -160,10 +195,33 @@ impl GpuEvaluator {
         }
     }
 
-    /// Bounds every submission to about `vertex_iterations` (at least one iteration), or lifts
-    /// the bound (`None`); adaptation then starts from there.
-    pub fn set_segment(&mut self, vertex_iterations: Option<u64>) {
-        self.segment = vertex_iterations;
+    /// Bounds every submission to about `vertex_steps` (at least one iteration or one part of
+    /// a measure; adaptation may make them smaller), or lifts the bound (`None`: whole runs).
+    pub fn set_segment(&mut self, vertex_steps: Option<u64>) {
+        self.segment =
+            vertex_steps.map(|s| AdaptiveSize::new(s, MIN_SEGMENT.min(s), s, TARGET_WORK_MS));
+    }
+
+    /// Sizes this frame's segments to `budget` vertex-steps in all instead of by the round
+    /// trips: a segment whose smallest piece (an iteration, a part of a measure) is larger
+    /// waits for a frame with room. See [`Self::frame_spent`].
+    pub fn share_frame(&mut self, budget: u64) {
+        self.frame = Some(FrameShare {
+            budget,
+            ..FrameShare::default()
+        });
+        self.held = false;
+    }
+
+    /// What happened since [`Self::share_frame`]: vertex-steps sent, whether the share
+    /// limited them, and the piece held back for want of room (0: none).
+    pub fn frame_spent(&self) -> (u64, bool, u64) {
+        self.frame
+            .map_or((0, false, 0), |f| (f.spent, f.full || self.held, f.held))
+    }
+
+    fn adaptive(first: u64) -> AdaptiveSize {
+        AdaptiveSize::new(first, MIN_SEGMENT, MAX_SEGMENT, TARGET_WORK_MS)
     }
 
     /// The model on the device for `model`, uploaded (or its weights updated) when it changed.
@@ -193,33 +251,67 @@ impl GpuEvaluator {
     }
 
     /// Submits job `j`'s next segment: cumulative filters up to the next counts that fit the
-    /// segment size (`budget`, vertex-iterations; `None`: the whole run); windowed sinc one
-    /// count (one whole run).
-    fn submit_next(&mut self, j: usize, budget: Option<u64>) -> Result<(), GpuError> {
+    /// segment size (`budget`, vertex-steps; `None`: the whole run), a measure that does not
+    /// fit going on in parts over the next segments; windowed sinc one count (one whole run).
+    fn submit_next(&mut self, j: usize, budget: Option<u64>) -> Result<Sent, GpuError> {
         let (Some(job), Some((_, mesh))) = (self.jobs.get_mut(j), self.mesh.as_mut()) else {
-            return Ok(());
+            return Ok(Sent::default());
         };
         let vertices = mesh.vertex_count() as u64;
         let (params, at) = &job.request;
         let remaining = &at[job.terms.len()..];
-        let Some(&last) = remaining.last() else {
-            return Ok(());
-        };
-        let (from, to, measure_at) = if is_cumulative(params.filter) {
-            let per_iteration = (vertices * steps_per_iteration(params.filter)).max(1);
-            let most = budget.map_or(u64::from(last), |s| (s / per_iteration).max(1));
-            let to = (u64::from(job.done) + most).min(u64::from(last)) as u32;
-            let upto = remaining.iter().take_while(|&&k| k <= to).count();
-            // Another run since this one's last segment left other positions on the device:
-            // run again from the original (measuring only what is missing).
-            let resumes = self.last_run.as_ref() == Some(&(job.model, job.request.clone()));
+        if remaining.is_empty() {
+            return Ok(Sent::default());
+        }
+        // Another run since this one's last segment left other positions on the device:
+        // run again from the original (measuring only what is missing).
+        let resumes = self.last_run.as_ref() == Some(&(job.model, job.request.clone()));
+        if !resumes {
+            job.measuring = None;
+        }
+        let bytes = mesh.surface()?.partial_bytes();
+        let parts = GpuSmoother::measure_part_count(mesh)?;
+        if let Some(next) = job.measuring {
+            // Parts of the measure after `done` iterations, its sums read back after the last.
+            let part_cost = measure_part_cost(vertices, parts);
+            let count = budget.map_or(parts, |b| (b / part_cost).max(1) as usize);
+            let end = (next + count).min(parts);
+            self.smoother
+                .measure_parts(&self.device, &self.queue, mesh, next..end)?;
+            let finished = end == parts;
+            let sizes: &[u64] = if finished { &[bytes] } else { &[] };
+            let staging = Staging::create(&self.device, "meshsmooth evaluator readback", sizes);
+            if finished {
+                let mut encoder = self.device.create_command_encoder(&Default::default());
+                let (buffer, offset) = staging.region(0);
+                encoder.copy_buffer_to_buffer(&mesh.surface()?.partials, 0, buffer, offset, bytes);
+                self.queue.submit([encoder.finish()]);
+            }
+            staging.request_map();
+            job.measuring = (!finished).then_some(end);
+            let full = count < parts - next;
+            job.in_flight = Some(InFlight {
+                staging,
+                to: job.done,
+                submitted_ms: (self.clock)(),
+                full,
+            });
+            return Ok(Sent {
+                steps: (end - next) as u64 * part_cost,
+                full,
+            });
+        }
+        let iteration = iteration_cost(params.filter, vertices);
+        let measure = measure_part_cost(vertices, parts) * parts as u64;
+        let (from, to, upto, full) = if is_cumulative(params.filter) {
             let from = if resumes { job.done } else { 0 };
-            (from, to, &remaining[..upto])
+            let plan = plan_segment(from, remaining, iteration, measure, budget);
+            job.measuring = plan.then_measure.then_some(0);
+            (from, plan.to, plan.measured, plan.full)
         } else {
-            (0, remaining[0], &remaining[..1])
+            (0, remaining[0], 1, false)
         };
-        let bytes =
-            u64::from(mesh.surface()?.partial_count) * std::mem::size_of::<MeasurePartial>() as u64;
+        let measure_at = &remaining[..upto];
         let sizes = vec![bytes; measure_at.len()];
         let staging = Staging::create(&self.device, "meshsmooth evaluator readback", &sizes);
         let segment = Segment {
@@ -236,54 +328,85 @@ impl GpuEvaluator {
             staging,
             to,
             submitted_ms: (self.clock)(),
+            full,
         });
-        Ok(())
+        Ok(Sent {
+            steps: u64::from(to - from) * iteration + upto as u64 * measure,
+            full,
+        })
     }
 
     /// Submits job `asked`'s next segment and, when it finishes its run, whole runs of the
     /// upcoming requests while they fit the rest of the segment size.
     fn submit(&mut self, asked: usize, model: &ModelRef<'_>) -> Result<(), GpuError> {
         let vertices = model.original.mesh().vertex_count() as u64;
-        let cost = self.jobs[asked].cost(vertices);
-        self.submit_next(asked, self.segment)?;
-        let Some(mut left) = self.segment.map(|s| s.saturating_sub(cost)) else {
-            return Ok(());
+        let budget = match self.frame {
+            Some(f) => Some(f.budget.saturating_sub(f.spent)),
+            None => self.segment.map(|s| s.size),
         };
+        if let (Some(f), Some(left), Some((_, mesh))) = (self.frame.as_mut(), budget, &self.mesh) {
+            let job = &self.jobs[asked];
+            let smallest = match job.measuring {
+                Some(_) => measure_part_cost(vertices, GpuSmoother::measure_part_count(mesh)?),
+                None => job.smallest_piece(vertices),
+            };
+            if left < smallest {
+                self.held = true;
+                f.held = f.held.max(smallest);
+                return Ok(());
+            }
+        }
+        let sent = self.submit_next(asked, budget)?;
+        let mut spent = sent.steps;
         // Other runs may follow only once this one is complete: a later segment goes on from
         // the state it leaves on the device.
         let job = &self.jobs[asked];
         let to = job.in_flight.as_ref().map(|f| f.to);
-        if is_cumulative(job.request.0.filter) && to != job.request.1.last().copied() {
-            return Ok(());
-        }
-        for request in std::mem::take(&mut self.upcoming) {
-            let known = self
-                .jobs
-                .iter()
-                .any(|j| j.is(model, &request.0, &request.1));
-            if known {
-                continue;
-            }
-            let job = Job::new(model, request);
-            let cost = job.cost(vertices);
-            if job.answered() {
+        let unfinished = to != job.request.1.last().copied() || job.measuring.is_some();
+        let packs = budget.is_some() && !(is_cumulative(job.request.0.filter) && unfinished);
+        if packs {
+            let parts = match &self.mesh {
+                Some((_, mesh)) => GpuSmoother::measure_part_count(mesh)?,
+                None => 0,
+            };
+            let left = budget.unwrap_or(0);
+            for request in std::mem::take(&mut self.upcoming) {
+                let known = self
+                    .jobs
+                    .iter()
+                    .any(|j| j.is(model, &request.0, &request.1));
+                if known {
+                    continue;
+                }
+                let job = Job::new(model, request);
+                let cost = job.cost(vertices, parts);
+                if job.answered() {
+                    self.jobs.push(job);
+                    continue;
+                }
+                let whole = is_cumulative(job.request.0.filter) || job.request.1.len() == 1;
+                if spent + cost > left || !whole {
+                    break;
+                }
                 self.jobs.push(job);
-                continue;
+                let j = self.jobs.len() - 1;
+                spent += self.submit_next(j, None)?.steps;
             }
-            if cost > left || !(is_cumulative(job.request.0.filter) || job.request.1.len() == 1) {
-                break;
-            }
-            left -= cost;
-            self.jobs.push(job);
-            let j = self.jobs.len() - 1;
-            self.submit_next(j, None)?;
+        }
+        if let Some(f) = self.frame.as_mut() {
+            f.spent += spent;
+            f.full |= sent.full;
         }
         Ok(())
     }
 
     /// Collects every segment that is back; returns the round trip (ms) of job `asked`'s
-    /// segment when it came back in this call.
-    fn collect(&mut self, original: &Original, asked: usize) -> Result<Option<f64>, GpuError> {
+    /// segment when it came back in this call, and whether the segment size limited it.
+    fn collect(
+        &mut self,
+        original: &Original,
+        asked: usize,
+    ) -> Result<Option<(f64, bool)>, GpuError> {
         let now = (self.clock)();
         let mut asked_back = None;
         for (j, job) in self.jobs.iter_mut().enumerate() {
@@ -303,7 +426,7 @@ impl GpuEvaluator {
                 continue;
             };
             let terms = terms?;
-            let (to, round_trip) = (flight.to, now - flight.submitted_ms);
+            let (to, round_trip, full) = (flight.to, now - flight.submitted_ms, flight.full);
             job.in_flight = None;
             job.terms.extend(terms);
             job.done = to;
@@ -311,29 +434,10 @@ impl GpuEvaluator {
                 self.runs += 1;
             }
             if j == asked {
-                asked_back = Some(round_trip);
+                asked_back = Some((round_trip, full));
             }
         }
         Ok(asked_back)
-    }
-
-    /// Sizes the next segments from a round trip of `round_trip_ms`: twice as large while the
-    /// work in it (beyond the shortest round trip seen) stays well under [`TARGET_WORK_MS`],
-    /// half as large when it is well over, down to [`MIN_SEGMENT`] (or the size set, when
-    /// smaller).
-    fn adapt(&mut self, round_trip_ms: f64) {
-        let latency = self
-            .latency_ms
-            .map_or(round_trip_ms, |l| l.min(round_trip_ms));
-        self.latency_ms = Some(latency);
-        let work = round_trip_ms - latency;
-        if let Some(s) = self.segment.as_mut() {
-            if work < TARGET_WORK_MS / 2.0 {
-                *s = (*s * 2).min(MAX_SEGMENT);
-            } else if work > 2.0 * TARGET_WORK_MS {
-                *s = (*s / 2).max(MIN_SEGMENT.min(*s));
-            }
-        }
     }
 
     #[cfg(not(target_arch = "wasm32"))]
@@ -375,7 +479,12 @@ impl Offload for GpuEvaluator {
         loop {
             match self.collect(model.original, asked) {
                 Err(e) => return self.fail(e, at.len()),
-                Ok(Some(round_trip)) => self.adapt(round_trip),
+                Ok(Some((round_trip, full))) => {
+                    // A frame's share, when given, sizes the segments instead.
+                    if let (Some(size), None) = (self.segment.as_mut(), self.frame) {
+                        size.adapt(round_trip, full);
+                    }
+                }
                 Ok(None) => {}
             }
             let job = &self.jobs[asked];
@@ -406,7 +515,7 @@ impl Offload for GpuEvaluator {
     }
 
     fn waiting(&self) -> bool {
-        !self.blocking && self.jobs.iter().any(|j| j.in_flight.is_some())
+        !self.blocking && (self.held || self.jobs.iter().any(|j| j.in_flight.is_some()))
     }
 
     fn failure(&self) -> Option<String> {

@@ -59,6 +59,41 @@ pub(crate) struct MeasurePartial {
 
 const _: () = assert!(std::mem::size_of::<MeasurePartial>() == 32);
 
+/// Which workgroups one part of a measure pass covers, `MeasurePart` in shaders/measure.wgsl
+/// (16 bytes): the pass runs as parts, each a 1-D dispatch of its own, so a caller may spread
+/// one measure over several submissions (a frame each in the browser).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub(crate) struct MeasurePart {
+    pub first_group: u32,
+    pub group_count: u32,
+    pub pad: [u32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<MeasurePart>() == 16);
+
+/// How many parts a measure pass has at most: small enough pieces for a slow (software)
+/// adapter's frame, few enough that recording them all costs nothing.
+pub(crate) const MEASURE_PARTS: u32 = 16;
+
+/// The parts of a measure pass over `vertex_count` vertices: consecutive runs of whole
+/// workgroups, at most [`MEASURE_PARTS`] of them (more only where a part would exceed
+/// `max_per_dimension` workgroups), covering every workgroup once.
+pub(crate) fn measure_parts(vertex_count: u32, max_per_dimension: u32) -> Vec<MeasurePart> {
+    let groups = vertex_count.div_ceil(WORKGROUP_SIZE);
+    let per_part = groups
+        .div_ceil(MEASURE_PARTS)
+        .clamp(1, max_per_dimension.max(1));
+    (0..groups)
+        .step_by(per_part as usize)
+        .map(|first_group| MeasurePart {
+            first_group,
+            group_count: per_part.min(groups - first_group),
+            pad: [0; 2],
+        })
+        .collect()
+}
+
 /// Step records a run may need at once: windowed sinc's one per term after the first, up to its
 /// largest valid iteration count (100); the other filters use one or two.
 pub(crate) const MAX_STEP_SLOTS: usize = 100;
@@ -66,8 +101,13 @@ pub(crate) const MAX_STEP_SLOTS: usize = 100;
 /// Distance between step records in the uniform buffer: each is bound at a dynamic offset,
 /// which must be a multiple of the device's `min_uniform_buffer_offset_alignment`.
 pub(crate) fn step_stride(min_uniform_buffer_offset_alignment: u32) -> u64 {
+    record_stride::<StepParams>(min_uniform_buffer_offset_alignment)
+}
+
+/// Distance between records of type `T` bound at dynamic offsets of a uniform buffer.
+pub(crate) fn record_stride<T>(min_uniform_buffer_offset_alignment: u32) -> u64 {
     let align = u64::from(min_uniform_buffer_offset_alignment.max(1));
-    (std::mem::size_of::<StepParams>() as u64).div_ceil(align) * align
+    (std::mem::size_of::<T>() as u64).div_ceil(align) * align
 }
 
 /// Workgroups `(x, y)` covering `vertex_count` vertices: one row while it fits in
@@ -106,6 +146,37 @@ mod tests {
             }
         }
         assert_eq!(dispatch_size(64 * 16 + 1, 4), None);
+    }
+
+    #[test]
+    fn measure_parts_cover_every_workgroup_once() {
+        assert!(measure_parts(0, 65_535).is_empty());
+        for (n, max) in [
+            (1u32, 65_535u32),
+            (64, 65_535),
+            (2_296, 65_535),
+            (206_512, 65_535),
+            (64 * 40, 3),
+            (10_000_000, 65_535),
+        ] {
+            let parts = measure_parts(n, max);
+            let mut next = 0;
+            for part in &parts {
+                assert_eq!(part.first_group, next, "n {n}");
+                assert!(part.group_count >= 1 && part.group_count <= max, "n {n}");
+                next += part.group_count;
+            }
+            assert_eq!(next, n.div_ceil(64), "n {n}");
+            if n.div_ceil(64) <= MEASURE_PARTS * max {
+                assert!(
+                    parts.len() as u32 <= MEASURE_PARTS,
+                    "n {n}: {} parts",
+                    parts.len()
+                );
+            }
+        }
+        // Far past one part per workgroup: more parts rather than a dispatch over the limit.
+        assert_eq!(measure_parts(64 * 40, 2).len(), 20);
     }
 
     #[test]

@@ -39,8 +39,7 @@ impl MeasureReadback {
     ) -> Result<Self, GpuError> {
         let surface = mesh.surface()?;
         let n = mesh.vertex_count();
-        let partial_bytes =
-            u64::from(surface.partial_count) * std::mem::size_of::<MeasurePartial>() as u64;
+        let partial_bytes = surface.partial_bytes();
         let vertex_bytes = if with_vertices {
             n as u64 * VERTEX_MEASURE_BYTES
         } else {

@@ -30,11 +30,13 @@ mod layout;
 mod limits;
 mod measures;
 mod mesh_buffers;
+mod pieces;
 mod pipelines;
 mod readback;
 pub mod shaders;
 mod smoother;
 mod surface;
+mod work;
 
 #[cfg(not(target_arch = "wasm32"))]
 mod bench;
@@ -46,8 +48,10 @@ pub use evaluator::GpuEvaluator;
 pub use layout::WORKGROUP_SIZE;
 pub use measures::{GpuMeasures, MeasureReadback};
 pub use mesh_buffers::GpuMesh;
+pub use pieces::{Advance, RunPieces};
 pub use readback::{PositionReadback, ResultReadback, SmoothResult};
 pub use smoother::GpuSmoother;
+pub use work::{FrameWork, FRAME_WORK_MS};
 
 #[cfg(not(target_arch = "wasm32"))]
 pub use bench::{time_measures, time_smoothing};

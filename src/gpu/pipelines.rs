@@ -10,7 +10,7 @@
 
 use std::num::NonZeroU64;
 
-use super::layout::{StepParams, SurfaceParams};
+use super::layout::{MeasurePart, StepParams, SurfaceParams};
 use super::shaders::{Kernel, DRIFT, HC, MEASURE, NORMALS, SINC, UMBRELLA};
 
 #[derive(Clone)]
@@ -49,7 +49,8 @@ pub(crate) struct SurfaceLayouts {
     /// Group 0 of the normals: constants, fan offsets and corners (read); normals (written).
     pub normals: wgpu::BindGroupLayout,
     /// Group 0 of the measures: constants, original, fan offsets and corners, boundary flags,
-    /// reference (read); per-vertex measures and workgroup partials (written).
+    /// reference (read); per-vertex measures and workgroup partials (written); the part of
+    /// the pass (uniform, dynamic offset).
     pub measure: wgpu::BindGroupLayout,
     /// Group 1 of every surface kernel: the positions looked at (read).
     pub looked_at: wgpu::BindGroupLayout,
@@ -87,19 +88,35 @@ fn surface_layout(
     read: u32,
     written: u32,
 ) -> wgpu::BindGroupLayout {
-    let constants = wgpu::BindGroupLayoutEntry {
-        binding: 0,
+    surface_layout_with(device, label, read, written, &[])
+}
+
+/// A uniform buffer binding of records of type `T`, at a dynamic offset or not.
+fn uniform<T>(binding: u32, has_dynamic_offset: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
         visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: NonZeroU64::new(std::mem::size_of::<SurfaceParams>() as u64),
+            has_dynamic_offset,
+            min_binding_size: NonZeroU64::new(std::mem::size_of::<T>() as u64),
         },
         count: None,
-    };
-    let entries: Vec<_> = std::iter::once(constants)
+    }
+}
+
+/// [`surface_layout`] with `extra` entries after the storage buffers.
+fn surface_layout_with(
+    device: &wgpu::Device,
+    label: &str,
+    read: u32,
+    written: u32,
+    extra: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    let entries: Vec<_> = std::iter::once(uniform::<SurfaceParams>(0, false))
         .chain((1..=read).map(|b| storage(b, true)))
         .chain((read + 1..=read + written).map(|b| storage(b, false)))
+        .chain(extra.iter().cloned())
         .collect();
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
@@ -112,7 +129,14 @@ impl SurfaceLayouts {
         Self {
             drift: surface_layout(device, "meshsmooth drift", 4, 1),
             normals: surface_layout(device, "meshsmooth normals", 2, 1),
-            measure: surface_layout(device, "meshsmooth measures", 5, 2),
+            // The part of the pass a dispatch covers, at a dynamic offset, after the arrays.
+            measure: surface_layout_with(
+                device,
+                "meshsmooth measures",
+                5,
+                2,
+                &[uniform::<MeasurePart>(8, true)],
+            ),
             looked_at: positions_layout(device, "meshsmooth looked-at positions", 0),
         }
     }
@@ -120,16 +144,7 @@ impl SurfaceLayouts {
 
 impl Layouts {
     pub(crate) fn new(device: &wgpu::Device) -> Self {
-        let step = wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: NonZeroU64::new(std::mem::size_of::<StepParams>() as u64),
-            },
-            count: None,
-        };
+        let step = uniform::<StepParams>(0, true);
         let mesh = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("meshsmooth mesh"),
             entries: &[

@@ -2,9 +2,7 @@
 //! (every iteration's dispatches in one compute pass, no readback in between, the reference
 //! vertices drifting along), and the surface passes on a run's result (normals, measures).
 
-use super::layout::{
-    dispatch_size, MeasurePartial, StepParams, HAS_BOUND, HAS_WEIGHTS, MAX_STEP_SLOTS,
-};
+use super::layout::{dispatch_size, StepParams, HAS_BOUND, HAS_WEIGHTS, MAX_STEP_SLOTS};
 use super::measures::MeasureReadback;
 use super::mesh_buffers::{GpuMesh, Slot};
 use super::pipelines::{Layouts, Pipelines};
@@ -336,15 +334,21 @@ impl Recorder<'_, '_> {
         };
         let pipelines = self.pipelines;
         let pass = self.pass();
-        pass.set_pipeline(&pipelines.measure_vertices);
-        pass.set_bind_group(0, &surface.measure_group, &[]);
-        pass.set_bind_group(1, surface.looked_at(slot), &[]);
-        self.dispatch();
+        surface.record_measure(
+            pass,
+            &pipelines.measure_vertices,
+            slot,
+            0..surface.measure_parts.len(),
+        );
         self.pass = None;
-        let bytes = u64::from(surface.partial_count) * std::mem::size_of::<MeasurePartial>() as u64;
         let (buffer, offset) = staging.region(first + self.measured);
-        self.encoder
-            .copy_buffer_to_buffer(&surface.partials, 0, buffer, offset, bytes);
+        self.encoder.copy_buffer_to_buffer(
+            &surface.partials,
+            0,
+            buffer,
+            offset,
+            surface.partial_bytes(),
+        );
         self.measured += 1;
     }
 }
@@ -391,14 +395,54 @@ impl GpuSmoother {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("meshsmooth measures"),
         });
-        self.surface_pass(
-            device,
-            &mut encoder,
-            mesh,
-            &self.pipelines.measure_vertices,
-            &surface.measure_group,
-        );
+        self.record_measure_parts(&mut encoder, mesh, 0..surface.measure_parts.len())?;
         MeasureReadback::start(device, queue, encoder, mesh, with_vertices)
+    }
+
+    /// How many parts `mesh`'s measure pass has (see [`Self::measure_parts`]).
+    pub(crate) fn measure_part_count(mesh: &GpuMesh) -> Result<usize, GpuError> {
+        Ok(mesh.surface()?.measure_parts.len())
+    }
+
+    /// Parts `parts` of the measure pass on `mesh`'s latest result, in one submission: a
+    /// measure spread over several submissions (a frame each), with nothing run on `mesh`
+    /// between them. Once every part has run, [`MeasureReadback::start`] (or a copy of the
+    /// sums) takes the result; [`Self::measure`] is all parts and that readback at once.
+    pub(crate) fn measure_parts(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &GpuMesh,
+        parts: std::ops::Range<usize>,
+    ) -> Result<wgpu::SubmissionIndex, GpuError> {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("meshsmooth measure parts"),
+        });
+        self.record_measure_parts(&mut encoder, mesh, parts)?;
+        Ok(queue.submit([encoder.finish()]))
+    }
+
+    fn record_measure_parts(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        parts: std::ops::Range<usize>,
+    ) -> Result<(), GpuError> {
+        let surface = mesh.surface()?;
+        if mesh.vertex_count == 0 || parts.is_empty() {
+            return Ok(());
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("meshsmooth measures"),
+            timestamp_writes: None,
+        });
+        surface.record_measure(
+            &mut pass,
+            &self.pipelines.measure_vertices,
+            mesh.result,
+            parts,
+        );
+        Ok(())
     }
 
     /// One surface kernel over every vertex, looking at the latest result.

@@ -6,7 +6,9 @@
 
 use wgpu::util::DeviceExt;
 
-use super::layout::{dispatch_size, MeasurePartial, SurfaceParams};
+use super::layout::{
+    dispatch_size, measure_parts, record_stride, MeasurePart, MeasurePartial, SurfaceParams,
+};
 use super::limits::{check_surface_fits, POSITION_BYTES, VERTEX_MEASURE_BYTES};
 use super::mesh_buffers::{bind_group, storage_init, Slot};
 use super::pipelines::SurfaceLayouts;
@@ -24,6 +26,10 @@ pub(crate) struct SurfaceBuffers {
     /// One [`MeasurePartial`] per workgroup of the latest measure pass.
     pub partials: wgpu::Buffer,
     pub partial_count: u32,
+    /// The parts of the measure pass (see [`MeasurePart`]), and the distance between their
+    /// records: part `k` is bound at dynamic offset `k * measure_part_stride`.
+    pub measure_parts: Vec<MeasurePart>,
+    pub measure_part_stride: u32,
     pub drift_group: wgpu::BindGroup,
     pub normals_group: wgpu::BindGroup,
     pub measure_group: wgpu::BindGroup,
@@ -74,9 +80,11 @@ impl SurfaceBuffers {
         let topology = original.topology();
         let n = mesh.vertex_count();
         let limits = device.limits();
-        let (x, y) = dispatch_size(n as u32, limits.max_compute_workgroups_per_dimension)
+        dispatch_size(n as u32, limits.max_compute_workgroups_per_dimension)
             .ok_or_else(|| GpuError::Device("no workgroup grid covers the mesh".into()))?;
-        let partial_count = x * y;
+        // The measure pass runs as 1-D parts: one partial per workgroup that holds vertices.
+        let parts = measure_parts(n as u32, limits.max_compute_workgroups_per_dimension);
+        let partial_count = (n as u32).div_ceil(super::layout::WORKGROUP_SIZE);
         let fans = original.all_fan_corners();
         check_surface_fits(
             &limits,
@@ -138,6 +146,17 @@ impl SurfaceBuffers {
             false,
         );
 
+        let stride = record_stride::<MeasurePart>(limits.min_uniform_buffer_offset_alignment);
+        let mut records = vec![0u8; (stride as usize * parts.len()).max(stride as usize)];
+        for (record, part) in records.chunks_mut(stride as usize).zip(&parts) {
+            record[..std::mem::size_of::<MeasurePart>()].copy_from_slice(bytemuck::bytes_of(part));
+        }
+        let part_records = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("meshsmooth measure parts"),
+            contents: &records,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+
         let group = |layout, buffers: &[&wgpu::Buffer]| {
             let mut all = vec![&params];
             all.extend_from_slice(buffers);
@@ -148,18 +167,36 @@ impl SurfaceBuffers {
             &[slots.original, &ring_offsets, &ring, &stay, &reference],
         );
         let normals_group = group(&layouts.normals, &[&fan_offsets, &fan_corners, &normals]);
-        let measure_group = group(
-            &layouts.measure,
-            &[
-                slots.original,
-                &fan_offsets,
-                &fan_corners,
-                &boundary,
-                &reference,
-                &vertex_measures,
-                &partials,
-            ],
-        );
+        let measure_buffers = [
+            &params,
+            slots.original,
+            &fan_offsets,
+            &fan_corners,
+            &boundary,
+            &reference,
+            &vertex_measures,
+            &partials,
+        ];
+        let mut measure_entries: Vec<_> = (0u32..)
+            .zip(measure_buffers)
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            })
+            .collect();
+        measure_entries.push(wgpu::BindGroupEntry {
+            binding: 8,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &part_records,
+                offset: 0,
+                size: std::num::NonZeroU64::new(std::mem::size_of::<MeasurePart>() as u64),
+            }),
+        });
+        let measure_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("meshsmooth measures"),
+            layout: &layouts.measure,
+            entries: &measure_entries,
+        });
         let looked_at = [slots.original, slots.a, slots.b, slots.aux]
             .map(|b| bind_group(device, &layouts.looked_at, &[b]));
         Ok(Self {
@@ -168,12 +205,45 @@ impl SurfaceBuffers {
             vertex_measures,
             partials,
             partial_count,
+            measure_parts: parts,
+            measure_part_stride: stride as u32,
             drift_group,
             normals_group,
             measure_group,
             looked_at,
             track_reference: true,
         })
+    }
+
+    /// Records parts `parts` of the measure pass over the positions in `slot` into `pass`.
+    pub(crate) fn record_measure(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        pipeline: &wgpu::ComputePipeline,
+        slot: Slot,
+        parts: std::ops::Range<usize>,
+    ) {
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(1, self.looked_at(slot), &[]);
+        for (k, part) in self
+            .measure_parts
+            .iter()
+            .enumerate()
+            .take(parts.end)
+            .skip(parts.start)
+        {
+            pass.set_bind_group(
+                0,
+                &self.measure_group,
+                &[k as u32 * self.measure_part_stride],
+            );
+            pass.dispatch_workgroups(part.group_count, 1, 1);
+        }
+    }
+
+    /// Bytes of the measure pass's sums (one [`MeasurePartial`] per workgroup).
+    pub(crate) fn partial_bytes(&self) -> u64 {
+        u64::from(self.partial_count) * std::mem::size_of::<MeasurePartial>() as u64
     }
 
     /// Group 1 of a surface kernel looking at the positions in `slot`.
