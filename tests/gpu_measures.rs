@@ -22,7 +22,7 @@ mod open_scalp;
 mod runs;
 
 use device::{gpu, Gpu};
-use meshsmooth::gpu::{read_normals, read_result, GpuMesh, RunPieces};
+use meshsmooth::gpu::{read_normals, read_result, GpuMeasures, GpuMesh, RunPieces};
 use meshsmooth::mesh::{vertex_normals, Mesh};
 use meshsmooth::metrics::{
     identity, measure_vertices, vertex_curvatures, Metrics, Original, VertexMeasures,
@@ -309,6 +309,29 @@ fn measures_match_the_cpu_on_the_large_mesh() {
     check_measures(gpu, "large", &original, &params(Filter::Taubin, 10));
 }
 
+/// A whole run of `p`, then the normals and the measure pass, each in one submission: the
+/// positions with the references, the normals and the measures.
+fn whole_run(
+    g: &Gpu,
+    mesh: &mut GpuMesh,
+    original: &Original,
+    p: &Params,
+) -> (meshsmooth::gpu::SmoothResult, Vec<[f32; 3]>, GpuMeasures) {
+    let (device, queue) = (&g.ctx.device, &g.ctx.queue);
+    let result = run(g, mesh, p);
+    g.smoother
+        .compute_normals(device, queue, mesh)
+        .expect("has measures");
+    let normals = read_normals(device, queue, mesh).expect("readback");
+    let measured = g
+        .smoother
+        .measure(device, queue, mesh, true)
+        .expect("has measures")
+        .wait(device, original, 0.5)
+        .expect("readback");
+    (result, normals, measured)
+}
+
 /// Rows of 16 workgroups (a 2-D dispatch on a small mesh): the drift, the normals and the
 /// per-workgroup sums index the same vertices and give the same numbers as one row.
 #[test]
@@ -328,23 +351,11 @@ fn a_2d_grid_gives_the_same_drift_normals_and_measures() {
     let p = params(Filter::Laplace, 50);
     let mut results = Vec::new();
     for g in [gpu, &small] {
-        let (device, queue) = (&g.ctx.device, &g.ctx.queue);
         let mut mesh = g
             .smoother
-            .upload_with_measures(device, &original)
+            .upload_with_measures(&g.ctx.device, &original)
             .expect("fits");
-        let result = run(g, &mut mesh, &p);
-        g.smoother
-            .compute_normals(device, queue, &mesh)
-            .expect("has measures");
-        let normals = read_normals(device, queue, &mesh).expect("readback");
-        let measured = g
-            .smoother
-            .measure(device, queue, &mesh, true)
-            .expect("has measures")
-            .wait(device, &original, 0.5)
-            .expect("readback");
-        results.push((result, normals, measured));
+        results.push(whole_run(g, &mut mesh, &original, &p));
     }
     let (one_row, two_d) = (&results[0], &results[1]);
     assert!(
@@ -377,17 +388,7 @@ fn a_run_in_pieces_equals_the_whole_run() {
                 .smoother
                 .upload_with_measures(device, &original)
                 .expect("fits");
-            let whole = run(gpu, &mut mesh, &p);
-            gpu.smoother
-                .compute_normals(device, queue, &mesh)
-                .expect("has measures");
-            let whole_normals = read_normals(device, queue, &mesh).expect("readback");
-            let whole_measures = gpu
-                .smoother
-                .measure(device, queue, &mesh, true)
-                .expect("has measures")
-                .wait(device, &original, 0.5)
-                .expect("readback");
+            let (whole, whole_normals, whole_measures) = whole_run(gpu, &mut mesh, &original, &p);
 
             let mut mesh = gpu
                 .smoother

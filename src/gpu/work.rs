@@ -116,6 +116,13 @@ pub struct FrameWork {
 
 /// Frames after a frame's work in which its wait may show.
 const WINDOW: usize = 4;
+/// The size never goes below this (vertex-steps): a Laplace iteration of a 250k-vertex mesh, a
+/// whole run of a small one. Frames are long for other reasons too (a file opening, a page
+/// busy elsewhere), and a smaller size would only stretch every run over more frames.
+const SMALLEST_FRAME_WORK: u64 = 250_000;
+/// The most frames a piece larger than the size waits: however small the size has become,
+/// the frames save up at least this fraction of the piece each.
+const MOST_FRAMES_SAVING: u64 = 4;
 /// Frames without a wait over half the target before the size may grow.
 const CALM_FRAMES: usize = 8;
 /// Frames without work whose intervals estimate what drawing takes.
@@ -124,7 +131,7 @@ const IDLE_FRAMES: usize = 9;
 impl Default for FrameWork {
     fn default() -> Self {
         Self {
-            size: AdaptiveSize::new(2_000_000, 1, 1 << 40, FRAME_WORK_MS),
+            size: AdaptiveSize::new(2_000_000, SMALLEST_FRAME_WORK, 1 << 40, FRAME_WORK_MS),
             last_frame_ms: None,
             window: [(false, false, 0.0); WINDOW],
             idle_ms: [0.0; IDLE_FRAMES],
@@ -168,7 +175,8 @@ impl FrameWork {
             }
         }
         let size = self.size.size;
-        self.credit = (self.credit + size).min(size.max(self.held));
+        let rate = size.max(self.held.div_ceil(MOST_FRAMES_SAVING));
+        self.credit = (self.credit + rate).min(size.max(self.held));
         self.spent = 0;
         self.full = false;
         self.held = 0;
@@ -385,6 +393,22 @@ mod tests {
         assert_eq!(frames, 2);
         f.sent(piece, true);
         assert_eq!(f.left(), 0);
+        // Long frames after work shrink the size to its floor; a piece still waits only a few
+        // frames.
+        for _ in 0..64 {
+            f.sent(1, true);
+            t += 5000.0;
+            f.begin_frame(t);
+        }
+        assert_eq!(f.size(), SMALLEST_FRAME_WORK);
+        let mut frames = 0;
+        while f.left() < piece {
+            f.hold(piece);
+            t += 100.0;
+            f.begin_frame(t);
+            frames += 1;
+        }
+        assert_eq!(frames as u64, MOST_FRAMES_SAVING);
     }
 
     #[test]
@@ -396,81 +420,26 @@ mod tests {
         assert_eq!(measure_part_cost(0, 16), 1);
     }
 
-    fn plan(from: u32, remaining: &[u32], budget: Option<u64>) -> SegmentPlan {
-        plan_segment(from, remaining, 10, 60, budget)
+    /// `(to, measured, then_measure, full)` of the plan.
+    fn plan(from: u32, remaining: &[u32], budget: Option<u64>) -> (u32, usize, bool, bool) {
+        let p = plan_segment(from, remaining, 10, 60, budget);
+        (p.to, p.measured, p.then_measure, p.full)
     }
 
     #[test]
     fn segments_fit_the_budget_with_measures_in_parts() {
-        // Whole runs without a budget.
-        assert_eq!(
-            plan(0, &[5, 10], None),
-            SegmentPlan {
-                to: 10,
-                measured: 2,
-                then_measure: false,
-                full: false
-            }
-        );
-        // Everything fits.
-        assert_eq!(
-            plan(0, &[5, 10], Some(1000)),
-            SegmentPlan {
-                to: 10,
-                measured: 2,
-                then_measure: false,
-                full: false
-            }
-        );
+        // Whole runs without a budget; everything fits.
+        assert_eq!(plan(0, &[5, 10], None), (10, 2, false, false));
+        assert_eq!(plan(0, &[5, 10], Some(1000)), (10, 2, false, false));
         // The iterations to 5 and the measure fit, then three more iterations.
-        assert_eq!(
-            plan(0, &[5, 10], Some(140)),
-            SegmentPlan {
-                to: 8,
-                measured: 1,
-                then_measure: false,
-                full: true
-            }
-        );
+        assert_eq!(plan(0, &[5, 10], Some(140)), (8, 1, false, true));
         // The iterations to 5 fit, not the measure: it follows in parts.
-        assert_eq!(
-            plan(0, &[5, 10], Some(70)),
-            SegmentPlan {
-                to: 5,
-                measured: 0,
-                then_measure: true,
-                full: true
-            }
-        );
+        assert_eq!(plan(0, &[5, 10], Some(70)), (5, 0, true, true));
         // Not even one iteration fits: one goes anyway.
-        assert_eq!(
-            plan(3, &[5], Some(4)),
-            SegmentPlan {
-                to: 4,
-                measured: 0,
-                then_measure: false,
-                full: true
-            }
-        );
+        assert_eq!(plan(3, &[5], Some(4)), (4, 0, false, true));
         // A measure fitted and no further iteration does: the segment ends there.
-        assert_eq!(
-            plan(0, &[1, 10], Some(75)),
-            SegmentPlan {
-                to: 1,
-                measured: 1,
-                then_measure: false,
-                full: true
-            }
-        );
-        // A count at the start (0 iterations after a reset) is a measure only.
-        assert_eq!(
-            plan(0, &[0, 10], Some(30)),
-            SegmentPlan {
-                to: 0,
-                measured: 0,
-                then_measure: true,
-                full: true
-            }
-        );
+        assert_eq!(plan(0, &[1, 10], Some(75)), (1, 1, false, true));
+        // A count at the start is a measure only.
+        assert_eq!(plan(0, &[0, 10], Some(30)), (0, 0, true, true));
     }
 }
