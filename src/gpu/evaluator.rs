@@ -3,8 +3,10 @@
 //! the same submission, reading back only each measure's per-workgroup sums.
 //!
 //! A run may be split into segments of a bounded size, one submission each, so the web app's
-//! frames never queue behind a long run; the segment size adapts to how fast results come back.
-//! A measure that does not fit a segment runs in parts, over the next segments.
+//! frames never queue behind a long run: the size adapts to how fast results come back, or
+//! follows the share of each frame's device work the caller gives ([`GpuEvaluator::share_frame`],
+//! as the web app does). A measure that does not fit a segment runs in parts, over the next
+//! segments.
 //! Natively the evaluator can block instead ([`GpuEvaluator::blocking`]), for the CLI.
 
 use super::layout::MeasurePartial;
@@ -19,7 +21,7 @@ use crate::suggest::{
     failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Request, Terms,
 };
 
-/// Vertex-iterations in a segment at first and at least (about one iteration of a 206k-vertex
+/// Vertex-steps in a segment at first and at least (about one iteration of a 206k-vertex
 /// mesh, two whole 50-iteration runs of the 2,296-vertex sample), and at most. The floor
 /// matters where round trips are long and noisy for reasons other than the work (SwiftShader's
 /// slow frames): shrinking to single iterations of a small mesh would only multiply the trips.
