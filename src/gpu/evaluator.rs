@@ -14,7 +14,7 @@ use super::measures::totals;
 use super::readback::Staging;
 use super::smoother::Segment;
 use super::work::{iteration_cost, measure_part_cost, plan_segment, AdaptiveSize};
-use super::{GpuError, GpuMesh, GpuSmoother};
+use super::{Advance, GpuError, GpuMesh, GpuSmoother};
 use crate::metrics::{metrics_from_sums, Original};
 use crate::smooth::Params;
 use crate::suggest::{
@@ -101,13 +101,6 @@ impl Job {
     }
 }
 
-/// What a submission sent: vertex-steps, and whether the segment size limited it.
-#[derive(Clone, Copy, Debug, Default)]
-struct Sent {
-    steps: u64,
-    full: bool,
-}
-
 /// A frame's share of the device work (see [`GpuEvaluator::share_frame`]).
 #[derive(Clone, Copy, Debug, Default)]
 struct FrameShare {
@@ -149,8 +142,6 @@ pub struct GpuEvaluator {
     /// This frame's share of the device work, when the caller shares it out (it then sizes
     /// the segments instead of the round trips).
     frame: Option<FrameShare>,
-    /// Whether this frame's share ran out with a segment still to submit.
-    held: bool,
     /// The caller's clock (ms).
     clock: fn() -> f64,
     failure: Option<GpuError>,
@@ -180,7 +171,6 @@ impl GpuEvaluator {
             blocking: false,
             segment: Some(Self::adaptive(FIRST_SEGMENT)),
             frame: None,
-            held: false,
             clock,
             failure: None,
             runs: 0,
@@ -212,14 +202,13 @@ impl GpuEvaluator {
             budget,
             ..FrameShare::default()
         });
-        self.held = false;
     }
 
     /// What happened since [`Self::share_frame`]: vertex-steps sent, whether the share
     /// limited them, and the piece held back for want of room (0: none).
     pub fn frame_spent(&self) -> (u64, bool, u64) {
         self.frame
-            .map_or((0, false, 0), |f| (f.spent, f.full || self.held, f.held))
+            .map_or((0, false, 0), |f| (f.spent, f.full || f.held > 0, f.held))
     }
 
     fn adaptive(first: u64) -> AdaptiveSize {
@@ -255,15 +244,15 @@ impl GpuEvaluator {
     /// Submits job `j`'s next segment: cumulative filters up to the next counts that fit the
     /// segment size (`budget`, vertex-steps; `None`: the whole run), a measure that does not
     /// fit going on in parts over the next segments; windowed sinc one count (one whole run).
-    fn submit_next(&mut self, j: usize, budget: Option<u64>) -> Result<Sent, GpuError> {
+    fn submit_next(&mut self, j: usize, budget: Option<u64>) -> Result<Advance, GpuError> {
         let (Some(job), Some((_, mesh))) = (self.jobs.get_mut(j), self.mesh.as_mut()) else {
-            return Ok(Sent::default());
+            return Ok(Advance::default());
         };
         let vertices = mesh.vertex_count() as u64;
         let (params, at) = &job.request;
         let remaining = &at[job.terms.len()..];
         if remaining.is_empty() {
-            return Ok(Sent::default());
+            return Ok(Advance::default());
         }
         // Another run since this one's last segment left other positions on the device:
         // run again from the original (measuring only what is missing).
@@ -298,8 +287,8 @@ impl GpuEvaluator {
                 submitted_ms: (self.clock)(),
                 full,
             });
-            return Ok(Sent {
-                steps: (end - next) as u64 * part_cost,
+            return Ok(Advance {
+                spent: (end - next) as u64 * part_cost,
                 full,
             });
         }
@@ -332,8 +321,8 @@ impl GpuEvaluator {
             submitted_ms: (self.clock)(),
             full,
         });
-        Ok(Sent {
-            steps: u64::from(to - from) * iteration + upto as u64 * measure,
+        Ok(Advance {
+            spent: u64::from(to - from) * iteration + upto as u64 * measure,
             full,
         })
     }
@@ -353,13 +342,12 @@ impl GpuEvaluator {
                 None => job.smallest_piece(vertices),
             };
             if left < smallest {
-                self.held = true;
                 f.held = f.held.max(smallest);
                 return Ok(());
             }
         }
         let sent = self.submit_next(asked, budget)?;
-        let mut spent = sent.steps;
+        let mut spent = sent.spent;
         // Other runs may follow only once this one is complete: a later segment goes on from
         // the state it leaves on the device.
         let job = &self.jobs[asked];
@@ -392,7 +380,7 @@ impl GpuEvaluator {
                 }
                 self.jobs.push(job);
                 let j = self.jobs.len() - 1;
-                spent += self.submit_next(j, None)?.steps;
+                spent += self.submit_next(j, None)?.spent;
             }
         }
         if let Some(f) = self.frame.as_mut() {
@@ -517,7 +505,8 @@ impl Offload for GpuEvaluator {
     }
 
     fn waiting(&self) -> bool {
-        !self.blocking && (self.held || self.jobs.iter().any(|j| j.in_flight.is_some()))
+        let held = self.frame.is_some_and(|f| f.held > 0);
+        !self.blocking && (held || self.jobs.iter().any(|j| j.in_flight.is_some()))
     }
 
     fn failure(&self) -> Option<String> {

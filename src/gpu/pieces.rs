@@ -9,8 +9,8 @@ use super::work::{iteration_cost, measure_part_cost};
 use super::{GpuError, GpuMesh, GpuSmoother, MeasureReadback, ResultReadback};
 use crate::smooth::{Filter, Params};
 
-/// What one [`RunPieces::advance`] sent.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What one submission step sent ([`RunPieces::advance`], the evaluator's segments).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Advance {
     /// Vertex-steps submitted.
     pub spent: u64,

@@ -60,9 +60,8 @@ impl AdaptiveSize {
         self.adapt_work(ms - shortest, full);
     }
 
-    /// Learns from a submission whose work took `work_ms`; `full` as for [`Self::adapt`].
-    pub(crate) fn adapt_work(&mut self, work_ms: f64, full: bool) {
-        let work = work_ms;
+    /// Learns from a submission whose work took `work` ms; `full` as for [`Self::adapt`].
+    pub(crate) fn adapt_work(&mut self, work: f64, full: bool) {
         if work > 2.0 * self.target_ms {
             self.size = (self.size / 2).max(self.min);
         } else if full && work < self.target_ms / 2.0 {
