@@ -16,8 +16,8 @@ mod ground_truth;
 use meshsmooth::metrics::{DriftingReference, Original};
 use meshsmooth::smooth::{smooth, Filter, NoObserver, Params};
 use meshsmooth::suggest::{
-    run, EvaluatedGrid, Evaluator, GridSearch, LocalSearch, MeshEvaluator, QualitySweep,
-    Suggestion, Terms,
+    run, EvaluatedGrid, Evaluator, GridMinimum, GridSearch, LocalSearch, MeshEvaluator,
+    QualitySweep, Suggestion, Terms,
 };
 use std::time::Instant;
 
@@ -26,6 +26,12 @@ const TAUS: [f64; 3] = [0.2, 0.5, 0.8];
 fn grid(original: &Original, filter: Filter) -> EvaluatedGrid {
     let mut ev = MeshEvaluator::new(original, None).expect("no weights");
     let task = GridSearch::new(filter, &Params::defaults(filter)).expect("valid base");
+    run(task, &mut ev, &mut |_| true).expect("not cancelled")
+}
+
+fn minimum(original: &Original, filter: Filter, tau: f64) -> Suggestion {
+    let mut ev = MeshEvaluator::new(original, None).expect("no weights");
+    let task = GridMinimum::new(filter, &Params::defaults(filter), tau).expect("valid base");
     run(task, &mut ev, &mut |_| true).expect("not cancelled")
 }
 
@@ -138,6 +144,16 @@ fn check_mesh(name: &str) -> Vec<Comparison> {
         assert!(
             !g.best(1.0).expect("grid").leaves_mesh_unchanged(),
             "{name} {filter}: tau 1 must smooth"
+        );
+
+        // The grid minimum that measures the local error only where it can matter (the
+        // engine's bounds are real here) is the full grid's.
+        let bounded = minimum(&original, filter, 0.5);
+        let full = g.best(0.5).expect("grid not empty");
+        assert_eq!(
+            (bounded.params, bounded.score, bounded.terms),
+            (full.params, full.score, full.terms),
+            "{name} {filter}"
         );
 
         for tau in TAUS {

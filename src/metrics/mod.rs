@@ -19,8 +19,8 @@ pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Clos
 pub use local_error::{identity, smooth_drifting, DriftingReference};
 pub use original::{Original, OriginalInParts};
 pub use report::{
-    exact_distances, exact_error, measure, measure_vertices, ErrorSummary, MeasureInParts, Metrics,
-    VertexMeasures,
+    exact_distances, exact_error, measure, measure_shape, measure_vertices, ErrorSummary,
+    MeasureInParts, Metrics, VertexMeasures,
 };
 pub use score::ScoreTerms;
 pub use sinc_drifting::SincDrifting;

@@ -90,6 +90,16 @@ pub fn measure(
     metrics(original, &sums, tau)
 }
 
+/// The curvature and volume measures of `positions` without the local error, which needs the
+/// drifting reference along the run and costs about half of a pass: `mean_error` and
+/// `max_error` are 0, below their true values, and every other field is exactly [`measure`]'s.
+/// So the score is a lower bound of the full measure's, for searches that rule parameter sets
+/// out before measuring them fully.
+pub fn measure_shape(original: &Original, positions: &[[f32; 3]], tau: f64) -> Metrics {
+    let sums = measure_pass(original, positions, None);
+    metrics(original, &sums, tau)
+}
+
 /// [`measure`], also filling the per-vertex arrays, in the same pass.
 pub fn measure_vertices(
     original: &Original,
@@ -319,8 +329,8 @@ impl Sums {
     }
 }
 
-/// Volume, curvature and local error in one pass over the vertices (`reference`: `None` = every
-/// vertex its own reference), without per-vertex arrays ([`MeasureInParts`] fills those).
+/// Volume, curvature and local error in one pass over the vertices (`reference`: `None` leaves
+/// the local error out), without per-vertex arrays ([`MeasureInParts`] fills those).
 pub(crate) fn measure_pass(
     original: &Original,
     positions: &[[f32; 3]],
@@ -373,6 +383,7 @@ fn total_of(volume6: f64, partial: &[Sums]) -> Sums {
 struct Pass<'a> {
     original: &'a Original,
     positions: &'a [[f32; 3]],
+    /// Each vertex's drifted reference; `None`: no local error.
     reference: Option<&'a [u32]>,
     areas: &'a [TriangleArea],
 }
@@ -407,8 +418,10 @@ impl Pass<'_> {
                     s.curvature_count += 1;
                 }
             }
-            let r = self.reference.map_or(i, |r| r[i] as usize);
-            let e = vertex_local_error(self.original, self.positions[i], r);
+            let Some(reference) = self.reference else {
+                continue;
+            };
+            let e = vertex_local_error(self.original, self.positions[i], reference[i] as usize);
             s.error_sum += e;
             s.error_max = s.error_max.max(e);
             s.error_count += 1;

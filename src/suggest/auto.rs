@@ -3,7 +3,7 @@
 
 use super::mesh_evaluator::{MeshEvaluator, WeightsError};
 use super::{
-    run, Cancelled, Evaluator, GridSearch, LocalSearch, Progress, QualityGraphs, QualitySweep,
+    run, Cancelled, Evaluator, GridMinimum, LocalSearch, Progress, QualityGraphs, QualitySweep,
     SearchMethod, Suggestion,
 };
 use crate::mesh::{Mesh, Topology};
@@ -91,8 +91,8 @@ pub fn suggest_on(
     check_tau(tau)?;
     let suggestion = match method {
         SearchMethod::Grid => {
-            let task = GridSearch::new(base.filter, base)?;
-            run(task, evaluator, on_progress)?.best(tau)
+            let task = GridMinimum::new(base.filter, base, tau)?;
+            Some(run(task, evaluator, on_progress)?)
         }
         SearchMethod::Local => {
             let task = LocalSearch::new(base.filter, base, tau)?;

@@ -105,6 +105,31 @@ impl<E: Evaluator> Evaluator for Memoized<'_, E> {
         answer
     }
 
+    /// Known terms are exact; the inner evaluator bounds the rest (its exact answers are kept).
+    fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
+        let missing = self.memo.missing(params, at);
+        let fresh = if missing.is_empty() {
+            Vec::new()
+        } else {
+            self.inner.measure_bounds(params, &missing)?
+        };
+        for (&k, &(t, exact)) in missing.iter().zip(&fresh) {
+            if exact {
+                self.memo.insert(params, &[k], &[t]);
+            }
+        }
+        let key = RunKey::of(params);
+        let answer = at
+            .iter()
+            .map(|&k| match missing.iter().position(|&c| c == k) {
+                Some(i) => fresh.get(i).copied(),
+                None => self.memo.get(key, k).map(|t| (t, true)),
+            })
+            .collect::<Option<Vec<(Terms, bool)>>>();
+        debug_assert!(answer.is_some());
+        answer
+    }
+
     fn wants_prefetch(&self) -> bool {
         self.inner.wants_prefetch()
     }

@@ -2,7 +2,7 @@
 //! along the run, and measure against the original.
 
 use super::{is_cumulative, Evaluator, Terms};
-use crate::metrics::{measure, DriftingReference, Metrics, Original};
+use crate::metrics::{measure, measure_shape, DriftingReference, Metrics, Original};
 use crate::smooth::{smooth, Params, StepObserver};
 
 /// Per-vertex weights that do not fit the mesh.
@@ -71,6 +71,22 @@ impl<'a> MeshEvaluator<'a> {
     }
 }
 
+/// Measures curvature and volume after the wanted iterations (no drifting reference).
+struct Shapes<'o, 'e> {
+    original: &'o Original,
+    at: &'e [u32],
+    terms: Vec<Terms>,
+}
+
+impl StepObserver for Shapes<'_, '_> {
+    fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
+        if self.at.get(self.terms.len()) == Some(&iteration) {
+            self.terms
+                .push(terms_of(&measure_shape(self.original, positions, 0.5)));
+        }
+    }
+}
+
 /// Drifts the reference vertices after every step and measures after the wanted iterations.
 struct Along<'o, 'e> {
     drift: DriftingReference<'o>,
@@ -95,6 +111,37 @@ impl StepObserver for Along<'_, '_> {
 }
 
 impl Evaluator for MeshEvaluator<'_> {
+    /// Without the local error: the smoothing runs without the drifting reference and each
+    /// measure skips half its work.
+    fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
+        let (mesh, topology) = (self.original.mesh(), self.original.topology());
+        let zeros = params.unchanged_counts(at);
+        let mut out: Vec<(Terms, bool)> = (0..zeros).map(|_| (self.unchanged(), true)).collect();
+        let rest = &at[zeros..];
+        let runs: Vec<&[u32]> = match rest.last() {
+            None => Vec::new(),
+            Some(_) if is_cumulative(params.filter) => vec![rest],
+            Some(_) => rest.chunks(1).collect(),
+        };
+        for run in runs {
+            let mut p = *params;
+            p.iterations = run[run.len() - 1];
+            let mut shapes = Shapes {
+                original: self.original,
+                at: run,
+                terms: Vec::with_capacity(run.len()),
+            };
+            let positions = smooth(mesh, topology, &p, self.weights, &mut shapes);
+            while shapes.terms.len() < run.len() {
+                let t = terms_of(&measure_shape(self.original, &positions, 0.5));
+                shapes.terms.push(t);
+            }
+            out.extend(shapes.terms.into_iter().map(|t| (t, false)));
+            self.runs += 1;
+        }
+        Some(out)
+    }
+
     fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
         let mesh = self.original.mesh();
         let topology = self.original.topology();
@@ -165,6 +212,39 @@ mod tests {
                 "lambda 0 moves nothing"
             );
             assert_eq!(*terms, ev.measure_positions(&positions, &reference), "{k}");
+        }
+    }
+
+    #[test]
+    fn bounds_are_the_terms_without_the_local_error() {
+        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let mesh = crate::io::load(bytes, "sample.ply").unwrap();
+        let original = Original::new(&mesh, &crate::mesh::Topology::build(&mesh));
+        let mut ev = MeshEvaluator::new(&original, None).unwrap();
+        for filter in Filter::ALL {
+            let params = Params::defaults(filter);
+            let at: &[u32] = if filter == Filter::Sinc {
+                &[0, 7]
+            } else {
+                &[0, 3, 12]
+            };
+            let exact = ev.measure(&params, at).unwrap();
+            let bounds = ev.measure_bounds(&params, at).unwrap();
+            assert_eq!(
+                bounds[0],
+                (exact[0], true),
+                "{filter}: the unchanged mesh is exact"
+            );
+            for ((b, is_exact), e) in bounds.iter().zip(&exact).skip(1) {
+                assert!(!is_exact);
+                assert_eq!(b.curvature_ratio, e.curvature_ratio, "{filter}");
+                assert_eq!(b.volume_change, e.volume_change, "{filter}");
+                assert_eq!(b.mean_error, 0.0);
+                assert!(
+                    e.mean_error > 0.0 && b.score(0.5) < e.score(0.5),
+                    "{filter}"
+                );
+            }
         }
     }
 

@@ -10,6 +10,7 @@
 //! with [`run`], reporting progress and honouring cancellation between runs.
 
 mod auto;
+mod bounded;
 mod grid;
 mod local;
 mod memo;
@@ -23,6 +24,7 @@ mod sweep;
 pub use auto::{
     quality_graphs, quality_graphs_on, suggest, suggest_for_mesh, suggest_on, SuggestError,
 };
+pub use bounded::GridMinimum;
 pub use grid::{EvaluatedGrid, GridSearch};
 pub use local::{LocalOutcome, LocalSearch};
 pub use memo::{Memoized, TermsMemo};
@@ -85,6 +87,17 @@ pub trait Evaluator {
     /// use it; the others always answer.
     fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>>;
 
+    /// [`Self::measure`], where the evaluator may leave out the local error (which needs the
+    /// drifting reference along the run and about half of each measure): such terms hold a
+    /// mean error of 0, below the true one, and the flag beside them is `false`. Their score is
+    /// then a lower bound of the true score (the other terms are exact), which lets a search
+    /// rule parameter sets out before measuring them fully ([`GridMinimum`]). By default every
+    /// answer is exact.
+    fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
+        let terms = self.measure(params, at)?;
+        Some(terms.into_iter().map(|t| (t, true)).collect())
+    }
+
     /// Whether this evaluator does better knowing the requests to come ([`Self::prefetch`]):
     /// one that answers a frame later (the GPU's) batches them.
     fn wants_prefetch(&self) -> bool {
@@ -100,6 +113,10 @@ pub trait Evaluator {
 impl<E: Evaluator + ?Sized> Evaluator for &mut E {
     fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
         (**self).measure(params, at)
+    }
+
+    fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
+        (**self).measure_bounds(params, at)
     }
 
     fn wants_prefetch(&self) -> bool {

@@ -83,6 +83,10 @@ impl Measured {
         self.terms.iter().map(|(&p, &t)| (p, t))
     }
 
+    pub fn insert(&mut self, p: GridPoint, terms: Terms) {
+        self.terms.insert(p, terms);
+    }
+
     /// The points of `points` not measured yet.
     pub fn missing(&self, points: &[GridPoint]) -> Vec<GridPoint> {
         points

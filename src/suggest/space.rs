@@ -238,6 +238,12 @@ impl ParamSpace {
         out
     }
 
+    /// Whether `a` and `b` differ in their iteration count at most.
+    pub fn same_weights(&self, a: GridPoint, b: GridPoint) -> bool {
+        let it = self.iteration_axis();
+        (0..3).all(|k| k == it || a.0[k] == b.0[k])
+    }
+
     /// Sort key putting the weaker smoothing first: fewer iterations, then each weight in its
     /// weaker direction.
     pub fn weakness_key(&self, point: GridPoint) -> [u8; 3] {

@@ -66,8 +66,9 @@ impl<E> Slow<E> {
     }
 }
 
-impl<E: Evaluator> Evaluator for Slow<E> {
-    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+impl<E> Slow<E> {
+    /// Whether this asking of `(params, at)` is answered.
+    fn answers(&mut self, params: &Params, at: &[u32]) -> bool {
         let times = match &self.asked {
             Some((p, a, n)) => {
                 assert_eq!((p, a.as_slice()), (params, at), "asked for another run");
@@ -77,10 +78,26 @@ impl<E: Evaluator> Evaluator for Slow<E> {
         };
         if times <= self.delay {
             self.asked = Some((*params, at.to_vec(), times));
-            return None;
+            return false;
         }
         self.asked = None;
+        true
+    }
+}
+
+impl<E: Evaluator> Evaluator for Slow<E> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        if !self.answers(params, at) {
+            return None;
+        }
         self.inner.measure(params, at)
+    }
+
+    fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
+        if !self.answers(params, at) {
+            return None;
+        }
+        self.inner.measure_bounds(params, at)
     }
 }
 
