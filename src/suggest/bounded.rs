@@ -182,40 +182,9 @@ impl Task for GridMinimum {
 
 #[cfg(test)]
 mod tests {
-    use super::super::synthetic::{bowl, smoothing_model, FnEvaluator, Slow};
+    use super::super::synthetic::{bowl, smoothing_model, Bounding, FnEvaluator, Slow};
     use super::super::{run, GridSearch};
     use super::*;
-
-    /// Answers bounds without the mean error (and counts the full measures), like the CPU
-    /// engine's evaluator.
-    struct Bounding<E> {
-        inner: E,
-        full: usize,
-    }
-
-    impl<E: Evaluator> Evaluator for Bounding<E> {
-        fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
-            let terms = self.inner.measure(params, at)?;
-            self.full += terms.len();
-            Some(terms)
-        }
-
-        fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
-            let terms = self.inner.measure(params, at)?;
-            Some(
-                terms
-                    .into_iter()
-                    .map(|t| {
-                        let bound = Terms {
-                            mean_error: 0.0,
-                            ..t
-                        };
-                        (bound, t.mean_error == 0.0)
-                    })
-                    .collect(),
-            )
-        }
-    }
 
     fn minimum(filter: Filter, tau: f64, ev: &mut dyn Evaluator) -> Suggestion {
         let task = GridMinimum::new(filter, &Params::defaults(filter), tau).unwrap();
@@ -240,10 +209,7 @@ mod tests {
             for i in 0..=10 {
                 let tau = i as f64 / 10.0;
                 let want = full_grid(filter, tau, &mut FnEvaluator::new(smoothing_model(filter)));
-                let mut ev = Bounding {
-                    inner: FnEvaluator::new(smoothing_model(filter)),
-                    full: 0,
-                };
+                let mut ev = Bounding::new(FnEvaluator::new(smoothing_model(filter)));
                 let got = minimum(filter, tau, &mut ev);
                 assert_eq!(got, want, "{filter} tau {tau}");
                 full += ev.full;
@@ -264,10 +230,7 @@ mod tests {
             volume_change: Some(0.0),
         };
         let want = full_grid(Filter::Laplace, 0.5, &mut FnEvaluator::new(flat));
-        let mut ev = Bounding {
-            inner: FnEvaluator::new(flat),
-            full: 0,
-        };
+        let mut ev = Bounding::new(FnEvaluator::new(flat));
         assert_eq!(minimum(Filter::Laplace, 0.5, &mut ev), want);
         // An evaluator without bounds: the first pass is the grid, the second has nothing left.
         for (filter, at) in [(Filter::Hc, [7, 2, 9]), (Filter::Sinc, [6, 3, 0])] {
@@ -292,18 +255,9 @@ mod tests {
             let want = minimum(
                 filter,
                 0.5,
-                &mut Bounding {
-                    inner: FnEvaluator::new(smoothing_model(filter)),
-                    full: 0,
-                },
+                &mut Bounding::new(FnEvaluator::new(smoothing_model(filter))),
             );
-            let mut slow = Slow::new(
-                Bounding {
-                    inner: FnEvaluator::new(smoothing_model(filter)),
-                    full: 0,
-                },
-                2,
-            );
+            let mut slow = Slow::new(Bounding::new(FnEvaluator::new(smoothing_model(filter))), 2);
             assert_eq!(minimum(filter, 0.5, &mut slow), want, "{filter}");
         }
     }

@@ -101,6 +101,42 @@ impl<E: Evaluator> Evaluator for Slow<E> {
     }
 }
 
+/// Answers bounds without the mean error where it is not 0 (and counts the full measures),
+/// like the CPU engine's evaluator.
+pub struct Bounding<E> {
+    pub inner: E,
+    /// Parameter sets measured fully.
+    pub full: usize,
+}
+
+impl<E> Bounding<E> {
+    pub fn new(inner: E) -> Self {
+        Self { inner, full: 0 }
+    }
+}
+
+impl<E: Evaluator> Evaluator for Bounding<E> {
+    fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        let terms = self.inner.measure(params, at)?;
+        self.full += terms.len();
+        Some(terms)
+    }
+
+    fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
+        let terms = self.inner.measure(params, at)?;
+        let bound = |t: Terms| Terms {
+            mean_error: 0.0,
+            ..t
+        };
+        Some(
+            terms
+                .into_iter()
+                .map(|t| (bound(t), t.mean_error == 0.0))
+                .collect(),
+        )
+    }
+}
+
 /// K/K0 = 1 + squared grid distance to `centre` (in grid steps), no error: the minimum of S is
 /// at `centre` for every tau > 0.
 pub fn bowl(space: &ParamSpace, centre: GridPoint) -> impl FnMut(&Params) -> Terms {
