@@ -83,7 +83,10 @@ pub const FRAME_WORK_MS: f64 = 40.0;
 /// sent before it; the browser runs a frame or two ahead, so the wait shows in the interval of
 /// one of the next frames. What drawing alone takes is the lower quartile of the intervals of
 /// the recent frames with no work sent in the [`WINDOW`] frames before them; a frame's work is
-/// its interval beyond that. The size halves after a frame whose work is well over the
+/// its interval beyond that, or beyond the lower quartile of the last [`RECENT_FRAMES`]
+/// intervals of any frame where that is shorter (frames without work are rare while the
+/// background works, and the last ones may date from a file opening, which takes long). The
+/// size halves after a frame whose work is well over the
 /// target, and doubles once a frame that the size limited is [`WINDOW`] frames old and the
 /// last [`CALM_FRAMES`] frames all stayed well under it: quick to shrink, slow to grow. A
 /// piece larger than the size waits, the frames until then saving up for it. The size starts
@@ -99,6 +102,9 @@ pub struct FrameWork {
     /// Intervals of the latest frames without work, oldest overwritten first.
     idle_ms: [f64; IDLE_FRAMES],
     idle_seen: usize,
+    /// Intervals of the latest frames, with or without work, oldest overwritten first.
+    recent_ms: [f64; RECENT_FRAMES],
+    recent_seen: usize,
     shortest_ms: f64,
     /// Frames since one whose work was over half the target.
     calm_frames: usize,
@@ -126,6 +132,8 @@ const MOST_FRAMES_SAVING: u64 = 4;
 const CALM_FRAMES: usize = 8;
 /// Frames without work whose intervals estimate what drawing takes.
 const IDLE_FRAMES: usize = 9;
+/// Frames of any kind whose intervals bound what drawing takes from above.
+const RECENT_FRAMES: usize = 16;
 
 impl Default for FrameWork {
     fn default() -> Self {
@@ -135,6 +143,8 @@ impl Default for FrameWork {
             window: [(false, false, 0.0); WINDOW],
             idle_ms: [0.0; IDLE_FRAMES],
             idle_seen: 0,
+            recent_ms: [0.0; RECENT_FRAMES],
+            recent_seen: 0,
             shortest_ms: f64::INFINITY,
             calm_frames: 0,
             spent: 0,
@@ -151,6 +161,8 @@ impl FrameWork {
         if let Some(last) = self.last_frame_ms {
             let interval = now_ms - last;
             self.shortest_ms = self.shortest_ms.min(interval);
+            self.recent_ms[self.recent_seen % RECENT_FRAMES] = interval;
+            self.recent_seen += 1;
             let recent_work = self.spent > 0 || self.window.iter().any(|w| w.0);
             let work = if recent_work {
                 (interval - self.drawing_ms()).max(0.0)
@@ -184,16 +196,16 @@ impl FrameWork {
 
     /// What a frame without work takes: the lower quartile of the recent ones (frames that
     /// also open a file or lay out a new panel take longer; the quartile leaves them out), or
-    /// the shortest interval seen before there are any.
+    /// the shortest interval seen before there are any; at most the lower quartile of the
+    /// latest frames of any kind, once there are enough of them (no frame is shorter than its
+    /// drawing).
     fn drawing_ms(&self) -> f64 {
-        let seen = self.idle_seen.min(IDLE_FRAMES);
-        if seen == 0 {
-            return self.shortest_ms;
+        let idle = lower_quartile(&self.idle_ms[..self.idle_seen.min(IDLE_FRAMES)]);
+        let idle = idle.unwrap_or(self.shortest_ms);
+        match self.recent_seen >= RECENT_FRAMES {
+            true => idle.min(lower_quartile(&self.recent_ms).unwrap_or(idle)),
+            false => idle,
         }
-        let mut recent = self.idle_ms;
-        let recent = &mut recent[..seen];
-        recent.sort_by(f64::total_cmp);
-        recent[seen / 4]
     }
 
     /// Vertex-steps this frame may still send.
@@ -223,6 +235,13 @@ impl FrameWork {
         self.full |= full;
         self.credit = self.credit.saturating_sub(steps);
     }
+}
+
+/// The lower quartile of `values`; `None` when there are none.
+fn lower_quartile(values: &[f64]) -> Option<f64> {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.get(sorted.len() / 4).copied()
 }
 
 /// What a segment of a cumulative run does (see [`plan_segment`]).
@@ -368,6 +387,32 @@ mod tests {
             frame(&mut f, 110.0);
         }
         assert_eq!(f.size(), first);
+    }
+
+    #[test]
+    fn long_frames_without_work_long_ago_do_not_hide_the_work() {
+        let mut f = FrameWork::default();
+        let first = f.size();
+        let mut t = 0.0;
+        // A file opening: long frames without work.
+        for _ in 0..IDLE_FRAMES {
+            t += 450.0;
+            f.begin_frame(t);
+        }
+        // Then a little work in every frame, frames of 130 to 160 ms (drawing takes 130).
+        for k in 0..RECENT_FRAMES {
+            f.sent(1, false);
+            t += if k % 2 == 0 { 130.0 } else { 160.0 };
+            f.begin_frame(t);
+        }
+        assert_eq!(f.size(), first);
+        assert_eq!(f.drawing_ms(), 130.0);
+        // 270 ms beyond drawing: the size halves (judged against the idle frames alone, this
+        // frame would have looked like drawing).
+        f.sent(first, true);
+        t += 400.0;
+        f.begin_frame(t);
+        assert_eq!(f.size(), first / 2);
     }
 
     #[test]
