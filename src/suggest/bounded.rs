@@ -11,7 +11,7 @@
 //! An evaluator whose answers are all exact (the default) makes the first pass the whole grid
 //! search and the second empty.
 
-use super::grid::{check_base, lowest};
+use super::grid::{lowest, plan_grid};
 use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
 use super::{score_order, Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
@@ -42,12 +42,10 @@ pub struct GridMinimum {
 impl GridMinimum {
     /// `base` supplies what the grid does not vary (the displacement bound).
     pub fn new(filter: Filter, base: &Params, tau: f64) -> Result<Self, ParamError> {
-        let base = check_base(filter, base)?;
-        let space = ParamSpace::of(filter);
-        let points = space.all_points(&base);
+        let (space, base, runs, total) = plan_grid(filter, base)?;
         Ok(Self {
-            runs: plan_runs(&space, &points),
-            total: points.len(),
+            runs,
+            total,
             space,
             base,
             tau,

@@ -31,6 +31,19 @@ pub(crate) fn check_base(filter: Filter, base: &Params) -> Result<Params, ParamE
     Ok(base)
 }
 
+/// The grid of `filter` around `base` (checked): its space, the base, every run that measures
+/// it, and how many points it has.
+pub(crate) fn plan_grid(
+    filter: Filter,
+    base: &Params,
+) -> Result<(ParamSpace, Params, Vec<Run>, usize), ParamError> {
+    let base = check_base(filter, base)?;
+    let space = ParamSpace::of(filter);
+    let points = space.all_points(&base);
+    let runs = plan_runs(&space, &points);
+    Ok((space, base, runs, points.len()))
+}
+
 /// Measures the whole grid of one filter, one run per [`Task::step`].
 pub struct GridSearch {
     space: ParamSpace,
@@ -44,12 +57,10 @@ pub struct GridSearch {
 impl GridSearch {
     /// `base` supplies what the grid does not vary (the displacement bound).
     pub fn new(filter: Filter, base: &Params) -> Result<Self, ParamError> {
-        let base = check_base(filter, base)?;
-        let space = ParamSpace::of(filter);
-        let points = space.all_points(&base);
+        let (space, base, runs, total) = plan_grid(filter, base)?;
         Ok(Self {
-            runs: plan_runs(&space, &points),
-            total: points.len(),
+            runs,
+            total,
             space,
             base,
             next: 0,
