@@ -8,12 +8,21 @@
 //! background's runs get what is left): the device runs its queue in order, so a frame drawn
 //! after a whole run on a slow (software) adapter would wait for all of it. On a fast one the
 //! pieces grow until a run fits a frame or two.
+//!
+//! Nothing new goes out while the device still runs the work of an earlier frame: the browser
+//! does not wait for the queue, so without this the work of several frames piles up in it and
+//! every frame drawn meanwhile waits for all of it.
 
 use super::document::{now_ms, Document, EngineTimings};
 use crate::gpu::{
     FrameWork, GpuEvaluator, GpuMesh, GpuSmoother, MeasureReadback, ResultReadback, RunPieces,
 };
 use crate::suggest::Offload;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+
+/// Frames whose device work may be unfinished when the next frame sends more.
+const FRAMES_AHEAD: usize = 1;
 
 /// A run being sent to the device in pieces, for one session revision.
 struct Running {
@@ -97,6 +106,40 @@ pub struct GpuEngine {
     /// so they never disturb what is drawn. `None` once it has failed.
     evaluator: Option<GpuEvaluator>,
     policy: GuidancePolicy,
+    device_work: DeviceWork,
+}
+
+/// The frames whose device work is unfinished: a frame that finds [`FRAMES_AHEAD`] of them
+/// waits, sending nothing.
+#[derive(Default)]
+struct DeviceWork {
+    /// Counted down as the device reports each frame's work done.
+    unfinished: Arc<AtomicUsize>,
+    /// This frame waits for the device.
+    waiting: bool,
+    /// This frame sent work not counted yet.
+    sent: bool,
+}
+
+impl DeviceWork {
+    fn begin_frame(&mut self, queue: &wgpu::Queue) {
+        // A frame that ended without counting its work (it skipped the background) counts now.
+        self.end_frame(queue);
+        self.waiting = self.unfinished.load(Ordering::SeqCst) >= FRAMES_AHEAD;
+    }
+
+    /// Counts the frame's work, once all of it is submitted, as unfinished until the device
+    /// reports it done.
+    fn end_frame(&mut self, queue: &wgpu::Queue) {
+        if !std::mem::take(&mut self.sent) {
+            return;
+        }
+        self.unfinished.fetch_add(1, Ordering::SeqCst);
+        let unfinished = Arc::clone(&self.unfinished);
+        queue.on_submitted_work_done(move || {
+            unfinished.fetch_sub(1, Ordering::SeqCst);
+        });
+    }
 }
 
 impl GpuEngine {
@@ -114,6 +157,7 @@ impl GpuEngine {
             evaluator: Some(GpuEvaluator::new(device, queue, &smoother, now_ms)),
             policy: GuidancePolicy::from_query(),
             smoother,
+            device_work: DeviceWork::default(),
         }
     }
 
@@ -125,7 +169,7 @@ impl GpuEngine {
             return None;
         }
         // A run for the view waiting for room comes first: the background waits with it.
-        let left = match self.frame_work.holding() {
+        let left = match self.frame_work.holding() || self.device_work.waiting {
             true => 0,
             false => self.frame_work.left(),
         };
@@ -134,7 +178,8 @@ impl GpuEngine {
         Some(evaluator as &mut dyn Offload)
     }
 
-    /// Counts what the evaluator sent in this frame into the frame's work.
+    /// Counts what the evaluator sent in this frame into the frame's work; the frame's device
+    /// work is all submitted then (call it last).
     pub fn guidance_sent(&mut self) {
         if let Some(e) = &self.evaluator {
             let (steps, full, held) = e.frame_spent();
@@ -142,7 +187,9 @@ impl GpuEngine {
             if held > 0 {
                 self.frame_work.hold(held);
             }
+            self.device_work.sent |= steps > 0;
         }
+        self.device_work.end_frame(&self.queue);
     }
 
     /// Why the background's evaluator failed (it is dropped then: the CPU takes over).
@@ -175,8 +222,9 @@ impl GpuEngine {
     /// back for the caller to fall back to the CPU engine.
     pub fn step(&mut self, doc: &mut Document) -> Result<Sent, String> {
         self.frame_work.begin_frame(now_ms());
+        self.device_work.begin_frame(&self.queue);
         self.collect(doc)?;
-        if self.in_flight.is_some() {
+        if self.in_flight.is_some() || self.device_work.waiting {
             return Ok(Sent::Nothing);
         }
         let generation = doc.model_generation;
@@ -240,6 +288,7 @@ impl GpuEngine {
             )
             .map_err(e)?;
         self.frame_work.sent(advance.spent, advance.full);
+        self.device_work.sent = true;
         let stale = run.revision != doc.session.revision();
         if run.pieces.smoothed() && stale {
             // The parameters moved on: show where these took the mesh, skip its measures.
