@@ -65,48 +65,78 @@ impl<'a> MeshEvaluator<'a> {
     pub(crate) fn unchanged(&self) -> Terms {
         super::unchanged_terms(self.original)
     }
-
-    pub(crate) fn measure_positions(&self, positions: &[[f32; 3]], reference: &[u32]) -> Terms {
-        terms_of(&measure(self.original, positions, reference, 0.5))
-    }
 }
 
-/// Measures curvature and volume after the wanted iterations (no drifting reference).
-struct Shapes<'o, 'e> {
-    original: &'o Original,
-    at: &'e [u32],
-    terms: Vec<Terms>,
-}
-
-impl StepObserver for Shapes<'_, '_> {
-    fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
-        if self.at.get(self.terms.len()) == Some(&iteration) {
-            self.terms
-                .push(terms_of(&measure_shape(self.original, positions, 0.5)));
-        }
-    }
-}
-
-/// Drifts the reference vertices after every step and measures after the wanted iterations.
+/// Measures after the wanted iterations of a run; with a drifting reference watching every
+/// step the full terms, without one curvature and volume only (the mean error left at 0).
 struct Along<'o, 'e> {
-    drift: DriftingReference<'o>,
-    evaluator: &'e MeshEvaluator<'o>,
+    original: &'o Original,
+    drift: Option<DriftingReference<'o>>,
     at: &'e [u32],
     terms: Vec<Terms>,
+}
+
+impl Along<'_, '_> {
+    fn measure(&mut self, positions: &[[f32; 3]]) {
+        let metrics = match &self.drift {
+            Some(drift) => measure(self.original, positions, drift.reference(), 0.5),
+            None => measure_shape(self.original, positions, 0.5),
+        };
+        self.terms.push(terms_of(&metrics));
+    }
 }
 
 impl StepObserver for Along<'_, '_> {
     fn after_step(&mut self, positions: &[[f32; 3]]) {
-        self.drift.update(positions);
+        if let Some(drift) = &mut self.drift {
+            drift.update(positions);
+        }
     }
 
     fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
         if self.at.get(self.terms.len()) == Some(&iteration) {
-            let t = self
-                .evaluator
-                .measure_positions(positions, self.drift.reference());
-            self.terms.push(t);
+            self.measure(positions);
         }
+    }
+}
+
+impl MeshEvaluator<'_> {
+    /// The terms after each count of `at`: the unchanged mesh's for the counts that move
+    /// nothing, then one run per cumulative request (one per count for windowed sinc). With
+    /// `drift` the full terms, else curvature and volume only.
+    fn measure_runs(&mut self, params: &Params, at: &[u32], drift: bool) -> Vec<Terms> {
+        let (mesh, topology) = (self.original.mesh(), self.original.topology());
+        // Zero iterations (or steps that move nothing) give the original mesh, whose terms are
+        // known exactly.
+        let zeros = params.unchanged_counts(at);
+        let mut out: Vec<Terms> = (0..zeros).map(|_| self.unchanged()).collect();
+        let rest = &at[zeros..];
+        let cumulative = is_cumulative(params.filter);
+        let runs: Vec<&[u32]> = match cumulative {
+            true if !rest.is_empty() => vec![rest],
+            true => Vec::new(),
+            false => rest.chunks(1).collect(),
+        };
+        for run in runs {
+            let mut p = *params;
+            p.iterations = run[run.len() - 1];
+            let mut along = Along {
+                original: self.original,
+                drift: drift.then(|| DriftingReference::new(self.original)),
+                // Windowed sinc reports no iterations on the way: measured once it is done.
+                at: if cumulative { run } else { &[] },
+                terms: Vec::with_capacity(run.len()),
+            };
+            let positions = smooth(mesh, topology, &p, self.weights, &mut along);
+            // A mesh the engine cannot smooth (nothing to move) reports no iterations: its
+            // result is the same for every count.
+            while along.terms.len() < run.len() {
+                along.measure(&positions);
+            }
+            out.extend(along.terms);
+            self.runs += 1;
+        }
+        out
     }
 }
 
@@ -114,75 +144,19 @@ impl Evaluator for MeshEvaluator<'_> {
     /// Without the local error: the smoothing runs without the drifting reference and each
     /// measure skips half its work.
     fn measure_bounds(&mut self, params: &Params, at: &[u32]) -> Option<Vec<(Terms, bool)>> {
-        let (mesh, topology) = (self.original.mesh(), self.original.topology());
         let zeros = params.unchanged_counts(at);
-        let mut out: Vec<(Terms, bool)> = (0..zeros).map(|_| (self.unchanged(), true)).collect();
-        let rest = &at[zeros..];
-        let runs: Vec<&[u32]> = match rest.last() {
-            None => Vec::new(),
-            Some(_) if is_cumulative(params.filter) => vec![rest],
-            Some(_) => rest.chunks(1).collect(),
-        };
-        for run in runs {
-            let mut p = *params;
-            p.iterations = run[run.len() - 1];
-            let mut shapes = Shapes {
-                original: self.original,
-                at: run,
-                terms: Vec::with_capacity(run.len()),
-            };
-            let positions = smooth(mesh, topology, &p, self.weights, &mut shapes);
-            while shapes.terms.len() < run.len() {
-                let t = terms_of(&measure_shape(self.original, &positions, 0.5));
-                shapes.terms.push(t);
-            }
-            out.extend(shapes.terms.into_iter().map(|t| (t, false)));
-            self.runs += 1;
-        }
-        Some(out)
+        let terms = self.measure_runs(params, at, false);
+        Some(
+            terms
+                .into_iter()
+                .enumerate()
+                .map(|(k, t)| (t, k < zeros))
+                .collect(),
+        )
     }
 
     fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
-        let mesh = self.original.mesh();
-        let topology = self.original.topology();
-        let mut out = Vec::with_capacity(at.len());
-        // Zero iterations (or steps that move nothing) give the original mesh, whose terms are
-        // known exactly.
-        let zeros = params.unchanged_counts(at);
-        out.extend((0..zeros).map(|_| self.unchanged()));
-        let rest = &at[zeros..];
-        if rest.is_empty() {
-            return Some(out);
-        }
-        if is_cumulative(params.filter) {
-            let mut p = *params;
-            p.iterations = rest[rest.len() - 1];
-            let mut along = Along {
-                drift: DriftingReference::new(self.original),
-                evaluator: self,
-                at: rest,
-                terms: Vec::with_capacity(rest.len()),
-            };
-            let positions = smooth(mesh, topology, &p, self.weights, &mut along);
-            // A mesh the engine cannot smooth (nothing to move) reports no iterations: its
-            // result is the same for every count.
-            while along.terms.len() < rest.len() {
-                let t = self.measure_positions(&positions, along.drift.reference());
-                along.terms.push(t);
-            }
-            out.extend(along.terms);
-            self.runs += 1;
-        } else {
-            for &k in rest {
-                let mut p = *params;
-                p.iterations = k;
-                let mut drift = DriftingReference::new(self.original);
-                let positions = smooth(mesh, topology, &p, self.weights, &mut drift);
-                out.push(self.measure_positions(&positions, drift.reference()));
-                self.runs += 1;
-            }
-        }
-        Some(out)
+        Some(self.measure_runs(params, at, true))
     }
 }
 
@@ -211,7 +185,8 @@ mod tests {
                 original.mesh().positions,
                 "lambda 0 moves nothing"
             );
-            assert_eq!(*terms, ev.measure_positions(&positions, &reference), "{k}");
+            let measured = crate::metrics::measure(&original, &positions, &reference, 0.5);
+            assert_eq!(*terms, terms_of(&measured), "{k}");
         }
     }
 
