@@ -99,12 +99,10 @@ pub struct FrameWork {
     /// Per frame of the window, newest first: whether work went out, whether the size
     /// limited it, and the work seen in its interval (ms).
     window: [(bool, bool, f64); WINDOW],
-    /// Intervals of the latest frames without work, oldest overwritten first.
-    idle_ms: [f64; IDLE_FRAMES],
-    idle_seen: usize,
-    /// Intervals of the latest frames, with or without work, oldest overwritten first.
-    recent_ms: [f64; RECENT_FRAMES],
-    recent_seen: usize,
+    /// Intervals of the latest frames without work.
+    idle_ms: Intervals<IDLE_FRAMES>,
+    /// Intervals of the latest frames, with or without work.
+    recent_ms: Intervals<RECENT_FRAMES>,
     shortest_ms: f64,
     /// Frames since one whose work was over half the target.
     calm_frames: usize,
@@ -141,10 +139,8 @@ impl Default for FrameWork {
             size: AdaptiveSize::new(2_000_000, SMALLEST_FRAME_WORK, 1 << 40, FRAME_WORK_MS),
             last_frame_ms: None,
             window: [(false, false, 0.0); WINDOW],
-            idle_ms: [0.0; IDLE_FRAMES],
-            idle_seen: 0,
-            recent_ms: [0.0; RECENT_FRAMES],
-            recent_seen: 0,
+            idle_ms: Intervals::default(),
+            recent_ms: Intervals::default(),
             shortest_ms: f64::INFINITY,
             calm_frames: 0,
             spent: 0,
@@ -161,14 +157,12 @@ impl FrameWork {
         if let Some(last) = self.last_frame_ms {
             let interval = now_ms - last;
             self.shortest_ms = self.shortest_ms.min(interval);
-            self.recent_ms[self.recent_seen % RECENT_FRAMES] = interval;
-            self.recent_seen += 1;
+            self.recent_ms.push(interval);
             let recent_work = self.spent > 0 || self.window.iter().any(|w| w.0);
             let work = if recent_work {
                 (interval - self.drawing_ms()).max(0.0)
             } else {
-                self.idle_ms[self.idle_seen % IDLE_FRAMES] = interval;
-                self.idle_seen += 1;
+                self.idle_ms.push(interval);
                 0.0
             };
             self.window.rotate_right(1);
@@ -200,10 +194,12 @@ impl FrameWork {
     /// latest frames of any kind, once there are enough of them (no frame is shorter than its
     /// drawing).
     fn drawing_ms(&self) -> f64 {
-        let idle = lower_quartile(&self.idle_ms[..self.idle_seen.min(IDLE_FRAMES)]);
-        let idle = idle.unwrap_or(self.shortest_ms);
-        match self.recent_seen >= RECENT_FRAMES {
-            true => idle.min(lower_quartile(&self.recent_ms).unwrap_or(idle)),
+        let idle = self.idle_ms.lower_quartile().unwrap_or(self.shortest_ms);
+        match self.recent_ms.is_full() {
+            true => self
+                .recent_ms
+                .lower_quartile()
+                .map_or(idle, |any| idle.min(any)),
             false => idle,
         }
     }
@@ -237,11 +233,39 @@ impl FrameWork {
     }
 }
 
-/// The lower quartile of `values`; `None` when there are none.
-fn lower_quartile(values: &[f64]) -> Option<f64> {
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    sorted.get(sorted.len() / 4).copied()
+/// The latest `N` frame intervals (ms), the oldest overwritten first.
+#[derive(Clone, Copy, Debug)]
+struct Intervals<const N: usize> {
+    ms: [f64; N],
+    seen: usize,
+}
+
+impl<const N: usize> Default for Intervals<N> {
+    fn default() -> Self {
+        Self {
+            ms: [0.0; N],
+            seen: 0,
+        }
+    }
+}
+
+impl<const N: usize> Intervals<N> {
+    fn push(&mut self, ms: f64) {
+        self.ms[self.seen % N] = ms;
+        self.seen += 1;
+    }
+
+    fn is_full(&self) -> bool {
+        self.seen >= N
+    }
+
+    /// The lower quartile of the intervals kept; `None` before the first.
+    fn lower_quartile(&self) -> Option<f64> {
+        let mut sorted = self.ms;
+        let sorted = &mut sorted[..self.seen.min(N)];
+        sorted.sort_by(f64::total_cmp);
+        sorted.get(sorted.len() / 4).copied()
+    }
 }
 
 /// What a segment of a cumulative run does (see [`plan_segment`]).

@@ -31,8 +31,6 @@ pub struct GridMinimum {
     bounds: BTreeMap<GridPoint, Terms>,
     /// Points measured fully.
     exact: Measured,
-    /// Points ruled out by their bound.
-    ruled_out: usize,
     /// The run of the second pass under way (kept while the evaluator has not answered).
     pending: Option<Run>,
     finished: bool,
@@ -52,16 +50,14 @@ impl GridMinimum {
             next: 0,
             bounds: BTreeMap::new(),
             exact: Measured::default(),
-            ruled_out: 0,
             pending: None,
             finished: false,
         })
     }
 
     /// The points still in question, lowest bound first (ties: the weaker smoothing): those
-    /// measured only by bound whose bound does not exceed the best full score. The others are
-    /// counted as ruled out.
-    fn open_points(&mut self) -> Vec<GridPoint> {
+    /// measured only by bound whose bound does not exceed the best full score.
+    fn open_points(&self) -> Vec<GridPoint> {
         let best = lowest(&self.space, self.tau, self.exact.iter()).map(|(_, t)| t.score(self.tau));
         let mut open: Vec<(GridPoint, f64)> = self
             .bounds
@@ -69,7 +65,6 @@ impl GridMinimum {
             .map(|(&p, t)| (p, t.score(self.tau)))
             .filter(|&(_, s)| best.is_none_or(|b| score_order(s, b).is_le()))
             .collect();
-        self.ruled_out = self.bounds.len() - open.len();
         open.sort_by(|(pa, sa), (pb, sb)| {
             score_order(*sa, *sb).then_with(|| {
                 self.space
@@ -81,7 +76,7 @@ impl GridMinimum {
     }
 
     /// The next full run: the open points that share the lowest open point's weights.
-    fn next_full_run(&mut self) -> Option<Run> {
+    fn next_full_run(&self) -> Option<Run> {
         let open = self.open_points();
         let &first = open.first()?;
         let row: Vec<GridPoint> = open
@@ -116,12 +111,9 @@ impl GridMinimum {
         self.next += 1;
     }
 
+    /// Measures the pending run fully (planned by [`Task::step`]).
     fn second_pass(&mut self, evaluator: &mut dyn Evaluator) {
-        if self.pending.is_none() {
-            self.pending = self.next_full_run();
-        }
         let Some(run) = &self.pending else {
-            self.finished = true;
             return;
         };
         if self.exact.measure(&self.space, &self.base, evaluator, run) {
@@ -143,7 +135,8 @@ impl Task for GridMinimum {
             self.second_pass(evaluator);
         }
         if self.next >= self.runs.len() && !self.finished && self.pending.is_none() {
-            // Settle now when nothing is open, so the last step reports the search finished.
+            // Plan the next full run now, so the step that leaves nothing open reports the
+            // search finished.
             self.pending = self.next_full_run();
             self.finished = self.pending.is_none();
         }
@@ -153,7 +146,11 @@ impl Task for GridMinimum {
     /// Both passes: every point once bounded (or measured), then once measured or ruled out.
     fn progress(&self) -> Progress {
         let seen = self.bounds.len() + self.exact.len();
-        let settled = self.exact.len() + self.ruled_out;
+        let open = match self.next < self.runs.len() {
+            true => self.bounds.len(),
+            false => self.open_points().len(),
+        };
+        let settled = seen - open;
         Progress {
             done: seen + settled,
             total: 2 * self.total,
