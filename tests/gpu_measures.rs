@@ -5,8 +5,8 @@
 //! - Normals within 1e-5 rad of the CPU's.
 //! - Measures of the GPU's result against the CPU's measures of the same positions and
 //!   references: volume within 1e-6 relative, mean local error 1e-5, maximum 1e-4, every angle
-//!   defect within 1e-6 rad (f32 leaves a few 1e-7), hence K within 1e-6 times the mean of
-//!   1 / A_mixed.
+//!   defect within 2e-6 rad (both engines' angles are f32, each within a few 1e-7), hence K
+//!   within 2e-6 times the mean of 1 / A_mixed.
 //! - The same numbers from a 2-D workgroup grid, and from a run sent in pieces.
 //!
 //! Without an adapter these tests print a notice and pass, unless REQUIRE_GPU=1, where they fail.
@@ -101,6 +101,9 @@ fn normals_match_the_cpu() {
     }
 }
 
+/// How far one vertex's angle defect may differ between the engines (radians).
+const DEFECT: f64 = 2e-6;
+
 fn relative(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
 }
@@ -116,8 +119,8 @@ struct Agreement {
     vertex_error: f64,
     /// Largest per-vertex difference of `K_G * A_mixed` (the angle defect, radians).
     vertex_defect: f64,
-    /// What K may differ by when every angle defect differs by 1e-6 rad at most: 1e-6 times the
-    /// mean of `1 / A_mixed` over the vertices K averages.
+    /// What K may differ by when every angle defect differs by [`DEFECT`] at most: that times
+    /// the mean of `1 / A_mixed` over the vertices K averages.
     curvature_bound: f64,
 }
 
@@ -149,15 +152,16 @@ fn compare(
         let de = f64::from((gv.local_error[i] - cv.local_error[i]).abs());
         a.vertex_error = a.vertex_error.max(de / cm.mean_error.max(1e-12));
         let (gk, ck) = (gv.gaussian_curvature[i], cv.gaussian_curvature[i]);
-        assert_eq!(
-            gk == 0.0,
-            ck == 0.0,
+        let dd = f64::from((gk - ck).abs()) * area.mixed_area;
+        // 0 marks a vertex left out (boundary, no area); an angle defect within the rounding
+        // of the angles may also come out as exactly 0 on one side.
+        assert!(
+            (gk == 0.0) == (ck == 0.0) || dd <= DEFECT,
             "vertex {i}: K_G {gk} on the GPU, {ck} on the CPU"
         );
-        let dd = f64::from((gk - ck).abs()) * area.mixed_area;
         a.vertex_defect = a.vertex_defect.max(dd);
     }
-    a.curvature_bound = 1e-6 * inverse_areas.0 / inverse_areas.1.max(1) as f64;
+    a.curvature_bound = DEFECT * inverse_areas.0 / inverse_areas.1.max(1) as f64;
     a
 }
 
@@ -203,7 +207,7 @@ fn check_measures(gpu: &Gpu, name: &str, original: &Original, p: &Params) -> Agr
         a.curvature_bound
     );
     assert!(
-        a.vertex_defect <= 1e-6,
+        a.vertex_defect <= DEFECT,
         "{name} {}: defect {}",
         p.filter,
         a.vertex_defect
@@ -296,7 +300,7 @@ fn measures_of_the_original_and_of_untracked_runs() {
         &(measured.metrics, measured.vertex.expect("asked for")),
     );
     assert!(
-        a.volume <= 1e-6 && a.mean_error <= 1e-5 && a.vertex_defect <= 1e-6,
+        a.volume <= 1e-6 && a.mean_error <= 1e-5 && a.vertex_defect <= DEFECT,
         "{a:?}"
     );
 }

@@ -14,7 +14,7 @@ mod report;
 mod score;
 mod sinc_drifting;
 
-pub use curvature::{vertex_curvature, vertex_curvatures, VertexCurvature};
+pub use curvature::{vertex_curvatures, VertexCurvature};
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
 pub use local_error::{identity, smooth_drifting, DriftingReference};
 pub use original::{Original, OriginalInParts};

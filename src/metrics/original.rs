@@ -1,7 +1,7 @@
 //! The original mesh M as the measures see it: built once per loaded mesh, so every measure pass
 //! over a smoothed mesh only reads what stays fixed.
 
-use super::curvature::fan_corners;
+use super::curvature::{fan_corners, CornerCode};
 use super::report::MeasureInParts;
 use crate::mesh::{Mesh, Topology};
 
@@ -14,6 +14,9 @@ pub struct Original {
     topology: Topology,
     /// Other two corners of each vertex->triangle incidence (parallel to `vertex_triangles`).
     fan_corners: Vec<[u32; 2]>,
+    /// Each vertex->triangle incidence as the triangle's corner (parallel to
+    /// `vertex_triangles`).
+    corner_codes: Vec<CornerCode>,
     /// Per vertex, the square of 0.49 times its shortest edge: a point that near the vertex is
     /// nearer to it than to any neighbour (each is at least 0.51 edge away), so the drift can
     /// skip the ring. The margin keeps the shortcut exact in f32.
@@ -44,6 +47,7 @@ impl Original {
             .count();
         Self {
             fan_corners: Vec::new(),
+            corner_codes: Vec::new(),
             stay_radius2: Vec::new(),
             mesh,
             topology,
@@ -82,6 +86,13 @@ impl Original {
     pub(crate) fn fan_corners(&self, i: usize) -> &[[u32; 2]] {
         let o = &self.topology.triangle_offsets;
         &self.fan_corners[o[i] as usize..o[i + 1] as usize]
+    }
+
+    /// The corners vertex `i` takes in its triangles.
+    #[inline]
+    pub(crate) fn corner_codes(&self, i: usize) -> &[CornerCode] {
+        let o = &self.topology.triangle_offsets;
+        &self.corner_codes[o[i] as usize..o[i + 1] as usize]
     }
 
     /// [`Self::fan_corners`] of every vertex, in vertex order (parallel to the topology's
@@ -156,7 +167,7 @@ impl OriginalInParts {
     pub fn advance(&mut self, vertices: usize) -> bool {
         let o = &mut self.original;
         match self.prepared {
-            0 => o.fan_corners = fan_corners(&o.mesh.triangles, &o.topology),
+            0 => (o.fan_corners, o.corner_codes) = fan_corners(&o.mesh.triangles, &o.topology),
             1 => o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology),
             2 => {
                 self.reference = super::identity(o.mesh.vertex_count());

@@ -1,15 +1,14 @@
 //! One measure pass over a smoothed mesh and the report it yields: volume, curvature, local
 //! error and the score, plus per-vertex arrays for colour-coding.
 
-use super::curvature::{fan_sums, triangle_areas, TriangleArea};
+use super::curvature::{triangle_shapes, TriangleShape, VertexCurvature};
 use super::exact_distance::TriangleBvh;
-use super::local_error::vertex_local_error;
+use super::local_error::{local_errors, vertex_local_error};
 use super::score::ScoreTerms;
 use super::Original;
 use crate::mesh::to_f64;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::f64::consts::PI;
 
 /// Vertices per parallel work item. Partial sums are combined in chunk order, so every result
 /// is bit-for-bit the same whatever the thread count (ties in parameter searches stay ties).
@@ -117,7 +116,7 @@ pub fn measure_vertices(
 /// [`Self::advance`] by runs of vertices. The result is the one-call pass's, bit for bit.
 #[derive(Clone, Debug)]
 pub struct MeasureInParts {
-    areas: Vec<TriangleArea>,
+    shapes: Vec<TriangleShape>,
     volume6: f64,
     /// One entry per chunk of vertices measured so far, added in chunk order at the end.
     partial: Vec<Sums>,
@@ -132,9 +131,9 @@ impl MeasureInParts {
     /// `positions` and `reference` must stay the same through [`Self::advance`].
     pub fn new(original: &Original, positions: &[[f32; 3]], reference: &[u32]) -> Self {
         let n = check_arrays(original, positions, Some(reference));
-        let (areas, volume6) = triangle_areas(positions, &original.mesh().triangles);
+        let (shapes, volume6) = triangle_shapes(positions, &original.mesh().triangles);
         Self {
-            areas,
+            shapes,
             volume6,
             partial: Vec::with_capacity(n.div_ceil(CHUNK)),
             vertex: VertexMeasures {
@@ -157,7 +156,7 @@ impl MeasureInParts {
             original,
             positions,
             reference: Some(reference),
-            areas: &self.areas,
+            shapes: &self.shapes,
         };
         let (done, total) = self.progress();
         let end = total.min(done + vertices.div_ceil(CHUNK).max(1));
@@ -337,12 +336,12 @@ pub(crate) fn measure_pass(
     reference: Option<&[u32]>,
 ) -> Sums {
     let n = check_arrays(original, positions, reference);
-    let (areas, volume6) = triangle_areas(positions, &original.mesh().triangles);
+    let (shapes, volume6) = triangle_shapes(positions, &original.mesh().triangles);
     let pass = Pass {
         original,
         positions,
         reference,
-        areas: &areas,
+        shapes: &shapes,
     };
     let partial: Vec<Sums> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
@@ -385,7 +384,7 @@ struct Pass<'a> {
     positions: &'a [[f32; 3]],
     /// Each vertex's drifted reference; `None`: no local error.
     reference: Option<&'a [u32]>,
-    areas: &'a [TriangleArea],
+    shapes: &'a [TriangleShape],
 }
 
 impl Pass<'_> {
@@ -400,35 +399,36 @@ impl Pass<'_> {
             if fan.is_empty() {
                 continue;
             }
-            let corners = self.original.fan_corners(i);
-            let f = fan_sums(
-                self.positions,
-                fan,
-                i as u32,
-                |k, _| (corners[k][0], corners[k][1]),
-                |_, t| self.areas[t as usize],
-            );
+            let codes = self.original.corner_codes(i).iter();
+            let c = VertexCurvature::of_fan(self.shapes, codes.map(|c| c.split()));
             let mut k_g = 0.0;
-            if !topology.is_boundary[i] && f.mixed_area > 0.0 {
-                let k = (2.0 * PI - f.angle_sum) / f.mixed_area;
-                // A fan of vanishing area has no meaningful curvature: leave it out, like no area.
-                if k.is_finite() {
+            if !topology.is_boundary[i] {
+                // A fan without area, or of vanishing area, has no meaningful curvature.
+                if let Some(k) = c.gaussian() {
                     k_g = k;
                     s.curvature_sum += k.abs();
                     s.curvature_count += 1;
                 }
             }
-            let Some(reference) = self.reference else {
-                continue;
-            };
-            let e = vertex_local_error(self.original, self.positions[i], reference[i] as usize);
-            s.error_sum += e;
-            s.error_max = s.error_max.max(e);
-            s.error_count += 1;
-            if let Some((error, curvature)) = out.as_mut() {
-                error[i - start] = e as f32;
+            if let Some((_, curvature)) = out.as_mut() {
                 curvature[i - start] = k_g as f32;
             }
+        }
+        if let Some(reference) = self.reference {
+            local_errors(
+                self.original,
+                self.positions,
+                reference,
+                start..end,
+                |i, e| {
+                    s.error_sum += e;
+                    s.error_max = s.error_max.max(e);
+                    s.error_count += 1;
+                    if let Some((error, _)) = out.as_mut() {
+                        error[i - start] = e as f32;
+                    }
+                },
+            );
         }
         s
     }
