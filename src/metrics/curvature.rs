@@ -108,7 +108,19 @@ pub(crate) fn triangle_shapes(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
 ) -> (Vec<TriangleShape>, f64) {
-    let mut shapes = vec![TriangleShape::default(); triangles.len()];
+    let mut shapes = Vec::new();
+    let volume6 = triangle_shapes_into(positions, triangles, &mut shapes);
+    (shapes, volume6)
+}
+
+/// [`triangle_shapes`] into `shapes` (resized to one per triangle), so a caller measuring again
+/// and again can keep the memory: returns six times the enclosed volume.
+pub(crate) fn triangle_shapes_into(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    shapes: &mut Vec<TriangleShape>,
+) -> f64 {
+    shapes.resize(triangles.len(), TriangleShape::default());
     // The volume's terms are taken about a point of the mesh, which keeps them small: on a
     // closed mesh, where the volume means something, the point does not change the sum.
     let origin = triangles
@@ -124,7 +136,7 @@ pub(crate) fn triangle_shapes(
                 .sum::<f64>()
         })
         .collect();
-    (shapes, partial.iter().sum())
+    partial.iter().sum()
 }
 
 /// The shapes of up to [`BLOCK`] triangles and their part of six times the volume. The corners

@@ -247,11 +247,19 @@ impl<'a> DriftingReference<'a> {
             .zip(self.anchors.par_chunks_mut(DRIFT_CHUNK))
             .zip(positions.par_chunks(DRIFT_CHUNK))
             .for_each(|((references, anchors), positions)| {
-                for ((r, a), q) in references.iter_mut().zip(anchors).zip(positions) {
-                    if distance2(*q, [a[0], a[1], a[2]]) <= a[3] {
-                        continue;
-                    }
-                    (*r, *a) = drift_step(original, *q, *r);
+                // First which vertices left their anchors, without a branch per vertex (whether
+                // one did is a coin toss while the mesh moves), then their rings.
+                let mut moved = [0u16; DRIFT_CHUNK];
+                let mut count = 0;
+                for (k, (a, q)) in anchors.iter().zip(positions).enumerate() {
+                    moved[count] = k as u16;
+                    // Written so that a NaN position counts as moved.
+                    let stays = distance2(*q, [a[0], a[1], a[2]]) <= a[3];
+                    count += usize::from(!stays);
+                }
+                for &k in &moved[..count] {
+                    let k = k as usize;
+                    (references[k], anchors[k]) = drift_step(original, positions[k], references[k]);
                 }
             });
     }

@@ -1,7 +1,7 @@
 //! One measure pass over a smoothed mesh and the report it yields: volume, curvature, local
 //! error and the score, plus per-vertex arrays for colour-coding.
 
-use super::curvature::{triangle_shapes, TriangleShape, VertexCurvature};
+use super::curvature::{triangle_shapes, triangle_shapes_into, TriangleShape, VertexCurvature};
 use super::exact_distance::TriangleBvh;
 use super::local_error::{local_errors, vertex_local_error};
 use super::score::ScoreTerms;
@@ -9,6 +9,7 @@ use super::Original;
 use crate::mesh::to_f64;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::cell::RefCell;
 
 /// Vertices per parallel work item. Partial sums are combined in chunk order, so every result
 /// is bit-for-bit the same whatever the thread count (ties in parameter searches stay ties).
@@ -335,8 +336,14 @@ pub(crate) fn measure_pass(
     positions: &[[f32; 3]],
     reference: Option<&[u32]>,
 ) -> Sums {
+    thread_local! {
+        /// The triangle shapes of the last pass on this thread: searches measure hundreds of
+        /// times, and fresh memory each time costs its page faults.
+        static SHAPES: RefCell<Vec<TriangleShape>> = const { RefCell::new(Vec::new()) };
+    }
     let n = check_arrays(original, positions, reference);
-    let (shapes, volume6) = triangle_shapes(positions, &original.mesh().triangles);
+    let mut shapes = SHAPES.take();
+    let volume6 = triangle_shapes_into(positions, &original.mesh().triangles, &mut shapes);
     let pass = Pass {
         original,
         positions,
@@ -347,6 +354,7 @@ pub(crate) fn measure_pass(
         .into_par_iter()
         .map(|c| pass.chunk(c * CHUNK, None))
         .collect();
+    SHAPES.set(shapes);
     total_of(volume6, &partial)
 }
 
