@@ -7,7 +7,8 @@
 //! - runs split into small segments (as the web app submits them between frames) give the
 //!   whole run's terms bit for bit;
 //! - grid and local searches suggest the same parameters as on the CPU on the small shared
-//!   meshes, for every filter.
+//!   meshes, for every filter, unless S is flat to within rounding there: then the GPU's
+//!   choice scores within 1e-6 of the CPU's minimum on the CPU too.
 //!
 //! Without an adapter these tests print a notice and pass, unless REQUIRE_GPU=1, where they fail.
 #![cfg(not(target_arch = "wasm32"))]
@@ -247,10 +248,27 @@ fn suggestions_equal_the_cpu_on_small_meshes() {
                     gpu.score,
                     gpu.evaluations
                 );
-                assert_eq!(gpu.params, cpu.params, "{name} {filter} {}", method.name());
-                // Where S is flat (the open scalp: S near 0.5 everywhere) f32 rounding may
-                // send the local search another way to the same minimum: the counts are printed.
-                assert_terms_close(&gpu.terms, &cpu.terms, &name);
+                if gpu.params == cpu.params {
+                    assert_terms_close(&gpu.terms, &cpu.terms, &name);
+                } else {
+                    // Where S is flat (the open scalp: S near 0.5 everywhere) the engines' f32
+                    // rounding may break a near-tie either way, or send the local search down
+                    // another path: the GPU's choice must then be, on the CPU too, within 1e-6
+                    // of the CPU's minimum.
+                    let mut cpu_ev = MeshEvaluator::new(&original, None).expect("no weights");
+                    let there = cpu_ev
+                        .measure(&gpu.params, &[gpu.params.iterations])
+                        .expect("the CPU answers")[0]
+                        .score(0.5);
+                    eprintln!("  the GPU's choice scores {there:.9} on the CPU");
+                    assert!(
+                        (there - cpu.score).abs() <= 1e-6 && (gpu.score - cpu.score).abs() <= 1e-6,
+                        "{name} {filter} {}: {} vs {}",
+                        method.name(),
+                        gpu.params.describe(),
+                        cpu.params.describe()
+                    );
+                }
             }
         }
     }
