@@ -272,7 +272,8 @@ fn prism_height_and_edge_fallback_on_a_flat_fan() {
     assert_eq!(v.local_error[7], 0.0);
     let sum: f64 = v.local_error.iter().map(|&e| e as f64).sum();
     assert!((m.mean_error - sum / 25.0).abs() < 1e-7);
-    assert!((m.max_error - 2f64.sqrt()).abs() < 1e-12);
+    // Local errors are worked out in f32: sqrt(2) to its f32 rounding.
+    assert!((m.max_error - 2f64.sqrt()).abs() < 1e-7);
 }
 
 #[test]

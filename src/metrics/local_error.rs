@@ -4,18 +4,14 @@
 //!
 //! It measures to part of the original mesh, so it is never below the exact distance to it.
 
-use super::exact_distance::{point_segment_distance2, SLIVER_SINE};
+use super::exact_distance::SLIVER_SINE;
+use super::prism_rows::ROW;
 use super::Original;
-use crate::mesh::{cross, dot, sub, to_f64};
 use crate::smooth::{smooth, Params, StepObserver};
 use rayon::prelude::*;
 
 /// Local errors of the vertices `vertices` whose fan on the original is not empty, in order, to
 /// `each(i, e)`; `reference` holds every vertex's reference.
-///
-/// The prism tests of a run of vertices go in blocks of (vertex, triangle) pairs, gathered into
-/// one array per coordinate so the processor tests several at a time; a vertex in no prism then
-/// takes the distance to its fan's edges. The same numbers as [`vertex_local_error`], bit for bit.
 pub(crate) fn local_errors(
     original: &Original,
     positions: &[[f32; 3]],
@@ -23,161 +19,158 @@ pub(crate) fn local_errors(
     vertices: std::ops::Range<usize>,
     mut each: impl FnMut(usize, f64),
 ) {
-    let original_positions = &original.mesh().positions;
     let topology = original.topology();
-    let start = vertices.start;
-    let mut best = vec![f64::INFINITY; vertices.len()];
-    let mut block = PrismBlock::default();
-    for i in vertices.clone() {
-        if topology.triangles_of(i).is_empty() {
-            continue;
+    for i in vertices {
+        if !topology.triangles_of(i).is_empty() {
+            each(
+                i,
+                vertex_local_error(original, positions[i], reference[i] as usize),
+            );
         }
-        let r = reference[i] as usize;
-        let pr = to_f64(original_positions[r]);
-        let d = sub(to_f64(positions[i]), pr);
-        for &[j, k] in original.fan_corners(r) {
-            let e1 = sub(to_f64(original_positions[j as usize]), pr);
-            let e2 = sub(to_f64(original_positions[k as usize]), pr);
-            if block.push((i - start) as u32, d, e1, e2) {
-                block.flush(&mut best);
-            }
-        }
-    }
-    block.flush(&mut best);
-    for (i, &best) in vertices.zip(&best) {
-        if topology.triangles_of(i).is_empty() {
-            continue;
-        }
-        let e = if best.is_finite() {
-            best
-        } else {
-            fan_edge_distance(original, positions[i], reference[i] as usize)
-        };
-        each(i, e);
-    }
-}
-
-/// Pairs of a vertex and a triangle of its reference's fan, one array per coordinate.
-struct PrismBlock {
-    len: usize,
-    /// The pair's vertex (its place in the run).
-    owner: [u32; PAIRS],
-    /// `d`, `e1`, `e2` of [`prism_height`], coordinate by coordinate.
-    v: [[f64; PAIRS]; 9],
-}
-
-/// Pairs per block.
-const PAIRS: usize = 32;
-
-impl Default for PrismBlock {
-    fn default() -> Self {
-        Self {
-            len: 0,
-            owner: [0; PAIRS],
-            v: [[0.0; PAIRS]; 9],
-        }
-    }
-}
-
-impl PrismBlock {
-    /// Adds a pair; returns whether the block is full.
-    #[inline]
-    fn push(&mut self, owner: u32, d: [f64; 3], e1: [f64; 3], e2: [f64; 3]) -> bool {
-        let l = self.len;
-        self.owner[l] = owner;
-        for k in 0..3 {
-            self.v[k][l] = d[k];
-            self.v[3 + k][l] = e1[k];
-            self.v[6 + k][l] = e2[k];
-        }
-        self.len += 1;
-        self.len == PAIRS
-    }
-
-    /// Tests every pair and lowers its vertex's `best` height; empties the block. Lanes past
-    /// the last pair test zeros, which have no prism, and are dropped.
-    fn flush(&mut self, best: &mut [f64]) {
-        let mut height = [f64::INFINITY; PAIRS];
-        let v = &self.v;
-        for (l, h) in height.iter_mut().enumerate() {
-            let d = [v[0][l], v[1][l], v[2][l]];
-            let e1 = [v[3][l], v[4][l], v[5][l]];
-            let e2 = [v[6][l], v[7][l], v[8][l]];
-            *h = prism_height(e1, e2, d);
-        }
-        for (&owner, &h) in self.owner[..self.len].iter().zip(&height) {
-            let b = &mut best[owner as usize];
-            *b = b.min(h);
-        }
-        self.len = 0;
     }
 }
 
 /// Local error of a smoothed vertex at `q` whose reference vertex on the original mesh is `r`:
-/// the smallest prism height over the triangles around `r`, else the distance to the fan's edges
-/// (see [`fan_edge_distance`]). One vertex at a time: [`local_errors`] is the fast way.
+/// the smallest prism height over the triangles around `r`, else the distance to the fan's
+/// edges (spokes from `r` and the rim opposite it), which cover its vertices.
+///
+/// All in f32 on edges taken from `r`, so the rounding is a few ulps of the distances
+/// themselves, far below that of the f32 positions at their coordinates. A fan with a rim row
+/// is one fixed loop of [`ROW`] pairs, which the processor runs as vectors.
+// A call per vertex: inlined into the loop over the vertices, the same code ran half as fast.
+#[inline(never)]
 pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> f64 {
     let positions = &original.mesh().positions;
-    let pr = to_f64(positions[r]);
-    let d = sub(to_f64(q), pr);
-    let mut best = f64::INFINITY;
-    for &[j, k] in original.fan_corners(r) {
-        let e1 = sub(to_f64(positions[j as usize]), pr);
-        let e2 = sub(to_f64(positions[k as usize]), pr);
-        best = best.min(prism_height(e1, e2, d));
+    let pr = positions[r];
+    let d = sub32(q, pr);
+    let Some(row) = original.prism_row(r) else {
+        return fan_local_error(original, r, d);
+    };
+    // Coordinate by coordinate, slot by slot: the first edges, and the second (the next slot's).
+    let mut e1 = [[0.0f32; ROW]; 3];
+    for (t, &j) in row.iter().enumerate() {
+        let p = positions[j as usize];
+        for c in 0..3 {
+            e1[c][t] = p[c] - pr[c];
+        }
     }
-    if best.is_finite() {
-        return best;
+    let e2 = e1.map(|e| std::array::from_fn::<f32, ROW, _>(|t| e[(t + 1) % ROW]));
+    let lane = |e: &[[f32; ROW]; 3], t: usize| [e[0][t], e[1][t], e[2][t]];
+    let height2: [f32; ROW] = std::array::from_fn(|t| prism_height2(lane(&e1, t), lane(&e2, t), d));
+    let mut best2 = smallest(height2);
+    if !best2.is_finite() {
+        // In no prism. Pads name `r` itself, so their segments are spokes or the point `r`.
+        let edge2: [f32; ROW] = std::array::from_fn(|t| {
+            let (a, b) = (lane(&e1, t), lane(&e2, t));
+            min(
+                segment_distance2([0.0; 3], a, d),
+                segment_distance2(a, b, d),
+            )
+        });
+        best2 = min(smallest(edge2), dot32(d, d));
     }
-    fan_edge_distance(original, q, r)
+    f64::from(best2.sqrt())
 }
 
-/// The distance from `q` to the edges of the fan around `r` (spokes from `r` and the rim
-/// opposite it), which covers its vertices; just to `r` for a vertex no triangle uses.
+/// [`vertex_local_error`] for a fan without a rim row, from its lists of corners and neighbours.
 #[cold]
-fn fan_edge_distance(original: &Original, q: [f32; 3], r: usize) -> f64 {
+fn fan_local_error(original: &Original, r: usize, d: [f32; 3]) -> f64 {
     let positions = &original.mesh().positions;
-    let q = to_f64(q);
-    let pr = to_f64(positions[r]);
-    let d = sub(q, pr);
-    let mut best2 = dot(d, d);
-    for &j in original.topology().neighbors_of(r) {
-        best2 = best2.min(point_segment_distance2(
-            q,
-            pr,
-            to_f64(positions[j as usize]),
-        ));
+    let pr = positions[r];
+    let edge = |j: u32| sub32(positions[j as usize], pr);
+    let fan = original.fan_corners(r);
+    let mut best2 = fan
+        .iter()
+        .map(|&[j, k]| prism_height2(edge(j), edge(k), d))
+        .fold(f32::INFINITY, f32::min);
+    if !best2.is_finite() {
+        best2 = dot32(d, d);
+        for &j in original.topology().neighbors_of(r) {
+            best2 = best2.min(segment_distance2([0.0; 3], edge(j), d));
+        }
+        for &[j, k] in fan {
+            best2 = best2.min(segment_distance2(edge(j), edge(k), d));
+        }
     }
-    for &[j, k] in original.fan_corners(r) {
-        best2 = best2.min(point_segment_distance2(
-            q,
-            to_f64(positions[j as usize]),
-            to_f64(positions[k as usize]),
-        ));
+    f64::from(best2.sqrt())
+}
+
+/// The smallest of `values`, which hold no NaN: a plain select, which the processor's minimum
+/// instruction does (`f32::min` must also look for NaNs).
+#[inline(always)]
+fn smallest(values: [f32; ROW]) -> f32 {
+    values.into_iter().fold(f32::INFINITY, min)
+}
+
+/// `a` or `b`, whichever is smaller, for values that hold no NaN.
+#[inline(always)]
+fn min(a: f32, b: f32) -> f32 {
+    if b < a {
+        b
+    } else {
+        a
     }
-    best2.sqrt()
+}
+
+/// The squared distance from `p` to the segment from `a` to `b` (a point if they meet).
+#[inline(always)]
+fn segment_distance2(a: [f32; 3], b: [f32; 3], p: [f32; 3]) -> f32 {
+    let ab = sub32(b, a);
+    let ap = sub32(p, a);
+    let length2 = dot32(ab, ab);
+    // Written so that a NaN (a segment of length 0) comes out as 0.
+    let along = dot32(ap, ab) / length2;
+    let along = if along > 0.0 { along } else { 0.0 };
+    let along = if along < 1.0 { along } else { 1.0 };
+    let x = [
+        ap[0] - along * ab[0],
+        ap[1] - along * ab[1],
+        ap[2] - along * ab[2],
+    ];
+    dot32(x, x)
 }
 
 /// The paper's prism test, `(a, b, c) = P^-1 d` with `P = [e1 e2 n]`, `e1`, `e2` the triangle's
 /// edges from the reference vertex and `d = q - p_r`. By Cramer's rule with `m = e1 x e2`
 /// (`n = m / |m|`): `a = (d x e2).m / |m|^2`, `b = (e1 x d).m / |m|^2`, `c = d.m / |m|`, so the
-/// inside test needs no division. Returns `|c|` when `a, b >= 0` and `a + b <= 1`, else
+/// inside test needs no division. Returns `c^2` when `a, b >= 0` and `a + b <= 1`, else
 /// infinity. A degenerate or sliver triangle (`P` not safely invertible) has no prism; its edges
-/// still count. Selects rather than branches, so a block of pairs runs as vectors.
-#[inline]
-fn prism_height(e1: [f64; 3], e2: [f64; 3], d: [f64; 3]) -> f64 {
-    let m = cross(e1, e2);
-    let m2 = dot(m, m);
-    let a = dot(cross(d, e2), m);
-    let b = dot(cross(e1, d), m);
+/// still count. Selects rather than branches, so a row of pairs runs as vectors.
+#[inline(always)]
+fn prism_height2(e1: [f32; 3], e2: [f32; 3], d: [f32; 3]) -> f32 {
+    let m = cross32(e1, e2);
+    let m2 = dot32(m, m);
+    let a = dot32(cross32(d, e2), m);
+    let b = dot32(cross32(e1, d), m);
     let inside = (a >= 0.0) & (b >= 0.0) & (a + b <= m2);
-    let solid = m2 > SLIVER_SINE * SLIVER_SINE * dot(e1, e1) * dot(e2, e2);
-    let h = dot(d, m).abs() / m2.sqrt();
+    const SLIVER2: f32 = (SLIVER_SINE * SLIVER_SINE) as f32;
+    let solid = m2 > SLIVER2 * dot32(e1, e1) * dot32(e2, e2);
+    let c = dot32(d, m);
+    let h2 = c * (c / m2);
     if inside & solid {
-        h
+        h2
     } else {
-        f64::INFINITY
+        f32::INFINITY
     }
+}
+
+#[inline(always)]
+fn sub32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+fn cross32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline(always)]
+fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Vertices per parallel task of a drift step.
@@ -350,4 +343,81 @@ pub fn smooth_drifting(
 /// `0, 1, ..., n - 1`: every vertex its own reference (nothing has drifted).
 pub fn identity(n: usize) -> Vec<u32> {
     (0..n as u32).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::fixtures::{grid, tetrahedron};
+    use crate::mesh::{Mesh, Topology};
+
+    /// A closed double cone: two apexes of `k` triangles each around a wavy rim.
+    fn double_cone(k: u32) -> Mesh {
+        let mut positions = vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.3]];
+        for j in 0..k {
+            let a = j as f32 * std::f32::consts::TAU / k as f32;
+            positions.push([a.cos(), a.sin(), 0.1 * (j % 3) as f32]);
+        }
+        let rim = |j: u32| 2 + j % k;
+        let triangles = (0..k)
+            .flat_map(|j| [[0, rim(j), rim(j + 1)], [1, rim(j + 1), rim(j)]])
+            .collect();
+        Mesh::new(positions, triangles)
+    }
+
+    /// Points near and far from `p`: inside some prisms, and in none.
+    fn around(p: [f32; 3]) -> impl Iterator<Item = [f32; 3]> {
+        let offsets = [
+            [0.0, 0.0, 0.0],
+            [0.05, 0.02, 0.3],
+            [0.2, -0.1, -0.25],
+            [-0.3, 0.35, 0.1],
+            [0.6, 0.1, -0.05],
+            [2.0, 1.0, 0.5],
+            [-1.5, 0.2, -2.0],
+            [0.0, 0.0, 3.0],
+        ];
+        offsets
+            .into_iter()
+            .map(move |o| [p[0] + o[0], p[1] + o[1], p[2] + o[2]])
+    }
+
+    #[test]
+    fn rim_rows_measure_what_the_lists_of_corners_do() {
+        for (mesh, rowless) in [(tetrahedron(), 0), (grid(5, 4), 0), (double_cone(10), 2)] {
+            let topology = Topology::build(&mesh);
+            let original = Original::new(&mesh, &topology);
+            let mut without = 0;
+            for (r, &p) in mesh.positions.iter().enumerate() {
+                if original.prism_row(r).is_none() {
+                    without += 1;
+                    continue;
+                }
+                for q in around(p) {
+                    let by_row = vertex_local_error(&original, q, r);
+                    let by_list = fan_local_error(&original, r, sub32(q, p));
+                    // Prism heights are the same numbers; an edge may be walked the other way.
+                    assert!(
+                        (by_row - by_list).abs() <= 1e-6 * by_list.max(1.0),
+                        "vertex {r} at {q:?}: {by_row} by its row, {by_list} by its list"
+                    );
+                }
+            }
+            assert_eq!(without, rowless, "vertices read from their list of corners");
+        }
+    }
+
+    #[test]
+    fn the_error_is_the_distance_to_the_nearest_part_of_the_fan() {
+        // The tetrahedron's corner 0 at the origin; its fan: the faces x = 0, y = 0 and z = 0.
+        let mesh = tetrahedron();
+        let topology = Topology::build(&mesh);
+        let original = Original::new(&mesh, &topology);
+        // Over all three faces (inside each prism): the height over the nearest, x = 0.
+        let e = vertex_local_error(&original, [0.2, 0.3, 0.25], 0);
+        assert!((e - 0.2).abs() < 1e-7, "{e}");
+        // Off every prism, beyond corner 1: the distance to corner 1, the fan's nearest point.
+        let e = vertex_local_error(&original, [2.0, -0.5, -0.5], 0);
+        assert!((e - 1.5f64.sqrt()).abs() < 1e-7, "{e}");
+    }
 }

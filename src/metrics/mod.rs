@@ -10,6 +10,7 @@ mod curvature;
 mod exact_distance;
 mod local_error;
 mod original;
+mod prism_rows;
 mod report;
 mod score;
 mod sinc_drifting;

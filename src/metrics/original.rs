@@ -2,6 +2,7 @@
 //! over a smoothed mesh only reads what stays fixed.
 
 use super::curvature::{fan_corners, CornerCode};
+use super::prism_rows::PrismRows;
 use super::report::MeasureInParts;
 use crate::mesh::{Mesh, Topology};
 
@@ -17,6 +18,8 @@ pub struct Original {
     /// Each vertex->triangle incidence as the triangle's corner (parallel to
     /// `vertex_triangles`).
     corner_codes: Vec<CornerCode>,
+    /// Each vertex's fan as one row of its rim, where it fits (the local error's fast path).
+    prism_rows: PrismRows,
     /// Per vertex, the square of 0.49 times its shortest edge: a point that near the vertex is
     /// nearer to it than to any neighbour (each is at least 0.51 edge away), so the drift can
     /// skip the ring. The margin keeps the shortcut exact in f32.
@@ -48,6 +51,7 @@ impl Original {
         Self {
             fan_corners: Vec::new(),
             corner_codes: Vec::new(),
+            prism_rows: PrismRows::default(),
             stay_radius2: Vec::new(),
             mesh,
             topology,
@@ -95,6 +99,12 @@ impl Original {
         &self.corner_codes[o[i] as usize..o[i + 1] as usize]
     }
 
+    /// The rim row of vertex `i`'s fan, where it has one.
+    #[inline(always)]
+    pub(crate) fn prism_row(&self, i: usize) -> Option<&[u32; super::prism_rows::ROW]> {
+        self.prism_rows.row(i)
+    }
+
     /// [`Self::fan_corners`] of every vertex, in vertex order (parallel to the topology's
     /// `vertex_triangles`): what the GPU engine uploads.
     pub(crate) fn all_fan_corners(&self) -> &[[u32; 2]] {
@@ -137,7 +147,7 @@ fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
 
 /// [`Original::new`] spread over calls, for a caller that must return between them (the
 /// browser's one thread opening a large mesh). Each [`Self::advance`] does one step: the fan
-/// corners, the drift's stay radii, the triangle areas, then the measure pass of the original
+/// corners, their rim rows, the drift's stay radii, the triangle areas, then the measure pass of the original
 /// ([`MeasureInParts`], every vertex its own reference) a run of vertices per call. The result
 /// is [`Original::new`]'s, bit for bit.
 pub struct OriginalInParts {
@@ -148,8 +158,8 @@ pub struct OriginalInParts {
     pass: Option<MeasureInParts>,
 }
 
-/// The fan corners, the stay radii and the triangle areas.
-const PREPARATION_STEPS: usize = 3;
+/// The fan corners, their rim rows, the stay radii and the triangle areas.
+const PREPARATION_STEPS: usize = 4;
 
 impl OriginalInParts {
     /// `topology` must be `Topology::build(&mesh)`. Nothing is computed yet.
@@ -168,8 +178,9 @@ impl OriginalInParts {
         let o = &mut self.original;
         match self.prepared {
             0 => (o.fan_corners, o.corner_codes) = fan_corners(&o.mesh.triangles, &o.topology),
-            1 => o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology),
-            2 => {
+            1 => o.prism_rows = PrismRows::new(o.mesh.vertex_count(), |r| o.fan_corners(r)),
+            2 => o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology),
+            3 => {
                 self.reference = super::identity(o.mesh.vertex_count());
                 self.pass = Some(MeasureInParts::new(o, &o.mesh.positions, &self.reference));
             }
