@@ -20,18 +20,33 @@ pub(crate) fn local_errors(
     mut each: impl FnMut(usize, f64),
 ) {
     let topology = original.topology();
-    for i in vertices {
-        if !topology.triangles_of(i).is_empty() {
-            each(
-                i,
-                vertex_local_error(original, positions[i], reference[i] as usize),
-            );
+    // A run of squared errors first, then their roots: the root's latency at the end of every
+    // vertex would otherwise hold up the next one.
+    const RUN: usize = 64;
+    let mut squared = [0.0f32; RUN];
+    let mut start = vertices.start;
+    while start < vertices.end {
+        let run = start..(start + RUN).min(vertices.end);
+        for (i, s) in run.clone().zip(&mut squared) {
+            *s = vertex_local_error2(original, positions[i], reference[i] as usize);
         }
+        for (i, &s) in run.clone().zip(&squared) {
+            if !topology.triangles_of(i).is_empty() {
+                each(i, f64::from(s.sqrt()));
+            }
+        }
+        start = run.end;
     }
 }
 
-/// Local error of a smoothed vertex at `q` whose reference vertex on the original mesh is `r`:
-/// the smallest prism height over the triangles around `r`, else the distance to the fan's
+/// Local error of a smoothed vertex at `q` whose reference vertex on the original mesh is `r`
+/// (see [`vertex_local_error2`]).
+pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> f64 {
+    f64::from(vertex_local_error2(original, q, r).sqrt())
+}
+
+/// The square of the local error of a smoothed vertex at `q` whose reference vertex on the
+/// original mesh is `r`: the smallest prism height over the triangles around `r`, else the distance to the fan's
 /// edges (spokes from `r` and the rim opposite it), which cover its vertices.
 ///
 /// All in f32 on edges taken from `r`, so the rounding is a few ulps of the distances
@@ -39,12 +54,12 @@ pub(crate) fn local_errors(
 /// is one fixed loop of [`ROW`] pairs, which the processor runs as vectors.
 // A call per vertex: inlined into the loop over the vertices, the same code ran half as fast.
 #[inline(never)]
-pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> f64 {
+fn vertex_local_error2(original: &Original, q: [f32; 3], r: usize) -> f32 {
     let positions = &original.mesh().positions;
     let pr = positions[r];
     let d = sub32(q, pr);
     let Some(row) = original.prism_row(r) else {
-        return fan_local_error(original, r, d);
+        return fan_local_error2(original, r, d);
     };
     // Coordinate by coordinate, slot by slot: the first edges, and the second (the next slot's).
     let mut e1 = [[0.0f32; ROW]; 3];
@@ -69,12 +84,13 @@ pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> 
         });
         best2 = min(smallest(edge2), dot32(d, d));
     }
-    f64::from(best2.sqrt())
+    best2
 }
 
-/// [`vertex_local_error`] for a fan without a rim row, from its lists of corners and neighbours.
+/// [`vertex_local_error2`] for a fan without a rim row, from its lists of corners and
+/// neighbours.
 #[cold]
-fn fan_local_error(original: &Original, r: usize, d: [f32; 3]) -> f64 {
+fn fan_local_error2(original: &Original, r: usize, d: [f32; 3]) -> f32 {
     let positions = &original.mesh().positions;
     let pr = positions[r];
     let edge = |j: u32| sub32(positions[j as usize], pr);
@@ -92,14 +108,16 @@ fn fan_local_error(original: &Original, r: usize, d: [f32; 3]) -> f64 {
             best2 = best2.min(segment_distance2(edge(j), edge(k), d));
         }
     }
-    f64::from(best2.sqrt())
+    best2
 }
 
-/// The smallest of `values`, which hold no NaN: a plain select, which the processor's minimum
-/// instruction does (`f32::min` must also look for NaNs).
+/// The smallest of `values`, which hold no NaN, by halves (a short chain of the processor's
+/// minimum instruction; `f32::min` must also look for NaNs).
 #[inline(always)]
 fn smallest(values: [f32; ROW]) -> f32 {
-    values.into_iter().fold(f32::INFINITY, min)
+    const { assert!(ROW == 8, "halves of four") };
+    let half: [f32; 4] = std::array::from_fn(|k| min(values[k], values[k + 4]));
+    min(min(half[0], half[2]), min(half[1], half[3]))
 }
 
 /// `a` or `b`, whichever is smaller, for values that hold no NaN.
@@ -395,7 +413,7 @@ mod tests {
                 }
                 for q in around(p) {
                     let by_row = vertex_local_error(&original, q, r);
-                    let by_list = fan_local_error(&original, r, sub32(q, p));
+                    let by_list = f64::from(fan_local_error2(&original, r, sub32(q, p)).sqrt());
                     // Prism heights are the same numbers; an edge may be walked the other way.
                     assert!(
                         (by_row - by_list).abs() <= 1e-6 * by_list.max(1.0),
