@@ -167,6 +167,22 @@ pub(crate) mod fixtures {
         }
         Mesh::new(positions, triangles)
     }
+
+    /// A closed double cone: two apexes with `k` neighbours each around a wavy rim of `k`
+    /// vertices (valence 4 each), and an isolated vertex.
+    pub(crate) fn double_cone(k: u32) -> Mesh {
+        let mut positions = vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.3]];
+        for j in 0..k {
+            let a = j as f32 * std::f32::consts::TAU / k as f32;
+            positions.push([a.cos(), a.sin(), 0.1 * (j % 3) as f32]);
+        }
+        positions.push([5.0, 5.0, 5.0]);
+        let rim = |j: u32| 2 + j % k;
+        let triangles = (0..k)
+            .flat_map(|j| [[0, rim(j), rim(j + 1)], [1, rim(j + 1), rim(j)]])
+            .collect();
+        Mesh::new(positions, triangles)
+    }
 }
 
 #[cfg(test)]

@@ -180,23 +180,7 @@ pub(crate) fn xyz0(v: [f32; 3]) -> [f32; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Mesh;
-
-    /// A closed double cone: two apexes with `k` neighbours each around a rim of `k` vertices
-    /// (valence 4 each), and an isolated vertex.
-    fn double_cone(k: u32) -> Mesh {
-        let mut positions = vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.3]];
-        for j in 0..k {
-            let a = j as f32 * std::f32::consts::TAU / k as f32;
-            positions.push([a.cos(), a.sin(), 0.1 * (j % 3) as f32]);
-        }
-        positions.push([5.0, 5.0, 5.0]);
-        let rim = |j: u32| 2 + j % k;
-        let triangles = (0..k)
-            .flat_map(|j| [[0, rim(j), rim(j + 1)], [1, rim(j + 1), rim(j)]])
-            .collect();
-        Mesh::new(positions, triangles)
-    }
+    use crate::mesh::fixtures::double_cone;
 
     #[test]
     fn means_over_rows_and_larger_rings_equal_the_plain_mean() {
