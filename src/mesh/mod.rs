@@ -125,6 +125,28 @@ pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+/// [`sub`] in f32, for the measure pass's vector kernels.
+#[inline(always)]
+pub(crate) fn sub32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// [`cross`] in f32.
+#[inline(always)]
+pub(crate) fn cross32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// [`dot`] in f32.
+#[inline(always)]
+pub(crate) fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 /// Meshes the unit tests of several modules share.
 #[cfg(test)]
 pub(crate) mod fixtures {

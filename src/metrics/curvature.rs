@@ -5,7 +5,7 @@
 //! the mixed areas (and the volume), in blocks the processor takes several triangles at a time;
 //! one over the vertices adds up the parts of each vertex's fan.
 
-use crate::mesh::{by_blocks, Topology};
+use crate::mesh::{by_blocks, cross32, dot32, sub32, Topology};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -163,12 +163,12 @@ fn shape_block(
     for l in 0..BLOCK {
         let corner = |c: usize| [p[c][0][l], p[c][1][l], p[c][2][l]];
         let (a, b, c) = (corner(0), corner(1), corner(2));
-        let (ab, ac, bc) = (sub(b, a), sub(c, a), sub(c, b));
-        let m = cross(ab, ac);
-        let twice = dot(m, m).sqrt();
+        let (ab, ac, bc) = (sub32(b, a), sub32(c, a), sub32(c, b));
+        let m = cross32(ab, ac);
+        let twice = dot32(m, m).sqrt();
         // The dot product of the two edges leaving each corner: negative where it is obtuse.
-        let dots = [dot(ab, ac), -dot(ab, bc), dot(ac, bc)];
-        let lengths2 = [dot(bc, bc), dot(ac, ac), dot(ab, ab)];
+        let dots = [dot32(ab, ac), -dot32(ab, bc), dot32(ac, bc)];
+        let lengths2 = [dot32(bc, bc), dot32(ac, ac), dot32(ab, ab)];
         angles[0][l] = angle(dots[0], twice);
         angles[1][l] = angle(dots[1], twice);
         // Without area, each angle is 0 or pi by the sign of its dot product.
@@ -201,7 +201,7 @@ fn shape_block(
         }
         // Edges are differences of nearby coordinates, exact in f32; the volume's terms, taken
         // about the origin point, are only as good as f32's rounding of the shifted corner.
-        volume6[l] = dot(sub(a, origin), m);
+        volume6[l] = dot32(sub32(a, origin), m);
     }
     for (lane, o) in out.iter_mut().enumerate() {
         *o = TriangleShape {
@@ -210,25 +210,6 @@ fn shape_block(
         };
     }
     volume6[..tris.len()].iter().map(|&v| v as f64).sum()
-}
-
-#[inline]
-fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-#[inline]
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// `atan2(y, x)` for `y >= 0`, in `[0, pi]`, within 3e-7 (f32 steps are 2.4e-7 near pi): the arctangent of the smaller of

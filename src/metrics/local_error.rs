@@ -7,6 +7,7 @@
 use super::exact_distance::SLIVER_SINE;
 use super::prism_rows::ROW;
 use super::Original;
+use crate::mesh::{cross32, dot32, sub32};
 use crate::smooth::{smooth, Params, StepObserver};
 use rayon::prelude::*;
 
@@ -172,25 +173,6 @@ fn prism_height2(e1: [f32; 3], e2: [f32; 3], d: [f32; 3]) -> f32 {
     } else {
         f32::INFINITY
     }
-}
-
-#[inline(always)]
-fn sub32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline(always)]
-fn cross32(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-#[inline(always)]
-fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Vertices per parallel task of a drift step.

@@ -147,9 +147,9 @@ fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
 
 /// [`Original::new`] spread over calls, for a caller that must return between them (the
 /// browser's one thread opening a large mesh). Each [`Self::advance`] does one step: the fan
-/// corners, their rim rows, the drift's stay radii, the triangle areas, then the measure pass of the original
-/// ([`MeasureInParts`], every vertex its own reference) a run of vertices per call. The result
-/// is [`Original::new`]'s, bit for bit.
+/// corners, their rim rows, the drift's stay radii, the triangle shapes, then the measure pass
+/// of the original ([`MeasureInParts`], every vertex its own reference) a run of vertices per
+/// call. The result is [`Original::new`]'s, bit for bit.
 pub struct OriginalInParts {
     original: Original,
     /// Precomputation steps done, of [`PREPARATION_STEPS`].
@@ -158,7 +158,7 @@ pub struct OriginalInParts {
     pass: Option<MeasureInParts>,
 }
 
-/// The fan corners, their rim rows, the stay radii and the triangle areas.
+/// The fan corners, their rim rows, the stay radii and the triangle shapes.
 const PREPARATION_STEPS: usize = 4;
 
 impl OriginalInParts {
