@@ -302,6 +302,11 @@ impl Shell {
                     .set_open(open, &mut self.doc.borrow_mut().session);
             }
             Action::ToggleBrush => self.brush.active = !self.brush.active,
+            Action::CancelBackground => {
+                let session = &mut self.doc.borrow_mut().session;
+                session.cancel_suggest();
+                session.cancel_gallery();
+            }
         }
     }
 

@@ -16,9 +16,10 @@ pub enum Action {
     ApplySuggestion,
     ToggleGraphs,
     ToggleBrush,
+    CancelBackground,
 }
 
-const KEYS: [(egui::Key, Action, &str); 14] = [
+const KEYS: [(egui::Key, Action, &str); 15] = [
     (egui::Key::O, Action::Open, "Open a mesh file"),
     (egui::Key::W, Action::ToggleWireframe, "Wireframe on/off"),
     (
@@ -55,6 +56,11 @@ const KEYS: [(egui::Key, Action, &str); 14] = [
         egui::Key::P,
         Action::ToggleBrush,
         "Weight brush on/off (paint where smoothing may act)",
+    ),
+    (
+        egui::Key::Escape,
+        Action::CancelBackground,
+        "Cancel the suggestion or gallery under way",
     ),
     (egui::Key::H, Action::ToggleHelp, "This help"),
 ];

@@ -24,6 +24,7 @@
 //! `readback` and `measures` (results back); natively also `device` (adapter choice) and
 //! `bench`.
 
+mod adapter;
 mod error;
 mod evaluator;
 mod layout;
@@ -43,6 +44,7 @@ mod bench;
 #[cfg(not(target_arch = "wasm32"))]
 mod device;
 
+pub use adapter::is_software_adapter;
 pub use error::GpuError;
 pub use evaluator::GpuEvaluator;
 pub use layout::WORKGROUP_SIZE;
