@@ -85,8 +85,9 @@ impl Shell {
         let gpu = cc.wgpu_render_state.as_ref().and_then(|rs| {
             let info = rs.adapter.get_info();
             log::info!("adapter: {} ({:?})", info.name, info.backend);
+            let software = crate::gpu::is_software_adapter(&info);
             (info.backend == wgpu::Backend::BrowserWebGpu)
-                .then(|| GpuEngine::new(&rs.device, &rs.queue))
+                .then(|| GpuEngine::new(&rs.device, &rs.queue, software))
         });
         let backend = if gpu.is_some() {
             Backend::WebGpu
