@@ -1,16 +1,15 @@
 //! What kind of adapter a device came from, where that changes how to use it.
 
-/// Whether `info` describes a software rasteriser (SwiftShader, llvmpipe, lavapipe, WARP): the
-/// CPU runs every fragment and every sample of it, so the view draws without multisampling
-/// there. The browser reports a software adapter as its fallback adapter (mapped to
-/// [`wgpu::DeviceType::Cpu`]) or only by name.
+/// Whether `info` describes a software rasteriser (SwiftShader, llvmpipe, lavapipe, WARP), where
+/// the CPU runs every shader: the app draws without multisampling there and keeps its
+/// background work on its own CPU engine. The browser reports one as its fallback adapter
+/// (mapped to [`wgpu::DeviceType::Cpu`]) or only by name.
 pub fn is_software_adapter(info: &wgpu::AdapterInfo) -> bool {
-    const NAMES: [&str; 5] = [
+    const NAMES: [&str; 4] = [
         "swiftshader",
         "llvmpipe",
         "lavapipe",
         "microsoft basic render",
-        "warp",
     ];
     let name = info.name.to_lowercase();
     info.device_type == wgpu::DeviceType::Cpu || NAMES.iter().any(|n| name.contains(n))
