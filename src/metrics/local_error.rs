@@ -210,7 +210,8 @@ impl<'a> DriftingReference<'a> {
             "one reference per vertex"
         );
         let anchors = reference
-            .iter()
+            .par_iter()
+            .with_min_len(DRIFT_CHUNK)
             .map(|&r| home_anchor(original, r as usize))
             .collect();
         Self {

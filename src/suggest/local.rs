@@ -14,9 +14,9 @@ use std::collections::VecDeque;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Phase {
-    /// Start the next search (or finish).
+    /// Start the next search (or finish): queue its start and the start's neighbours.
     Start,
-    /// The centre is measured: queue its neighbours.
+    /// The search moved to a measured centre: queue its neighbours.
     AtCentre,
     /// The neighbours are measured: move or stop.
     Decide,
@@ -71,10 +71,14 @@ impl LocalSearch {
             match self.phase {
                 Phase::Start => match self.starts.get(self.paths.len()) {
                     Some(&start) => {
+                        // The start and its neighbours at once: those of the same weights
+                        // then share one run instead of a run each.
                         self.centre = start;
                         self.paths.push(vec![start]);
-                        self.queue(&[start]);
-                        self.phase = Phase::AtCentre;
+                        let mut points = vec![start];
+                        points.extend(self.space.neighbours(&self.base, start));
+                        self.queue(&points);
+                        self.phase = Phase::Decide;
                     }
                     None => self.phase = Phase::Done,
                 },
@@ -272,6 +276,39 @@ mod tests {
         let best = g.best(0.5).unwrap();
         assert_eq!(space.point_of(&best.params), Some(global));
         assert!(out.suggestion.score > best.score);
+    }
+
+    #[test]
+    fn a_start_shares_its_run_with_its_neighbours() {
+        // HC's last search starts with every weight at its lowest and iterations at the most;
+        // the minimum lies at the first search's start, so nothing before has measured those
+        // weights. Their first run measures iterations 45 and 50 together.
+        struct Requests(Vec<(Params, Vec<u32>)>);
+        impl Evaluator for Requests {
+            fn measure(&mut self, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+                self.0.push((*params, at.to_vec()));
+                let space = ParamSpace::of(Filter::Hc);
+                let mut f = bowl(&space, GridPoint([10, 0, 0]));
+                Some(
+                    at.iter()
+                        .map(|&k| {
+                            f(&Params {
+                                iterations: k,
+                                ..*params
+                            })
+                        })
+                        .collect(),
+                )
+            }
+        }
+        let mut ev = Requests(Vec::new());
+        let out = local(Filter::Hc, 0.5, &mut ev);
+        assert_eq!(out.paths[2][0], GridPoint([0, 0, 10]));
+        let corner =
+            ev.0.iter()
+                .find(|(p, _)| p.alpha == 0.0 && p.beta == 0.0)
+                .map(|(_, at)| at);
+        assert_eq!(corner, Some(&vec![45, 50]));
     }
 
     #[test]
