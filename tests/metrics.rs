@@ -329,6 +329,38 @@ fn drift_follows_its_definition() {
 }
 
 #[test]
+fn the_drift_inside_the_passes_follows_its_definition() {
+    use observers::PlainDrift;
+    use smooth::StepObserver;
+    /// Runs the plain definition on the positions of every step.
+    struct Plain<'a>(PlainDrift<'a>);
+    impl StepObserver for Plain<'_> {
+        fn after_step(&mut self, positions: &[[f32; 3]]) {
+            self.0.update(positions);
+        }
+    }
+    let (mesh, topology) = data::load("synthetic/synthetic_bent_tube_r3.5.ply");
+    let o = Original::new(&mesh, &topology);
+    let n = mesh.vertex_count();
+    for filter in Filter::ALL {
+        let mut params = Params::defaults(filter);
+        params.iterations = 30;
+        let mut plain = Plain(PlainDrift {
+            mesh: &mesh,
+            topology: &topology,
+            reference: identity(n),
+        });
+        let positions = smooth::smooth(&mesh, &topology, &params, None, &mut plain);
+        let (fused_positions, fused) = meshsmooth::metrics::smooth_drifting(&o, &params, None);
+        assert_eq!(fused_positions, positions, "{filter}");
+        let differ = (0..n).filter(|&i| fused[i] != plain.0.reference[i]).count();
+        assert_eq!(differ, 0, "{filter}: references that differ");
+        let moved = (0..n).filter(|&i| fused[i] != i as u32).count();
+        assert!(moved > 0, "{filter}: no reference drifted");
+    }
+}
+
+#[test]
 fn degenerate_triangles_give_no_nan() {
     // A strip whose triangles include a collapsed one (two corners at the same point), a
     // zero-area one (three collinear corners) and one naming a vertex twice.

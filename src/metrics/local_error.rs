@@ -8,7 +8,7 @@ use super::exact_distance::SLIVER_SINE;
 use super::prism_rows::ROW;
 use super::Original;
 use crate::mesh::{cross32, dot32, sub32};
-use crate::smooth::{smooth, Params, StepObserver};
+use crate::smooth::{smooth, FollowPart, Follower, Params, StepObserver};
 use rayon::prelude::*;
 
 /// Local errors of the vertices `vertices` whose fan on the original is not empty, in order, to
@@ -210,8 +210,7 @@ impl<'a> DriftingReference<'a> {
             "one reference per vertex"
         );
         let anchors = reference
-            .par_iter()
-            .with_min_len(DRIFT_CHUNK)
+            .iter()
             .map(|&r| home_anchor(original, r as usize))
             .collect();
         Self {
@@ -243,20 +242,7 @@ impl<'a> DriftingReference<'a> {
             .zip(self.anchors.par_chunks_mut(DRIFT_CHUNK))
             .zip(positions.par_chunks(DRIFT_CHUNK))
             .for_each(|((references, anchors), positions)| {
-                // First which vertices left their anchors, without a branch per vertex (whether
-                // one did is a coin toss while the mesh moves), then their rings.
-                let mut moved = [0u16; DRIFT_CHUNK];
-                let mut count = 0;
-                for (k, (a, q)) in anchors.iter().zip(positions).enumerate() {
-                    moved[count] = k as u16;
-                    // Written so that a NaN position counts as moved.
-                    let stays = distance2(*q, [a[0], a[1], a[2]]) <= a[3];
-                    count += usize::from(!stays);
-                }
-                for &k in &moved[..count] {
-                    let k = k as usize;
-                    (references[k], anchors[k]) = drift_step(original, positions[k], references[k]);
-                }
+                drift_run(original, references, anchors, positions, |&q| q);
             });
     }
 
@@ -267,6 +253,37 @@ impl<'a> DriftingReference<'a> {
 
     pub fn into_reference(self) -> Vec<u32> {
         self.reference
+    }
+}
+
+/// One drift step for a run of vertices: their references, anchors and new positions (read
+/// by `xyz`).
+fn drift_run<P>(
+    original: &Original,
+    references: &mut [u32],
+    anchors: &mut [[f32; 4]],
+    positions: &[P],
+    xyz: impl Fn(&P) -> [f32; 3],
+) {
+    let blocks = references
+        .chunks_mut(DRIFT_CHUNK)
+        .zip(anchors.chunks_mut(DRIFT_CHUNK))
+        .zip(positions.chunks(DRIFT_CHUNK));
+    for ((references, anchors), positions) in blocks {
+        // First which vertices left their anchors, without a branch per vertex (whether one
+        // did is a coin toss while the mesh moves), then their rings.
+        let mut moved = [0u16; DRIFT_CHUNK];
+        let mut count = 0;
+        for (k, (a, q)) in anchors.iter().zip(positions).enumerate() {
+            moved[count] = k as u16;
+            // Written so that a NaN position counts as moved.
+            let stays = distance2(xyz(q), [a[0], a[1], a[2]]) <= a[3];
+            count += usize::from(!stays);
+        }
+        for &k in &moved[..count] {
+            let k = k as usize;
+            (references[k], anchors[k]) = drift_step(original, xyz(&positions[k]), references[k]);
+        }
     }
 }
 
@@ -317,9 +334,32 @@ fn drift_step(original: &Original, q: [f32; 3], r: u32) -> (u32, [f32; 4]) {
     }
 }
 
+/// The drift follows every step inside the engine's passes ([`Follower`]); it wants no
+/// positions laid out.
 impl StepObserver for DriftingReference<'_> {
-    fn after_step(&mut self, positions: &[[f32; 3]]) {
-        self.update(positions);
+    fn watches(&self) -> bool {
+        false
+    }
+
+    fn follower(&mut self) -> Option<&mut dyn Follower> {
+        Some(self)
+    }
+}
+
+impl Follower for DriftingReference<'_> {
+    fn parts(&mut self, run: usize) -> Vec<FollowPart<'_>> {
+        let original = self.original;
+        self.reference
+            .chunks_mut(run)
+            .zip(self.anchors.chunks_mut(run))
+            .map(|(references, anchors)| {
+                Box::new(move |positions: &[[f32; 4]]| {
+                    drift_run(original, references, anchors, positions, |q| {
+                        [q[0], q[1], q[2]]
+                    });
+                }) as FollowPart
+            })
+            .collect()
     }
 }
 

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use super::constraint::Constrain;
 use super::rings::{xyz, xyz0, Field, Rings, CHUNK};
-use super::StepObserver;
+use super::{follow_parts, FollowPart, StepObserver};
 
 /// Runs HC iterations `done + 1 ..= done + more` from `start` (the original positions, or the
 /// result of `done` iterations); one step (and report) per iteration.
@@ -35,17 +35,28 @@ pub(crate) fn run<C: Constrain>(
     // `points` receives the 3-vectors the observer and the caller see.
     let mut points = start;
     let mut b = Field::zeros(n);
-    let watching = observer.watches();
+    let mut written = false;
     for iteration in done + 1..=done + more {
         differences(rings, original, &q, &mut b, alpha);
-        correct(rings, original, &b, &mut q, alpha, beta, constraint);
-        if watching {
+        let mut parts = follow_parts(observer, n);
+        correct(
+            rings,
+            original,
+            &b,
+            &mut q,
+            (alpha, beta),
+            constraint,
+            &mut parts,
+        );
+        drop(parts);
+        written = observer.watches_iteration(iteration);
+        if written {
             q.write_points(&mut points);
             observer.after_step(&points);
             observer.after_iteration(iteration, &points);
         }
     }
-    if !watching {
+    if !written {
         q.write_points(&mut points);
     }
     points
@@ -77,15 +88,16 @@ fn differences(rings: Rings, original: &[[f32; 3]], q: &Field, b: &mut Field, al
         });
 }
 
-/// Pass 2: `q_i <- p_i - (beta b_i + (1 - beta) mean_{N(i)} b)`, constrained, in place.
+/// Pass 2: `q_i <- p_i - (beta b_i + (1 - beta) mean_{N(i)} b)`, constrained, in place; each
+/// chunk then goes to its follower part.
 fn correct<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
     b: &Field,
     q: &mut Field,
-    alpha: f32,
-    beta: f32,
+    (alpha, beta): (f32, f32),
     constraint: &C,
+    parts: &mut [Option<FollowPart>],
 ) {
     let keep = 1.0 - alpha;
     let spread = 1.0 - beta;
@@ -96,8 +108,9 @@ fn correct<C: Constrain>(
                 .par_chunks(CHUNK)
                 .zip(original.par_chunks(CHUNK)),
         )
+        .zip(parts.par_iter_mut())
         .enumerate()
-        .for_each(|(c, (q, (own_b, orig)))| {
+        .for_each(|(c, ((q, (own_b, orig)), part))| {
             let rows = q.iter_mut().zip(own_b.iter().zip(orig)).zip(rings.chunk(c));
             for (k, ((qi, (&bi, &oi)), ring)) in rows.enumerate() {
                 if ring.is_empty() {
@@ -110,6 +123,9 @@ fn correct<C: Constrain>(
                     p - (beta * bi[k] + spread * mb[k])
                 });
                 *qi = xyz0(constraint.apply(c * CHUNK + k, xyz(*qi), xyz(proposed)));
+            }
+            if let Some(follow) = part {
+                follow(q);
             }
         });
 }

@@ -45,6 +45,46 @@ pub trait StepObserver {
     fn watches(&self) -> bool {
         true
     }
+    /// Whether the observer wants the calls of iteration `iteration` (its steps and the
+    /// iteration): one that measures at a few counts along a run says no to the others, and
+    /// the engine skips laying out their positions. By default [`Self::watches`].
+    fn watches_iteration(&self, _iteration: u32) -> bool {
+        self.watches()
+    }
+    /// Work on the positions of every step that the engine does inside the step's own pass
+    /// ([`Follower`]), before the step's calls. Asked for once per step.
+    fn follower(&mut self) -> Option<&mut dyn Follower> {
+        None
+    }
+}
+
+/// Per-vertex work on the new positions of every step of a run (the drifting reference of the
+/// local error), done by the step's own pass over the vertices, a run of them at a time, while
+/// they are at hand: no pass of its own, and no laying out of positions for it.
+pub trait Follower {
+    /// One part per run of `run` vertices (the last may be shorter), in vertex order. Each part
+    /// is handed the new positions of its run once, four lanes per vertex (the fourth 0).
+    fn parts(&mut self, run: usize) -> Vec<FollowPart<'_>>;
+}
+
+/// A [`Follower`]'s work on one run of vertices.
+pub type FollowPart<'a> = Box<dyn FnMut(&[[f32; 4]]) + Send + 'a>;
+
+/// The observer's follower split into one part per chunk of `n` vertices for the next step
+/// (`None` for every chunk when it has none).
+pub(crate) fn follow_parts(
+    observer: &mut dyn StepObserver,
+    n: usize,
+) -> Vec<Option<FollowPart<'_>>> {
+    let chunks = n.div_ceil(rings::CHUNK);
+    match observer.follower() {
+        Some(follower) => {
+            let parts = follower.parts(rings::CHUNK);
+            assert_eq!(parts.len(), chunks, "one follower part per chunk");
+            parts.into_iter().map(Some).collect()
+        }
+        None => (0..chunks).map(|_| None).collect(),
+    }
 }
 
 /// An observer that watches nothing.

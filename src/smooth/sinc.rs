@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use super::constraint::Constrain;
 use super::rings::{Field, Rings, CHUNK};
 use super::sinc_coefficients::sinc_coefficients;
-use super::StepObserver;
+use super::{follow_parts, StepObserver};
 use crate::mesh::bounding_box;
 
 /// Runs the windowed-sinc filter of degree `iterations` (one neighbour pass per degree).
@@ -46,11 +46,38 @@ pub(crate) fn run<C: Constrain>(
     };
     while !terms.advance(rings, u32::MAX) {}
     let result = terms.finish(original, constraint);
+    let watching = observer.watches_iteration(iterations);
     for _ in 0..iterations {
-        observer.after_step(&result);
+        follow_points(observer, &result);
+        if watching {
+            observer.after_step(&result);
+        }
     }
-    observer.after_iteration(iterations, &result);
+    if watching {
+        observer.after_iteration(iterations, &result);
+    }
     result
+}
+
+/// Hands `positions` to the observer's follower, if it has one, for a step no pass of which
+/// could take them in.
+fn follow_points(observer: &mut dyn StepObserver, positions: &[[f32; 3]]) {
+    let parts = follow_parts(observer, positions.len());
+    if parts.iter().all(Option::is_none) {
+        return;
+    }
+    parts
+        .into_par_iter()
+        .zip(positions.par_chunks(CHUNK))
+        .for_each(|(part, points)| {
+            if let Some(mut follow) = part {
+                let mut lanes = [[0.0f32; 4]; CHUNK];
+                for (l, p) in lanes.iter_mut().zip(points) {
+                    *l = [p[0], p[1], p[2], 0.0];
+                }
+                follow(&lanes[..points.len()]);
+            }
+        });
 }
 
 /// The recurrence under way: the terms so far summed into the estimate. Advancing it a few

@@ -4,7 +4,7 @@ use rayon::prelude::*;
 
 use super::constraint::Constrain;
 use super::rings::{xyz, xyz0, Field, Rings, CHUNK};
-use super::StepObserver;
+use super::{follow_parts, FollowPart, StepObserver};
 
 /// Runs iterations `done + 1 ..= done + more` of the umbrella steps `factors` (Laplace:
 /// `[lambda]`; Taubin: `[lambda, mu]`) from `start` (the result of `done` iterations; `None`:
@@ -26,36 +26,48 @@ pub(crate) fn run<C: Constrain>(
     let mut q = Field::from_points(start.as_deref().unwrap_or(original));
     let mut next = Field::zeros(original.len());
     let mut points = start.unwrap_or_default();
-    let watching = observer.watches();
+    let n = original.len();
+    let mut written = false;
     for iteration in done + 1..=done + more {
+        written = observer.watches_iteration(iteration);
         for &factor in factors {
-            step(rings, factor, &q, &mut next, constraint);
+            let mut parts = follow_parts(observer, n);
+            step(rings, factor, &q, &mut next, constraint, &mut parts);
+            drop(parts);
             std::mem::swap(&mut q, &mut next);
-            if watching {
+            if written {
                 q.write_points(&mut points);
                 observer.after_step(&points);
             }
         }
-        if watching {
+        if written {
             observer.after_iteration(iteration, &points);
         }
     }
-    if !watching {
+    if !written {
         q.write_points(&mut points);
     }
     points
 }
 
-/// One Jacobi umbrella step: `dst_i = src_i + factor * (mean_{N(i)} src - src_i)`, constrained.
-/// Isolated vertices keep their position.
-fn step<C: Constrain>(rings: Rings, factor: f32, src: &Field, dst: &mut Field, constraint: &C) {
+/// One Jacobi umbrella step: `dst_i = src_i + factor * (mean_{N(i)} src - src_i)`, constrained;
+/// each chunk then goes to its follower part. Isolated vertices keep their position.
+fn step<C: Constrain>(
+    rings: Rings,
+    factor: f32,
+    src: &Field,
+    dst: &mut Field,
+    constraint: &C,
+    parts: &mut [Option<FollowPart>],
+) {
     assert!(src.vertices().len() == rings.vertex_count());
     assert!(dst.vertices().len() == rings.vertex_count());
     dst.vertices_mut()
         .par_chunks_mut(CHUNK)
         .zip(src.vertices().par_chunks(CHUNK))
+        .zip(parts.par_iter_mut())
         .enumerate()
-        .for_each(|(c, (dst, own))| {
+        .for_each(|(c, ((dst, own), part))| {
             let rows = dst.iter_mut().zip(own).zip(rings.chunk(c)).enumerate();
             for (k, ((out, &q), ring)) in rows {
                 *out = if ring.is_empty() {
@@ -65,6 +77,9 @@ fn step<C: Constrain>(rings: Rings, factor: f32, src: &Field, dst: &mut Field, c
                     let proposed = std::array::from_fn(|k| q[k] + factor * (m[k] - q[k]));
                     xyz0(constraint.apply(c * CHUNK + k, xyz(q), xyz(proposed)))
                 };
+            }
+            if let Some(follow) = part {
+                follow(dst);
             }
         });
 }

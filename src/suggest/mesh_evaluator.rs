@@ -3,7 +3,7 @@
 
 use super::{is_cumulative, Evaluator, Terms};
 use crate::metrics::{measure, measure_shape, DriftingReference, Metrics, Original};
-use crate::smooth::{smooth, Params, StepObserver};
+use crate::smooth::{smooth, Follower, Params, StepObserver};
 
 /// Per-vertex weights that do not fit the mesh.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -87,10 +87,12 @@ impl Along<'_, '_> {
 }
 
 impl StepObserver for Along<'_, '_> {
-    fn after_step(&mut self, positions: &[[f32; 3]]) {
-        if let Some(drift) = &mut self.drift {
-            drift.update(positions);
-        }
+    fn watches_iteration(&self, iteration: u32) -> bool {
+        self.at.get(self.terms.len()) == Some(&iteration)
+    }
+
+    fn follower(&mut self) -> Option<&mut dyn Follower> {
+        self.drift.as_mut().map(|d| d as &mut dyn Follower)
     }
 
     fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {

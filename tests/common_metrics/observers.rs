@@ -65,7 +65,7 @@ pub struct Snapshot<'a> {
 
 impl StepObserver for Snapshot<'_> {
     fn after_step(&mut self, positions: &[[f32; 3]]) {
-        self.drift.after_step(positions);
+        self.drift.update(positions);
     }
     fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
         if iteration == self.at {
