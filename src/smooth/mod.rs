@@ -30,7 +30,8 @@ use constraint::{Constrain, Free, Limits};
 use rings::Rings;
 
 /// Watches a smoothing run. The local-error measure drifts its reference vertices after every
-/// step; sweeps over iterations measure along one run instead of restarting.
+/// step (as a [`Follower`], inside the step's pass); sweeps over iterations measure along one
+/// run instead of restarting.
 pub trait StepObserver {
     /// After every position update (Taubin: twice per iteration; HC: once per iteration).
     /// Windowed sinc's running sums between terms are not meshes, so it reports its result
