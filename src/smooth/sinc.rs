@@ -26,7 +26,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{Field, Rings, CHUNK};
+use super::rings::{xyz0, Field, Rings, CHUNK};
 use super::sinc_coefficients::sinc_coefficients;
 use super::{follow_parts, StepObserver};
 use crate::mesh::bounding_box;
@@ -72,8 +72,8 @@ fn follow_points(observer: &mut dyn StepObserver, positions: &[[f32; 3]]) {
         .for_each(|(part, points)| {
             if let Some(mut follow) = part {
                 let mut lanes = [[0.0f32; 4]; CHUNK];
-                for (l, p) in lanes.iter_mut().zip(points) {
-                    *l = [p[0], p[1], p[2], 0.0];
+                for (l, &p) in lanes.iter_mut().zip(points) {
+                    *l = xyz0(p);
                 }
                 follow(&lanes[..points.len()]);
             }

@@ -96,7 +96,7 @@ impl StepObserver for Along<'_, '_> {
     }
 
     fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
-        if self.at.get(self.terms.len()) == Some(&iteration) {
+        if self.watches_iteration(iteration) {
             self.measure(positions);
         }
     }
