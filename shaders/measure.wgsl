@@ -4,7 +4,9 @@
 //     where it is not finite;
 //   - the local error (paper section 4.1) of q_i against the fan of its reference r_i on the
 //     original mesh: the smallest prism height, else the distance to the fan's edges;
-//   - its share of six times the volume: the triangles whose smallest corner index it is.
+//   - its share of six times the volume: the triangles whose smallest corner index it is;
+//   - its roughness term n |mean - p|^2 over the corner after it in each of its n triangles
+//     (metrics::roughness: on a closed mesh, its 1-ring).
 // Each workgroup then sums its vertices into one `Partial`; the host adds those in f64.
 //
 // f32 throughout. Angles avoid atan2 (WGSL allows it 4096 ULP) and are summed exactly in
@@ -42,8 +44,8 @@ struct Partial {
     volume6: f32,
     error_count: u32,
     curvature_count: u32,
-    pad0: u32,
-    pad1: u32,
+    roughness: f32,
+    pad: u32,
 }
 
 // Angles in units of 2^-26 rad: pi is 2.1e8 units, so a u32 holds 20 angles of pi before it
@@ -178,7 +180,7 @@ fn local_error(q: vec3<f32>, r: u32) -> f32 {
 }
 
 fn empty_partial() -> Partial {
-    return Partial(0.0, 0.0, 0.0, 0.0, 0u, 0u, 0u, 0u);
+    return Partial(0.0, 0.0, 0.0, 0.0, 0u, 0u, 0.0, 0u);
 }
 
 // Vertex i's measures: writes its per-vertex entry and returns its share of the sums.
@@ -195,10 +197,12 @@ fn measure_vertex(i: u32) -> Partial {
     var units = 0u;
     var carries = 0u;
     var mixed_area = 0.0;
+    var ring_sum = vec3<f32>(0.0);
     for (var n = start; n < end; n++) {
         let c = fan_corners[n];
         let pj = positions[c.x].xyz;
         let pk = positions[c.y].xyz;
+        ring_sum += pj;
         let u = pj - p;
         let v = pk - p;
         // The third edge straight from the positions, not as v - u: the products below then
@@ -228,6 +232,9 @@ fn measure_vertex(i: u32) -> Partial {
             s.volume6 += dot(centred, m);
         }
     }
+    let count = f32(end - start);
+    let umbrella = ring_sum * (1.0 / count) - p;
+    s.roughness = count * dot(umbrella, umbrella);
     var k_g = 0.0;
     if boundary[i] == 0u && mixed_area > 0.0 {
         let k = angle_defect(units, carries) / mixed_area;
@@ -255,7 +262,7 @@ fn combine(a: Partial, b: Partial) -> Partial {
         a.volume6 + b.volume6,
         a.error_count + b.error_count,
         a.curvature_count + b.curvature_count,
-        0u,
+        a.roughness + b.roughness,
         0u,
     );
 }

@@ -180,6 +180,14 @@ fn check_measures(gpu: &Gpu, name: &str, original: &Original, p: &Params) -> Agr
         .expect("has measures")
         .wait(device, original, 0.5)
         .expect("readback");
+    // The roughness: f32 terms summed pairwise per workgroup on the GPU, in f64 on the CPU.
+    let roughness = original.roughness_ratio(&result.positions);
+    assert!(
+        relative(measured.roughness_ratio, roughness) <= 1e-5,
+        "{name} {}: R/R0 {} on the GPU, {roughness} on the CPU",
+        p.filter,
+        measured.roughness_ratio
+    );
     let on_gpu = (measured.metrics, measured.vertex.expect("asked for"));
     let a = compare(original, &result.positions, &cpu, &on_gpu);
     eprintln!(
@@ -272,6 +280,11 @@ fn measures_of_the_original_and_of_untracked_runs() {
         .wait(device, &original, 0.5)
         .expect("readback");
     assert!(own.vertex.is_none());
+    assert!(
+        relative(own.roughness_ratio, 1.0) <= 1e-5,
+        "{}",
+        own.roughness_ratio
+    );
     assert_eq!(own.metrics.mean_error, 0.0);
     assert_eq!(own.metrics.max_error, 0.0);
     assert!(

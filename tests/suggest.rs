@@ -327,7 +327,9 @@ fn measuring_along_one_run_equals_separate_runs() {
             let mut drift = DriftingReference::new(&original);
             let pos = smooth(&mesh, &topology, &q, None, &mut drift);
             let m = meshsmooth::metrics::measure(&original, &pos, drift.reference(), 0.5);
-            assert_eq!(meshsmooth::suggest::terms_of(&m), t);
+            let roughness = original.roughness_ratio(&pos);
+            assert!(roughness < 1.0, "{filter} {k}: the defaults smooth");
+            assert_eq!(meshsmooth::suggest::terms_of(&m, roughness), t);
             assert!((t.score(0.5) - m.score).abs() < 1e-12);
         }
         assert!(along[2].curvature_ratio < 1.0 && along[2].mean_error > 0.0);
@@ -388,4 +390,77 @@ fn quality_graphs_on_a_real_mesh() {
     assert_eq!(its.samples[p.iterations as usize].terms, at_current[0]);
     // More HC iterations smooth more here.
     assert!(its.samples[50].terms.curvature_ratio < its.samples[5].terms.curvature_ratio);
+}
+
+/// Smooths `name` with `params` (no drift) and returns R/R0.
+fn roughness_after(original: &Original, params: &Params) -> f64 {
+    let positions = smooth(
+        original.mesh(),
+        original.topology(),
+        params,
+        None,
+        &mut NoObserver,
+    );
+    original.roughness_ratio(&positions)
+}
+
+fn with(filter: Filter, a: f32, b: f32, iterations: u32) -> Params {
+    let mut p = Params::defaults(filter);
+    p.iterations = iterations;
+    match filter {
+        Filter::Hc => (p.alpha, p.beta) = (a, b),
+        _ => (p.lambda, p.mu) = (a, b),
+    }
+    p
+}
+
+/// HC with alpha = beta = 0 amplifies the highest frequencies of the umbrella operator
+/// (`q <- q - L^2 q`), and so does Taubin with lambda 0.1 and mu -0.4 (its factor at the top of
+/// the spectrum is 0.8 x 1.8): on every shared mesh they leave it rougher than it was, while
+/// each filter at its defaults leaves it smoother.
+#[test]
+fn diverging_parameters_roughen_every_shared_mesh_and_the_defaults_never_do() {
+    for (name, _) in data::CLOSED_MESHES {
+        let (mesh, topology) = data::load(name);
+        let original = Original::new(&mesh, &topology);
+        for p in [
+            with(Filter::Hc, 0.0, 0.0, 50),
+            with(Filter::Taubin, 0.1, -0.4, 15),
+        ] {
+            let r = roughness_after(&original, &p);
+            assert!(r > 1.0, "{name} {p:?}: R/R0 {r}");
+        }
+        for filter in Filter::ALL {
+            let r = roughness_after(&original, &Params::defaults(filter));
+            assert!(r < 1.0, "{name} {filter}: R/R0 {r}");
+        }
+    }
+}
+
+/// On the large staircase brain, HC at alpha = beta = 0 and 50 iterations blows the mesh up
+/// (mean error tens of mm), yet its S at tau 0.5 beats that of the set the searches suggest
+/// there: curvature falls as the mesh grows and E/(E+1) saturates. The rank puts it last.
+#[test]
+fn the_blown_up_brain_scores_lower_but_ranks_last() {
+    let (mesh, topology) = data::load(data::LARGE);
+    let original = Original::new(&mesh, &topology);
+    let terms = |p: &Params| {
+        let mut drift = DriftingReference::new(&original);
+        let positions = smooth(&mesh, &topology, p, None, &mut drift);
+        let m = meshsmooth::metrics::measure(&original, &positions, drift.reference(), 0.5);
+        (m, original.roughness_ratio(&positions))
+    };
+    let (blown, blown_r) = terms(&with(Filter::Hc, 0.0, 0.0, 50));
+    let (smoothed, smoothed_r) = terms(&with(Filter::Hc, 0.2, 0.7, 5));
+    assert!(
+        blown.mean_error > 10.0 && blown_r > 1000.0,
+        "{blown:?} {blown_r}"
+    );
+    assert!(smoothed.mean_error < 0.1 && smoothed_r < 0.5);
+    assert!(
+        blown.score < smoothed.score,
+        "the score alone would pick the blown-up mesh"
+    );
+    let rank = |m, r| meshsmooth::suggest::terms_of(m, r).rank(0.5);
+    assert!(rank(&smoothed, smoothed_r) < rank(&blown, blown_r));
 }

@@ -5,7 +5,8 @@
 //! local error in mm, with half the voxel diagonal as a reference line when the voxel size is
 //! known), the size of the volume change (%), and the score S(tau) with its minimum marked. A
 //! dashed line marks the current value in every strip; clicking or dragging in any strip sets
-//! the parameter.
+//! the parameter. Where the filter diverges (the mesh comes out rougher than the original) the
+//! curves break off and red bars mark the samples: those values are never suggested.
 
 use super::document::GraphColumn;
 use crate::session::Session;
@@ -20,6 +21,7 @@ const VOLUME: egui::Color32 = egui::Color32::from_rgb(0x60, 0xbd, 0x68);
 const SCORE: egui::Color32 = egui::Color32::from_rgb(0xf1, 0x7c, 0xb0);
 const CURRENT: egui::Color32 = egui::Color32::from_gray(230);
 const REFERENCE: egui::Color32 = egui::Color32::from_rgb(0xb2, 0x76, 0xb2);
+const DIVERGES: egui::Color32 = egui::Color32::from_rgba_premultiplied(0x70, 0x18, 0x18, 0x70);
 
 /// One strip: which measure, how it reads.
 struct Strip {
@@ -121,16 +123,35 @@ fn column(
     if stale {
         ui.small("Updating for the new values…");
     }
+    let diverging: Vec<f64> = curve
+        .samples
+        .iter()
+        .filter(|s| s.terms.roughens())
+        .map(|s| s.value)
+        .collect();
+    if !diverging.is_empty() {
+        ui.small(
+            egui::RichText::new("Red: the filter diverges here (rougher than the original)")
+                .color(egui::Color32::from_rgb(0xe0, 0x60, 0x60)),
+        )
+        .on_hover_text(
+            "At these values the filter amplifies the mesh's finest ripples instead of damping              them, and repeating it blows the mesh up. They are never suggested.",
+        );
+    }
     let strip_height = ((ui.available_height() - 30.0) / STRIPS.len() as f32).clamp(56.0, 120.0);
     let link = ui.scope_id().with(("graphs_x", format!("{param:?}")));
     let mut picked = None;
     for (k, strip) in STRIPS.iter().enumerate() {
-        let points: Vec<[f64; 2]> = curve
-            .samples
-            .iter()
-            .filter_map(|s| (strip.value)(s).map(|v| [s.value, v]))
-            .filter(|p| p[1].is_finite())
-            .collect();
+        // Runs of measured samples: a curve breaks off where a sample has no value.
+        let mut runs: Vec<Vec<[f64; 2]>> = vec![Vec::new()];
+        for s in &curve.samples {
+            match (strip.value)(s).filter(|v| v.is_finite()) {
+                Some(v) => runs.last_mut().expect("never empty").push([s.value, v]),
+                None if runs.last().is_some_and(|r| !r.is_empty()) => runs.push(Vec::new()),
+                None => {}
+            }
+        }
+        runs.retain(|r| !r.is_empty());
         let last = k + 1 == STRIPS.len();
         let plot = Plot::new(("graph", format!("{param:?}"), k))
             .height(strip_height)
@@ -157,14 +178,19 @@ fn column(
                 ))
             });
         let response = plot.show(ui, |plot_ui| {
-            if points.is_empty() {
+            if runs.is_empty() {
                 return None;
             }
-            plot_ui.line(
-                Line::new(strip.title, PlotPoints::from(points.clone()))
-                    .color(strip.color)
-                    .width(2.0),
-            );
+            for &x in &diverging {
+                plot_ui.vline(VLine::new("filter diverges", x).color(DIVERGES).width(5.0));
+            }
+            for run in &runs {
+                plot_ui.line(
+                    Line::new(strip.title, PlotPoints::from(run.clone()))
+                        .color(strip.color)
+                        .width(2.0),
+                );
+            }
             plot_ui.vline(
                 VLine::new("current value", curve.current)
                     .color(CURRENT)

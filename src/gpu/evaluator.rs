@@ -10,7 +10,7 @@
 //! Natively the evaluator can block instead ([`GpuEvaluator::blocking`]), for the CLI.
 
 use super::layout::MeasurePartial;
-use super::measures::totals;
+use super::measures::{roughness_ratio, totals};
 use super::readback::Staging;
 use super::smoother::Segment;
 use super::work::{iteration_cost, measure_part_cost, plan_segment, AdaptiveSize};
@@ -408,7 +408,8 @@ impl GpuEvaluator {
                     .iter()
                     .map(|bytes| {
                         let partials: Vec<MeasurePartial> = bytemuck::pod_collect_to_vec(bytes);
-                        terms_of(&metrics_from_sums(original, &totals(&partials), 0.5))
+                        let metrics = metrics_from_sums(original, &totals(&partials), 0.5);
+                        terms_of(&metrics, roughness_ratio(original, &partials))
                     })
                     .collect::<Vec<Terms>>())
             });

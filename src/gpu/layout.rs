@@ -54,7 +54,9 @@ pub(crate) struct MeasurePartial {
     pub volume6: f32,
     pub error_count: u32,
     pub curvature_count: u32,
-    pub pad: [u32; 2],
+    /// The workgroup's share of the roughness R ([`crate::metrics::roughness()`]).
+    pub roughness: f32,
+    pub pad: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<MeasurePartial>() == 32);

@@ -18,6 +18,8 @@ pub struct GpuMeasures {
     pub metrics: Metrics,
     /// Per-vertex local error and `K_G`, when the readback asked for them.
     pub vertex: Option<VertexMeasures>,
+    /// R/R0 ([`Original::roughness_ratio`]), up to f32 rounding.
+    pub roughness_ratio: f64,
 }
 
 /// A measure pass's readback in flight (from [`super::GpuSmoother::measure`]).
@@ -75,6 +77,7 @@ impl MeasureReadback {
             }
             let partials: Vec<MeasurePartial> = bytemuck::pod_collect_to_vec(parts[0]);
             let metrics = metrics_from_sums(original, &totals(&partials), tau);
+            let roughness_ratio = roughness_ratio(original, &partials);
             let vertex = self.with_vertices.then(|| {
                 let pairs: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(parts[1]);
                 VertexMeasures {
@@ -82,7 +85,11 @@ impl MeasureReadback {
                     gaussian_curvature: pairs.iter().map(|p| p[1]).collect(),
                 }
             });
-            Ok(GpuMeasures { metrics, vertex })
+            Ok(GpuMeasures {
+                metrics,
+                vertex,
+                roughness_ratio,
+            })
         })
     }
 
@@ -96,6 +103,12 @@ impl MeasureReadback {
     ) -> Result<GpuMeasures, GpuError> {
         super::readback::wait_for(device, || self.try_take(original, tau))
     }
+}
+
+/// R/R0 of the pass's positions: the workgroups' roughness added in f64.
+pub(super) fn roughness_ratio(original: &Original, partials: &[MeasurePartial]) -> f64 {
+    let r = partials.iter().map(|p| f64::from(p.roughness)).sum();
+    crate::metrics::roughness_ratio(r, original.roughness())
 }
 
 /// The workgroups' partial sums added in f64.

@@ -12,6 +12,7 @@ mod local_error;
 mod original;
 mod prism_rows;
 mod report;
+mod roughness;
 mod score;
 mod sinc_drifting;
 
@@ -23,6 +24,7 @@ pub use report::{
     exact_distances, exact_error, measure, measure_shape, measure_vertices, ErrorSummary,
     MeasureInParts, Metrics, VertexMeasures,
 };
+pub use roughness::{roughness, roughness_ratio};
 pub use score::ScoreTerms;
 pub use sinc_drifting::SincDrifting;
 

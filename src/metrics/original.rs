@@ -7,8 +7,8 @@ use super::report::MeasureInParts;
 use crate::mesh::{Mesh, Topology};
 
 /// The original mesh with what the measures precompute from it: the triangle fans in the order
-/// the passes read them, the drift's shortcut radius, the volume V0 (closed meshes only) and the
-/// curvature K0.
+/// the passes read them, the drift's shortcut radius, the volume V0 (closed meshes only), the
+/// curvature K0 and the roughness R0.
 #[derive(Clone, Debug)]
 pub struct Original {
     mesh: Mesh,
@@ -26,6 +26,8 @@ pub struct Original {
     stay_radius2: Vec<f32>,
     volume: Option<f64>,
     curvature: f64,
+    /// R0, the original's roughness (see [`super::roughness()`]).
+    roughness: f64,
     /// Vertices some triangle uses: the ones the local error averages over.
     referenced: usize,
 }
@@ -57,6 +59,7 @@ impl Original {
             topology,
             volume: None,
             curvature: 0.0,
+            roughness: 0.0,
             referenced,
         }
     }
@@ -70,6 +73,17 @@ impl Original {
     /// K0: mean `|K_G|` over the interior vertices with a defined curvature.
     pub fn curvature(&self) -> f64 {
         self.curvature
+    }
+
+    /// R0: the original's roughness (see [`super::roughness()`]).
+    pub fn roughness(&self) -> f64 {
+        self.roughness
+    }
+
+    /// `R / R0` of smoothed `positions`: above 1, the smoothing left the mesh rougher than it
+    /// was (see [`super::roughness_ratio`]).
+    pub fn roughness_ratio(&self, positions: &[[f32; 3]]) -> f64 {
+        super::roughness_ratio(super::roughness(self, positions), self.roughness)
     }
 
     /// No boundary edges and at least one triangle.
@@ -147,7 +161,7 @@ fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
 
 /// [`Original::new`] spread over calls, for a caller that must return between them (the
 /// browser's one thread opening a large mesh). Each [`Self::advance`] does one step: the fan
-/// corners, their rim rows, the drift's stay radii, the triangle shapes, then the measure pass
+/// corners, their rim rows, the drift's stay radii and the roughness R0, the triangle shapes, then the measure pass
 /// of the original ([`MeasureInParts`], every vertex its own reference) a run of vertices per
 /// call. The result is [`Original::new`]'s, bit for bit.
 pub struct OriginalInParts {
@@ -158,7 +172,7 @@ pub struct OriginalInParts {
     pass: Option<MeasureInParts>,
 }
 
-/// The fan corners, their rim rows, the stay radii and the triangle shapes.
+/// The fan corners, their rim rows, the stay radii with the roughness, and the triangle shapes.
 const PREPARATION_STEPS: usize = 4;
 
 impl OriginalInParts {
@@ -179,7 +193,10 @@ impl OriginalInParts {
         match self.prepared {
             0 => (o.fan_corners, o.corner_codes) = fan_corners(&o.mesh.triangles, &o.topology),
             1 => o.prism_rows = PrismRows::new(o.mesh.vertex_count(), |r| o.fan_corners(r)),
-            2 => o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology),
+            2 => {
+                o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology);
+                o.roughness = super::roughness(o, &o.mesh.positions);
+            }
             3 => {
                 self.reference = super::identity(o.mesh.vertex_count());
                 self.pass = Some(MeasureInParts::new(o, &o.mesh.positions, &self.reference));

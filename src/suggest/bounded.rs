@@ -7,6 +7,8 @@
 //! measured fully, a run of one weight setting at a time, until every other bound lies above
 //! it. A point left out has a bound, hence a score, above that of a measured one, so the result
 //! is the full grid's minimum, ties and all ([`super::GridSearch`] measures everything).
+//! Scores are compared by [`Terms::rank`]; both passes measure the roughness, so a bound never
+//! ranks above its set's full measure.
 //!
 //! An evaluator whose answers are all exact (the default) makes the first pass the whole grid
 //! search and the second empty.
@@ -14,7 +16,7 @@
 use super::grid::{lowest, plan_grid};
 use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
-use super::{score_order, Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
+use super::{Evaluator, Progress, Rank, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
 use std::collections::BTreeMap;
 
@@ -58,15 +60,15 @@ impl GridMinimum {
     /// The points still in question, lowest bound first (ties: the weaker smoothing): those
     /// measured only by bound whose bound does not exceed the best full score.
     fn open_points(&self) -> Vec<GridPoint> {
-        let best = lowest(&self.space, self.tau, self.exact.iter()).map(|(_, t)| t.score(self.tau));
-        let mut open: Vec<(GridPoint, f64)> = self
+        let best = lowest(&self.space, self.tau, self.exact.iter()).map(|(_, t)| t.rank(self.tau));
+        let mut open: Vec<(GridPoint, Rank)> = self
             .bounds
             .iter()
-            .map(|(&p, t)| (p, t.score(self.tau)))
-            .filter(|&(_, s)| best.is_none_or(|b| score_order(s, b).is_le()))
+            .map(|(&p, t)| (p, t.rank(self.tau)))
+            .filter(|&(_, r)| best.is_none_or(|b| r <= b))
             .collect();
-        open.sort_by(|(pa, sa), (pb, sb)| {
-            score_order(*sa, *sb).then_with(|| {
+        open.sort_by(|(pa, ra), (pb, rb)| {
+            ra.cmp(rb).then_with(|| {
                 self.space
                     .weakness_key(*pa)
                     .cmp(&self.space.weakness_key(*pb))
@@ -223,6 +225,7 @@ mod tests {
             curvature_ratio: 1.0 + ((p.iterations as f64) - 20.0).powi(2),
             mean_error: 0.01 * p.lambda as f64,
             volume_change: Some(0.0),
+            roughness_ratio: 0.5,
         };
         let want = full_grid(Filter::Laplace, 0.5, &mut FnEvaluator::new(flat));
         let mut ev = Bounding::new(FnEvaluator::new(flat));

@@ -5,18 +5,20 @@
 
 use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
-use super::{score_order, Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
+use super::{Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
 use serde::{Deserialize, Serialize};
 
-/// The grid point with the lowest S(tau); ties go to the weaker smoothing.
+/// The grid point of the lowest [`Terms::rank`] at `tau` (the lowest S(tau) among the sets that
+/// do not roughen the mesh); ties go to the weaker smoothing.
 pub(crate) fn lowest(
     space: &ParamSpace,
     tau: f64,
     candidates: impl IntoIterator<Item = (GridPoint, Terms)>,
 ) -> Option<(GridPoint, Terms)> {
     candidates.into_iter().min_by(|(pa, ta), (pb, tb)| {
-        score_order(ta.score(tau), tb.score(tau))
+        ta.rank(tau)
+            .cmp(&tb.rank(tau))
             .then_with(|| space.weakness_key(*pa).cmp(&space.weakness_key(*pb)))
     })
 }
@@ -200,6 +202,7 @@ mod tests {
             curvature_ratio: 1.0 + ((p.iterations as f64) - 20.0).powi(2),
             mean_error: 0.0,
             volume_change: Some(0.0),
+            roughness_ratio: 0.5,
         });
         let best = grid(Filter::Laplace, &mut ev).best(0.5).unwrap();
         assert_eq!(space.point_of(&best.params), Some(GridPoint([0, 4, 0])));
@@ -209,6 +212,7 @@ mod tests {
             curvature_ratio: 1.0 + ((p.iterations as f64) - 10.0).powi(2),
             mean_error: 0.0,
             volume_change: None,
+            roughness_ratio: 0.5,
         });
         let best = grid(Filter::Hc, &mut ev).best(0.5).unwrap();
         assert_eq!(hc.point_of(&best.params), Some(GridPoint([10, 10, 2])));

@@ -3,11 +3,16 @@
 //! neighbours of the centre and moves to the lowest S; a search stops at a local minimum; the
 //! result is the best of the n minima. Measured points are remembered, so revisits cost nothing
 //! and the evaluation count is the number of distinct parameter sets measured.
+//!
+//! "Lowest" is by [`Terms::rank`]: S among the sets that do not roughen the mesh, which come
+//! before every set that does; among those, the lower roughness. So a search that starts where
+//! the filter diverges (HC's corner of alpha 0, beta 0 and the most iterations, on a staircase
+//! mesh) walks out of that region instead of ending on a blown-up mesh.
 
 use super::grid::{check_base, lowest};
 use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
-use super::{score_order, Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
+use super::{Evaluator, Progress, Rank, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -61,8 +66,8 @@ impl LocalSearch {
         self.pending.extend(plan_runs(&self.space, &missing));
     }
 
-    fn score(&self, p: GridPoint) -> f64 {
-        self.measured.get(p).map_or(f64::NAN, |t| t.score(self.tau))
+    fn rank(&self, p: GridPoint) -> Option<Rank> {
+        self.measured.get(p).map(|t| t.rank(self.tau))
     }
 
     /// Advances the state machine until a run is due or the search is over.
@@ -96,9 +101,9 @@ impl LocalSearch {
                             .iter()
                             .filter_map(|&p| self.measured.get(p).map(|t| (p, t))),
                     );
-                    let centre_score = self.score(self.centre);
+                    let centre = self.rank(self.centre);
                     match best {
-                        Some((p, t)) if score_order(t.score(self.tau), centre_score).is_lt() => {
+                        Some((p, t)) if centre.is_none_or(|c| t.rank(self.tau) < c) => {
                             self.centre = p;
                             if let Some(path) = self.paths.last_mut() {
                                 path.push(p);
@@ -276,6 +281,44 @@ mod tests {
         let best = g.best(0.5).unwrap();
         assert_eq!(space.point_of(&best.params), Some(global));
         assert!(out.suggestion.score > best.score);
+    }
+
+    #[test]
+    fn a_search_that_starts_where_the_filter_diverges_walks_out() {
+        // S falls towards HC's corner of weak weights and many iterations, but there the filter
+        // roughens the mesh, more the deeper in: the lowest S of the sets that smooth lies on
+        // the region's edge, and every search must end on a set that smooths.
+        let corner = GridPoint([0, 0, 10]);
+        let diverges = |g: [u8; 3]| g[0] + g[1] < 4 && g[2] > 5;
+        let landscape = move |p: &Params| {
+            let space = ParamSpace::of(Filter::Hc);
+            let g = space.point_of(p).unwrap().0;
+            if diverges(g) {
+                let depth = (4 - g[0] - g[1]) + (g[2] - 5);
+                Terms::roughened(1.0 + f64::from(depth))
+            } else {
+                bowl(&space, corner)(p)
+            }
+        };
+        let out = local(Filter::Hc, 0.5, &mut FnEvaluator::new(landscape));
+        let best = run(
+            GridSearch::new(Filter::Hc, &Params::defaults(Filter::Hc)).unwrap(),
+            &mut FnEvaluator::new(landscape),
+            &mut |_| true,
+        )
+        .unwrap()
+        .best(0.5)
+        .unwrap();
+        assert!(!best.terms.roughens() && best.score.is_finite());
+        assert_eq!(out.suggestion.params, best.params);
+        let third = &out.paths[2];
+        assert_eq!(third[0], corner);
+        let end = *third.last().unwrap();
+        assert!(
+            !diverges(end.0),
+            "it ended at {end:?}, where the filter diverges"
+        );
+        assert!(third.len() > 2, "it walked: {third:?}");
     }
 
     #[test]

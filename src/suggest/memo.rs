@@ -66,7 +66,7 @@ impl TermsMemo {
         let key = RunKey::of(params);
         for (&k, t) in at.iter().zip(terms) {
             // A failed evaluator answers NaN terms: never keep those.
-            if t.curvature_ratio.is_finite() && t.mean_error.is_finite() {
+            if !t.failed() {
                 self.known.insert((key, k), *t);
             }
         }
@@ -232,6 +232,7 @@ mod tests {
             curvature_ratio: f64::NAN,
             mean_error: f64::NAN,
             volume_change: None,
+            roughness_ratio: f64::NAN,
         };
         let mut inner = FnEvaluator::new(|_: &Params| nan);
         let mut memo = TermsMemo::default();
@@ -243,5 +244,13 @@ mod tests {
         let got = memoized.measure(&params, &[5, 10]).unwrap();
         assert!(got.iter().all(|t| t.curvature_ratio.is_nan()));
         assert!(memo.is_empty());
+        // A set that blew the mesh up has NaN measures too, but its answer is known: kept.
+        let mut inner = FnEvaluator::new(|_: &Params| Terms::roughened(3.0));
+        let mut memoized = Memoized {
+            memo: &mut memo,
+            inner: &mut inner,
+        };
+        memoized.measure(&params, &[5, 10]).unwrap();
+        assert_eq!(memo.len(), 2);
     }
 }

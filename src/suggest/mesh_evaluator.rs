@@ -31,12 +31,17 @@ pub fn check_weights(weights: &[f32], vertices: usize) -> Result<(), WeightsErro
     }
 }
 
-/// The score terms of a measured mesh.
-pub fn terms_of(metrics: &Metrics) -> Terms {
+/// The score terms of a measured mesh whose roughness is `roughness_ratio` times the
+/// original's ([`Terms::roughened`] when above 1: what a blown-up mesh measures means nothing).
+pub fn terms_of(metrics: &Metrics, roughness_ratio: f64) -> Terms {
+    if roughness_ratio > 1.0 {
+        return Terms::roughened(roughness_ratio);
+    }
     Terms {
         curvature_ratio: metrics.score_terms().curvature_ratio,
         mean_error: metrics.mean_error,
         volume_change: metrics.volume_change.map(f64::abs),
+        roughness_ratio,
     }
 }
 
@@ -69,26 +74,74 @@ impl<'a> MeshEvaluator<'a> {
 
 /// Measures after the wanted iterations of a run; with a drifting reference watching every
 /// step the full terms, without one curvature and volume only (the mean error left at 0).
+///
+/// A run the filter blows up makes every vertex check its ring at every drift step, tens of
+/// times the cost of the smoothing. So when most vertices checked their rings in a step, the
+/// roughness is taken there too (at most every [`CHECK_EVERY`] iterations); once the mesh is
+/// rougher than the original, the drift stops. Each count measured after that which still
+/// roughens the mesh needs no drift; one that does not (a filter that is not linear, with
+/// weights or a bound, may come back) is left for a run of its own.
 struct Along<'o, 'e> {
     original: &'o Original,
     drift: Option<DriftingReference<'o>>,
+    /// Whether the terms are full (measured with the drift): the drift was asked for.
+    full: bool,
+    /// Whether the roughness may stop the drift.
+    checks: bool,
+    last_check: u32,
     at: &'e [u32],
     terms: Vec<Terms>,
+    /// Indices into `at` of the counts that need a run of their own.
+    rerun: Vec<usize>,
 }
 
-impl Along<'_, '_> {
+/// Iterations between roughness checks of a run.
+const CHECK_EVERY: u32 = 5;
+
+impl<'o, 'e> Along<'o, 'e> {
+    fn new(original: &'o Original, full: bool, at: &'e [u32]) -> Self {
+        Self {
+            original,
+            drift: full.then(|| DriftingReference::new(original)),
+            full,
+            checks: full,
+            last_check: 0,
+            at,
+            terms: Vec::with_capacity(at.len()),
+            rerun: Vec::new(),
+        }
+    }
+
+    /// The roughness first: a set that roughens the mesh needs no measure.
     fn measure(&mut self, positions: &[[f32; 3]]) {
-        let metrics = match &self.drift {
-            Some(drift) => measure(self.original, positions, drift.reference(), 0.5),
-            None => measure_shape(self.original, positions, 0.5),
+        let roughness = self.original.roughness_ratio(positions);
+        if roughness > 1.0 {
+            self.terms.push(Terms::roughened(roughness));
+            return;
+        }
+        let metrics = match (&self.drift, self.full) {
+            (Some(drift), _) => measure(self.original, positions, drift.reference(), 0.5),
+            (None, false) => measure_shape(self.original, positions, 0.5),
+            (None, true) => {
+                self.rerun.push(self.terms.len());
+                self.terms.push(Terms::roughened(f64::NAN));
+                return;
+            }
         };
-        self.terms.push(terms_of(&metrics));
+        self.terms.push(terms_of(&metrics, roughness));
+    }
+
+    fn wants_check(&self, iteration: u32) -> bool {
+        let n = self.original.mesh().vertex_count();
+        self.checks
+            && iteration >= self.last_check + CHECK_EVERY
+            && self.drift.as_ref().is_some_and(|d| d.ring_checks() > n / 2)
     }
 }
 
 impl StepObserver for Along<'_, '_> {
     fn watches_iteration(&self, iteration: u32) -> bool {
-        self.at.get(self.terms.len()) == Some(&iteration)
+        self.at.get(self.terms.len()) == Some(&iteration) || self.wants_check(iteration)
     }
 
     fn follower(&mut self) -> Option<&mut dyn Follower> {
@@ -96,8 +149,13 @@ impl StepObserver for Along<'_, '_> {
     }
 
     fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
-        if self.watches_iteration(iteration) {
+        if self.at.get(self.terms.len()) == Some(&iteration) {
             self.measure(positions);
+        } else if self.wants_check(iteration) {
+            self.last_check = iteration;
+            if self.original.roughness_ratio(positions) > 1.0 {
+                self.drift = None;
+            }
         }
     }
 }
@@ -122,23 +180,38 @@ impl MeshEvaluator<'_> {
         for run in runs {
             let mut p = *params;
             p.iterations = run[run.len() - 1];
-            let mut along = Along {
-                original: self.original,
-                drift: drift.then(|| DriftingReference::new(self.original)),
-                // Windowed sinc reports no iterations on the way: measured once it is done.
-                at: if cumulative { run } else { &[] },
-                terms: Vec::with_capacity(run.len()),
-            };
+            // Windowed sinc reports no iterations on the way: measured once it is done.
+            let mut along = Along::new(self.original, drift, if cumulative { run } else { &[] });
             let positions = smooth(mesh, topology, &p, self.weights, &mut along);
             // A mesh the engine cannot smooth (nothing to move) reports no iterations: its
             // result is the same for every count.
             while along.terms.len() < run.len() {
                 along.measure(&positions);
             }
-            out.extend(along.terms);
             self.runs += 1;
+            let mut terms = along.terms;
+            for k in along.rerun {
+                terms[k] = self.run_alone(&p, run[k]);
+            }
+            out.extend(terms);
         }
         out
+    }
+
+    /// The full terms after `count` iterations of `params`, drifting all the way.
+    fn run_alone(&mut self, params: &Params, count: u32) -> Terms {
+        let (mesh, topology) = (self.original.mesh(), self.original.topology());
+        let mut p = *params;
+        p.iterations = count;
+        let at = [count];
+        let mut along = Along::new(self.original, true, &at);
+        along.checks = false;
+        let positions = smooth(mesh, topology, &p, self.weights, &mut along);
+        if along.terms.is_empty() {
+            along.measure(&positions);
+        }
+        self.runs += 1;
+        along.terms[0]
     }
 }
 
@@ -188,8 +261,62 @@ mod tests {
                 "lambda 0 moves nothing"
             );
             let measured = crate::metrics::measure(&original, &positions, &reference, 0.5);
-            assert_eq!(*terms, terms_of(&measured), "{k}");
+            let roughness = original.roughness_ratio(&positions);
+            assert_eq!(roughness, 1.0);
+            assert_eq!(*terms, terms_of(&measured, roughness), "{k}");
         }
+    }
+
+    fn bent_tube() -> Original {
+        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let mesh = crate::io::load(bytes, "sample.ply").unwrap();
+        Original::new(&mesh, &crate::mesh::Topology::build(&mesh))
+    }
+
+    /// The terms by hand: smooth with the drift all the way, then the roughness and measures.
+    fn by_hand(original: &Original, params: &Params, count: u32) -> Terms {
+        let mut p = *params;
+        p.iterations = count;
+        let (positions, reference) = smooth_drifting(original, &p, None);
+        let metrics = crate::metrics::measure(original, &positions, &reference, 0.5);
+        terms_of(&metrics, original.roughness_ratio(&positions))
+    }
+
+    #[test]
+    fn a_run_the_filter_blows_up_stops_drifting_and_reports_the_same_terms() {
+        let original = bent_tube();
+        let mut params = Params::defaults(Filter::Hc);
+        (params.alpha, params.beta) = (0.0, 0.0);
+        let at = [5, 30, 50];
+        let mut ev = MeshEvaluator::new(&original, None).unwrap();
+        let got = ev.measure(&params, &at).unwrap();
+        for (&k, t) in at.iter().zip(&got) {
+            // By their printouts: the terms of a blown-up mesh are NaN, which equals nothing.
+            let want = by_hand(&original, &params, k);
+            assert_eq!(format!("{t:?}"), format!("{want:?}"), "{k}");
+        }
+        assert!(!got[0].roughens() && got[2].roughens(), "{got:?}");
+        // The run stopped its drift on the way.
+        let mut p = params;
+        p.iterations = 50;
+        let at = [50];
+        let mut along = Along::new(&original, true, &at);
+        smooth(original.mesh(), original.topology(), &p, None, &mut along);
+        assert!(along.drift.is_none() && along.last_check > 0 && along.last_check < 50);
+        assert!(along.terms[0].roughens() && along.rerun.is_empty());
+    }
+
+    #[test]
+    fn a_count_that_smooths_after_the_drift_stopped_gets_a_run_of_its_own() {
+        let original = bent_tube();
+        let params = Params::defaults(Filter::Hc);
+        let at = [7];
+        let mut along = Along::new(&original, true, &at);
+        along.drift = None;
+        along.measure(&original.mesh().positions);
+        assert_eq!(along.rerun, vec![0]);
+        let mut ev = MeshEvaluator::new(&original, None).unwrap();
+        assert_eq!(ev.run_alone(&params, 7), by_hand(&original, &params, 7));
     }
 
     #[test]

@@ -37,8 +37,9 @@ pub use sweep::{Curve, QualityGraphs, QualitySweep, Sample};
 use crate::smooth::{Filter, Params};
 use serde::{Deserialize, Serialize};
 
-/// The quantities the score is made of (paper eq. 4).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// The quantities the score is made of (paper eq. 4). Equal when every field is, NaN equal to
+/// NaN: the terms of a set not measured further ([`Terms::roughened`]) are the same answer.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct Terms {
     /// K/K0: mean |Gaussian curvature| relative to the original mesh.
     pub curvature_ratio: f64,
@@ -46,6 +47,60 @@ pub struct Terms {
     pub mean_error: f64,
     /// |V - V0| / V0; `None` when the mesh is open and its volume means nothing.
     pub volume_change: Option<f64>,
+    /// R/R0, the roughness relative to the original's ([`crate::metrics::roughness()`]). Not
+    /// part of S: above 1 the filter amplified what it should damp (it is unstable at these
+    /// parameters on this mesh), and [`Terms::rank`] puts the set after every one that smooths.
+    pub roughness_ratio: f64,
+}
+
+/// Where a measured parameter set stands in a search (lower is better): every set that does
+/// not roughen the mesh by its score S, then those that do by their roughness ratio (so a
+/// local search that starts among them walks out towards the sets that smooth), then the
+/// failed ones (NaN).
+#[derive(Clone, Copy, Debug)]
+pub struct Rank {
+    class: u8,
+    /// Never NaN.
+    key: f64,
+}
+
+impl PartialEq for Terms {
+    fn eq(&self, other: &Self) -> bool {
+        same(self.curvature_ratio, other.curvature_ratio)
+            && same(self.mean_error, other.mean_error)
+            && same(self.roughness_ratio, other.roughness_ratio)
+            && match (self.volume_change, other.volume_change) {
+                (Some(a), Some(b)) => same(a, b),
+                (a, b) => a.is_none() && b.is_none(),
+            }
+    }
+}
+
+/// Equal, or both NaN.
+pub(crate) fn same(a: f64, b: f64) -> bool {
+    a == b || a.is_nan() && b.is_nan()
+}
+
+impl PartialEq for Rank {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl Eq for Rank {}
+
+impl PartialOrd for Rank {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Rank {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.class
+            .cmp(&other.class)
+            .then_with(|| score_order(self.key, other.key))
+    }
 }
 
 impl Terms {
@@ -54,7 +109,51 @@ impl Terms {
         curvature_ratio: 1.0,
         mean_error: 0.0,
         volume_change: Some(0.0),
+        roughness_ratio: 1.0,
     };
+
+    /// The terms of a set that left the mesh `roughness_ratio` (> 1) times as rough as the
+    /// original: the score's terms are NaN, since measures of a mesh the filter blew up mean
+    /// nothing (its curvature falls as it grows, and E/(E+1) saturates), and the evaluators
+    /// skip them.
+    pub fn roughened(roughness_ratio: f64) -> Terms {
+        Terms {
+            curvature_ratio: f64::NAN,
+            mean_error: f64::NAN,
+            volume_change: None,
+            roughness_ratio,
+        }
+    }
+
+    /// Whether the smoothed mesh came out rougher than the original: the filter diverges here.
+    pub fn roughens(&self) -> bool {
+        self.roughness_ratio > 1.0
+    }
+
+    /// Whether the evaluation failed (a lost device): NaN terms that say nothing, not even
+    /// the roughness.
+    pub fn failed(&self) -> bool {
+        self.roughness_ratio.is_nan()
+            || !self.roughens() && (self.curvature_ratio.is_nan() || self.mean_error.is_nan())
+    }
+
+    /// The set's [`Rank`] at `tau`.
+    pub fn rank(&self, tau: f64) -> Rank {
+        let score = self.score(tau);
+        if self.failed() || score.is_nan() && !self.roughens() {
+            Rank { class: 2, key: 0.0 }
+        } else if self.roughens() {
+            Rank {
+                class: 1,
+                key: self.roughness_ratio,
+            }
+        } else {
+            Rank {
+                class: 0,
+                key: score,
+            }
+        }
+    }
 
     /// The accuracy half of the score, `0.5 * (E/(E+1) + |V-V0|/V0)`. Without a volume (open
     /// mesh) it is `E/(E+1)` alone, the mean of the terms that exist, as in [`crate::metrics`].
@@ -258,11 +357,36 @@ mod tests {
     use super::*;
 
     #[test]
+    fn sets_that_smooth_rank_first_then_the_least_rough_then_failures() {
+        let smooths = |s: f64| Terms {
+            curvature_ratio: s,
+            mean_error: 0.0,
+            volume_change: Some(0.0),
+            roughness_ratio: 0.3,
+        };
+        let (good, worse) = (smooths(0.4), smooths(0.9));
+        // A blown-up mesh whose score, had it been measured, would beat both.
+        let (rough, rougher) = (Terms::roughened(1.5), Terms::roughened(80.0));
+        let failed = failed_terms(1)[0];
+        let ranks = [good, worse, rough, rougher, failed].map(|t| t.rank(1.0));
+        for pair in ranks.windows(2) {
+            assert!(pair[0] < pair[1], "{pair:?}");
+        }
+        assert!(
+            !Terms::UNCHANGED.roughens(),
+            "the unchanged mesh is as rough as itself"
+        );
+        assert!(Terms::roughened(1.0 + 1e-9).roughens());
+        assert_eq!(smooths(0.4).rank(1.0), good.rank(1.0));
+    }
+
+    #[test]
     fn score_follows_equation_four() {
         let t = Terms {
             curvature_ratio: 0.4,
             mean_error: 0.25,
             volume_change: Some(0.02),
+            roughness_ratio: 0.5,
         };
         let accuracy = 0.5 * (0.25 / 1.25 + 0.02);
         assert!((t.accuracy() - accuracy).abs() < 1e-15);

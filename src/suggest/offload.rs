@@ -75,6 +75,7 @@ pub fn failed_terms(count: usize) -> Vec<Terms> {
             curvature_ratio: f64::NAN,
             mean_error: f64::NAN,
             volume_change: None,
+            roughness_ratio: f64::NAN,
         };
         count
     ]

@@ -20,8 +20,9 @@ struct Partial {
     terms: Vec<Terms>,
     /// Windowed sinc's run towards the next count, under way.
     sinc: Option<SincDrifting>,
-    /// The measure pass at the count reached, under way.
-    measuring: Option<MeasureInParts>,
+    /// The measure pass at the count reached, under way, and R/R0 there (taken first: a count
+    /// that roughens the mesh needs no measure pass).
+    measuring: Option<(MeasureInParts, f64)>,
 }
 
 /// Vertices of the first part of a measure pass, before its speed is known; also the smallest.
@@ -118,13 +119,18 @@ impl<'a> Sliced<'a> {
         let original = self.original;
         let n = original.mesh().vertex_count();
         loop {
-            let Some(pass) = partial.measuring.as_mut() else {
+            let Some((pass, roughness)) = partial.measuring.as_mut() else {
                 let areas = self.runs.vertex_ms.map(|ms| ms * n as f64 * AREAS_SHARE);
                 if !self.fits(areas) {
                     return None;
                 }
+                let roughness = original.roughness_ratio(&partial.positions);
+                if roughness > 1.0 {
+                    self.worked = true;
+                    return Some(Terms::roughened(roughness));
+                }
                 let pass = MeasureInParts::new(original, &partial.positions, &partial.reference);
-                partial.measuring = Some(pass);
+                partial.measuring = Some((pass, roughness));
                 self.worked = true;
                 continue;
             };
@@ -145,8 +151,9 @@ impl<'a> Sliced<'a> {
             self.runs.vertex_ms = Some(((self.clock)() - now) / measured as f64);
             self.worked = true;
             if complete {
-                let (metrics, _) = partial.measuring.take()?.finish(original, 0.5);
-                return Some(terms_of(&metrics));
+                let roughness = *roughness;
+                let (metrics, _) = partial.measuring.take()?.0.finish(original, 0.5);
+                return Some(terms_of(&metrics, roughness));
             }
         }
     }

@@ -4,17 +4,25 @@
 //! since its k-iteration result is not a prefix of a longer run).
 
 use super::space::{Param, ParamSpace};
-use super::{is_cumulative, score_order, Evaluator, Progress, Request, Task, Terms};
+use super::{is_cumulative, Evaluator, Progress, Request, Task, Terms};
 use crate::smooth::{ParamError, Params};
 use serde::{Deserialize, Serialize};
 
-/// One measured sample of a curve.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// One measured sample of a curve (equal as [`Terms`] are: NaN equal to NaN).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct Sample {
     pub value: f64,
     pub terms: Terms,
     /// S(tau) at the sweep's tau.
     pub score: f64,
+}
+
+impl PartialEq for Sample {
+    fn eq(&self, other: &Self) -> bool {
+        self.value == other.value
+            && self.terms == other.terms
+            && super::same(self.score, other.score)
+    }
 }
 
 /// One parameter's graph.
@@ -25,8 +33,9 @@ pub struct Curve {
     pub current: f64,
     /// Ascending by value; only values valid with the others held (Taubin: mu < -lambda).
     pub samples: Vec<Sample>,
-    /// Index of the lowest S (ties: the weaker smoothing): this parameter's suggestion given the
-    /// others. `None` for an empty curve.
+    /// Index of the lowest [`Terms::rank`] (the lowest S among the samples that do not roughen
+    /// the mesh; ties: the weaker smoothing): this parameter's suggestion given the others.
+    /// `None` for an empty curve.
     pub best: Option<usize>,
 }
 
@@ -47,13 +56,10 @@ impl Curve {
         } else {
             (0..n).rev().collect()
         };
-        self.best = order.into_iter().reduce(|a, b| {
-            if score_order(self.samples[b].score, self.samples[a].score).is_lt() {
-                b
-            } else {
-                a
-            }
-        });
+        let rank = |i: usize| self.samples[i].terms.rank(tau);
+        self.best = order
+            .into_iter()
+            .reduce(|a, b| if rank(b) < rank(a) { b } else { a });
     }
 }
 
@@ -154,6 +160,7 @@ impl QualitySweep {
                             curvature_ratio: f64::NAN,
                             mean_error: f64::NAN,
                             volume_change: None,
+                            roughness_ratio: f64::NAN,
                         },
                         score: f64::NAN,
                     })
@@ -270,6 +277,7 @@ mod tests {
                 + ((q.iterations as f64) - 17.0).powi(2) / 100.0,
             mean_error: 0.0,
             volume_change: Some(0.0),
+            roughness_ratio: 0.5,
         });
         let g = sweep(&p, 0.5, &mut ev);
         assert_eq!(g.curves[0].suggestion(), Some(0.35));

@@ -150,6 +150,7 @@ pub fn bowl(space: &ParamSpace, centre: GridPoint) -> impl FnMut(&Params) -> Ter
             curvature_ratio: 1.0 + 0.01 * d2,
             mean_error: 0.0,
             volume_change: Some(0.0),
+            roughness_ratio: 0.5,
         }
     }
 }
@@ -171,6 +172,7 @@ pub fn two_basins(
             curvature_ratio: ta.min(tb),
             mean_error: 0.0,
             volume_change: Some(0.0),
+            roughness_ratio: 0.5,
         }
     }
 }
@@ -196,6 +198,7 @@ pub fn smoothing_model(filter: Filter) -> impl FnMut(&Params) -> Terms {
             curvature_ratio: 0.2 + 0.8 * (-s).exp(),
             mean_error: 0.05 * s,
             volume_change: Some(0.01 * s * (1.0 + 0.1 * s)),
+            roughness_ratio: (-s).exp(),
         }
     }
 }

@@ -16,6 +16,8 @@ const ERROR: RGBColor = RGBColor(44, 160, 44);
 const VOLUME: RGBColor = RGBColor(230, 120, 0);
 const CURRENT: RGBColor = RGBColor(110, 110, 110);
 const BEST: RGBColor = RGBColor(214, 39, 40);
+/// The samples where the filter diverges (a light red bar across the panel).
+const DIVERGES: RGBColor = RGBColor(244, 190, 190);
 
 /// What the figure is of, for its title.
 pub struct Figure<'a> {
@@ -156,6 +158,16 @@ pub fn draw(graphs: &QualityGraphs, figure: &Figure, path: &std::path::Path) -> 
     if figure.voxel_size.is_some() {
         key.push((Mark::Dashed(ERROR), "half voxel diagonal".to_string()));
     }
+    let diverges = graphs
+        .curves
+        .iter()
+        .any(|c| c.samples.iter().any(|s| s.terms.roughens()));
+    if diverges {
+        key.push((
+            Mark::Line(DIVERGES, 8),
+            "filter diverges: rougher than the original, never suggested".to_string(),
+        ));
+    }
     draw_key(&header, &key, 18, 88)?;
     let cells = body.split_evenly((2, columns));
     for (k, curve) in graphs.curves.iter().enumerate() {
@@ -204,8 +216,18 @@ fn draw_key(area: &Area, key: &[(Mark, String)], x0: i32, y0: i32) -> Result<(),
     Ok(())
 }
 
-/// The markers both panels share: the current value (dashed) and the lowest S (thin red).
+/// The markers both panels share: bars where the filter diverges, the current value (dashed)
+/// and the lowest S (thin red).
 fn markers(chart: &mut Chart, curve: &Curve, y_top: f64) -> Result<(), String> {
+    for s in curve.samples.iter().filter(|s| s.terms.roughens()) {
+        let x = x_of(curve.param, s.value);
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(x, 0.0), (x, y_top)],
+                DIVERGES.stroke_width(8),
+            )))
+            .map_err(err)?;
+    }
     let x = x_of(curve.param, curve.current);
     chart
         .draw_series(std::iter::once(DashedPathElement::new(
@@ -233,15 +255,23 @@ fn line(
     value: impl Fn(&Sample) -> Option<f64>,
     style: ShapeStyle,
 ) -> Result<(), String> {
-    let points: Vec<(f64, f64)> = curve
-        .samples
-        .iter()
-        .filter_map(|s| Some((x_of(curve.param, s.value), value(s)?)))
-        .filter(|p| p.1.is_finite())
-        .collect();
-    chart
-        .draw_series(LineSeries::new(points, style))
-        .map_err(err)?;
+    // Runs of samples with a value: the curve breaks off where the filter diverges.
+    let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for s in &curve.samples {
+        match value(s).filter(|v| v.is_finite()) {
+            Some(v) => runs
+                .last_mut()
+                .expect("never empty")
+                .push((x_of(curve.param, s.value), v)),
+            None if runs.last().is_some_and(|r| !r.is_empty()) => runs.push(Vec::new()),
+            None => {}
+        }
+    }
+    for run in runs.into_iter().filter(|r| !r.is_empty()) {
+        chart
+            .draw_series(LineSeries::new(run, style))
+            .map_err(err)?;
+    }
     Ok(())
 }
 
