@@ -142,16 +142,7 @@ fn column(
     let link = ui.scope_id().with(("graphs_x", format!("{param:?}")));
     let mut picked = None;
     for (k, strip) in STRIPS.iter().enumerate() {
-        // Runs of measured samples: a curve breaks off where a sample has no value.
-        let mut runs: Vec<Vec<[f64; 2]>> = vec![Vec::new()];
-        for s in &curve.samples {
-            match (strip.value)(s).filter(|v| v.is_finite()) {
-                Some(v) => runs.last_mut().expect("never empty").push([s.value, v]),
-                None if runs.last().is_some_and(|r| !r.is_empty()) => runs.push(Vec::new()),
-                None => {}
-            }
-        }
-        runs.retain(|r| !r.is_empty());
+        let runs = curve.runs(strip.value);
         let last = k + 1 == STRIPS.len();
         let plot = Plot::new(("graph", format!("{param:?}"), k))
             .height(strip_height)

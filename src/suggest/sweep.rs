@@ -40,6 +40,21 @@ pub struct Curve {
 }
 
 impl Curve {
+    /// The curve of `value` as runs of `[parameter value, value]` points: it breaks off at each
+    /// sample without a finite value (not measured, or where the filter diverges).
+    pub fn runs(&self, value: impl Fn(&Sample) -> Option<f64>) -> Vec<Vec<[f64; 2]>> {
+        let mut runs: Vec<Vec<[f64; 2]>> = vec![Vec::new()];
+        for s in &self.samples {
+            match value(s).filter(|v| v.is_finite()) {
+                Some(v) => runs.last_mut().expect("never empty").push([s.value, v]),
+                None if runs.last().is_some_and(|r| !r.is_empty()) => runs.push(Vec::new()),
+                None => {}
+            }
+        }
+        runs.retain(|r| !r.is_empty());
+        runs
+    }
+
     /// The suggested value of this parameter with the others held.
     pub fn suggestion(&self) -> Option<f64> {
         self.best.map(|i| self.samples[i].value)
@@ -266,6 +281,37 @@ mod tests {
                 assert_eq!(s.score, s.terms.score(0.5));
             }
         }
+    }
+
+    #[test]
+    fn a_curve_breaks_off_where_a_sample_has_no_value() {
+        let sample = |value: f64, ratio: f64| Sample {
+            value,
+            terms: Terms {
+                roughness_ratio: ratio,
+                ..Terms::UNCHANGED
+            },
+            score: 0.0,
+        };
+        let roughened = |value: f64| Sample {
+            value,
+            terms: Terms::roughened(2.0),
+            score: f64::NAN,
+        };
+        let curve = Curve {
+            param: Param::Lambda,
+            current: 0.5,
+            samples: vec![
+                roughened(0.0),
+                sample(0.1, 0.5),
+                sample(0.2, 0.4),
+                roughened(0.3),
+                sample(0.4, 0.3),
+            ],
+            best: None,
+        };
+        let runs = curve.runs(|s| Some(s.terms.curvature_ratio));
+        assert_eq!(runs, vec![vec![[0.1, 1.0], [0.2, 1.0]], vec![[0.4, 1.0]]]);
     }
 
     #[test]

@@ -255,21 +255,10 @@ fn line(
     value: impl Fn(&Sample) -> Option<f64>,
     style: ShapeStyle,
 ) -> Result<(), String> {
-    // Runs of samples with a value: the curve breaks off where the filter diverges.
-    let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for s in &curve.samples {
-        match value(s).filter(|v| v.is_finite()) {
-            Some(v) => runs
-                .last_mut()
-                .expect("never empty")
-                .push((x_of(curve.param, s.value), v)),
-            None if runs.last().is_some_and(|r| !r.is_empty()) => runs.push(Vec::new()),
-            None => {}
-        }
-    }
-    for run in runs.into_iter().filter(|r| !r.is_empty()) {
+    for run in curve.runs(value) {
+        let points = run.into_iter().map(|[x, y]| (x_of(curve.param, x), y));
         chart
-            .draw_series(LineSeries::new(run, style))
+            .draw_series(LineSeries::new(points, style))
             .map_err(err)?;
     }
     Ok(())
