@@ -99,6 +99,51 @@ fn errors_exit_non_zero_with_a_message_naming_the_file() {
 }
 
 #[test]
+fn an_output_that_cannot_be_written_is_refused_and_what_was_there_is_kept() {
+    let input = data("synthetic/synthetic_sphere_r20.ply");
+    let input = input.to_str().unwrap();
+    let missing = tmp("no such folder/out.ply");
+    let out = meshsmooth(&["smooth", input, "-o", missing.to_str().unwrap(), "--auto"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("does not exist"), "{err}");
+    let plot = tmp("no such folder/graphs.png");
+    let out = meshsmooth(&["sweep", input, "--plot", plot.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
+
+    // A file the user protected stays as it was; a writable one is replaced whole, no
+    // temporary file left beside it.
+    // A folder of its own: other tests write beside each other at the same time.
+    let kept = tmp("protected").join("model.ply");
+    std::fs::create_dir_all(kept.parent().unwrap()).unwrap();
+    std::fs::write(&kept, b"the user's model").unwrap();
+    let mut permissions = std::fs::metadata(&kept).unwrap().permissions();
+    permissions.set_readonly(true);
+    std::fs::set_permissions(&kept, permissions.clone()).unwrap();
+    let out = meshsmooth(&["smooth", input, "-o", kept.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("read-only"));
+    assert_eq!(std::fs::read(&kept).unwrap(), b"the user's model");
+    #[allow(clippy::permissions_set_readonly_false)]
+    permissions.set_readonly(false);
+    std::fs::set_permissions(&kept, permissions).unwrap();
+    json(&meshsmooth(&["smooth", input, "-o", kept.to_str().unwrap(), "--json"]));
+    assert!(meshsmooth_load(&kept) > 0);
+    let litter: Vec<_> = std::fs::read_dir(kept.parent().unwrap())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(litter.is_empty(), "{litter:?}");
+}
+
+/// The vertex count `meshsmooth info` reads from `path`.
+fn meshsmooth_load(path: &std::path::Path) -> u64 {
+    json(&meshsmooth(&["info", path.to_str().unwrap(), "--json"]))["vertices"]
+        .as_u64()
+        .unwrap()
+}
+
+#[test]
 fn convert_keeps_vertex_order_through_every_format() {
     let input = data("synthetic/synthetic_bent_tube_r3.5.ply");
     let original = json(&meshsmooth(&["info", input.to_str().unwrap(), "--json"]));

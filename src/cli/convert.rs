@@ -5,6 +5,7 @@ use std::path::Path;
 
 pub(super) fn run(input: &Path, output: &Path) -> Result<(), String> {
     let format = output_format(output)?;
+    super::check_destination(output)?;
     let mesh = super::load_file(input)?;
     let bytes = export::write(&mesh, format, &ExportOptions::default())
         .map_err(|e| format!("{}: {e}", output.display()))?;

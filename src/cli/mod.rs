@@ -7,6 +7,7 @@ mod bench_load;
 mod convert;
 mod info;
 mod measure;
+mod output;
 mod params;
 mod smooth;
 mod suggest;
@@ -15,6 +16,8 @@ mod sweep;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+pub(crate) use output::{check_destination, write_file};
 
 #[derive(Parser)]
 #[command(
@@ -160,11 +163,6 @@ pub(crate) fn load_file(path: &Path) -> Result<crate::mesh::Mesh, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let name = path.to_string_lossy();
     crate::io::load(&bytes, &name).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// Writes bytes to a file; errors name the file.
-pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// Refuses a score weight outside [0, 1].

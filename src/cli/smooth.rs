@@ -24,6 +24,7 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
     let (tau, json) = (how.tau, how.json);
     super::check_tau(tau)?;
     let format = super::convert::output_format(output)?;
+    super::check_destination(output)?;
     let mut params = args.params()?;
     let mesh = super::load_file(file)?;
     let topology = Topology::build(&mesh);

@@ -47,6 +47,9 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
         }
     }
     let current = args.params.params()?;
+    if let Some(path) = &args.plot {
+        super::check_destination(path)?;
+    }
     let mesh = super::load_file(&args.file)?;
     let start = std::time::Instant::now();
     let topology = Topology::build(&mesh);
@@ -67,7 +70,9 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
             title: &title,
             voxel_size: args.voxel_size,
         };
-        plot::draw(&graphs, &figure, path).map_err(|e| format!("{}: {e}", path.display()))?;
+        super::output::write_whole(path, |partial| {
+            plot::draw(&graphs, &figure, partial).map_err(|e| format!("{}: {e}", path.display()))
+        })?;
     }
     if args.json {
         println!("{}", super::to_json(&graphs.to_json(seconds))?);
