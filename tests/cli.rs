@@ -126,7 +126,13 @@ fn an_output_that_cannot_be_written_is_refused_and_what_was_there_is_kept() {
     #[allow(clippy::permissions_set_readonly_false)]
     permissions.set_readonly(false);
     std::fs::set_permissions(&kept, permissions).unwrap();
-    json(&meshsmooth(&["smooth", input, "-o", kept.to_str().unwrap(), "--json"]));
+    json(&meshsmooth(&[
+        "smooth",
+        input,
+        "-o",
+        kept.to_str().unwrap(),
+        "--json",
+    ]));
     assert!(meshsmooth_load(&kept) > 0);
     let litter: Vec<_> = std::fs::read_dir(kept.parent().unwrap())
         .unwrap()

@@ -89,11 +89,17 @@ impl Activity {
                 progress,
                 tau,
                 method,
-            } => format!(
-                "Suggesting for tau {tau:.2} ({} search): {} parameter sets",
-                method.name(),
-                progress.done
-            ),
+            } => match method {
+                // Short enough for the side panel. The local search ends long before it could
+                // have measured the whole grid, so it counts without a total.
+                SearchMethod::Local => {
+                    format!("Local search, τ {tau:.2}: {} sets measured", progress.done)
+                }
+                SearchMethod::Grid => format!(
+                    "Grid search, τ {tau:.2}: {} of {} sets",
+                    progress.done, progress.total
+                ),
+            },
             Activity::Gallery { done, total } => format!("Gallery: {done} of {total} models"),
         }
     }

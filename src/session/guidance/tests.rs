@@ -255,3 +255,27 @@ fn searches_reuse_the_terms_measured_before_until_the_weights_change() {
     settle_on(&mut s, Some(&mut offload));
     assert!(offload.requests.len() > suggestion + gallery);
 }
+
+#[test]
+fn a_suggestion_in_progress_says_how_far_it_is_in_a_line_the_side_panel_fits() {
+    let progress = Progress {
+        done: 250,
+        total: 1331,
+    };
+    let grid = Activity::Suggest {
+        progress,
+        tau: 0.5,
+        method: SearchMethod::Grid,
+    };
+    assert_eq!(grid.describe(), "Grid search, τ 0.50: 250 of 1331 sets");
+    let local = Activity::Suggest {
+        progress,
+        tau: 0.5,
+        method: SearchMethod::Local,
+    };
+    assert_eq!(local.describe(), "Local search, τ 0.50: 250 sets measured");
+    // About 40 characters fit the side panel's default width.
+    for a in [grid, local] {
+        assert!(a.describe().chars().count() <= 40, "{}", a.describe());
+    }
+}
