@@ -9,6 +9,7 @@ mod info;
 mod measure;
 mod output;
 mod params;
+mod progress;
 mod smooth;
 mod suggest;
 mod sweep;

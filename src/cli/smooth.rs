@@ -34,11 +34,14 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
     let engine = Engine::open(how.backend)?;
     let suggestion = match how.auto {
         Some(method) => {
+            let mut line = super::suggest::search_progress(params.filter, method);
             let s = engine
                 .with_evaluator(&original, |ev| {
-                    suggest_on(ev, &params, tau, method, &mut |_| true)
+                    suggest_on(ev, &params, tau, method, &mut |p| line.update(p))
                 })?
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| e.to_string());
+            line.finish();
+            let s = s?;
             params = s.params;
             Some(s)
         }

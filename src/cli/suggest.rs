@@ -3,10 +3,12 @@
 
 use super::backend::{parse_backend, Backend, Engine};
 use super::params::filter as parse_filter;
+use super::progress::ProgressLine;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::{Filter, Params};
 use crate::suggest::{suggest_on, SearchMethod, Suggestion};
+use std::io::Stderr;
 use std::path::PathBuf;
 
 /// Parses a search method for clap.
@@ -52,11 +54,14 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
     if original.mesh().vertex_count() == 0 {
         return Err(format!("{}: the mesh has no vertices", args.file.display()));
     }
+    let mut line = search_progress(args.filter, args.search);
     let s = Engine::open(args.backend)?
         .with_evaluator(&original, |ev| {
-            suggest_on(ev, &base, args.tau, args.search, &mut |_| true)
+            suggest_on(ev, &base, args.tau, args.search, &mut |p| line.update(p))
         })?
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| e.to_string());
+    line.finish();
+    let s = s?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
         println!("{}", super::to_json(&s.to_json(seconds))?);
@@ -64,6 +69,12 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
         print!("{}", text(&s, seconds));
     }
     Ok(())
+}
+
+/// The terminal's progress line for a search.
+pub(super) fn search_progress(filter: Filter, search: SearchMethod) -> ProgressLine<Stderr> {
+    let what = format!("suggesting {filter} parameters ({} search)", search.name());
+    ProgressLine::on_terminal(&what, search == SearchMethod::Local)
 }
 
 fn text(s: &Suggestion, seconds: f64) -> String {

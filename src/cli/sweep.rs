@@ -5,6 +5,7 @@ mod plot;
 
 use super::backend::{parse_backend, Backend, Engine};
 use super::params::FilterArgs;
+use super::progress::ProgressLine;
 use crate::mesh::Topology;
 use crate::metrics::Original;
 use crate::smooth::Filter;
@@ -54,11 +55,15 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
     let start = std::time::Instant::now();
     let topology = Topology::build(&mesh);
     let original = Original::new(&mesh, &topology);
+    let what = format!("sweeping the {} parameters", current.filter);
+    let mut line = ProgressLine::on_terminal(&what, false);
     let graphs = Engine::open(args.backend)?
         .with_evaluator(&original, |ev| {
-            quality_graphs_on(ev, &current, args.tau, &mut |_| true)
+            quality_graphs_on(ev, &current, args.tau, &mut |p| line.update(p))
         })?
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| e.to_string());
+    line.finish();
+    let graphs = graphs?;
     let seconds = start.elapsed().as_secs_f64();
     if let Some(path) = &args.plot {
         let title = format!(
