@@ -82,7 +82,7 @@ impl PaddedRing {
     /// Whether these rows describe `vertex_count` vertices, so a kernel gathering from a buffer of
     /// `vertex_count + 1` entries (the zero entry last) reads nothing out of range: one row per
     /// vertex, every slot of a row that fits at most `vertex_count`, every large ring's range
-    /// within the list and its entries below `vertex_count`. Checked once per smoothing run;
+    /// within the list and its entries below `vertex_count`. Checked once per topology;
     /// each task's loop has no early exit.
     pub fn describes(&self, vertex_count: usize) -> bool {
         let sized = self.rows.len() == vertex_count && self.inverse_sizes.len() == vertex_count;

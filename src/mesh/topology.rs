@@ -30,6 +30,9 @@ pub struct Topology {
     boundary_ring: Option<(Vec<u32>, Vec<u32>)>,
     /// The smoothing neighbourhood in fixed rows, as the CPU kernels read it.
     padded_ring: PaddedRing,
+    /// The vertex count `padded_ring` describes ([`PaddedRing::describes`]), checked once here:
+    /// every smoothing run asks, and the web app's runs come in many short pieces.
+    padded_ring_for: Option<usize>,
 }
 
 impl Topology {
@@ -81,6 +84,7 @@ impl Topology {
             Some((offsets, ring)) => PaddedRing::new(offsets, ring),
             None => PaddedRing::new(&neighbor_offsets, &neighbors),
         };
+        let padded_ring_for = padded_ring.describes(n).then_some(n);
 
         Self {
             neighbor_offsets,
@@ -91,6 +95,7 @@ impl Topology {
             is_boundary,
             boundary_ring,
             padded_ring,
+            padded_ring_for,
         }
     }
 
@@ -128,6 +133,12 @@ impl Topology {
     /// [`Self::smoothing_ring`] in fixed rows of eight slots (see [`PaddedRing`]).
     pub fn padded_ring(&self) -> &PaddedRing {
         &self.padded_ring
+    }
+
+    /// Whether [`Self::padded_ring`] describes `vertex_count` vertices, so the kernels may
+    /// gather with it from buffers of that many (see [`PaddedRing::describes`]).
+    pub fn padded_ring_describes(&self, vertex_count: usize) -> bool {
+        self.padded_ring_for == Some(vertex_count)
     }
 
     /// Number of distinct undirected edges.

@@ -209,29 +209,63 @@ impl Clone for DriftingReference<'_> {
     }
 }
 
+/// What a drift carries from one piece of a run to the next, for a run spread over several
+/// calls (the web app spreads one over frames): each vertex's reference and its anchor. The
+/// references alone would give the same drift, but every vertex would start the next piece
+/// from its home anchor, and most would check their rings again.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DriftState {
+    reference: Vec<u32>,
+    anchors: Vec<[f32; 4]>,
+}
+
+impl DriftState {
+    /// Every vertex of `original` at itself, as a run starts.
+    pub fn start(original: &Original) -> Self {
+        let n = original.mesh().vertex_count();
+        Self {
+            reference: identity(n),
+            anchors: (0..n).map(|i| home_anchor(original, i)).collect(),
+        }
+    }
+
+    /// The current reference vertex of every vertex.
+    pub fn reference(&self) -> &[u32] {
+        &self.reference
+    }
+
+    pub fn into_reference(self) -> Vec<u32> {
+        self.reference
+    }
+}
+
 impl<'a> DriftingReference<'a> {
     /// Every vertex starts at itself.
     pub fn new(original: &'a Original) -> Self {
-        Self::resume(original, identity(original.mesh().vertex_count()))
+        Self::resume(original, DriftState::start(original))
     }
 
-    /// Continues a drift from `reference` (an earlier state of one, one entry per vertex): a
-    /// run spread over several calls keeps its references between them.
-    pub fn resume(original: &'a Original, reference: Vec<u32>) -> Self {
-        assert_eq!(
-            reference.len(),
-            original.mesh().vertex_count(),
-            "one reference per vertex"
+    /// Continues a drift from `state`, which an earlier piece of the same run on `original`
+    /// left ([`Self::into_state`]).
+    pub fn resume(original: &'a Original, state: DriftState) -> Self {
+        let n = original.mesh().vertex_count();
+        assert!(
+            state.reference.len() == n && state.anchors.len() == n,
+            "one reference and one anchor per vertex"
         );
-        let anchors = reference
-            .iter()
-            .map(|&r| home_anchor(original, r as usize))
-            .collect();
         Self {
             original,
-            reference,
-            anchors,
+            reference: state.reference,
+            anchors: state.anchors,
             ring_checks: AtomicUsize::new(0),
+        }
+    }
+
+    /// The state to [`Self::resume`] from in the next piece of the run.
+    pub fn into_state(self) -> DriftState {
+        DriftState {
+            reference: self.reference,
+            anchors: self.anchors,
         }
     }
 
@@ -478,5 +512,58 @@ mod tests {
         // Off every prism, beyond corner 1: the distance to corner 1, the fan's nearest point.
         let e = vertex_local_error(&original, [2.0, -0.5, -0.5], 0);
         assert!((e - 1.5f64.sqrt()).abs() < 1e-7, "{e}");
+    }
+}
+
+#[cfg(test)]
+mod resume_tests {
+    use super::*;
+    use crate::smooth::{Filter, Params};
+
+    /// The positions after each iteration of HC on the bundled sample.
+    fn steps(original: &Original, iterations: u32) -> Vec<Vec<[f32; 3]>> {
+        struct Keep(Vec<Vec<[f32; 3]>>);
+        impl StepObserver for Keep {
+            fn after_iteration(&mut self, _: u32, positions: &[[f32; 3]]) {
+                self.0.push(positions.to_vec());
+            }
+        }
+        let mut params = Params::defaults(Filter::Hc);
+        params.iterations = iterations;
+        let mut keep = Keep(Vec::new());
+        smooth(
+            original.mesh(),
+            original.topology(),
+            &params,
+            None,
+            &mut keep,
+        );
+        keep.0
+    }
+
+    #[test]
+    fn a_drift_resumed_from_its_state_goes_on_as_if_never_stopped() {
+        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let mesh = crate::io::load(bytes, "sample.ply").unwrap();
+        let original = Original::new(&mesh, &crate::mesh::Topology::build(&mesh));
+        let steps = steps(&original, 12);
+        let mut whole = DriftingReference::new(&original);
+        let mut pieces = DriftingReference::new(&original);
+        for (k, positions) in steps.iter().enumerate() {
+            whole.update(positions);
+            if k % 3 == 0 {
+                pieces = DriftingReference::resume(&original, pieces.into_state());
+            }
+            pieces.update(positions);
+            assert_eq!(pieces.reference(), whole.reference(), "step {k}");
+            // The anchors came along: no vertex checks its ring again for having stopped.
+            assert_eq!(pieces.ring_checks(), whole.ring_checks(), "step {k}");
+        }
+        assert!(
+            whole.ring_checks() < mesh.vertex_count() / 2,
+            "most vertices stay within their anchors"
+        );
+        let state = whole.into_state();
+        assert_eq!(state.clone().into_reference(), state.reference());
     }
 }

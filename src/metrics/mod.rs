@@ -18,7 +18,7 @@ mod sinc_drifting;
 
 pub use curvature::{vertex_curvatures, VertexCurvature};
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
-pub use local_error::{identity, smooth_drifting, DriftingReference};
+pub use local_error::{identity, smooth_drifting, DriftState, DriftingReference};
 pub use original::{Original, OriginalInParts};
 pub use report::{
     exact_distances, exact_error, measure, measure_shape, measure_vertices, ErrorSummary,

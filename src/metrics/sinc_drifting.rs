@@ -2,7 +2,7 @@
 //! passes, then the drifting reference's steps towards the result (one per degree, as the
 //! filter reports them to its observer), a few pieces per call.
 
-use super::{identity, DriftingReference, Original};
+use super::{DriftState, DriftingReference, Original};
 use crate::smooth::{Params, SincInParts};
 
 /// A windowed-sinc run with its drifting reference, under way between calls.
@@ -10,7 +10,7 @@ pub struct SincDrifting {
     /// The recurrence, until every term is summed.
     sinc: Option<SincInParts>,
     positions: Vec<[f32; 3]>,
-    reference: Vec<u32>,
+    drift: DriftState,
     /// Drift steps taken of `params.iterations`.
     drifted: u32,
     iterations: u32,
@@ -23,7 +23,7 @@ impl SincDrifting {
         Some(Self {
             sinc: Some(sinc),
             positions: Vec::new(),
-            reference: identity(original.mesh().vertex_count()),
+            drift: DriftState::start(original),
             drifted: 0,
             iterations: params.iterations,
         })
@@ -50,11 +50,11 @@ impl SincDrifting {
             self.positions = sinc.finish(mesh, params, weights);
         }
         let steps = left.min(self.iterations - self.drifted);
-        let mut drift = DriftingReference::resume(original, std::mem::take(&mut self.reference));
+        let mut drift = DriftingReference::resume(original, std::mem::take(&mut self.drift));
         for _ in 0..steps {
             drift.update(&self.positions);
         }
-        self.reference = drift.into_reference();
+        self.drift = drift.into_state();
         self.drifted += steps;
         self.drifted == self.iterations
     }
@@ -68,9 +68,9 @@ impl SincDrifting {
         (passes + self.drifted, 2 * self.iterations)
     }
 
-    /// The positions and their drifted references, once [`Self::advance`] returned true:
-    /// [`super::smooth_drifting`]'s result, bit for bit.
-    pub fn into_result(self) -> (Vec<[f32; 3]>, Vec<u32>) {
-        (self.positions, self.reference)
+    /// The positions and the drift (its references: [`super::smooth_drifting`]'s, bit for
+    /// bit), once [`Self::advance`] returned true.
+    pub fn into_result(self) -> (Vec<[f32; 3]>, DriftState) {
+        (self.positions, self.drift)
     }
 }

@@ -3,7 +3,7 @@
 //! of vertices at a time, each call within a time budget.
 
 use super::{Model, Smoothed, Timings};
-use crate::metrics::{self, DriftingReference, MeasureInParts, SincDrifting};
+use crate::metrics::{DriftState, DriftingReference, MeasureInParts, SincDrifting};
 use crate::smooth::{self, Filter, Params};
 
 /// How far a run got (see [`super::Session::progress`]).
@@ -41,7 +41,7 @@ impl CpuProgress {
 pub(super) struct CpuJob {
     pub revision: u64,
     positions: Vec<[f32; 3]>,
-    reference: Vec<u32>,
+    drift: DriftState,
     done: u32,
     smooth_ms: f64,
     /// Windowed sinc under way (its terms are not shorter runs' results, so it cannot be
@@ -50,23 +50,35 @@ pub(super) struct CpuJob {
     /// The measure pass, once the smoothing is done.
     measure: Option<MeasureInParts>,
     measure_ms: f64,
+    /// Milliseconds per iteration seen so far, with the filter that took them: a call sizes
+    /// its first piece of iterations by it, rather than starting with one (each piece costs a
+    /// few copies of the positions besides its iterations).
+    pace: Option<(Filter, f64)>,
 }
 
 /// Vertices of the first part of a measure pass, before its speed is known.
 const FIRST_MEASURE_PART: usize = MeasureInParts::SMALLEST_PART;
 
 impl CpuJob {
-    pub fn new(revision: u64, model: &Model) -> Self {
+    /// A job for `revision`; `pace`, the milliseconds per iteration seen by an earlier job on
+    /// the same model, with its filter.
+    pub fn new(revision: u64, model: &Model, pace: Option<(Filter, f64)>) -> Self {
         Self {
             revision,
             positions: model.mesh().positions.clone(),
-            reference: metrics::identity(model.mesh().vertex_count()),
+            drift: DriftState::start(&model.original),
             done: 0,
             smooth_ms: 0.0,
             sinc: None,
             measure: None,
             measure_ms: 0.0,
+            pace,
         }
+    }
+
+    /// Milliseconds per iteration seen so far, with the filter.
+    pub fn pace(&self) -> Option<(Filter, f64)> {
+        self.pace
     }
 
     pub fn progress(&self, params: &Params) -> CpuProgress {
@@ -129,8 +141,8 @@ impl CpuJob {
         Some((smoothed, timings))
     }
 
-    /// Iterations until `deadline` (at least one; each call of `smooth::resume` re-checks the
-    /// rings and allocates its second buffer, so fewer, longer calls cost less).
+    /// Iterations until `deadline` (at least one; each call of `smooth::resume` lays the
+    /// positions out and allocates its second buffer, so fewer, longer calls cost less).
     fn smooth(
         &mut self,
         model: &Model,
@@ -143,10 +155,17 @@ impl CpuJob {
             self.smooth_sinc(model, params, weights, clock, deadline);
             return;
         }
-        in_pieces(clock, deadline, 1, |n| {
+        let first = match self.pace {
+            Some((filter, ms)) if filter == params.filter && ms > 0.0 => {
+                ((deadline - clock()) / ms).max(1.0) as usize
+            }
+            _ => 1,
+        };
+        in_pieces(clock, deadline, first, |n| {
+            let start = clock();
             let chunk = (params.iterations - self.done).min(n.try_into().unwrap_or(u32::MAX));
             let mut drift =
-                DriftingReference::resume(&model.original, std::mem::take(&mut self.reference));
+                DriftingReference::resume(&model.original, std::mem::take(&mut self.drift));
             let positions = std::mem::take(&mut self.positions);
             self.positions = smooth::resume(
                 model.mesh(),
@@ -159,8 +178,9 @@ impl CpuJob {
                 &mut drift,
             )
             .unwrap_or_default();
-            self.reference = drift.into_reference();
+            self.drift = drift.into_state();
             self.done += chunk;
+            self.pace = Some((params.filter, (clock() - start) / f64::from(chunk.max(1))));
             self.done >= params.iterations
         });
     }
@@ -187,7 +207,7 @@ impl CpuJob {
             sinc.advance(original, params, weights, n.try_into().unwrap_or(u32::MAX))
         });
         if finished {
-            (self.positions, self.reference) = sinc.into_result();
+            (self.positions, self.drift) = sinc.into_result();
             self.done = params.iterations;
         } else {
             self.sinc = Some(sinc);
@@ -197,7 +217,7 @@ impl CpuJob {
     /// Parts of the measure pass until `deadline` (at least one); whether it is complete.
     fn measure(&mut self, model: &Model, clock: &dyn Fn() -> f64, deadline: f64) -> bool {
         let original = &model.original;
-        let (positions, reference) = (&self.positions, &self.reference);
+        let (positions, reference) = (&self.positions, self.drift.reference());
         let pass = self
             .measure
             .get_or_insert_with(|| MeasureInParts::new(original, positions, reference));

@@ -89,6 +89,9 @@ pub struct Session {
     revision: u64,
     result: Option<Smoothed>,
     job: Option<CpuJob>,
+    /// The CPU engine's last pace on a model (its id, the filter, milliseconds per iteration),
+    /// so a new run sizes its first piece of iterations to the frame.
+    cpu_pace: Option<(u64, Filter, f64)>,
     /// Why the last file could not be opened; cleared by the next successful open.
     error: Option<String>,
     /// Counts the models opened, so background results of another model are told apart.
@@ -115,6 +118,7 @@ impl Default for Session {
             revision: 0,
             result: None,
             job: None,
+            cpu_pace: None,
             error: None,
             model_id: 0,
             weights: None,
@@ -344,14 +348,24 @@ impl Session {
         let model = self.model.as_ref()?;
         let mut job = match self.job.take() {
             Some(job) if job.revision == self.revision => job,
-            _ => CpuJob::new(self.revision, model),
+            _ => {
+                let pace = self
+                    .cpu_pace
+                    .filter(|&(model, ..)| model == self.model_id)
+                    .map(|(_, filter, ms)| (filter, ms));
+                CpuJob::new(self.revision, model, pace)
+            }
         };
         let settings = (
             &self.params[slot(self.filter)],
             self.weights.as_deref(),
             self.tau,
         );
-        let (result, timings) = match job.step(model, settings, clock, budget_ms) {
+        let stepped = job.step(model, settings, clock, budget_ms);
+        if let Some((filter, ms)) = job.pace() {
+            self.cpu_pace = Some((self.model_id, filter, ms));
+        }
+        let (result, timings) = match stepped {
             Some(done) => done,
             None => {
                 self.job = Some(job);

@@ -21,13 +21,15 @@ pub(crate) struct Rings<'a> {
 
 impl<'a> Rings<'a> {
     /// `None` when the topology does not describe `vertex_count` vertices (built for another
-    /// mesh; see [`PaddedRing::describes`]).
+    /// mesh; see [`PaddedRing::describes`], checked when the topology was built).
     pub(crate) fn new(topology: &'a Topology, vertex_count: usize) -> Option<Self> {
         let padded = topology.padded_ring();
-        padded.describes(vertex_count).then_some(Self {
-            padded,
-            vertex_count,
-        })
+        topology
+            .padded_ring_describes(vertex_count)
+            .then_some(Self {
+                padded,
+                vertex_count,
+            })
     }
 
     pub(crate) fn vertex_count(&self) -> usize {

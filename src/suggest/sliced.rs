@@ -7,7 +7,7 @@
 
 use super::mesh_evaluator::{terms_of, MeshEvaluator, WeightsError};
 use super::{is_cumulative, Evaluator, Terms};
-use crate::metrics::{self, DriftingReference, MeasureInParts, Original, SincDrifting};
+use crate::metrics::{DriftState, DriftingReference, MeasureInParts, Original, SincDrifting};
 use crate::smooth::{self, Params};
 
 /// A run under way between calls.
@@ -15,7 +15,7 @@ struct Partial {
     params: Params,
     at: Vec<u32>,
     positions: Vec<[f32; 3]>,
-    reference: Vec<u32>,
+    drift: DriftState,
     done: u32,
     terms: Vec<Terms>,
     /// Windowed sinc's run towards the next count, under way.
@@ -101,7 +101,7 @@ impl<'a> Sliced<'a> {
             params: *params,
             at: at.to_vec(),
             positions: self.original.mesh().positions.clone(),
-            reference: metrics::identity(self.original.mesh().vertex_count()),
+            drift: DriftState::start(self.original),
             done: 0,
             terms: Vec::with_capacity(at.len()),
             sinc: None,
@@ -129,7 +129,8 @@ impl<'a> Sliced<'a> {
                     self.worked = true;
                     return Some(Terms::roughened(roughness));
                 }
-                let pass = MeasureInParts::new(original, &partial.positions, &partial.reference);
+                let pass =
+                    MeasureInParts::new(original, &partial.positions, partial.drift.reference());
                 partial.measuring = Some((pass, roughness));
                 self.worked = true;
                 continue;
@@ -146,7 +147,12 @@ impl<'a> Sliced<'a> {
                 return None;
             }
             let before = pass.measured();
-            let complete = pass.advance(original, &partial.positions, &partial.reference, vertices);
+            let complete = pass.advance(
+                original,
+                &partial.positions,
+                partial.drift.reference(),
+                vertices,
+            );
             let measured = (pass.measured() - before).max(1);
             self.runs.vertex_ms = Some(((self.clock)() - now) / measured as f64);
             self.worked = true;
@@ -172,8 +178,8 @@ impl<'a> Sliced<'a> {
         let chunk = if is_cumulative(params.filter) {
             let chunk = fit.clamp(1, target - partial.done);
             let positions = std::mem::take(&mut partial.positions);
-            let reference = std::mem::take(&mut partial.reference);
-            let mut drift = DriftingReference::resume(self.original, reference);
+            let state = std::mem::take(&mut partial.drift);
+            let mut drift = DriftingReference::resume(self.original, state);
             partial.positions = smooth::resume(
                 self.original.mesh(),
                 self.original.topology(),
@@ -185,7 +191,7 @@ impl<'a> Sliced<'a> {
                 &mut drift,
             )
             .unwrap_or_default();
-            partial.reference = drift.into_reference();
+            partial.drift = drift.into_state();
             partial.done += chunk;
             chunk
         } else {
@@ -194,7 +200,7 @@ impl<'a> Sliced<'a> {
             match sinc.or_else(|| SincDrifting::new(self.original, &params)) {
                 Some(mut sinc) => {
                     if sinc.advance(self.original, &params, self.weights, fit) {
-                        (partial.positions, partial.reference) = sinc.into_result();
+                        (partial.positions, partial.drift) = sinc.into_result();
                         partial.done = target;
                     } else {
                         partial.sinc = Some(sinc);
@@ -232,7 +238,7 @@ impl Sliced<'_> {
             self.advance(&mut partial, params.iterations);
         }
         self.runs.runs += 1;
-        Some((partial.positions, partial.reference))
+        Some((partial.positions, partial.drift.into_reference()))
     }
 }
 
@@ -270,6 +276,7 @@ mod tests {
     use super::*;
     use crate::io;
     use crate::mesh::Topology;
+    use crate::metrics;
     use crate::smooth::Filter;
     use std::cell::Cell;
 
