@@ -173,24 +173,32 @@ async function framesWhileGraphsCompute(query) {
         await app.call("setFilter", "hc");
         await app.loadMesh(readFileSync(BRAIN), "brain.ply");
         await app.call("metrics");
-        const frames = () =>
+        // Frame times over 8 s; with `whileBusy`, only while something runs in the background
+        // (looked at four times a second): the graphs may finish sooner.
+        const frames = (whileBusy = false) =>
             app.page.evaluate(
-                (ms) =>
+                ({ ms, whileBusy }) =>
                     new Promise((resolve) => {
                         const times = [];
                         const start = performance.now();
+                        let looked = start;
+                        let busy = true;
                         const tick = (now) => {
                             times.push(now);
-                            if (now - start < ms) requestAnimationFrame(tick);
+                            if (whileBusy && now - looked >= 250) {
+                                looked = now;
+                                busy = window.meshsmooth.state().guidance.activities.length > 0;
+                            }
+                            if (now - start < ms && busy) requestAnimationFrame(tick);
                             else {
                                 const d = times.slice(1).map((t, i) => t - times[i]).sort((a, b) => a - b);
                                 const q = (f) => d[Math.min(d.length - 1, Math.floor(f * d.length))];
-                                resolve({ frames: d.length, p50_ms: q(0.5), p95_ms: q(0.95), max_ms: d[d.length - 1] });
+                                resolve({ frames: d.length, p50_ms: q(0.5), p95_ms: q(0.95), max_ms: d[d.length - 1], window_ms: Math.round(now - start) });
                             }
                         };
                         requestAnimationFrame(tick);
                     }),
-                8000,
+                { ms: 8000, whileBusy },
             );
         const busy = async () => (await state(app)).guidance.activities.map((a) => `${a.what} (${Math.round(100 * a.fraction)}%)`);
         // Escape cancels the suggestion made on opening, G closes the graphs: nothing left in
@@ -220,8 +228,8 @@ async function framesWhileGraphsCompute(query) {
         // G opens the graphs again: they compute in the background.
         await app.page.keyboard.press("g");
         await app.page.waitForFunction(() => window.meshsmooth.state().guidance.activities.length > 0, null, { timeout: 30_000 });
-        const graphs = await frames();
         const graphsBusy = await busy();
+        const graphs = await frames(true);
         // Interaction while they compute: a parameter change every half second (each one
         // starts the graphs again, for the new parameters).
         const interacting = app.page.evaluate(async () => {
