@@ -359,3 +359,43 @@ fn a_bad_file_opened_in_stages_keeps_the_model_and_a_later_file_replaces_an_earl
     assert_eq!(s.model().unwrap().name, "second.ply");
     assert_eq!(s.error(), None);
 }
+
+#[test]
+fn a_new_run_sizes_its_first_piece_by_the_pace_seen_before() {
+    // A clock that runs 1 ms per reading: an iteration "takes" 1 ms between the readings
+    // around it, and every reading costs a millisecond of the budget.
+    let t = std::cell::Cell::new(0.0);
+    let clock = || {
+        t.set(t.get() + 1.0);
+        t.get()
+    };
+    // The iterations one call of 12 ms gets through.
+    let smoothed_in_one_call = |s: &mut Session| {
+        assert!(s.step_cpu(&clock, 12.0).is_none(), "not done in one call");
+        match s.progress() {
+            Some(CpuProgress::Smoothing { done, .. }) => done,
+            Some(CpuProgress::Measuring { .. }) => s.params().iterations,
+            None => panic!("no run under way"),
+        }
+    };
+    let mut s = sample_session();
+    s.set_params_json(&serde_json::json!({"iterations": 40}))
+        .unwrap();
+    // Without a pace the first piece is one iteration; the readings around each piece then
+    // leave room for few more.
+    let blind = smoothed_in_one_call(&mut s);
+    // A new run (other parameters) on the same model starts with the pace of the last one.
+    s.set_params_json(&serde_json::json!({"iterations": 39}))
+        .unwrap();
+    let paced = smoothed_in_one_call(&mut s);
+    assert!(
+        blind < 10,
+        "{blind} of 40 iterations in one call without a pace"
+    );
+    assert!(paced >= 2 * blind, "{paced} with the pace, {blind} without");
+    // Another model starts blind again.
+    s.open("bent_tube_staircase.ply", SAMPLE).unwrap();
+    s.set_params_json(&serde_json::json!({"iterations": 40}))
+        .unwrap();
+    assert_eq!(smoothed_in_one_call(&mut s), blind);
+}
