@@ -277,10 +277,8 @@ impl<'a> DriftingReference<'a> {
 
     /// Back to the start, for a new smoothing run from the original positions.
     pub fn reset(&mut self) {
-        for (i, (r, a)) in self.reference.iter_mut().zip(&mut self.anchors).enumerate() {
-            *r = i as u32;
-            *a = home_anchor(self.original, i);
-        }
+        let start = DriftState::start(self.original);
+        (self.reference, self.anchors) = (start.reference, start.anchors);
     }
 
     /// One drift step for the positions `positions` (one per vertex of the original mesh).

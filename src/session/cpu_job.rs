@@ -50,19 +50,30 @@ pub(super) struct CpuJob {
     /// The measure pass, once the smoothing is done.
     measure: Option<MeasureInParts>,
     measure_ms: f64,
-    /// Milliseconds per iteration seen so far, with the filter that took them: a call sizes
-    /// its first piece of iterations by it, rather than starting with one (each piece costs a
-    /// few copies of the positions besides its iterations).
-    pace: Option<(Filter, f64)>,
+}
+
+/// The CPU engine's milliseconds per iteration on the open model, with the filter that took
+/// them: a call sizes its first piece of iterations by it, rather than starting with one (each
+/// piece costs a few copies of the positions besides its iterations). The session keeps it
+/// across runs, and forgets it with the model.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Pace(Option<(Filter, f64)>);
+
+impl Pace {
+    /// The iterations of `filter` that fit in `ms_left` (at least one; one when unknown).
+    fn iterations_in(&self, filter: Filter, ms_left: f64) -> usize {
+        match self.0 {
+            Some((f, ms)) if f == filter && ms > 0.0 => (ms_left / ms).max(1.0) as usize,
+            _ => 1,
+        }
+    }
 }
 
 /// Vertices of the first part of a measure pass, before its speed is known.
 const FIRST_MEASURE_PART: usize = MeasureInParts::SMALLEST_PART;
 
 impl CpuJob {
-    /// A job for `revision`; `pace`, the milliseconds per iteration seen by an earlier job on
-    /// the same model, with its filter.
-    pub fn new(revision: u64, model: &Model, pace: Option<(Filter, f64)>) -> Self {
+    pub fn new(revision: u64, model: &Model) -> Self {
         Self {
             revision,
             positions: model.mesh().positions.clone(),
@@ -72,13 +83,7 @@ impl CpuJob {
             sinc: None,
             measure: None,
             measure_ms: 0.0,
-            pace,
         }
-    }
-
-    /// Milliseconds per iteration seen so far, with the filter.
-    pub fn pace(&self) -> Option<(Filter, f64)> {
-        self.pace
     }
 
     pub fn progress(&self, params: &Params) -> CpuProgress {
@@ -110,10 +115,11 @@ impl CpuJob {
         (params, weights, tau): (&Params, Option<&[f32]>, f64),
         clock: &dyn Fn() -> f64,
         budget_ms: f64,
+        pace: &mut Pace,
     ) -> Option<(Smoothed, Timings)> {
         let start = clock();
         if self.done < params.iterations {
-            self.smooth(model, params, weights, clock, start + budget_ms);
+            self.smooth(model, params, weights, (clock, start + budget_ms), pace);
             self.smooth_ms += clock() - start;
             if self.done < params.iterations || clock() - start >= budget_ms {
                 return None;
@@ -148,19 +154,14 @@ impl CpuJob {
         model: &Model,
         params: &Params,
         weights: Option<&[f32]>,
-        clock: &dyn Fn() -> f64,
-        deadline: f64,
+        (clock, deadline): (&dyn Fn() -> f64, f64),
+        pace: &mut Pace,
     ) {
         if params.filter == Filter::Sinc {
             self.smooth_sinc(model, params, weights, clock, deadline);
             return;
         }
-        let first = match self.pace {
-            Some((filter, ms)) if filter == params.filter && ms > 0.0 => {
-                ((deadline - clock()) / ms).max(1.0) as usize
-            }
-            _ => 1,
-        };
+        let first = pace.iterations_in(params.filter, deadline - clock());
         in_pieces(clock, deadline, first, |n| {
             let start = clock();
             let chunk = (params.iterations - self.done).min(n.try_into().unwrap_or(u32::MAX));
@@ -180,7 +181,10 @@ impl CpuJob {
             .unwrap_or_default();
             self.drift = drift.into_state();
             self.done += chunk;
-            self.pace = Some((params.filter, (clock() - start) / f64::from(chunk.max(1))));
+            *pace = Pace(Some((
+                params.filter,
+                (clock() - start) / f64::from(chunk.max(1)),
+            )));
             self.done >= params.iterations
         });
     }

@@ -18,7 +18,7 @@ pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use loading::{LoadProgress, Loaded, Loading};
 pub use weights::WeightsSummary;
 
-use cpu_job::CpuJob;
+use cpu_job::{CpuJob, Pace};
 
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::io;
@@ -89,9 +89,8 @@ pub struct Session {
     revision: u64,
     result: Option<Smoothed>,
     job: Option<CpuJob>,
-    /// The CPU engine's last pace on a model (its id, the filter, milliseconds per iteration),
-    /// so a new run sizes its first piece of iterations to the frame.
-    cpu_pace: Option<(u64, Filter, f64)>,
+    /// The CPU engine's pace on the open model.
+    cpu_pace: Pace,
     /// Why the last file could not be opened; cleared by the next successful open.
     error: Option<String>,
     /// Counts the models opened, so background results of another model are told apart.
@@ -118,7 +117,7 @@ impl Default for Session {
             revision: 0,
             result: None,
             job: None,
-            cpu_pace: None,
+            cpu_pace: Pace::default(),
             error: None,
             model_id: 0,
             weights: None,
@@ -257,6 +256,7 @@ impl Session {
         self.result = None;
         self.changed();
         self.model_id += 1;
+        self.cpu_pace = Pace::default();
         self.weights = None;
         self.weights_version += 1;
         self.reset_guidance();
@@ -348,30 +348,21 @@ impl Session {
         let model = self.model.as_ref()?;
         let mut job = match self.job.take() {
             Some(job) if job.revision == self.revision => job,
-            _ => {
-                let pace = self
-                    .cpu_pace
-                    .filter(|&(model, ..)| model == self.model_id)
-                    .map(|(_, filter, ms)| (filter, ms));
-                CpuJob::new(self.revision, model, pace)
-            }
+            _ => CpuJob::new(self.revision, model),
         };
         let settings = (
             &self.params[slot(self.filter)],
             self.weights.as_deref(),
             self.tau,
         );
-        let stepped = job.step(model, settings, clock, budget_ms);
-        if let Some((filter, ms)) = job.pace() {
-            self.cpu_pace = Some((self.model_id, filter, ms));
-        }
-        let (result, timings) = match stepped {
-            Some(done) => done,
-            None => {
-                self.job = Some(job);
-                return None;
-            }
-        };
+        let (result, timings) =
+            match job.step(model, settings, clock, budget_ms, &mut self.cpu_pace) {
+                Some(done) => done,
+                None => {
+                    self.job = Some(job);
+                    return None;
+                }
+            };
         self.result = Some(result);
         Some(timings)
     }

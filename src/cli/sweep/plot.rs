@@ -220,13 +220,12 @@ fn draw_key(area: &Area, key: &[(Mark, String)], x0: i32, y0: i32) -> Result<(),
 /// and the lowest S (thin red).
 fn markers(chart: &mut Chart, curve: &Curve, y_top: f64) -> Result<(), String> {
     for s in curve.samples.iter().filter(|s| s.terms.roughens()) {
-        let x = x_of(curve.param, s.value);
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                vec![(x, 0.0), (x, y_top)],
-                DIVERGES.stroke_width(8),
-            )))
-            .map_err(err)?;
+        vertical(
+            chart,
+            x_of(curve.param, s.value),
+            y_top,
+            DIVERGES.stroke_width(8),
+        )?;
     }
     let x = x_of(curve.param, curve.current);
     chart
@@ -238,14 +237,24 @@ fn markers(chart: &mut Chart, curve: &Curve, y_top: f64) -> Result<(), String> {
         )))
         .map_err(err)?;
     if let Some(best) = curve.best.map(|i| curve.samples[i]) {
-        let x = x_of(curve.param, best.value);
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                vec![(x, 0.0), (x, y_top)],
-                BEST.mix(0.5).stroke_width(1),
-            )))
-            .map_err(err)?;
+        vertical(
+            chart,
+            x_of(curve.param, best.value),
+            y_top,
+            BEST.mix(0.5).stroke_width(1),
+        )?;
     }
+    Ok(())
+}
+
+/// A solid vertical line at `x` from 0 to `y_top`.
+fn vertical(chart: &mut Chart, x: f64, y_top: f64, style: ShapeStyle) -> Result<(), String> {
+    chart
+        .draw_series(std::iter::once(PathElement::new(
+            vec![(x, 0.0), (x, y_top)],
+            style,
+        )))
+        .map_err(err)?;
     Ok(())
 }
 
