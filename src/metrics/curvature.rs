@@ -26,21 +26,18 @@ impl VertexCurvature {
         (self.mixed_area > 0.0 && k.is_finite()).then_some(k)
     }
 
-    /// The curvature of a vertex from its fan: each triangle's shape and the vertex's corner
-    /// in it.
+    /// The curvature of a vertex from its fan: the corners it has in its triangles, by their
+    /// places in the list of all corners ([`CornerCode`]).
     #[inline]
-    pub(crate) fn of_fan(
-        shapes: &[TriangleShape],
-        fan: impl Iterator<Item = (usize, usize)>,
-    ) -> Self {
-        let (mut angle_sum, mut mixed_area) = (0.0, 0.0);
-        for (t, corner) in fan {
-            let (angle, area) = shapes[t].corner(corner);
-            angle_sum += angle;
-            mixed_area += area;
+    pub(crate) fn of_fan(corners: &[CornerShape], fan: impl Iterator<Item = usize>) -> Self {
+        let (mut angle_sum, mut mixed_area) = (0i64, 0.0);
+        for code in fan {
+            let c = corners[code];
+            angle_sum += i64::from(c.angle);
+            mixed_area += f64::from(c.mixed);
         }
         Self {
-            angle_defect: 2.0 * PI - angle_sum,
+            angle_defect: (2 * HALF_TURN - angle_sum) as f64 * ANGLE_UNIT,
             mixed_area,
         }
     }
@@ -52,46 +49,46 @@ pub fn vertex_curvatures(
     triangles: &[[u32; 3]],
     topology: &Topology,
 ) -> Vec<VertexCurvature> {
-    let (shapes, _) = triangle_shapes(positions, triangles);
+    let (corners, _) = triangle_shapes(positions, triangles);
     (0..positions.len())
         .into_par_iter()
         .with_min_len(1024)
         .map(|i| {
             let fan = topology.triangles_of(i).iter().map(|&t| {
-                let corner = triangles[t as usize].iter().position(|&v| v as usize == i);
-                (t as usize, corner.unwrap_or(0))
+                let (corner, _, _) = other_corners(triangles[t as usize], i as u32);
+                CornerCode::new(t, corner).index()
             });
-            VertexCurvature::of_fan(&shapes, fan)
+            VertexCurvature::of_fan(&corners, fan)
         })
         .collect()
 }
 
-/// What the vertex pass needs of one triangle. Its third angle is kept as pi minus the other
-/// two, so every triangle's angles add up to pi and Gauss-Bonnet holds to the rounding of the
-/// sums, whatever the rounding of each angle. A triangle without area has no such sum: two
-/// corners in one place leave the third an angle of 0, and the record says by how much the third
-/// differs from pi minus the others.
-///
-/// Single precision: the angles come from a polynomial arctangent within 3e-7 radians (f32
-/// rounding near pi), far below what the f32 positions themselves carry (one unit in the last
-/// place of a 100 mm coordinate moves a 1 mm edge's direction by about 1e-5 radians).
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct TriangleShape {
-    /// The angles at the first two corners (radians), and what the third's differs from pi
-    /// minus both (0 unless the triangle has no area).
-    angles: [f32; 3],
-    /// Each corner's part of the mixed area: the Voronoi area `(1/8) sum(cot * |e|^2)` if the
-    /// triangle is not obtuse, half the area at an obtuse corner, else a quarter.
-    mixed: [f32; 3],
-}
+/// An angle of pi in the fixed-point unit of [`CornerShape::angle`].
+const HALF_TURN: i64 = 1 << 30;
 
-impl TriangleShape {
-    /// The angle and the mixed area at corner `c` (0, 1 or 2).
-    #[inline]
-    fn corner(&self, c: usize) -> (f64, f64) {
-        let [a, b, off] = self.angles.map(f64::from);
-        ([a, b, PI - a - b + off][c], self.mixed[c] as f64)
-    }
+/// The fixed-point angle unit in radians: pi / 2^30, about 2.9e-9.
+const ANGLE_UNIT: f64 = PI / HALF_TURN as f64;
+
+/// What the vertex pass needs of one corner of a triangle: its angle and its part of the mixed
+/// area. The corners lie three per triangle in triangle order, so a vertex reads its own by
+/// their place ([`CornerCode`]).
+///
+/// Angles are integers in units of pi / 2^30, and a triangle's third angle is 2^30 minus the
+/// other two: every triangle's angles add up to pi exactly, so Gauss-Bonnet holds to the
+/// rounding of the vertex sums, whatever the rounding of each angle. A triangle without area
+/// has no such sum: two corners in one place leave the third an angle of 0.
+///
+/// The angles come from a polynomial arctangent within 3e-7 radians in single precision (f32
+/// rounding near pi), far below what the f32 positions themselves carry (one unit in the last
+/// place of a 100 mm coordinate moves a 1 mm edge's direction by about 1e-5 radians); the
+/// fixed point adds at most 1.5e-9.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CornerShape {
+    /// The angle at the corner, in units of pi / 2^30.
+    angle: i32,
+    /// The corner's part of the mixed area: the Voronoi area `(1/8) sum(cot * |e|^2)` if the
+    /// triangle is not obtuse, half the area at an obtuse corner, else a quarter.
+    mixed: f32,
 }
 
 /// Triangles per parallel work item of [`triangle_shapes`]; partial volumes are added in this
@@ -103,34 +100,35 @@ const PI32: f32 = std::f32::consts::PI;
 /// Triangles gathered and worked out together, one per lane of the processor's vector unit.
 const BLOCK: usize = 64;
 
-/// The shape of every triangle and six times the enclosed volume.
+/// The corners of every triangle ([`CornerShape`], three per triangle) and six times the
+/// enclosed volume.
 pub(crate) fn triangle_shapes(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
-) -> (Vec<TriangleShape>, f64) {
-    let mut shapes = Vec::new();
-    let volume6 = triangle_shapes_into(positions, triangles, &mut shapes);
-    (shapes, volume6)
+) -> (Vec<CornerShape>, f64) {
+    let mut corners = Vec::new();
+    let volume6 = triangle_shapes_into(positions, triangles, &mut corners);
+    (corners, volume6)
 }
 
-/// [`triangle_shapes`] into `shapes` (resized to one per triangle), so a caller measuring again
-/// and again can keep the memory: returns six times the enclosed volume.
+/// [`triangle_shapes`] into `corners` (resized to three per triangle), so a caller measuring
+/// again and again can keep the memory: returns six times the enclosed volume.
 pub(crate) fn triangle_shapes_into(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
-    shapes: &mut Vec<TriangleShape>,
+    corners: &mut Vec<CornerShape>,
 ) -> f64 {
-    shapes.resize(triangles.len(), TriangleShape::default());
+    corners.resize(3 * triangles.len(), CornerShape::default());
     // The volume's terms are taken about a point of the mesh, which keeps them small: on a
     // closed mesh, where the volume means something, the point does not change the sum.
     let origin = triangles
         .first()
         .map_or([0.0; 3], |t| positions[t[0] as usize]);
-    let partial: Vec<f64> = shapes
-        .par_chunks_mut(TRIANGLE_CHUNK)
+    let partial: Vec<f64> = corners
+        .par_chunks_mut(3 * TRIANGLE_CHUNK)
         .zip(triangles.par_chunks(TRIANGLE_CHUNK))
         .map(|(out, tris)| {
-            out.chunks_mut(BLOCK)
+            out.chunks_mut(3 * BLOCK)
                 .zip(tris.chunks(BLOCK))
                 .map(|(out, tris)| shape_block(positions, tris, origin, out))
                 .sum::<f64>()
@@ -139,14 +137,43 @@ pub(crate) fn triangle_shapes_into(
     partial.iter().sum()
 }
 
-/// The shapes of up to [`BLOCK`] triangles and their part of six times the volume. The corners
-/// are gathered into one array per coordinate, so the arithmetic runs on whole vectors of
-/// triangles; lanes past the last triangle compute on zeros and are dropped.
+/// The shapes of up to [`BLOCK`] triangles and their part of six times the volume, on the
+/// processor's widest vectors ([`super::wide`]).
 fn shape_block(
     positions: &[[f32; 3]],
     tris: &[[u32; 3]],
     origin: [f32; 3],
-    out: &mut [TriangleShape],
+    out: &mut [CornerShape],
+) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if super::wide::available() {
+        // SAFETY: the processor has the features `shape_block_wide` is built with.
+        return unsafe { shape_block_wide(positions, tris, origin, out) };
+    }
+    shape_block_kernel(positions, tris, origin, out)
+}
+
+/// [`shape_block_kernel`] on AVX-512 (see [`super::wide`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma")]
+fn shape_block_wide(
+    positions: &[[f32; 3]],
+    tris: &[[u32; 3]],
+    origin: [f32; 3],
+    out: &mut [CornerShape],
+) -> f64 {
+    shape_block_kernel(positions, tris, origin, out)
+}
+
+/// The shapes of up to [`BLOCK`] triangles and their part of six times the volume. The corners
+/// are gathered into one array per coordinate, so the arithmetic runs on whole vectors of
+/// triangles; lanes past the last triangle compute on zeros and are dropped.
+#[inline(always)]
+fn shape_block_kernel(
+    positions: &[[f32; 3]],
+    tris: &[[u32; 3]],
+    origin: [f32; 3],
+    out: &mut [CornerShape],
 ) -> f64 {
     let mut p = [[[0.0f32; BLOCK]; 3]; 3];
     for (lane, t) in tris.iter().enumerate() {
@@ -157,7 +184,7 @@ fn shape_block(
             }
         }
     }
-    let mut angles = [[0.0f32; BLOCK]; 3];
+    let mut angles = [[0i32; BLOCK]; 3];
     let mut mixed = [[0.0f32; BLOCK]; 3];
     let mut volume6 = [0.0f32; BLOCK];
     for l in 0..BLOCK {
@@ -169,14 +196,14 @@ fn shape_block(
         // The dot product of the two edges leaving each corner: negative where it is obtuse.
         let dots = [dot32(ab, ac), -dot32(ab, bc), dot32(ac, bc)];
         let lengths2 = [dot32(bc, bc), dot32(ac, ac), dot32(ab, ab)];
-        angles[0][l] = angle(dots[0], twice);
-        angles[1][l] = angle(dots[1], twice);
+        angles[0][l] = fixed_angle(angle(dots[0], twice));
+        angles[1][l] = fixed_angle(angle(dots[1], twice));
         // Without area, each angle is 0 or pi by the sign of its dot product.
-        let third = if dots[2] < 0.0 { PI32 } else { 0.0 };
+        let flat = if dots[2] < 0.0 { HALF_TURN as i32 } else { 0 };
         angles[2][l] = if twice > 0.0 {
-            0.0
+            HALF_TURN as i32 - angles[0][l] - angles[1][l]
         } else {
-            third - (PI32 - angles[0][l] - angles[1][l])
+            flat
         };
         let inv_eight_twice = if twice > 0.0 {
             1.0 / (8.0 * twice)
@@ -203,13 +230,25 @@ fn shape_block(
         // about the origin point, are only as good as f32's rounding of the shifted corner.
         volume6[l] = dot32(sub32(a, origin), m);
     }
-    for (lane, o) in out.iter_mut().enumerate() {
-        *o = TriangleShape {
-            angles: [angles[0][lane], angles[1][lane], angles[2][lane]],
-            mixed: [mixed[0][lane], mixed[1][lane], mixed[2][lane]],
-        };
+    for (lane, o) in out.chunks_exact_mut(3).enumerate() {
+        let o: &mut [CornerShape; 3] = o.try_into().unwrap();
+        *o = [0, 1, 2].map(|c| CornerShape {
+            angle: angles[c][lane],
+            mixed: mixed[c][lane],
+        });
     }
     volume6[..tris.len()].iter().map(|&v| v as f64).sum()
+}
+
+/// An angle in `[0, pi]` (radians, within f32's rounding) in units of pi / 2^30, to the nearest.
+/// Rounded by adding 1.5 * 2^52, which leaves the integer in the low bits of the sum: plain
+/// arithmetic the processor runs on whole vectors, where a float-to-integer cast checks its
+/// range one lane at a time.
+#[inline]
+fn fixed_angle(radians: f32) -> i32 {
+    const PER_RADIAN: f64 = HALF_TURN as f64 / PI;
+    const ROUND: f64 = 6_755_399_441_055_744.0;
+    (f64::from(radians) * PER_RADIAN + ROUND).to_bits() as i32
 }
 
 /// `atan2(y, x)` for `y >= 0`, in `[0, pi]`, within 3e-7 (f32 steps are 2.4e-7 near pi): the arctangent of the smaller of
@@ -293,10 +332,10 @@ impl CornerCode {
         Self(3 * triangle + corner as u32)
     }
 
-    /// The triangle and the corner.
+    /// The corner's place in the list of all corners, three per triangle.
     #[inline]
-    pub(crate) fn split(self) -> (usize, usize) {
-        ((self.0 / 3) as usize, (self.0 % 3) as usize)
+    pub(crate) fn index(self) -> usize {
+        self.0 as usize
     }
 }
 

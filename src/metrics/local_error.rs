@@ -19,7 +19,34 @@ pub(crate) fn local_errors(
     positions: &[[f32; 3]],
     reference: &[u32],
     vertices: std::ops::Range<usize>,
+    each: impl FnMut(usize, f64),
+) {
+    #[cfg(target_arch = "x86_64")]
+    if super::wide::available() {
+        // SAFETY: the processor has the features `vertex_local_error2_wide` is built with.
+        let wide = |o: &Original, q, r| unsafe { vertex_local_error2_wide(o, q, r) };
+        return local_errors_with(original, positions, reference, vertices, each, wide);
+    }
+    local_errors_with(
+        original,
+        positions,
+        reference,
+        vertices,
+        each,
+        vertex_local_error2,
+    );
+}
+
+/// [`local_errors`] with the per-vertex kernel `error2` ([`vertex_local_error2`] or its wide
+/// build).
+#[inline(always)]
+fn local_errors_with(
+    original: &Original,
+    positions: &[[f32; 3]],
+    reference: &[u32],
+    vertices: std::ops::Range<usize>,
     mut each: impl FnMut(usize, f64),
+    error2: impl Fn(&Original, [f32; 3], usize) -> f32,
 ) {
     let topology = original.topology();
     // A run of squared errors first, then their roots: the root's latency at the end of every
@@ -31,7 +58,7 @@ pub(crate) fn local_errors(
     while start < vertices.end {
         let run = start..(start + RUN).min(vertices.end);
         for (i, s) in run.clone().zip(&mut squared) {
-            *s = vertex_local_error2(original, positions[i], reference[i] as usize);
+            *s = error2(original, positions[i], reference[i] as usize);
         }
         for (i, &s) in run.clone().zip(&squared) {
             if !topology.triangles_of(i).is_empty() {
@@ -59,6 +86,20 @@ pub(crate) fn vertex_local_error(original: &Original, q: [f32; 3], r: usize) -> 
 // A call per vertex: inlined into the loop over the vertices, the same code ran half as fast.
 #[inline(never)]
 fn vertex_local_error2(original: &Original, q: [f32; 3], r: usize) -> f32 {
+    vertex_local_error2_kernel(original, q, r)
+}
+
+/// [`vertex_local_error2`] on AVX-512 (see [`super::wide`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma")]
+#[inline(never)]
+fn vertex_local_error2_wide(original: &Original, q: [f32; 3], r: usize) -> f32 {
+    vertex_local_error2_kernel(original, q, r)
+}
+
+/// The body of [`vertex_local_error2`], for its builds.
+#[inline(always)]
+fn vertex_local_error2_kernel(original: &Original, q: [f32; 3], r: usize) -> f32 {
     let positions = &original.mesh().positions;
     let pr = positions[r];
     let d = sub32(q, pr);
@@ -66,6 +107,8 @@ fn vertex_local_error2(original: &Original, q: [f32; 3], r: usize) -> f32 {
         return fan_local_error2(original, r, d);
     };
     // Coordinate by coordinate, slot by slot: the first edges, and the second (the next slot's).
+    // Plain loops over the fixed row rather than `array::from_fn`, whose closures the compiler
+    // leaves as calls once the kernel has two builds.
     let mut e1 = [[0.0f32; ROW]; 3];
     for (t, &j) in row.iter().enumerate() {
         let p = positions[j as usize];
@@ -73,19 +116,28 @@ fn vertex_local_error2(original: &Original, q: [f32; 3], r: usize) -> f32 {
             e1[c][t] = p[c] - pr[c];
         }
     }
-    let e2 = e1.map(|e| std::array::from_fn::<f32, ROW, _>(|t| e[(t + 1) % ROW]));
+    let mut e2 = [[0.0f32; ROW]; 3];
+    for c in 0..3 {
+        for t in 0..ROW {
+            e2[c][t] = e1[c][(t + 1) % ROW];
+        }
+    }
     let lane = |e: &[[f32; ROW]; 3], t: usize| [e[0][t], e[1][t], e[2][t]];
-    let height2: [f32; ROW] = std::array::from_fn(|t| prism_height2(lane(&e1, t), lane(&e2, t), d));
+    let mut height2 = [0.0f32; ROW];
+    for (t, h) in height2.iter_mut().enumerate() {
+        *h = prism_height2(lane(&e1, t), lane(&e2, t), d);
+    }
     let mut best2 = smallest(height2);
     if !best2.is_finite() {
         // In no prism. Pads name `r` itself, so their segments are spokes or the point `r`.
-        let edge2: [f32; ROW] = std::array::from_fn(|t| {
+        let mut edge2 = [0.0f32; ROW];
+        for (t, e) in edge2.iter_mut().enumerate() {
             let (a, b) = (lane(&e1, t), lane(&e2, t));
-            min(
+            *e = min(
                 segment_distance2([0.0; 3], a, d),
                 segment_distance2(a, b, d),
-            )
-        });
+            );
+        }
         best2 = min(smallest(edge2), dot32(d, d));
     }
     best2

@@ -15,6 +15,8 @@ mod report;
 mod roughness;
 mod score;
 mod sinc_drifting;
+#[cfg(target_arch = "x86_64")]
+mod wide;
 
 pub use curvature::{vertex_curvatures, VertexCurvature};
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};

@@ -1,7 +1,7 @@
 //! One measure pass over a smoothed mesh and the report it yields: volume, curvature, local
 //! error and the score, plus per-vertex arrays for colour-coding.
 
-use super::curvature::{triangle_shapes, triangle_shapes_into, TriangleShape, VertexCurvature};
+use super::curvature::{triangle_shapes, triangle_shapes_into, CornerShape, VertexCurvature};
 use super::exact_distance::TriangleBvh;
 use super::local_error::{local_errors, vertex_local_error};
 use super::score::ScoreTerms;
@@ -117,7 +117,7 @@ pub fn measure_vertices(
 /// [`Self::advance`] by runs of vertices. The result is the one-call pass's, bit for bit.
 #[derive(Clone, Debug)]
 pub struct MeasureInParts {
-    shapes: Vec<TriangleShape>,
+    shapes: Vec<CornerShape>,
     volume6: f64,
     /// One entry per chunk of vertices measured so far, added in chunk order at the end.
     partial: Vec<Sums>,
@@ -339,7 +339,7 @@ pub(crate) fn measure_pass(
     thread_local! {
         /// The triangle shapes of the last pass on this thread: searches measure hundreds of
         /// times, and fresh memory each time costs its page faults.
-        static SHAPES: RefCell<Vec<TriangleShape>> = const { RefCell::new(Vec::new()) };
+        static SHAPES: RefCell<Vec<CornerShape>> = const { RefCell::new(Vec::new()) };
     }
     let n = check_arrays(original, positions, reference);
     let mut shapes = SHAPES.take();
@@ -392,7 +392,7 @@ struct Pass<'a> {
     positions: &'a [[f32; 3]],
     /// Each vertex's drifted reference; `None`: no local error.
     reference: Option<&'a [u32]>,
-    shapes: &'a [TriangleShape],
+    shapes: &'a [CornerShape],
 }
 
 impl Pass<'_> {
@@ -408,7 +408,7 @@ impl Pass<'_> {
                 continue;
             }
             let codes = self.original.corner_codes(i).iter();
-            let c = VertexCurvature::of_fan(self.shapes, codes.map(|c| c.split()));
+            let c = VertexCurvature::of_fan(self.shapes, codes.map(|c| c.index()));
             let mut k_g = 0.0;
             if !topology.is_boundary[i] {
                 // A fan without area, or of vanishing area, has no meaningful curvature.
