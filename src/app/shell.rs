@@ -13,7 +13,7 @@ use super::file_input::FileInput;
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
 use super::shortcuts::{self, Action};
-use super::viewer::Viewer;
+use super::viewer::{self, Viewer};
 use super::{api, download, legend, page, query, report_view, status, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
 use crate::session::{ColorField, Legend};
@@ -410,10 +410,25 @@ impl Shell {
     }
 
     fn view(&mut self, ui: &mut egui::Ui) {
+        // The legend takes a strip at the right; the view has the rest.
+        let whole = ui.available_rect_before_wrap();
+        let strip = self.shown.legend.as_ref().map(|l| {
+            let width = legend::width(ui, l).min(whole.width() * 0.4);
+            let strip = whole.with_min_x(whole.max.x - width);
+            (strip, l)
+        });
+        let view_rect = strip.map_or(whole, |(s, _)| whole.with_max_x(s.min.x));
+        if let Some((strip, l)) = strip {
+            legend::paint(ui, strip, l, viewer::BACKGROUND);
+        }
         let rect = match &mut self.view {
             Some((viewer, _)) => {
                 viewer.painting = self.brush.active;
-                let response = viewer.show(ui);
+                let response = ui
+                    .scope_builder(egui::UiBuilder::new().max_rect(view_rect), |ui| {
+                        viewer.show(ui)
+                    })
+                    .inner;
                 let mut doc = self.doc.borrow_mut();
                 let doc = &mut *doc;
                 let shown = match self.shown.positions {
@@ -434,12 +449,9 @@ impl Shell {
             }
             None => {
                 ui.label("The 3D view needs WebGPU or WebGL2, which this browser did not provide.");
-                ui.available_rect_before_wrap()
+                view_rect
             }
         };
-        if let Some(l) = &self.shown.legend {
-            legend::paint(ui, rect, l);
-        }
         // Messages over the view's top-left corner.
         let doc = self.doc.borrow();
         let reading = self.files.reading();

@@ -15,7 +15,7 @@ import { MODES } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
 import { jsonDifferences, metricDifferences, relativeDifference } from "./lib/compare.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
-import { colourHistogram, flatBoxes } from "./lib/png.mjs";
+import { colourAt, colourHistogram, flatBoxes } from "./lib/png.mjs";
 import { E2E_OUT, meshPath } from "./lib/paths.mjs";
 import { appSuite } from "./lib/suite.mjs";
 
@@ -409,7 +409,22 @@ test("8 the 3D view draws the mesh: the sample at start, the scalp smoothed and 
         await app.setFilter("hc");
         await app.setParams(FILTER_CASES.hc);
         await app.metrics();
-        await app.screenshotWhen("08-view-scalp-hc", middleShowsSomething, "the smoothed scalp in the middle of the page", 30_000);
+        const image = await app.screenshotWhen("08-view-scalp-hc", middleShowsSomething, "the smoothed scalp in the middle of the page", 30_000);
+        // The colour legend has a strip of its own right of the view, where no framing or
+        // turn of the model reaches: the top of its bar (viridis yellow) lies past the view's
+        // right edge.
+        const { view } = await app.state();
+        const scale = image.width / (await app.page.evaluate(() => innerWidth));
+        const right = Math.ceil((view.x + view.width) * scale);
+        let yellowBeyond = 0;
+        for (let y = Math.floor(view.y * scale); y < Math.min(image.height, (view.y + view.height) * scale); y++) {
+            for (let x = right; x < image.width; x++) {
+                const c = colourAt(image, x, y);
+                const [r, g, b] = [c >> 16, (c >> 8) & 0xff, c & 0xff];
+                yellowBeyond += r > 220 && g > 200 && b < 90 ? 1 : 0;
+            }
+        }
+        assert.ok(yellowBeyond >= 30, `the legend's bar right of the view (x >= ${right}): ${yellowBeyond} yellow pixels`);
     });
 });
 

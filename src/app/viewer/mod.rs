@@ -28,7 +28,7 @@ pub const EGUI_DEPTH_BUFFER_BITS: u8 = 0;
 
 /// Behind the model: dark and slightly cool, so the warm lit surface stands out.
 /// (Thumbnails share it: [`crate::view::thumbnail::BACKGROUND_SRGBA`].)
-const BACKGROUND: egui::Color32 = {
+pub const BACKGROUND: egui::Color32 = {
     let [r, g, b, _] = crate::view::thumbnail::BACKGROUND_SRGBA;
     egui::Color32::from_rgb(r, g, b)
 };
