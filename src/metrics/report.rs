@@ -117,7 +117,7 @@ pub fn measure_vertices(
 /// [`Self::advance`] by runs of vertices. The result is the one-call pass's, bit for bit.
 #[derive(Clone, Debug)]
 pub struct MeasureInParts {
-    shapes: Vec<CornerShape>,
+    corners: Vec<CornerShape>,
     volume6: f64,
     /// One entry per chunk of vertices measured so far, added in chunk order at the end.
     partial: Vec<Sums>,
@@ -132,9 +132,9 @@ impl MeasureInParts {
     /// `positions` and `reference` must stay the same through [`Self::advance`].
     pub fn new(original: &Original, positions: &[[f32; 3]], reference: &[u32]) -> Self {
         let n = check_arrays(original, positions, Some(reference));
-        let (shapes, volume6) = triangle_shapes(positions, &original.mesh().triangles);
+        let (corners, volume6) = triangle_shapes(positions, &original.mesh().triangles);
         Self {
-            shapes,
+            corners,
             volume6,
             partial: Vec::with_capacity(n.div_ceil(CHUNK)),
             vertex: VertexMeasures {
@@ -157,7 +157,7 @@ impl MeasureInParts {
             original,
             positions,
             reference: Some(reference),
-            shapes: &self.shapes,
+            corners: &self.corners,
         };
         let (done, total) = self.progress();
         let end = total.min(done + vertices.div_ceil(CHUNK).max(1));
@@ -337,24 +337,24 @@ pub(crate) fn measure_pass(
     reference: Option<&[u32]>,
 ) -> Sums {
     thread_local! {
-        /// The triangle shapes of the last pass on this thread: searches measure hundreds of
+        /// The triangles' corners of the last pass on this thread: searches measure hundreds of
         /// times, and fresh memory each time costs its page faults.
-        static SHAPES: RefCell<Vec<CornerShape>> = const { RefCell::new(Vec::new()) };
+        static CORNERS: RefCell<Vec<CornerShape>> = const { RefCell::new(Vec::new()) };
     }
     let n = check_arrays(original, positions, reference);
-    let mut shapes = SHAPES.take();
-    let volume6 = triangle_shapes_into(positions, &original.mesh().triangles, &mut shapes);
+    let mut corners = CORNERS.take();
+    let volume6 = triangle_shapes_into(positions, &original.mesh().triangles, &mut corners);
     let pass = Pass {
         original,
         positions,
         reference,
-        shapes: &shapes,
+        corners: &corners,
     };
     let partial: Vec<Sums> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| pass.chunk(c * CHUNK, None))
         .collect();
-    SHAPES.set(shapes);
+    CORNERS.set(corners);
     total_of(volume6, &partial)
 }
 
@@ -392,7 +392,7 @@ struct Pass<'a> {
     positions: &'a [[f32; 3]],
     /// Each vertex's drifted reference; `None`: no local error.
     reference: Option<&'a [u32]>,
-    shapes: &'a [CornerShape],
+    corners: &'a [CornerShape],
 }
 
 impl Pass<'_> {
@@ -408,7 +408,7 @@ impl Pass<'_> {
                 continue;
             }
             let codes = self.original.corner_codes(i).iter();
-            let c = VertexCurvature::of_fan(self.shapes, codes.map(|c| c.index()));
+            let c = VertexCurvature::of_fan(self.corners, codes.map(|c| c.index()));
             let mut k_g = 0.0;
             if !topology.is_boundary[i] {
                 // A fan without area, or of vanishing area, has no meaningful curvature.
