@@ -237,7 +237,17 @@ fn shape_block_kernel(
             mixed: mixed[c][lane],
         });
     }
-    volume6[..tris.len()].iter().map(|&v| v as f64).sum()
+    // Lanes past the last triangle hold 0 (no area). Eight running sums, a vector of them,
+    // instead of one chain of dependent additions; added in a fixed order, so the volume is
+    // the same bit for bit on every run and thread count.
+    const SUMS: usize = 8;
+    let mut sums = [0.0f64; SUMS];
+    for run in volume6.chunks_exact(SUMS) {
+        for (s, &v) in sums.iter_mut().zip(run) {
+            *s += f64::from(v);
+        }
+    }
+    ((sums[0] + sums[4]) + (sums[1] + sums[5])) + ((sums[2] + sums[6]) + (sums[3] + sums[7]))
 }
 
 /// An angle in `[0, pi]` (radians, within f32's rounding) in units of pi / 2^30, to the nearest.
