@@ -7,6 +7,7 @@
 //! [`TriangleBvh`] and [`exact_error`] give the exact distance the local error approximates.
 
 mod curvature;
+mod drift;
 mod exact_distance;
 mod local_error;
 mod original;
@@ -19,8 +20,8 @@ mod sinc_drifting;
 mod wide;
 
 pub use curvature::{vertex_curvatures, VertexCurvature};
+pub use drift::{identity, smooth_drifting, DriftState, DriftingReference};
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
-pub use local_error::{identity, smooth_drifting, DriftState, DriftingReference};
 pub use original::{Original, OriginalInParts};
 pub use report::{
     exact_distances, exact_error, measure, measure_shape, measure_vertices, ErrorSummary,
