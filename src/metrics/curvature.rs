@@ -138,7 +138,10 @@ pub(crate) fn triangle_shapes_into(
 }
 
 /// The shapes of up to [`BLOCK`] triangles and their part of six times the volume, on the
-/// processor's widest vectors ([`super::wide`]).
+/// processor's widest vectors ([`super::wide`]). Chosen per block, where the check (a cached
+/// flag) costs nothing next to 64 triangles: a wide copy of the loop over blocks would run it
+/// through the iterator adapters' generic code, which is built without the wide features, and
+/// took 4.5 ms instead of 2.6 on the brain.
 fn shape_block(
     positions: &[[f32; 3]],
     tris: &[[u32; 3]],
