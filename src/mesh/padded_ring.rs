@@ -28,6 +28,11 @@ pub struct PaddedRing {
     pub inverse_sizes: Vec<f32>,
     /// The rings larger than a row, whole, one after another in vertex order.
     pub large: Vec<u32>,
+    /// How far a ring reaches in vertex order: the largest `|j - i|` over every vertex `i` and
+    /// neighbour `j` (0 without edges). Meshes from a volume come in slice order, so this is
+    /// a few slices' worth of vertices, far below the vertex count; a kernel that sweeps the
+    /// vertices in order knows from it which results of an earlier pass a vertex can read.
+    pub span: u32,
 }
 
 impl PaddedRing {
@@ -55,6 +60,13 @@ impl PaddedRing {
                     }
                 }
             });
+        let span = offsets
+            .par_windows(2)
+            .enumerate()
+            .with_min_len(BLOCK)
+            .map(|(i, w)| reach(i, &neighbors[w[0] as usize..w[1] as usize]))
+            .max()
+            .unwrap_or(0);
         // The large rings, in one pass over the offsets (few of them: no need to split it).
         let mut large = Vec::new();
         for (row, w) in rows.iter_mut().zip(offsets.windows(2)) {
@@ -70,6 +82,7 @@ impl PaddedRing {
             rows,
             inverse_sizes,
             large,
+            span,
         }
     }
 
@@ -93,20 +106,25 @@ impl PaddedRing {
                 .rows
                 .par_chunks(BLOCK)
                 .zip(self.inverse_sizes.par_chunks(BLOCK))
-                .all(|(rows, inverse_sizes)| {
-                    rows.iter()
-                        .zip(inverse_sizes)
-                        .fold(true, |ok, (row, &inv)| {
-                            let fine = if Self::fits(inv) {
-                                row.iter()
-                                    .fold(true, |ok, &j| ok & (j as usize <= vertex_count))
-                            } else if inv != 0.0 {
-                                row[0] <= row[1] && row[1] as usize <= large
-                            } else {
-                                true
-                            };
-                            ok & fine
-                        })
+                .enumerate()
+                .all(|(b, (rows, inverse_sizes))| {
+                    let rows = rows.iter().zip(inverse_sizes).enumerate();
+                    rows.fold(true, |ok, (k, (row, &inv))| {
+                        let i = b * BLOCK + k;
+                        let fine = if Self::fits(inv) {
+                            let padding = vertex_count as u32;
+                            let near = |j: u32| j == padding || reach(i, &[j]) <= self.span;
+                            row.iter()
+                                .fold(true, |ok, &j| ok & (j as usize <= vertex_count) & near(j))
+                        } else if inv != 0.0 {
+                            row[0] <= row[1]
+                                && row[1] as usize <= large
+                                && reach(i, self.large_ring(row)) <= self.span
+                        } else {
+                            true
+                        };
+                        ok & fine
+                    })
                 })
     }
 
@@ -116,6 +134,15 @@ impl PaddedRing {
     pub fn fits(inverse_size: f32) -> bool {
         inverse_size >= 1.0 / PADDED_WIDTH as f32
     }
+}
+
+/// The largest `|j - i|` over `ring`, the neighbours of vertex `i`.
+#[inline]
+fn reach(i: usize, ring: &[u32]) -> u32 {
+    ring.iter()
+        .map(|&j| (j as usize).abs_diff(i) as u32)
+        .max()
+        .unwrap_or(0)
 }
 
 #[cfg(test)]
@@ -134,6 +161,8 @@ mod tests {
         assert_eq!(p.rows[2][..2], [0, 10]);
         assert_eq!(p.large_ring(&p.rows[2]), &big[..]);
         assert_eq!(p.inverse_sizes, vec![0.5, 0.0, 0.1]);
+        // Vertex 2 reaches vertex 12.
+        assert_eq!(p.span, 10);
         assert!(PaddedRing::fits(p.inverse_sizes[0]));
         assert!(!PaddedRing::fits(p.inverse_sizes[1]));
         assert!(!PaddedRing::fits(p.inverse_sizes[2]));
@@ -149,15 +178,18 @@ mod tests {
         let p = PaddedRing::new(&offsets, &neighbors);
         assert!(p.describes(12));
         assert!(!p.describes(11) && !p.describes(13));
+        assert_eq!(p.span, 9);
         // A slot past the zero entry, a large ring's range past the list, a neighbour that is
-        // no vertex: not these rows.
+        // no vertex, rings that reach further than the span: not these rows.
+        let mut short = p.clone();
+        short.span = 8;
         let mut past = p.clone();
         past.rows[0][1] = 13;
         let mut beyond = p.clone();
         beyond.rows[2][1] = 11;
         let mut foreign = p.clone();
         foreign.large[3] = 12;
-        for broken in [past, beyond, foreign] {
+        for broken in [short, past, beyond, foreign] {
             assert!(!broken.describes(12));
         }
     }

@@ -36,6 +36,11 @@ impl<'a> Rings<'a> {
         self.vertex_count
     }
 
+    /// How far a ring reaches in vertex order ([`PaddedRing::span`]).
+    pub(crate) fn span(&self) -> u32 {
+        self.padded.span
+    }
+
     /// The rings of the vertices of chunk `c` (`c * CHUNK ..`, at most `CHUNK` of them), in
     /// order.
     #[inline(always)]
