@@ -5,7 +5,9 @@
 use crate::gpu::{self, GpuContext, GpuEvaluator, GpuSmoother};
 use crate::metrics::{self, Metrics, Original};
 use crate::smooth::Params;
-use crate::suggest::{Evaluator, MeshEvaluator, ModelRef, Offload, Offloaded};
+use crate::suggest::{
+    search_evaluator, Evaluator, MeshEvaluator, ModelRef, Offload, Offloaded, SearchMethod,
+};
 
 /// Which engine does the work.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,16 +74,20 @@ impl Engine {
         }
     }
 
-    /// Runs `work` (a sweep, a search) with an evaluator of `original`.
+    /// Runs `work` (a sweep; a search by `search`) with an evaluator of `original`.
     pub(super) fn with_evaluator<R>(
         &self,
         original: &Original,
+        search: Option<SearchMethod>,
         work: impl FnOnce(&mut dyn Evaluator) -> R,
     ) -> Result<R, String> {
         match self {
             Engine::Cpu => {
-                let mut evaluator =
-                    MeshEvaluator::new(original, None).map_err(|e| e.to_string())?;
+                let mut evaluator = match search {
+                    Some(method) => search_evaluator(original, None, method),
+                    None => MeshEvaluator::new(original, None),
+                }
+                .map_err(|e| e.to_string())?;
                 Ok(work(&mut evaluator))
             }
             Engine::Gpu(engine) => {

@@ -58,7 +58,7 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
     let what = format!("sweeping the {} parameters", current.filter);
     let mut line = ProgressLine::on_terminal(&what, false);
     let graphs = Engine::open(args.backend)?
-        .with_evaluator(&original, |ev| {
+        .with_evaluator(&original, None, |ev| {
             quality_graphs_on(ev, &current, args.tau, &mut |p| line.update(p))
         })?
         .map_err(|e| e.to_string());

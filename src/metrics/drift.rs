@@ -60,6 +60,17 @@ impl DriftState {
         }
     }
 
+    /// The references `reference` (one per vertex of `original`, each a vertex of it), every
+    /// vertex anchored at its reference: the same drift from here on as with the anchors the
+    /// run had (those only spare ring checks), for a state kept without them.
+    pub fn at_home(original: &Original, reference: Vec<u32>) -> Self {
+        let anchors = reference
+            .iter()
+            .map(|&r| home_anchor(original, r as usize))
+            .collect();
+        Self { reference, anchors }
+    }
+
     /// The current reference vertex of every vertex.
     pub fn reference(&self) -> &[u32] {
         &self.reference

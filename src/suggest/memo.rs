@@ -10,14 +10,14 @@ use std::collections::HashMap;
 
 /// A parameter set without its iteration count, hashable (the weights' bit patterns).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct RunKey {
+pub(crate) struct RunKey {
     filter: Filter,
     weights: [u32; 5],
     bound: Option<u32>,
 }
 
 impl RunKey {
-    fn of(p: &Params) -> Self {
+    pub(crate) fn of(p: &Params) -> Self {
         Self {
             filter: p.filter,
             weights: [p.lambda, p.mu, p.alpha, p.beta, p.passband].map(f32::to_bits),

@@ -1,9 +1,10 @@
 //! The real evaluator: smooth with the CPU engine, drift the local error's reference vertices
 //! along the run, and measure against the original.
 
+use super::run_states::RunStates;
 use super::{is_cumulative, Evaluator, Terms};
-use crate::metrics::{measure, measure_shape, DriftingReference, Metrics, Original};
-use crate::smooth::{smooth, Follower, Params, StepObserver};
+use crate::metrics::{measure, measure_shape, DriftState, DriftingReference, Metrics, Original};
+use crate::smooth::{self, smooth, Follower, Params, StepObserver};
 
 /// Per-vertex weights that do not fit the mesh.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -49,8 +50,12 @@ pub fn terms_of(metrics: &Metrics, roughness_ratio: f64) -> Terms {
 pub struct MeshEvaluator<'a> {
     original: &'a Original,
     weights: Option<&'a [f32]>,
+    /// States of earlier runs to resume from ([`Self::keeping_states`]).
+    states: Option<RunStates>,
     /// Smoothing runs so far (for benchmarks).
     pub runs: usize,
+    /// Iterations smoothed so far (for benchmarks).
+    pub iterations: u64,
 }
 
 impl<'a> MeshEvaluator<'a> {
@@ -62,8 +67,19 @@ impl<'a> MeshEvaluator<'a> {
         Ok(Self {
             original,
             weights,
+            states: None,
             runs: 0,
+            iterations: 0,
         })
+    }
+
+    /// Keeps the states of its runs every `every` iterations, within `budget_bytes`, and
+    /// resumes later runs of the same weights from them ([`RunStates`]): the same terms, fewer
+    /// iterations, for searches that come back to the same weights at other counts (the
+    /// local search; the grid never does).
+    pub fn keeping_states(mut self, budget_bytes: usize, every: u32) -> Self {
+        self.states = Some(RunStates::new(budget_bytes, every));
+        self
     }
 
     /// The terms of the unchanged mesh (no volume term when it is open).
@@ -83,6 +99,8 @@ impl<'a> MeshEvaluator<'a> {
 /// weights or a bound, may come back) is left for a run of its own.
 struct Along<'o, 'e> {
     original: &'o Original,
+    /// Where to keep the run's states, and the run's parameters.
+    keep: Option<(&'e mut RunStates, Params)>,
     drift: Option<DriftingReference<'o>>,
     /// Whether the terms are full (measured with the drift): the drift was asked for.
     full: bool,
@@ -102,6 +120,7 @@ impl<'o, 'e> Along<'o, 'e> {
     fn new(original: &'o Original, full: bool, at: &'e [u32]) -> Self {
         Self {
             original,
+            keep: None,
             drift: full.then(|| DriftingReference::new(original)),
             full,
             checks: full,
@@ -137,11 +156,19 @@ impl<'o, 'e> Along<'o, 'e> {
             && iteration >= self.last_check + CHECK_EVERY
             && self.drift.as_ref().is_some_and(|d| d.ring_checks() > n / 2)
     }
+
+    /// Whether the run's state after `iteration` is to be kept: a multiple of the states'
+    /// interval while the drift still follows the run.
+    fn keeps(&self, iteration: u32) -> bool {
+        self.drift.is_some() && self.keep.as_ref().is_some_and(|(s, _)| s.keeps(iteration))
+    }
 }
 
 impl StepObserver for Along<'_, '_> {
     fn watches_iteration(&self, iteration: u32) -> bool {
-        self.at.get(self.terms.len()) == Some(&iteration) || self.wants_check(iteration)
+        self.at.get(self.terms.len()) == Some(&iteration)
+            || self.wants_check(iteration)
+            || self.keeps(iteration)
     }
 
     fn follower(&mut self) -> Option<&mut dyn Follower> {
@@ -149,6 +176,11 @@ impl StepObserver for Along<'_, '_> {
     }
 
     fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
+        if let (Some((states, params)), Some(drift)) = (self.keep.as_mut(), self.drift.as_ref()) {
+            if states.keeps(iteration) {
+                states.keep(params, iteration, positions, drift.reference());
+            }
+        }
         if self.at.get(self.terms.len()) == Some(&iteration) {
             self.measure(positions);
         } else if self.wants_check(iteration) {
@@ -182,7 +214,36 @@ impl MeshEvaluator<'_> {
             p.iterations = run[run.len() - 1];
             // Windowed sinc reports no iterations on the way: measured once it is done.
             let mut along = Along::new(self.original, drift, if cumulative { run } else { &[] });
-            let positions = smooth(mesh, topology, &p, self.weights, &mut along);
+            // A kept state of these weights before the first count: the run resumes there.
+            let mut from = None;
+            if let (Some(states), true) = (self.states.as_mut(), drift && cumulative) {
+                if let Some(kept) = states.latest(&p, run[0].saturating_sub(1)) {
+                    let state = DriftState::at_home(self.original, kept.reference.clone());
+                    along.drift = Some(DriftingReference::resume(self.original, state));
+                    along.last_check = kept.count;
+                    from = Some((kept.count, kept.positions.clone()));
+                }
+                along.keep = Some((states, p));
+            }
+            let done = from.as_ref().map_or(0, |f| f.0);
+            self.iterations += u64::from(p.iterations - done);
+            let positions = match from {
+                Some((count, start)) => {
+                    let more = p.iterations - count;
+                    smooth::resume(
+                        mesh,
+                        topology,
+                        &p,
+                        self.weights,
+                        start,
+                        count,
+                        more,
+                        &mut along,
+                    )
+                    .expect("a cumulative filter's run of the mesh's length resumes")
+                }
+                None => smooth(mesh, topology, &p, self.weights, &mut along),
+            };
             // A mesh the engine cannot smooth (nothing to move) reports no iterations: its
             // result is the same for every count.
             while along.terms.len() < run.len() {
@@ -206,6 +267,7 @@ impl MeshEvaluator<'_> {
         let at = [count];
         let mut along = Along::new(self.original, true, &at);
         along.checks = false;
+        self.iterations += u64::from(count);
         let positions = smooth(mesh, topology, &p, self.weights, &mut along);
         if along.terms.is_empty() {
             along.measure(&positions);
@@ -349,6 +411,56 @@ mod tests {
                     "{filter}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn runs_resumed_from_kept_states_measure_the_same_terms() {
+        let original = bent_tube();
+        let n = original.mesh().vertex_count();
+        let weights: Vec<f32> = (0..n).map(|i| (i % 4) as f32 / 3.0).collect();
+        for (filter, weights, bound) in [
+            (Filter::Hc, None, None),
+            (Filter::Hc, Some(&weights[..]), Some(0.5)),
+            (Filter::Taubin, None, None),
+            // Shrinks: vertices drift many hops from their own references.
+            (Filter::Laplace, None, None),
+        ] {
+            let mut params = Params::defaults(filter);
+            params.max_displacement = bound;
+            if filter == Filter::Laplace {
+                params.lambda = 0.9;
+            }
+            // Down the iteration axis as the local search walks it, and up again.
+            let requests: [&[u32]; 5] = [&[45, 50], &[40], &[30, 35], &[33], &[48]];
+            let mut fresh = MeshEvaluator::new(&original, weights).unwrap();
+            let mut kept = MeshEvaluator::new(&original, weights)
+                .unwrap()
+                .keeping_states(1 << 30, 5);
+            for at in requests {
+                let want = fresh.measure(&params, at).unwrap();
+                assert_eq!(kept.measure(&params, at).unwrap(), want, "{filter} {at:?}");
+            }
+            // From 0 to 50, then from 35, 25, 30 and 45 on.
+            assert_eq!(fresh.iterations, 50 + 40 + 35 + 33 + 48, "{filter}");
+            assert_eq!(kept.iterations, 50 + 5 + 10 + 3 + 3, "{filter}");
+            // Other weights share nothing.
+            params.beta = 0.25;
+            params.lambda *= 0.8;
+            kept.measure(&params, &[10]).unwrap();
+            assert_eq!(kept.iterations, 71 + 10, "{filter}");
+        }
+        // A run the filter blows up keeps no states once its drift stopped, and a count
+        // measured after that comes out the same.
+        let mut blown = Params::defaults(Filter::Hc);
+        (blown.alpha, blown.beta) = (0.0, 0.0);
+        let mut fresh = MeshEvaluator::new(&original, None).unwrap();
+        let mut kept = MeshEvaluator::new(&original, None)
+            .unwrap()
+            .keeping_states(1 << 30, 5);
+        for at in [&[50][..], &[45], &[5]] {
+            let (want, got) = (fresh.measure(&blown, at), kept.measure(&blown, at));
+            assert_eq!(format!("{got:?}"), format!("{want:?}"), "{at:?}");
         }
     }
 

@@ -17,12 +17,14 @@ mod memo;
 mod mesh_evaluator;
 mod offload;
 mod points;
+mod run_states;
 mod sliced;
 mod space;
 mod sweep;
 
 pub use auto::{
-    quality_graphs, quality_graphs_on, suggest, suggest_for_mesh, suggest_on, SuggestError,
+    quality_graphs, quality_graphs_on, search_evaluator, suggest, suggest_for_mesh, suggest_on,
+    SuggestError, LOCAL_SEARCH_STATE_BYTES,
 };
 pub use bounded::GridMinimum;
 pub use grid::{EvaluatedGrid, GridSearch};

@@ -19,6 +19,8 @@ pub const SINC_ITERATION_GRID: [u32; 9] = [0, 5, 10, 15, 20, 30, 50, 70, 100];
 
 /// Largest iteration count of the other filters' grids and graphs.
 pub const MAX_ITERATIONS: u32 = 50;
+/// The iteration grid's step (Laplace, Taubin and HC).
+pub const GRID_ITERATION_STEP: u32 = 5;
 
 /// One smoothing parameter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -123,7 +125,10 @@ impl ParamSpace {
     pub fn of(filter: Filter) -> Self {
         let its = || {
             iterations(
-                (0..=MAX_ITERATIONS).step_by(5).map(f64::from).collect(),
+                (0..=MAX_ITERATIONS)
+                    .step_by(GRID_ITERATION_STEP as usize)
+                    .map(f64::from)
+                    .collect(),
                 (0..=MAX_ITERATIONS).map(f64::from).collect(),
             )
         };
