@@ -4,7 +4,7 @@
 
 use super::{Model, Smoothed, Timings};
 use crate::metrics::{DriftState, DriftingReference, MeasureInParts, SincDrifting};
-use crate::smooth::{self, Filter, Params};
+use crate::smooth::{Filter, Params, RunInParts};
 
 /// How far a run got (see [`super::Session::progress`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,7 +40,10 @@ impl CpuProgress {
 /// A CPU run in progress, kept between calls.
 pub(super) struct CpuJob {
     pub revision: u64,
+    /// The result once the smoothing is done (the original positions until then).
     positions: Vec<[f32; 3]>,
+    /// Laplace, Taubin or HC under way, its buffers kept between calls.
+    run: Option<RunInParts>,
     drift: DriftState,
     done: u32,
     smooth_ms: f64,
@@ -53,9 +56,8 @@ pub(super) struct CpuJob {
 }
 
 /// The CPU engine's milliseconds per iteration on the open model, with the filter that took
-/// them: a call sizes its first piece of iterations by it, rather than starting with one (each
-/// piece costs a few copies of the positions besides its iterations). The session keeps it
-/// across runs, and forgets it with the model.
+/// them: a call sizes its first piece of iterations by it, rather than starting with one. The
+/// session keeps it across runs, and forgets it with the model.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Pace(Option<(Filter, f64)>);
 
@@ -77,6 +79,7 @@ impl CpuJob {
         Self {
             revision,
             positions: model.mesh().positions.clone(),
+            run: None,
             drift: DriftState::start(&model.original),
             done: 0,
             smooth_ms: 0.0,
@@ -147,8 +150,7 @@ impl CpuJob {
         Some((smoothed, timings))
     }
 
-    /// Iterations until `deadline` (at least one; each call of `smooth::resume` lays the
-    /// positions out and allocates its second buffer, so fewer, longer calls cost less).
+    /// Iterations until `deadline` (at least one).
     fn smooth(
         &mut self,
         model: &Model,
@@ -161,32 +163,35 @@ impl CpuJob {
             self.smooth_sinc(model, params, weights, clock, deadline);
             return;
         }
+        let Some(mut run) = self
+            .run
+            .take()
+            .or_else(|| RunInParts::new(model.mesh(), params))
+        else {
+            return;
+        };
         let first = pace.iterations_in(params.filter, deadline - clock());
-        in_pieces(clock, deadline, first, |n| {
+        let finished = in_pieces(clock, deadline, first, |n| {
             let start = clock();
-            let chunk = (params.iterations - self.done).min(n.try_into().unwrap_or(u32::MAX));
+            let before = run.done();
             let mut drift =
                 DriftingReference::resume(&model.original, std::mem::take(&mut self.drift));
-            let positions = std::mem::take(&mut self.positions);
-            self.positions = smooth::resume(
-                model.mesh(),
-                model.topology(),
-                params,
-                weights,
-                positions,
-                self.done,
-                chunk,
-                &mut drift,
-            )
-            .unwrap_or_default();
+            let more = n.try_into().unwrap_or(u32::MAX);
+            let finished = run.advance(model.mesh(), model.topology(), weights, more, &mut drift);
             self.drift = drift.into_state();
-            self.done += chunk;
+            let chunk = run.done() - before;
             *pace = Pace(Some((
                 params.filter,
                 (clock() - start) / f64::from(chunk.max(1)),
             )));
-            self.done >= params.iterations
+            finished
         });
+        self.done = run.done();
+        if finished {
+            self.positions = run.into_positions();
+        } else {
+            self.run = Some(run);
+        }
     }
 
     /// Windowed sinc until `deadline`: its neighbour passes, then the drift's steps (at least

@@ -22,7 +22,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz, xyz0, Field, Ring, Rings, CHUNK};
+use super::rings::{xyz, xyz0, Field, Fields, Ring, Rings, CHUNK};
 use super::{follow_parts, FollowPart, StepObserver};
 
 /// How an iteration runs (see the module's documentation).
@@ -62,90 +62,73 @@ impl Plan {
     }
 }
 
-/// Runs HC iterations `done + 1 ..= done + more` from `start` (the original positions, or the
-/// result of `done` iterations); one step (and report) per iteration.
+/// Runs HC iterations `done + 1 ..= done + more` on `fields` (the result of `done`
+/// iterations); one step (and report) per iteration, the positions the observer sees laid out
+/// in `points`. Returns whether `points` holds the last iteration's positions.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn run<C: Constrain>(
+pub(crate) fn advance<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
-    start: Vec<[f32; 3]>,
-    alpha: f32,
-    beta: f32,
+    fields: &mut Fields,
+    points: &mut Vec<[f32; 3]>,
+    weights: (f32, f32),
     counts: (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
-) -> Vec<[f32; 3]> {
+) -> bool {
     let plan = Plan::choose(rings, rayon::current_num_threads());
-    run_planned(
-        rings,
-        original,
-        start,
-        (alpha, beta),
-        counts,
-        constraint,
-        observer,
-        &plan,
+    advance_planned(
+        rings, original, fields, points, weights, counts, constraint, observer, &plan,
     )
 }
 
 #[allow(clippy::too_many_arguments)]
-fn run_planned<C: Constrain>(
+fn advance_planned<C: Constrain>(
     rings: Rings,
     original: &[[f32; 3]],
-    start: Vec<[f32; 3]>,
+    fields: &mut Fields,
+    points: &mut Vec<[f32; 3]>,
     weights: (f32, f32),
     (done, more): (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
     plan: &Plan,
-) -> Vec<[f32; 3]> {
-    if more == 0 {
-        return start;
-    }
-    let n = start.len();
-    assert!(n == rings.vertex_count() && original.len() == n);
-    let mut q = Field::from_points(&start);
-    // `points` receives the 3-vectors the observer and the caller see.
-    let mut points = start;
-    // Two passes: one `b`, `q` updated in place. The sweep: a `b` per run (zeros, so the pages
-    // a run never touches cost nothing) and the next positions.
-    let (mut bs, mut next) = match plan {
-        Plan::TwoPass => (vec![Field::zeros(n)], None),
-        Plan::Sweep { runs, .. } => (
-            runs.iter().map(|_| Field::zeros(n)).collect(),
-            Some(Field::zeros(n)),
-        ),
-    };
-    let mut written = false;
+) -> bool {
+    let n = rings.vertex_count();
+    assert!(original.len() == n && fields.q.vertices().len() == n);
+    // Two passes: one `b`, `q` updated in place. The sweep: a `b` per run and the next
+    // positions.
+    let (q, next, bs) = fields.with_scratch(match plan {
+        Plan::TwoPass => 1,
+        Plan::Sweep { runs, .. } => runs.len(),
+    });
     let kernel = Kernel {
         rings,
         original,
         weights,
     };
+    let mut written = false;
     for iteration in done + 1..=done + more {
         let mut parts = follow_parts(observer, n);
-        match (plan, next.as_mut()) {
-            (Plan::Sweep { runs, lead }, Some(next)) => {
-                kernel.sweep(&q, next, &mut bs, runs, *lead, constraint, &mut parts);
-                std::mem::swap(&mut q, next);
+        match plan {
+            Plan::Sweep { runs, lead } => {
+                kernel.sweep(q, next, bs, runs, *lead, constraint, &mut parts);
+                std::mem::swap(q, next);
             }
-            _ => {
-                kernel.differences(&q, &mut bs[0]);
-                kernel.correct(&bs[0], &mut q, constraint, &mut parts);
+            Plan::TwoPass => {
+                kernel.differences(q, &mut bs[0]);
+                kernel.correct(&bs[0], q, constraint, &mut parts);
             }
         }
         drop(parts);
         written = observer.watches_iteration(iteration);
         if written {
-            q.write_points(&mut points);
-            observer.after_step(&points);
-            observer.after_iteration(iteration, &points);
+            q.write_points(points);
+            observer.after_step(points);
+            observer.after_iteration(iteration, points);
         }
     }
-    if !written {
-        q.write_points(&mut points);
-    }
-    points
+    written
 }
 
 /// What both passes read besides the fields: the rings, the original positions and
@@ -354,31 +337,19 @@ mod tests {
         let limits = Limits::new(Some(&weights), Some(0.3), &mesh.positions).expect("limits");
         let run = |plan: &Plan, limited: bool| {
             let mut seen = Iterations::default();
-            let start = mesh.positions.clone();
-            let ab = (0.2, 0.6);
-            let last = if limited {
-                run_planned(
-                    rings,
-                    &mesh.positions,
-                    start,
-                    ab,
-                    (0, 4),
-                    &limits,
-                    &mut seen,
-                    plan,
-                )
-            } else {
-                run_planned(
-                    rings,
-                    &mesh.positions,
-                    start,
-                    ab,
-                    (0, 4),
-                    &Free,
-                    &mut seen,
-                    plan,
-                )
-            };
+            let mut fields = Fields::from_points(&mesh.positions);
+            let mut last = Vec::new();
+            let (o, ab) = (&mesh.positions, (0.2, 0.6));
+            // In two calls, the second on the buffers the first left.
+            for counts in [(0, 3), (3, 1)] {
+                let (f, seen) = (&mut fields, &mut seen);
+                let written = if limited {
+                    advance_planned(rings, o, f, &mut last, ab, counts, &limits, seen, plan)
+                } else {
+                    advance_planned(rings, o, f, &mut last, ab, counts, &Free, seen, plan)
+                };
+                assert!(written, "the observer watches every iteration");
+            }
             (last, seen.0)
         };
         for limited in [false, true] {

@@ -27,7 +27,7 @@ pub(crate) use sinc_coefficients::sinc_coefficients;
 
 use crate::mesh::{Mesh, Topology};
 use constraint::{Constrain, Free, Limits};
-use rings::Rings;
+use rings::{Fields, Rings};
 
 /// Watches a smoothing run. The local-error measure drifts its reference vertices after every
 /// step (as a [`Follower`], inside the step's pass); sweeps over iterations measure along one
@@ -164,50 +164,191 @@ fn run(
     let Some(rings) = Rings::new(topology, original.len()) else {
         return resume.map_or_else(|| original.clone(), |r| r.0);
     };
+    if params.filter == Filter::Sinc {
+        return match Limits::new(weights, params.max_displacement, original) {
+            None => sinc::run(
+                rings,
+                original,
+                params.passband,
+                params.iterations,
+                &Free,
+                observer,
+            ),
+            Some(limits) => sinc::run(
+                rings,
+                original,
+                params.passband,
+                params.iterations,
+                &limits,
+                observer,
+            ),
+        };
+    }
     // `None`: the run starts from the original positions, read in place.
-    let (start, span) = match resume {
+    let (start, counts) = match resume {
         Some((current, done, more)) => (Some(current), (done, more)),
         None => (None, (0, params.iterations)),
     };
-    match Limits::new(weights, params.max_displacement, original) {
-        None => run_filter(rings, original, start, span, params, &Free, observer),
-        Some(limits) => run_filter(rings, original, start, span, params, &limits, observer),
+    if counts.1 == 0 {
+        return start.unwrap_or_else(|| original.clone());
+    }
+    let mut fields = Fields::from_points(start.as_deref().unwrap_or(original));
+    // `points` receives the 3-vectors the observer and the caller see (the start's
+    // allocation, reused).
+    let mut points = start.unwrap_or_default();
+    let step = Advance {
+        rings,
+        original,
+        params,
+        weights,
+    };
+    if !step.advance(&mut fields, &mut points, counts, observer) {
+        fields.q.write_points(&mut points);
+    }
+    points
+}
+
+/// One call's iterations of a Laplace, Taubin or HC run.
+struct Advance<'a> {
+    rings: Rings<'a>,
+    original: &'a [[f32; 3]],
+    params: &'a Params,
+    weights: Option<&'a [f32]>,
+}
+
+impl Advance<'_> {
+    /// Iterations `done + 1 ..= done + more` on `fields`; whether `points` holds the last.
+    fn advance(
+        &self,
+        fields: &mut Fields,
+        points: &mut Vec<[f32; 3]>,
+        counts: (u32, u32),
+        observer: &mut dyn StepObserver,
+    ) -> bool {
+        let p = self.params;
+        match Limits::new(self.weights, p.max_displacement, self.original) {
+            None => self.constrained(fields, points, counts, &Free, observer),
+            Some(limits) => self.constrained(fields, points, counts, &limits, observer),
+        }
+    }
+
+    fn constrained<C: Constrain>(
+        &self,
+        fields: &mut Fields,
+        points: &mut Vec<[f32; 3]>,
+        counts: (u32, u32),
+        constraint: &C,
+        observer: &mut dyn StepObserver,
+    ) -> bool {
+        let (p, rings) = (self.params, self.rings);
+        match p.filter {
+            Filter::Laplace => {
+                let factors = [p.lambda];
+                umbrella::advance(
+                    rings, fields, points, &factors, counts, constraint, observer,
+                )
+            }
+            Filter::Taubin => {
+                let factors = [p.lambda, p.mu];
+                umbrella::advance(
+                    rings, fields, points, &factors, counts, constraint, observer,
+                )
+            }
+            Filter::Hc => hc::advance(
+                rings,
+                self.original,
+                fields,
+                points,
+                (p.alpha, p.beta),
+                counts,
+                constraint,
+                observer,
+            ),
+            // Not resumable: `run` and `SincInParts` take it whole.
+            Filter::Sinc => false,
+        }
     }
 }
 
-fn run_filter<C: Constrain>(
-    rings: Rings,
-    original: &[[f32; 3]],
-    start: Option<Vec<[f32; 3]>>,
-    span: (u32, u32),
-    p: &Params,
-    constraint: &C,
-    observer: &mut dyn StepObserver,
-) -> Vec<[f32; 3]> {
-    match p.filter {
-        Filter::Laplace => {
-            let factors = [p.lambda];
-            umbrella::run(rings, original, start, &factors, span, constraint, observer)
+/// A Laplace, Taubin or HC run spread over calls that keeps its buffers laid out for the
+/// kernels between them: a call costs its iterations and nothing more, where each
+/// [`resume`] lays the positions out and makes its buffers again (on the 206k-vertex brain in
+/// the browser, about a frame's iteration's worth). Its results are [`smooth`]'s, bit for bit.
+pub struct RunInParts {
+    params: Params,
+    done: u32,
+    fields: Fields,
+    /// The positions after `points_at` iterations, laid out for the caller.
+    points: Vec<[f32; 3]>,
+    points_at: u32,
+}
+
+impl RunInParts {
+    /// A run of `params` from `mesh`'s positions; `None` for windowed sinc, whose terms are not
+    /// shorter runs' results ([`SincInParts`] spreads it).
+    pub fn new(mesh: &Mesh, params: &Params) -> Option<Self> {
+        (params.filter != Filter::Sinc).then(|| Self {
+            params: *params,
+            done: 0,
+            fields: Fields::from_points(&mesh.positions),
+            points: mesh.positions.clone(),
+            points_at: 0,
+        })
+    }
+
+    /// Iterations done so far.
+    pub fn done(&self) -> u32 {
+        self.done
+    }
+
+    /// Runs up to `more` further iterations (no further than the parameters' count), the
+    /// observer seeing them as in [`smooth`]; whether the run is complete. `mesh` and
+    /// `topology` must be the run's; if they do not fit it, nothing moves and the run is
+    /// complete.
+    pub fn advance(
+        &mut self,
+        mesh: &Mesh,
+        topology: &Topology,
+        weights: Option<&[f32]>,
+        more: u32,
+        observer: &mut dyn StepObserver,
+    ) -> bool {
+        let more = more.min(self.params.iterations.saturating_sub(self.done));
+        let n = self.fields.q.vertices().len();
+        let rings = Rings::new(topology, n).filter(|_| mesh.vertex_count() == n);
+        match rings {
+            Some(rings) if more > 0 => {
+                let step = Advance {
+                    rings,
+                    original: &mesh.positions,
+                    params: &self.params,
+                    weights,
+                };
+                let counts = (self.done, more);
+                if step.advance(&mut self.fields, &mut self.points, counts, observer) {
+                    self.points_at = self.done + more;
+                }
+                self.done += more;
+            }
+            Some(_) => {}
+            None => self.done = self.params.iterations,
         }
-        Filter::Taubin => {
-            let factors = [p.lambda, p.mu];
-            umbrella::run(rings, original, start, &factors, span, constraint, observer)
+        self.done >= self.params.iterations
+    }
+
+    /// The positions after the iterations done so far.
+    pub fn positions(&mut self) -> &[[f32; 3]] {
+        if self.points_at != self.done {
+            self.fields.q.write_points(&mut self.points);
+            self.points_at = self.done;
         }
-        Filter::Hc => {
-            // HC starts from a copy (whose allocation receives the result).
-            let start = start.unwrap_or_else(|| original.to_vec());
-            hc::run(
-                rings, original, start, p.alpha, p.beta, span, constraint, observer,
-            )
-        }
-        Filter::Sinc => sinc::run(
-            rings,
-            original,
-            p.passband,
-            p.iterations,
-            constraint,
-            observer,
-        ),
+        &self.points
+    }
+
+    /// The positions after the iterations done so far, taken.
+    pub fn into_positions(mut self) -> Vec<[f32; 3]> {
+        self.positions();
+        self.points
     }
 }
 
@@ -268,6 +409,44 @@ mod tests {
         assert_eq!(nothing.finish(&mesh, &p, None), mesh.positions);
         let laplace = Params::defaults(Filter::Laplace);
         assert!(SincInParts::new(&mesh, &topology, &laplace).is_none());
+    }
+
+    #[test]
+    fn a_run_in_parts_equals_the_whole_run() {
+        let (mesh, topology, weights) = sample_with_weights();
+        for filter in [Filter::Laplace, Filter::Taubin, Filter::Hc] {
+            let mut p = Params::defaults(filter);
+            p.iterations = 7;
+            p.max_displacement = Some(0.4);
+            let mut whole = Steps::default();
+            let expected = smooth(&mesh, &topology, &p, Some(&weights), &mut whole);
+            let mut shorter = p;
+            shorter.iterations = 5;
+            let after_five = smooth(&mesh, &topology, &shorter, Some(&weights), &mut NoObserver);
+
+            let mut run = RunInParts::new(&mesh, &p).expect("not sinc");
+            assert_eq!(run.positions(), &mesh.positions[..]);
+            let mut parts = Steps::default();
+            // One, none, four (the observer watching), then past the end.
+            assert!(!run.advance(&mesh, &topology, Some(&weights), 1, &mut NoObserver));
+            assert!(!run.advance(&mesh, &topology, Some(&weights), 0, &mut NoObserver));
+            assert!(!run.advance(&mesh, &topology, Some(&weights), 4, &mut parts));
+            assert_eq!(run.done(), 5);
+            assert_eq!(run.positions(), &after_five[..], "{filter}");
+            assert!(run.advance(&mesh, &topology, Some(&weights), 9, &mut parts));
+            assert_eq!(run.done(), 7);
+            assert_eq!(parts.1, (2..=7).collect::<Vec<_>>(), "{filter}");
+            let steps = whole.0.len() / 7;
+            assert_eq!(parts.0, whole.0[steps..], "{filter}: the same steps");
+            assert_eq!(run.into_positions(), expected, "{filter}");
+        }
+        assert!(RunInParts::new(&mesh, &Params::defaults(Filter::Sinc)).is_none());
+        // Another mesh's topology: nothing moves, and the run is over.
+        let p = Params::defaults(Filter::Hc);
+        let other = Topology::build(&crate::mesh::fixtures::double_cone(5));
+        let mut run = RunInParts::new(&mesh, &p).expect("not sinc");
+        assert!(run.advance(&mesh, &other, None, 1, &mut NoObserver));
+        assert_eq!(run.into_positions(), mesh.positions);
     }
 
     #[test]

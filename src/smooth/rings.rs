@@ -172,6 +172,35 @@ impl Field {
     }
 }
 
+/// A run's buffers, kept between the calls of a run spread over several: the positions `q`,
+/// and the second positions buffer and the HC differences, made when first needed.
+pub(crate) struct Fields {
+    pub(crate) q: Field,
+    next: Option<Field>,
+    differences: Vec<Field>,
+}
+
+impl Fields {
+    /// `points`, one per vertex, as the positions; nothing else made yet.
+    pub(crate) fn from_points(points: &[[f32; 3]]) -> Self {
+        Self {
+            q: Field::from_points(points),
+            next: None,
+            differences: Vec::new(),
+        }
+    }
+
+    /// The positions, the second buffer and `count` difference buffers (zeros when made).
+    pub(crate) fn with_scratch(&mut self, count: usize) -> (&mut Field, &mut Field, &mut [Field]) {
+        let n = self.q.vertices().len();
+        if self.differences.len() != count {
+            self.differences = (0..count).map(|_| Field::zeros(n)).collect();
+        }
+        let next = self.next.get_or_insert_with(|| Field::zeros(n));
+        (&mut self.q, next, &mut self.differences)
+    }
+}
+
 /// The first three lanes.
 #[inline(always)]
 pub(crate) fn xyz(v: [f32; 4]) -> [f32; 3] {

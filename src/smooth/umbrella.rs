@@ -3,51 +3,42 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz, xyz0, Field, Rings, CHUNK};
+use super::rings::{xyz, xyz0, Field, Fields, Rings, CHUNK};
 use super::{follow_parts, FollowPart, StepObserver};
 
 /// Runs iterations `done + 1 ..= done + more` of the umbrella steps `factors` (Laplace:
-/// `[lambda]`; Taubin: `[lambda, mu]`) from `start` (the result of `done` iterations; `None`:
-/// `original`), reporting after every step and iteration.
-pub(crate) fn run<C: Constrain>(
+/// `[lambda]`; Taubin: `[lambda, mu]`) on `fields` (the result of `done` iterations),
+/// reporting after every step and iteration; the positions the observer sees are laid out in
+/// `points`. Returns whether `points` holds the last iteration's positions.
+pub(crate) fn advance<C: Constrain>(
     rings: Rings,
-    original: &[[f32; 3]],
-    start: Option<Vec<[f32; 3]>>,
+    fields: &mut Fields,
+    points: &mut Vec<[f32; 3]>,
     factors: &[f32],
     (done, more): (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
-) -> Vec<[f32; 3]> {
-    if more == 0 || factors.is_empty() {
-        return start.unwrap_or_else(|| original.to_vec());
-    }
-    // The ping-pong pair, allocated once per run; `points` receives the 3-vectors the observer
-    // and the caller see (the start's allocation, reused).
-    let mut q = Field::from_points(start.as_deref().unwrap_or(original));
-    let mut next = Field::zeros(original.len());
-    let mut points = start.unwrap_or_default();
-    let n = original.len();
+) -> bool {
+    let n = rings.vertex_count();
+    let (q, next, _) = fields.with_scratch(0);
     let mut written = false;
     for iteration in done + 1..=done + more {
         written = observer.watches_iteration(iteration);
         for &factor in factors {
             let mut parts = follow_parts(observer, n);
-            step(rings, factor, &q, &mut next, constraint, &mut parts);
+            step(rings, factor, q, next, constraint, &mut parts);
             drop(parts);
-            std::mem::swap(&mut q, &mut next);
+            std::mem::swap(q, next);
             if written {
-                q.write_points(&mut points);
-                observer.after_step(&points);
+                q.write_points(points);
+                observer.after_step(points);
             }
         }
         if written {
-            observer.after_iteration(iteration, &points);
+            observer.after_iteration(iteration, points);
         }
     }
-    if !written {
-        q.write_points(&mut points);
-    }
-    points
+    written
 }
 
 /// One Jacobi umbrella step: `dst_i = src_i + factor * (mean_{N(i)} src - src_i)`, constrained;

@@ -8,13 +8,17 @@
 use super::mesh_evaluator::{terms_of, MeshEvaluator, WeightsError};
 use super::{is_cumulative, Evaluator, Terms};
 use crate::metrics::{DriftState, DriftingReference, MeasureInParts, Original, SincDrifting};
-use crate::smooth::{self, Params};
+use crate::smooth::{Params, RunInParts};
 
 /// A run under way between calls.
 struct Partial {
     params: Params,
     at: Vec<u32>,
+    /// The positions reached: the original's until a windowed sinc run ends.
     positions: Vec<[f32; 3]>,
+    /// Laplace, Taubin or HC under way, its buffers kept between calls; its positions are the
+    /// ones reached.
+    run: Option<RunInParts>,
     drift: DriftState,
     done: u32,
     terms: Vec<Terms>,
@@ -23,6 +27,15 @@ struct Partial {
     /// The measure pass at the count reached, under way, and R/R0 there (taken first: a count
     /// that roughens the mesh needs no measure pass).
     measuring: Option<(MeasureInParts, f64)>,
+}
+
+/// The positions a partial run reached: its `run`'s (laid out from the run's buffers) when it
+/// has one, else its `positions`.
+fn reached<'a>(run: &'a mut Option<RunInParts>, positions: &'a [[f32; 3]]) -> &'a [[f32; 3]] {
+    match run.as_mut() {
+        Some(run) => run.positions(),
+        None => positions,
+    }
 }
 
 /// Vertices of the first part of a measure pass, before its speed is known; also the smallest.
@@ -97,10 +110,17 @@ impl<'a> Sliced<'a> {
     }
 
     fn start(&self, params: &Params, at: &[u32]) -> Partial {
+        // The run goes as far as the last count (or the parameters' own for `smoothed`).
+        let mut run_params = *params;
+        run_params.iterations = at.last().copied().unwrap_or(params.iterations);
+        let mesh = self.original.mesh();
         Partial {
             params: *params,
             at: at.to_vec(),
-            positions: self.original.mesh().positions.clone(),
+            positions: mesh.positions.clone(),
+            run: is_cumulative(params.filter)
+                .then(|| RunInParts::new(mesh, &run_params))
+                .flatten(),
             drift: DriftState::start(self.original),
             done: 0,
             terms: Vec::with_capacity(at.len()),
@@ -124,13 +144,14 @@ impl<'a> Sliced<'a> {
                 if !self.fits(areas) {
                     return None;
                 }
-                let roughness = original.roughness_ratio(&partial.positions);
+                let roughness =
+                    original.roughness_ratio(reached(&mut partial.run, &partial.positions));
                 if roughness > 1.0 {
                     self.worked = true;
                     return Some(Terms::roughened(roughness));
                 }
-                let pass =
-                    MeasureInParts::new(original, &partial.positions, partial.drift.reference());
+                let positions = reached(&mut partial.run, &partial.positions);
+                let pass = MeasureInParts::new(original, positions, partial.drift.reference());
                 partial.measuring = Some((pass, roughness));
                 self.worked = true;
                 continue;
@@ -147,12 +168,8 @@ impl<'a> Sliced<'a> {
                 return None;
             }
             let before = pass.measured();
-            let complete = pass.advance(
-                original,
-                &partial.positions,
-                partial.drift.reference(),
-                vertices,
-            );
+            let positions = reached(&mut partial.run, &partial.positions);
+            let complete = pass.advance(original, positions, partial.drift.reference(), vertices);
             let measured = (pass.measured() - before).max(1);
             self.runs.vertex_ms = Some(((self.clock)() - now) / measured as f64);
             self.worked = true;
@@ -175,24 +192,14 @@ impl<'a> Sliced<'a> {
             _ => 1,
         };
         let mut params = partial.params;
-        let chunk = if is_cumulative(params.filter) {
+        let chunk = if let Some(run) = partial.run.as_mut() {
             let chunk = fit.clamp(1, target - partial.done);
-            let positions = std::mem::take(&mut partial.positions);
             let state = std::mem::take(&mut partial.drift);
             let mut drift = DriftingReference::resume(self.original, state);
-            partial.positions = smooth::resume(
-                self.original.mesh(),
-                self.original.topology(),
-                &params,
-                self.weights,
-                positions,
-                partial.done,
-                chunk,
-                &mut drift,
-            )
-            .unwrap_or_default();
+            let (mesh, topology) = (self.original.mesh(), self.original.topology());
+            run.advance(mesh, topology, self.weights, chunk, &mut drift);
             partial.drift = drift.into_state();
-            partial.done += chunk;
+            partial.done = run.done();
             chunk
         } else {
             params.iterations = target;
@@ -238,7 +245,11 @@ impl Sliced<'_> {
             self.advance(&mut partial, params.iterations);
         }
         self.runs.runs += 1;
-        Some((partial.positions, partial.drift.into_reference()))
+        let positions = match partial.run {
+            Some(run) => run.into_positions(),
+            None => partial.positions,
+        };
+        Some((positions, partial.drift.into_reference()))
     }
 }
 
