@@ -411,15 +411,27 @@ mod tests {
         assert!(SincInParts::new(&mesh, &topology, &laplace).is_none());
     }
 
+    /// Seven iterations of `filter`'s defaults with a bound and `weights`: the parameters,
+    /// the steps the observer saw, the result.
+    fn seven_bounded(
+        filter: Filter,
+        mesh: &Mesh,
+        topology: &Topology,
+        weights: &[f32],
+    ) -> (Params, Steps, Vec<[f32; 3]>) {
+        let mut p = Params::defaults(filter);
+        p.iterations = 7;
+        p.max_displacement = Some(0.4);
+        let mut whole = Steps::default();
+        let expected = smooth(mesh, topology, &p, Some(weights), &mut whole);
+        (p, whole, expected)
+    }
+
     #[test]
     fn a_run_in_parts_equals_the_whole_run() {
         let (mesh, topology, weights) = sample_with_weights();
         for filter in [Filter::Laplace, Filter::Taubin, Filter::Hc] {
-            let mut p = Params::defaults(filter);
-            p.iterations = 7;
-            p.max_displacement = Some(0.4);
-            let mut whole = Steps::default();
-            let expected = smooth(&mesh, &topology, &p, Some(&weights), &mut whole);
+            let (p, whole, expected) = seven_bounded(filter, &mesh, &topology, &weights);
             let mut shorter = p;
             shorter.iterations = 5;
             let after_five = smooth(&mesh, &topology, &shorter, Some(&weights), &mut NoObserver);
@@ -453,11 +465,7 @@ mod tests {
     fn a_resumed_run_equals_the_whole_run() {
         let (mesh, topology, weights) = sample_with_weights();
         for filter in [Filter::Laplace, Filter::Taubin, Filter::Hc] {
-            let mut p = Params::defaults(filter);
-            p.iterations = 7;
-            p.max_displacement = Some(0.4);
-            let mut whole = Steps::default();
-            let expected = smooth(&mesh, &topology, &p, Some(&weights), &mut whole);
+            let (p, whole, expected) = seven_bounded(filter, &mesh, &topology, &weights);
 
             let mut parts = Steps::default();
             let mut current = mesh.positions.clone();
