@@ -10,8 +10,8 @@
 //! - [`Plan::Sweep`]: one sweep over the vertices in order, pass 1 running `lead` chunks ahead
 //!   of pass 2. A ring reaches at most [`PaddedRing::span`] vertices away in vertex order, so
 //!   pass 2 of a chunk finds every `b` it reads already made, still in the cache: the rings,
-//!   the originals and `q` come from memory once per iteration instead of twice, and `b` not
-//!   at all. Each thread sweeps a run of chunks with its own `b`, making the `lead` chunks on
+//!   the originals and `q` come from memory once per iteration instead of twice, and `b` is
+//!   read back before it leaves the cache. Each thread sweeps a run of chunks with its own `b`, making the `lead` chunks on
 //!   either side of its run itself. Pass 2 writes into a second buffer (pass 1 further on
 //!   still reads this iteration's `q`).
 //! - [`Plan::TwoPass`]: pass 1 over every vertex, then pass 2 over every vertex, in place;
@@ -71,14 +71,14 @@ pub(crate) fn advance<C: Constrain>(
     original: &[[f32; 3]],
     fields: &mut Fields,
     points: &mut Vec<[f32; 3]>,
-    weights: (f32, f32),
+    alpha_beta: (f32, f32),
     counts: (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> bool {
     let plan = Plan::choose(rings, rayon::current_num_threads());
     advance_planned(
-        rings, original, fields, points, weights, counts, constraint, observer, &plan,
+        rings, original, fields, points, alpha_beta, counts, constraint, observer, &plan,
     )
 }
 
@@ -88,7 +88,7 @@ fn advance_planned<C: Constrain>(
     original: &[[f32; 3]],
     fields: &mut Fields,
     points: &mut Vec<[f32; 3]>,
-    weights: (f32, f32),
+    alpha_beta: (f32, f32),
     (done, more): (u32, u32),
     constraint: &C,
     observer: &mut dyn StepObserver,
@@ -105,7 +105,7 @@ fn advance_planned<C: Constrain>(
     let kernel = Kernel {
         rings,
         original,
-        weights,
+        alpha_beta,
     };
     let mut written = false;
     for iteration in done + 1..=done + more {
@@ -136,7 +136,7 @@ fn advance_planned<C: Constrain>(
 struct Kernel<'a> {
     rings: Rings<'a>,
     original: &'a [[f32; 3]],
-    weights: (f32, f32),
+    alpha_beta: (f32, f32),
 }
 
 impl Kernel<'_> {
@@ -147,7 +147,7 @@ impl Kernel<'_> {
         if ring.is_empty() {
             return [0.0; 4];
         }
-        let alpha = self.weights.0;
+        let alpha = self.alpha_beta.0;
         let keep = 1.0 - alpha;
         let p = self.rings.mean(ring, q);
         let oi = xyz0(oi);
@@ -168,7 +168,7 @@ impl Kernel<'_> {
         if ring.is_empty() {
             return None;
         }
-        let (alpha, beta) = self.weights;
+        let (alpha, beta) = self.alpha_beta;
         let (keep, spread) = (1.0 - alpha, 1.0 - beta);
         let mb = self.rings.mean(ring, b);
         let oi = xyz0(oi);

@@ -271,9 +271,9 @@ impl Advance<'_> {
 }
 
 /// A Laplace, Taubin or HC run spread over calls that keeps its buffers laid out for the
-/// kernels between them: a call costs its iterations and nothing more, where each
-/// [`resume`] lays the positions out and makes its buffers again (on the 206k-vertex brain in
-/// the browser, about a frame's iteration's worth). Its results are [`smooth`]'s, bit for bit.
+/// kernels between them: a call costs its iterations and little more, where each [`resume`]
+/// lays the positions out, makes its buffers again and lays the result out (the web app's
+/// CPU engine runs a few iterations per frame). Its results are [`smooth`]'s, bit for bit.
 pub struct RunInParts {
     params: Params,
     done: u32,
