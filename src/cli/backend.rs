@@ -4,7 +4,7 @@
 
 use crate::gpu::{self, GpuContext, GpuEvaluator, GpuSmoother};
 use crate::metrics::{self, Metrics, Original};
-use crate::smooth::Params;
+use crate::smooth::{Filter, Params};
 use crate::suggest::{
     search_evaluator, Evaluator, MeshEvaluator, ModelRef, Offload, Offloaded, SearchMethod,
 };
@@ -74,17 +74,18 @@ impl Engine {
         }
     }
 
-    /// Runs `work` (a sweep; a search by `search`) with an evaluator of `original`.
+    /// Runs `work` (a sweep; a search of a filter's parameters by a method) with an evaluator
+    /// of `original`.
     pub(super) fn with_evaluator<R>(
         &self,
         original: &Original,
-        search: Option<SearchMethod>,
+        search: Option<(Filter, SearchMethod)>,
         work: impl FnOnce(&mut dyn Evaluator) -> R,
     ) -> Result<R, String> {
         match self {
             Engine::Cpu => {
                 let mut evaluator = match search {
-                    Some(method) => search_evaluator(original, None, method),
+                    Some((filter, method)) => search_evaluator(original, None, filter, method),
                     None => MeshEvaluator::new(original, None),
                 }
                 .map_err(|e| e.to_string())?;

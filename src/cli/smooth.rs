@@ -36,7 +36,7 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
         Some(method) => {
             let mut line = super::suggest::search_progress(params.filter, method);
             let s = engine
-                .with_evaluator(&original, Some(method), |ev| {
+                .with_evaluator(&original, Some((params.filter, method)), |ev| {
                     suggest_on(ev, &params, tau, method, &mut |p| line.update(p))
                 })?
                 .map_err(|e| e.to_string());

@@ -56,7 +56,7 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
     }
     let mut line = search_progress(args.filter, args.search);
     let s = Engine::open(args.backend)?
-        .with_evaluator(&original, Some(args.search), |ev| {
+        .with_evaluator(&original, Some((args.filter, args.search)), |ev| {
             suggest_on(ev, &base, args.tau, args.search, &mut |p| line.update(p))
         })?
         .map_err(|e| e.to_string());

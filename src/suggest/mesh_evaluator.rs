@@ -157,10 +157,11 @@ impl<'o, 'e> Along<'o, 'e> {
             && self.drift.as_ref().is_some_and(|d| d.ring_checks() > n / 2)
     }
 
-    /// Whether the run's state after `iteration` is to be kept: a multiple of the states'
-    /// interval while the drift still follows the run.
+    /// Whether the run's state after `iteration` is to be kept ([`RunStates::keeps`]) while
+    /// the drift still follows the run.
     fn keeps(&self, iteration: u32) -> bool {
-        self.drift.is_some() && self.keep.as_ref().is_some_and(|(s, _)| s.keeps(iteration))
+        let first = self.at.first().copied().unwrap_or(0);
+        self.drift.is_some() && (self.keep.as_ref()).is_some_and(|(s, _)| s.keeps(iteration, first))
     }
 }
 
@@ -176,8 +177,8 @@ impl StepObserver for Along<'_, '_> {
     }
 
     fn after_iteration(&mut self, iteration: u32, positions: &[[f32; 3]]) {
-        if let (Some((states, params)), Some(drift)) = (self.keep.as_mut(), self.drift.as_ref()) {
-            if states.keeps(iteration) {
+        if self.keeps(iteration) {
+            if let (Some((states, params)), Some(drift)) = (self.keep.as_mut(), &self.drift) {
                 states.keep(params, iteration, positions, drift.reference());
             }
         }
@@ -441,14 +442,15 @@ mod tests {
                 let want = fresh.measure(&params, at).unwrap();
                 assert_eq!(kept.measure(&params, at).unwrap(), want, "{filter} {at:?}");
             }
-            // From 0 to 50, then from 35, 25, 30 and 45 on.
+            // From 0 to 50 (keeping 35 to 50), then from 35, from 0 (nothing kept below 35;
+            // keeping 20 to 35), from 30 and from 45.
             assert_eq!(fresh.iterations, 50 + 40 + 35 + 33 + 48, "{filter}");
-            assert_eq!(kept.iterations, 50 + 5 + 10 + 3 + 3, "{filter}");
+            assert_eq!(kept.iterations, 50 + 5 + 35 + 3 + 3, "{filter}");
             // Other weights share nothing.
             params.beta = 0.25;
             params.lambda *= 0.8;
             kept.measure(&params, &[10]).unwrap();
-            assert_eq!(kept.iterations, 71 + 10, "{filter}");
+            assert_eq!(kept.iterations, 96 + 10, "{filter}");
         }
         // A run the filter blows up keeps no states once its drift stopped, and a count
         // measured after that comes out the same.

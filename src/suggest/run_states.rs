@@ -4,8 +4,8 @@
 //! The local search asks for the same weights again and again at other iteration counts: a
 //! search that starts at the most iterations walks down the iteration axis, and each step asks
 //! for the neighbours' counts below those already run. A run keeps its state (positions and
-//! the local error's drifting references) at every multiple of `every` iterations it passes;
-//! a run that needs `k` iterations then resumes from the kept state of the most iterations up
+//! the local error's drifting references) at the multiples of `every` iterations it passes
+//! from two intervals below its first count on; a run that needs `k` iterations then resumes from the kept state of the most iterations up
 //! to `k`. The states take `16` bytes per vertex each, within a byte budget; past it the state
 //! used least recently goes.
 
@@ -41,9 +41,12 @@ impl RunStates {
         }
     }
 
-    /// Whether a run keeps its state after `iteration` iterations.
-    pub fn keeps(&self, iteration: u32) -> bool {
-        iteration > 0 && iteration.is_multiple_of(self.every)
+    /// Whether a run whose first measured count is `first` keeps its state after `iteration`
+    /// iterations: at the multiples of the interval from two intervals below `first` on. The
+    /// search asks for the same weights again a step or two further down the iteration axis;
+    /// states further down went unused and their copies cost more than they saved.
+    pub fn keeps(&self, iteration: u32, first: u32) -> bool {
+        iteration > 0 && iteration.is_multiple_of(self.every) && iteration + 2 * self.every >= first
     }
 
     /// The kept state of `params`'s weights with the most iterations up to `count`.
@@ -127,7 +130,12 @@ mod tests {
     #[test]
     fn the_latest_state_up_to_a_count_of_the_same_weights() {
         let mut states = RunStates::new(1 << 20, 5);
-        assert!(states.keeps(5) && states.keeps(50) && !states.keeps(0) && !states.keeps(7));
+        assert!(states.keeps(5, 5) && states.keeps(50, 50) && states.keeps(50, 20));
+        assert!(!states.keeps(0, 0) && !states.keeps(7, 5));
+        assert!(
+            states.keeps(10, 20) && !states.keeps(5, 20),
+            "two intervals below the first"
+        );
         let positions = vec![[1.0, 2.0, 3.0]; 4];
         for count in [5, 10, 15] {
             states.keep(&hc(0.1), count, &positions, &[count; 4]);
