@@ -140,3 +140,28 @@ pub fn suggest_for_mesh(
     let original = Original::new(mesh, topology);
     suggest(&original, weights, base, tau, method, &mut |_| true)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_hcs_local_search_resumes_runs_from_kept_states() {
+        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let mesh = crate::io::load(bytes, "tube.ply").expect("the sample");
+        let topology = Topology::build(&mesh);
+        let original = Original::new(&mesh, &topology);
+        for filter in [Filter::Hc, Filter::Taubin, Filter::Laplace] {
+            for method in [SearchMethod::Local, SearchMethod::Grid] {
+                let mut ev = search_evaluator(&original, None, filter, method).expect("no weights");
+                let p = Params::defaults(filter);
+                ev.measure(&p, &[20]).expect("measured");
+                ev.measure(&p, &[15]).expect("measured");
+                // 15 resumes from the state kept at 10.
+                let resumed = filter == Filter::Hc && method == SearchMethod::Local;
+                let expected = if resumed { 20 + 5 } else { 20 + 15 };
+                assert_eq!(ev.iterations, expected, "{filter} {method:?}");
+            }
+        }
+    }
+}
