@@ -278,9 +278,10 @@ pub struct RunInParts {
     params: Params,
     done: u32,
     fields: Fields,
-    /// The positions after `points_at` iterations, laid out for the caller.
+    /// The positions after `points_at` iterations, laid out for the caller (`None`: nothing
+    /// laid out yet).
     points: Vec<[f32; 3]>,
-    points_at: u32,
+    points_at: Option<u32>,
 }
 
 impl RunInParts {
@@ -291,8 +292,8 @@ impl RunInParts {
             params: *params,
             done: 0,
             fields: Fields::from_points(&mesh.positions),
-            points: mesh.positions.clone(),
-            points_at: 0,
+            points: Vec::new(),
+            points_at: None,
         })
     }
 
@@ -326,7 +327,7 @@ impl RunInParts {
                 };
                 let counts = (self.done, more);
                 if step.advance(&mut self.fields, &mut self.points, counts, observer) {
-                    self.points_at = self.done + more;
+                    self.points_at = Some(self.done + more);
                 }
                 self.done += more;
             }
@@ -338,9 +339,9 @@ impl RunInParts {
 
     /// The positions after the iterations done so far.
     pub fn positions(&mut self) -> &[[f32; 3]] {
-        if self.points_at != self.done {
+        if self.points_at != Some(self.done) {
             self.fields.q.write_points(&mut self.points);
-            self.points_at = self.done;
+            self.points_at = Some(self.done);
         }
         &self.points
     }

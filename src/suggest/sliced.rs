@@ -14,7 +14,7 @@ use crate::smooth::{Params, RunInParts};
 struct Partial {
     params: Params,
     at: Vec<u32>,
-    /// The positions reached: the original's until a windowed sinc run ends.
+    /// The positions reached, without a `run`: the original's until a windowed sinc run ends.
     positions: Vec<[f32; 3]>,
     /// Laplace, Taubin or HC under way, its buffers kept between calls; its positions are the
     /// ones reached.
@@ -114,13 +114,18 @@ impl<'a> Sliced<'a> {
         let mut run_params = *params;
         run_params.iterations = at.last().copied().unwrap_or(params.iterations);
         let mesh = self.original.mesh();
+        let run = is_cumulative(params.filter)
+            .then(|| RunInParts::new(mesh, &run_params))
+            .flatten();
         Partial {
             params: *params,
             at: at.to_vec(),
-            positions: mesh.positions.clone(),
-            run: is_cumulative(params.filter)
-                .then(|| RunInParts::new(mesh, &run_params))
-                .flatten(),
+            // A run holds its own positions.
+            positions: match run {
+                Some(_) => Vec::new(),
+                None => mesh.positions.clone(),
+            },
+            run,
             drift: DriftState::start(self.original),
             done: 0,
             terms: Vec::with_capacity(at.len()),
