@@ -10,6 +10,7 @@ pub mod gpu;
 pub mod io;
 pub mod mesh;
 pub mod metrics;
+pub mod segmentation;
 pub mod session;
 pub mod smooth;
 pub mod suggest;
