@@ -1,13 +1,17 @@
 //! Typed load errors: every message says what is wrong and where (format, line or byte offset).
+//! Label maps (NIfTI, NRRD) and colour tables report through the same variants.
 
 use super::Format;
 
-/// Why a file could not be read as a mesh.
+/// Why a file could not be read as a mesh (or a label map, or a colour table).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LoadError {
     #[error("{format}: the file is empty")]
     Empty { format: Format },
-    #[error("cannot tell the format of '{name}': use one of .stl .obj .ply .glb .gltf")]
+    #[error(
+        "cannot tell the format of '{name}': use one of .stl .obj .ply .glb .gltf (meshes) or \
+         .nii .nii.gz .nrrd (label maps)"
+    )]
     UnknownFormat { name: String },
     #[error("{format}: not a {format} file ({detail})")]
     BadMagic { format: Format, detail: String },

@@ -1,17 +1,26 @@
-//! Parsers: bytes in, indexed mesh out. They take `&[u8]`, never paths, so the browser and the
-//! CLI share them. No input may panic; every failure is a [`LoadError`] naming what and where.
+//! Parsers: bytes in, indexed mesh (or label map) out. They take `&[u8]`, never paths, so the
+//! browser and the CLI share them. No input may panic; every failure is a [`LoadError`] naming
+//! what and where.
 
+mod color_table;
 mod error;
 mod gltf;
+mod gzip;
+mod label_map;
+mod nifti;
+mod nrrd;
 mod obj;
 mod ply;
 mod ply_ascii;
 mod ply_binary;
 mod stl;
 mod text;
+mod voxels;
 mod weld;
 
+pub use color_table::{parse_color_table, LabelEntry};
 pub use error::{LoadError, Location};
+pub use label_map::{is_label_map, load_label_map, LabelMapOptions};
 pub use weld::weld_exact;
 
 use crate::mesh::Mesh;
@@ -24,6 +33,12 @@ pub enum Format {
     Ply,
     Glb,
     Gltf,
+    /// A label map (segmentation), read by [`load_label_map`], not by [`load`].
+    Nifti,
+    /// A label map (segmentation), read by [`load_label_map`], not by [`load`].
+    Nrrd,
+    /// A label map's colour table, read by [`parse_color_table`].
+    ColorTable,
 }
 
 impl std::fmt::Display for Format {
@@ -34,13 +49,20 @@ impl std::fmt::Display for Format {
             Format::Ply => "PLY",
             Format::Glb => "GLB",
             Format::Gltf => "glTF",
+            Format::Nifti => "NIfTI",
+            Format::Nrrd => "NRRD",
+            Format::ColorTable => "colour table",
         })
     }
 }
 
 impl Format {
-    /// The format named by a file name's extension (case-insensitive).
+    /// The format named by a file name's extension (case-insensitive): a mesh format, or a
+    /// label-map one (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`).
     pub fn from_name(name: &str) -> Option<Format> {
+        if let Some(format) = label_map::label_format_of(name) {
+            return Some(format);
+        }
         let ext = name.rsplit_once('.')?.1.to_ascii_lowercase();
         Some(match ext.as_str() {
             "stl" => Format::Stl,
@@ -51,19 +73,34 @@ impl Format {
             _ => return None,
         })
     }
+
+    /// Whether files of this format hold label maps (segmentations) rather than meshes.
+    pub fn is_label_map(self) -> bool {
+        matches!(self, Format::Nifti | Format::Nrrd)
+    }
 }
 
-/// Reads a mesh, choosing the parser by the file name's extension.
+/// Reads a mesh, choosing the parser by the file name's extension. A label map's name gives an
+/// error that says so (see [`load_label_map`]).
 pub fn load(bytes: &[u8], name: &str) -> Result<Mesh, LoadError> {
     let format = Format::from_name(name).ok_or_else(|| LoadError::UnknownFormat {
         name: name.to_string(),
     })?;
+    if format.is_label_map() {
+        return Err(LoadError::Unsupported {
+            format,
+            detail: format!(
+                "'{name}' is a label map: open it as a segmentation (meshsmooth extract)"
+            ),
+        });
+    }
     load_as(bytes, format)
 }
 
 /// Reads a mesh in the given format.
 pub fn load_as(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
-    if bytes.is_empty() {
+    let is_mesh = !matches!(format, Format::Nifti | Format::Nrrd | Format::ColorTable);
+    if bytes.is_empty() && is_mesh {
         return Err(LoadError::Empty { format });
     }
     match format {
@@ -71,5 +108,10 @@ pub fn load_as(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
         Format::Obj => obj::parse(bytes),
         Format::Ply => ply::parse(bytes),
         Format::Glb | Format::Gltf => gltf::parse(bytes, format),
+        Format::Nifti | Format::Nrrd | Format::ColorTable => Err(LoadError::Unsupported {
+            format,
+            detail: "not a mesh format: open label maps as a segmentation (meshsmooth extract)"
+                .into(),
+        }),
     }
 }
