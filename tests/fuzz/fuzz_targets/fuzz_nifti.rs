@@ -1,0 +1,28 @@
+#![no_main]
+//! Fuzzes the NIfTI label-map parser (raw and gzip) through `load_label_map(data, "fuzz.nii")`:
+//! it either refuses the input or returns a label map whose codes and segments are consistent.
+
+use meshsmooth::io::{load_label_map, LabelMapOptions};
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let Ok(map) = load_label_map(data, "fuzz.nii", &LabelMapOptions::default()) else {
+        return;
+    };
+    let voxels = map.voxel_count();
+    assert!(
+        map.affine.0.iter().flatten().all(|v| v.is_finite()),
+        "a finite affine"
+    );
+    assert_eq!(map.layers.len(), 1, "NIfTI has one layer");
+    for layer in &map.layers {
+        assert_eq!(layer.codes.len(), voxels, "a code per voxel");
+        assert_eq!(layer.values[0], 0, "code 0 is background");
+        assert!(
+            layer
+                .codes
+                .iter()
+                .all(|&c| (c as usize) < layer.values.len()),
+            "codes in range"
+        );
+    }
+});
