@@ -1,0 +1,139 @@
+//! Opening a segmentation from files: one label map (each label a structure), or several binary
+//! masks (each file a structure, named by its file name, as TotalSegmentator writes them), with
+//! an optional colour table that names the labels. Shared by the CLI and the page.
+
+use super::{extract, ExtractError, ExtractOptions, LabelMap, Segment, Structure};
+use crate::io::{self, LabelMapOptions, LoadError};
+
+/// A file's name and bytes.
+#[derive(Clone, Copy, Debug)]
+pub struct NamedBytes<'a> {
+    pub name: &'a str,
+    pub bytes: &'a [u8],
+}
+
+/// How to open a segmentation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OpenOptions {
+    pub extract: ExtractOptions,
+    /// The level at which float images become masks (default 0.5).
+    pub level: Option<f64>,
+}
+
+/// Why a segmentation could not be opened; each names the file at fault.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OpenError {
+    #[error("{name}: {error}")]
+    Load { name: String, error: LoadError },
+    #[error("{name}: {error}")]
+    Extract { name: String, error: ExtractError },
+    #[error("no label map given")]
+    NoFiles,
+    #[error("--labels picks labels of one label map; with several mask files each file is one structure")]
+    LabelsWithMasks,
+}
+
+/// Reads the files and extracts their structures. One file: a label map, its labels named by
+/// the file, else by `table`, else `label N`. Several: each a mask (every non-zero voxel), one
+/// structure per file named by it; each keeps its own grid.
+pub fn open(
+    files: &[NamedBytes],
+    table: Option<NamedBytes>,
+    options: &OpenOptions,
+) -> Result<Vec<Structure>, OpenError> {
+    let read_options = LabelMapOptions {
+        level: options.level,
+    };
+    let names = match table {
+        Some(t) => io::parse_color_table(t.bytes)
+            .map_err(|error| OpenError::Load {
+                name: t.name.to_string(),
+                error,
+            })?
+            .into_iter()
+            .map(|e| Segment {
+                layer: 0,
+                value: e.value,
+                name: e.name,
+                color: e.color,
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let read = |f: &NamedBytes| {
+        io::load_label_map(f.bytes, f.name, &read_options).map_err(|error| OpenError::Load {
+            name: f.name.to_string(),
+            error,
+        })
+    };
+    let extract_from = |f: &NamedBytes, map: &LabelMap, o: &ExtractOptions| {
+        extract(map, &names, o).map_err(|error| OpenError::Extract {
+            name: f.name.to_string(),
+            error,
+        })
+    };
+    match files {
+        [] => Err(OpenError::NoFiles),
+        [one] => extract_from(one, &read(one)?, &options.extract),
+        several => {
+            if !options.extract.labels.is_empty() {
+                return Err(OpenError::LabelsWithMasks);
+            }
+            let mut out = Vec::with_capacity(several.len());
+            for (ordinal, f) in several.iter().enumerate() {
+                let map = as_mask(read(f)?);
+                for mut s in extract_from(f, &map, &options.extract)? {
+                    s.label = ordinal as i64 + 1;
+                    s.name = structure_name(f.name);
+                    s.color = super::default_color(ordinal);
+                    out.push(s);
+                }
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// Every labelled voxel of every layer as one label, 1.
+fn as_mask(mut map: LabelMap) -> LabelMap {
+    let mut layers = std::mem::take(&mut map.layers).into_iter();
+    if let Some(mut first) = layers.next() {
+        for c in &mut first.codes {
+            *c = u16::from(*c != 0);
+        }
+        for layer in layers {
+            for (c, &o) in first.codes.iter_mut().zip(&layer.codes) {
+                *c |= u16::from(o != 0);
+            }
+        }
+        first.values = vec![0, 1];
+        map.layers = vec![first];
+    }
+    map.segments.clear();
+    map
+}
+
+/// A structure's name from its file's: the folder and the label-map extensions dropped,
+/// underscores read as spaces (`portal_vein.nii.gz` is "portal vein").
+pub fn structure_name(file: &str) -> String {
+    let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
+    let lower = base.to_ascii_lowercase();
+    let stem_len = [".seg.nrrd", ".nii.gz", ".nii", ".nrrd", ".nhdr"]
+        .iter()
+        .find(|ext| lower.ends_with(*ext))
+        .map_or(base.len(), |ext| base.len() - ext.len());
+    base[..stem_len].replace('_', " ").trim().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_come_from_file_names() {
+        assert_eq!(structure_name("out/portal_vein.nii.gz"), "portal vein");
+        assert_eq!(structure_name("C:\\seg\\Liver.NII"), "Liver");
+        assert_eq!(structure_name("case.seg.nrrd"), "case");
+        assert_eq!(structure_name("tumour"), "tumour");
+    }
+}
