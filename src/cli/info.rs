@@ -4,6 +4,9 @@ use crate::mesh::{MeshReport, Topology};
 use std::path::Path;
 
 pub(super) fn run(file: &Path, json: bool) -> Result<(), String> {
+    if crate::io::is_label_map(&file.to_string_lossy()) {
+        return label_map(file, json);
+    }
     let mesh = super::load_file(file)?;
     let report = MeshReport::new(&mesh, &Topology::build(&mesh));
     if json {
@@ -42,4 +45,54 @@ fn text(r: &MeshReport) -> String {
         s += &format!("warning: {w}\n");
     }
     s
+}
+
+/// A label map's grid and the structures it holds (their voxels; `extract` makes the surfaces).
+fn label_map(file: &Path, json: bool) -> Result<(), String> {
+    let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
+    let map = crate::io::load_label_map(&bytes, &file.to_string_lossy(), &Default::default())
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    let labels = crate::segmentation::labels(&map, &[]);
+    let spacing = map.spacing();
+    let voxel_volume: f64 = spacing.iter().product();
+    if json {
+        let list: Vec<_> = labels
+            .iter()
+            .map(|l| {
+                serde_json::json!({
+                    "layer": l.layer, "label": l.label, "name": l.name, "color": l.color,
+                    "voxels": l.voxels, "voxel_volume": l.voxels as f64 * voxel_volume,
+                })
+            })
+            .collect();
+        let out = serde_json::json!({
+            "dims": map.dims,
+            "voxel_size": spacing,
+            "affine": map.affine.0,
+            "layers": map.layers.len(),
+            "structures": list,
+        });
+        println!("{}", super::to_json(&out)?);
+        return Ok(());
+    }
+    println!(
+        "grid                   {} x {} x {}",
+        map.dims[0], map.dims[1], map.dims[2]
+    );
+    println!(
+        "voxel size             {:.4} x {:.4} x {:.4} mm",
+        spacing[0], spacing[1], spacing[2]
+    );
+    println!("layers                 {}", map.layers.len());
+    println!("structures             {}", labels.len());
+    for l in &labels {
+        println!(
+            "{:>6}  {:<40} {:>10} voxels {:>12.1} mm3",
+            l.label,
+            l.name,
+            l.voxels,
+            l.voxels as f64 * voxel_volume
+        );
+    }
+    Ok(())
 }

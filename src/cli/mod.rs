@@ -5,6 +5,7 @@ mod backend;
 mod bench;
 mod bench_load;
 mod convert;
+mod extract;
 mod info;
 mod measure;
 mod output;
@@ -33,13 +34,15 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Print the mesh report: counts, topology, oddities, volume.
+    /// Print the mesh report (counts, topology, oddities, volume), or a label map's structures.
     Info {
         file: PathBuf,
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
     },
+    /// One closed surface per structure of a segmentation (NIfTI, NRRD, 3D Slicer .seg.nrrd).
+    Extract(extract::ExtractArgs),
     /// Convert any supported input to .ply (binary), .stl (binary), .obj or .glb, keeping vertex order.
     Convert { input: PathBuf, output: PathBuf },
     /// Smooth from the original and write the result; prints the quality measures.
@@ -113,6 +116,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info { file, json } => info::run(&file, json),
         Command::Convert { input, output } => convert::run(&input, &output),
+        Command::Extract(args) => extract::run(&args),
         Command::Smooth {
             file,
             output,

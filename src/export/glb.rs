@@ -7,24 +7,25 @@ use serde_json::{json, Value};
 use super::{ExportError, ExportOptions};
 use crate::mesh::{bounding_box, Mesh};
 
-const ARRAY_BUFFER: u32 = 34962;
-const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-const FLOAT: u32 = 5126;
+pub(super) const ARRAY_BUFFER: u32 = 34962;
+pub(super) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+pub(super) const FLOAT: u32 = 5126;
 const UNSIGNED_BYTE: u32 = 5121;
-const UNSIGNED_INT: u32 = 5125;
-const TRIANGLES: u32 = 4;
+pub(super) const UNSIGNED_INT: u32 = 5125;
+pub(super) const TRIANGLES: u32 = 4;
 
 /// The BIN chunk being built, with one buffer view and accessor per array.
-struct Builder {
-    bin: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+#[derive(Default)]
+pub(super) struct Builder {
+    pub(super) bin: Vec<u8>,
+    pub(super) views: Vec<Value>,
+    pub(super) accessors: Vec<Value>,
 }
 
 impl Builder {
     /// Appends `bytes` as a new buffer view (4-byte aligned) and returns the accessor index of
     /// `accessor`, which gets the view filled in.
-    fn push(&mut self, bytes: &[u8], target: u32, mut accessor: Value) -> usize {
+    pub(super) fn push(&mut self, bytes: &[u8], target: u32, mut accessor: Value) -> usize {
         while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
@@ -42,7 +43,7 @@ impl Builder {
     }
 }
 
-fn floats(values: &[[f32; 3]]) -> Vec<u8> {
+pub(super) fn floats(values: &[[f32; 3]]) -> Vec<u8> {
     values
         .iter()
         .flatten()
@@ -53,7 +54,7 @@ fn floats(values: &[[f32; 3]]) -> Vec<u8> {
 /// The specification requires NORMAL to be unit length. Normals within rounding of unit length
 /// are kept bit for bit; others are rescaled, and a zero normal (a vertex with no incident
 /// area) becomes +Z.
-fn unit_normal(n: [f32; 3]) -> [f32; 3] {
+pub(super) fn unit_normal(n: [f32; 3]) -> [f32; 3] {
     let len = n.iter().map(|&v| f64::from(v).powi(2)).sum::<f64>().sqrt();
     if (len - 1.0).abs() <= 1e-4 {
         n
@@ -105,14 +106,8 @@ pub(super) fn write(mesh: &Mesh, options: &ExportOptions) -> Result<Vec<u8>, Exp
             json!({"componentType": UNSIGNED_BYTE, "normalized": true, "count": n, "type": "VEC4"}),
         ));
     }
-    let index_bytes: Vec<u8> = mesh
-        .triangles
-        .iter()
-        .flatten()
-        .flat_map(|v| v.to_le_bytes())
-        .collect();
     let indices = b.push(
-        &index_bytes,
+        &index_bytes(mesh),
         ELEMENT_ARRAY_BUFFER,
         json!({"componentType": UNSIGNED_INT, "count": 3 * mesh.triangle_count(), "type": "SCALAR"}),
     );
@@ -133,27 +128,42 @@ pub(super) fn write(mesh: &Mesh, options: &ExportOptions) -> Result<Vec<u8>, Exp
         "bufferViews": b.views,
         "buffers": [{ "byteLength": b.bin.len() }],
     });
+    container(&document, b.bin).ok_or_else(too_large)
+}
+
+/// The indices of a mesh's triangles as little-endian u32s.
+pub(super) fn index_bytes(mesh: &Mesh) -> Vec<u8> {
+    mesh.triangles
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect()
+}
+
+/// The GLB container around a JSON document and its BIN chunk; `None` past the 4 GiB its
+/// header can describe.
+pub(super) fn container(document: &Value, mut bin: Vec<u8>) -> Option<Vec<u8>> {
     let mut json = document.to_string().into_bytes();
     while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
-    while !b.bin.len().is_multiple_of(4) {
-        b.bin.push(0);
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
     }
-    let total = 12 + 8 + json.len() + 8 + b.bin.len();
-    let total32 = u32::try_from(total).map_err(|_| too_large())?;
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let total32 = u32::try_from(total).ok()?;
 
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend(2u32.to_le_bytes());
     out.extend(total32.to_le_bytes());
-    for (kind, data) in [(b"JSON", &json), (b"BIN\0", &b.bin)] {
+    for (kind, data) in [(b"JSON", &json), (b"BIN\0", &bin)] {
         // Each chunk is shorter than the total checked above.
         out.extend((data.len() as u32).to_le_bytes());
         out.extend_from_slice(kind);
         out.extend_from_slice(data);
     }
-    Ok(out)
+    Some(out)
 }
 
 #[cfg(test)]

@@ -1,10 +1,14 @@
-//! Writers: an indexed mesh out as bytes (binary PLY, binary STL, OBJ, GLB), vertex order kept.
+//! Writers: an indexed mesh out as bytes (binary PLY, binary STL, OBJ, GLB), vertex order kept,
+//! and several named surfaces as one GLB scene.
 //! Nothing from an input file's header is ever written (STL headers often carry patient names).
 
 mod glb;
 mod obj;
 mod ply;
+mod scene;
 mod stl;
+
+pub use scene::{srgb_to_linear, write_scene_glb, SceneFrame, SceneMesh};
 
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;

@@ -1,0 +1,189 @@
+//! `meshsmooth extract` and `info` on label maps: what they write and print, and their refusals.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn data(rel: &str) -> String {
+    format!("{}/../shared/data/{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn meshsmooth(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_meshsmooth"))
+        .args(args)
+        .output()
+        .expect("the meshsmooth binary runs")
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("meshsmooth-extract-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+/// The JSON chunk of a GLB.
+fn glb_json(bytes: &[u8]) -> serde_json::Value {
+    assert_eq!(&bytes[..4], b"glTF");
+    let len = u32::from_le_bytes(bytes[12..16].try_into().expect("4")) as usize;
+    serde_json::from_slice(&bytes[20..20 + len]).expect("JSON chunk")
+}
+
+#[test]
+fn extract_writes_one_named_ply_per_structure_and_lists_them() {
+    let dir = tmp("phantom/");
+    let out = meshsmooth(&[
+        "extract",
+        &data("labelmaps/case_phantom_shared.nii.gz"),
+        "--colors",
+        &data("labelmaps/case_phantom_shared_labels.txt"),
+        "-o",
+        dir.to_str().expect("utf-8"),
+        "--json",
+    ]);
+    let v = json(&out);
+    let list = v["structures"].as_array().expect("structures");
+    assert_eq!(list.len(), 4);
+    let keys = [
+        "label",
+        "name",
+        "color",
+        "voxels",
+        "vertices",
+        "triangles",
+        "volume",
+        "voxel_size",
+        "file",
+    ];
+    for s in list {
+        for key in keys {
+            assert!(s.get(key).is_some(), "missing {key}");
+        }
+        let file = s["file"].as_str().expect("a path");
+        let info = json(&meshsmooth(&["info", file, "--json"]));
+        assert_eq!(info["vertices"], s["vertices"]);
+        assert_eq!(info["closed"], true);
+        assert_eq!(info["nonmanifold_edges"], 0);
+    }
+    assert_eq!(list[1]["name"], "portal_vein");
+    assert!(list[1]["file"]
+        .as_str()
+        .expect("path")
+        .ends_with("portal_vein.ply"));
+    assert_eq!(list[0]["voxels"], 81887);
+}
+
+#[test]
+fn extract_to_glb_gives_a_named_node_per_structure_in_metres_with_y_up() {
+    let path = tmp("phantom.glb");
+    let p = path.to_str().expect("utf-8");
+    let out = meshsmooth(&[
+        "extract",
+        &data("labelmaps/case_phantom_shared.seg.nrrd"),
+        "--labels",
+        "1,3",
+        "-o",
+        p,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc = glb_json(&std::fs::read(&path).expect("written"));
+    let names: Vec<&str> = doc["nodes"]
+        .as_array()
+        .expect("nodes")
+        .iter()
+        .filter_map(|n| n["name"].as_str())
+        .collect();
+    assert_eq!(names, ["segmentation", "liver", "tumor"]);
+    assert_eq!(doc["nodes"][0]["matrix"][0], -0.001);
+    assert_eq!(doc["materials"].as_array().expect("materials").len(), 2);
+    assert_eq!(doc["nodes"][2]["extras"]["label"], 3);
+    // Millimetres when asked: no root transform.
+    let raw = tmp("phantom_mm.glb");
+    let out = meshsmooth(&[
+        "extract",
+        &data("labelmaps/case_phantom_shared.seg.nrrd"),
+        "--millimetres",
+        "-o",
+        raw.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success());
+    let doc = glb_json(&std::fs::read(&raw).expect("written"));
+    assert!(doc["nodes"][0].get("matrix").is_none());
+    assert_eq!(doc["nodes"].as_array().expect("nodes").len(), 5);
+}
+
+#[test]
+fn info_on_a_label_map_lists_its_structures() {
+    let v = json(&meshsmooth(&[
+        "info",
+        &data("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz"),
+        "--json",
+    ]));
+    assert_eq!(v["dims"], serde_json::json!([182, 218, 182]));
+    let list = v["structures"].as_array().expect("structures");
+    assert_eq!(list.len(), 48);
+    assert_eq!(list[0]["label"], 1);
+    assert!(list[0]["voxels"].as_u64().expect("count") > 0);
+    let text = meshsmooth(&["info", &data("labelmaps/case_phantom_shared.seg.nrrd")]);
+    let text = String::from_utf8(text.stdout).expect("utf-8");
+    assert!(
+        text.contains("tumor") && text.contains("structures             4"),
+        "{text}"
+    );
+}
+
+#[test]
+fn extract_refuses_what_it_cannot_do_naming_the_file() {
+    let map = data("labelmaps/case_phantom_shared.nii.gz");
+    let refusal = |args: &[&str]| {
+        let out = meshsmooth(args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    let e = refusal(&["extract", &map, "-o", tmp("x.stl").to_str().expect("utf-8")]);
+    assert!(e.contains("give a folder"), "{e}");
+    let e = refusal(&[
+        "extract",
+        &map,
+        "--labels",
+        "9",
+        "-o",
+        tmp("x.glb").to_str().expect("utf-8"),
+    ]);
+    assert!(
+        e.contains("label 9 is not in the label map") && e.contains("case_phantom_shared.nii.gz"),
+        "{e}"
+    );
+    let broken = tmp("broken.nii.gz");
+    let bytes = std::fs::read(&map).expect("phantom");
+    std::fs::write(&broken, &bytes[..bytes.len() / 3]).expect("write");
+    let e = refusal(&[
+        "extract",
+        broken.to_str().expect("utf-8"),
+        "-o",
+        tmp("y/").to_str().expect("utf-8"),
+    ]);
+    assert!(e.contains("broken.nii.gz"), "{e}");
+    let sphere = data("synthetic/sphere_r20_mask.nii.gz");
+    let e = refusal(&[
+        "extract",
+        &map,
+        &sphere,
+        "--labels",
+        "1",
+        "-o",
+        tmp("z/").to_str().expect("utf-8"),
+    ]);
+    assert!(e.contains("several mask files"), "{e}");
+}
