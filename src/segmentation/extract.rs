@@ -44,14 +44,38 @@ struct Builder {
 /// Vertex slots of the voxel edges of one plane (edges along x and along y, interleaved) or of
 /// the edges between two planes (along z): per edge, the vertex of the label at its lower end and
 /// at its upper end.
-struct Slots(Vec<[u32; 2]>);
+struct Slots {
+    slots: Vec<[u32; 2]>,
+    /// The slots filled since the last clear: clearing only these keeps a large, mostly empty
+    /// grid from costing a full pass over its slots per layer.
+    touched: Vec<u32>,
+}
 
 impl Slots {
     fn new(len: usize) -> Self {
-        Slots(vec![[NONE; 2]; len])
+        Slots {
+            slots: vec![[NONE; 2]; len],
+            touched: Vec::new(),
+        }
     }
+
     fn clear(&mut self) {
-        self.0.fill([NONE; 2]);
+        for &i in &self.touched {
+            self.slots[i as usize] = [NONE; 2];
+        }
+        self.touched.clear();
+    }
+
+    fn get(&self, index: usize, end: usize) -> u32 {
+        self.slots[index][end]
+    }
+
+    fn set(&mut self, index: usize, end: usize, id: u32) {
+        let slot = &mut self.slots[index];
+        if *slot == [NONE; 2] {
+            self.touched.push(index as u32);
+        }
+        slot[end] = id;
     }
 }
 
@@ -82,9 +106,6 @@ pub(crate) fn surfaces_by_code(
         }
         fill_plane(&mut above, &layer.codes, dims, pz + 1);
         planes.swap(0, 1);
-        if pz == 0 {
-            planes[0].clear();
-        }
         planes[1].clear();
         between.clear();
         let mut sweep = LayerSweep {
@@ -96,6 +117,9 @@ pub(crate) fn surfaces_by_code(
             pz,
         };
         for py in 0..=ny {
+            if uniform_rows(&below, &above, py * w, w) {
+                continue;
+            }
             for px in 0..=nx {
                 let i = py * w + px;
                 let c0 = below[i];
@@ -120,6 +144,17 @@ pub(crate) fn surfaces_by_code(
         .into_iter()
         .map(|b| b.map(|b| Mesh::new(b.positions, b.triangles)))
         .collect()
+}
+
+/// Whether the two rows of cube corners starting at `start` in both planes all hold one code,
+/// so no cube of that row is mixed (most rows of a segmentation are background throughout).
+fn uniform_rows(below: &[u16], above: &[u16], start: usize, w: usize) -> bool {
+    let row = &below[start..start + w];
+    let first = row[0];
+    row.iter().all(|&c| c == first)
+        && below[start + w..start + 2 * w] == *row
+        && above[start..start + w] == *row
+        && above[start + w..start + 2 * w] == *row
 }
 
 /// Copies voxel slice `pz - 1` into a padded plane (a border of background around it); planes
@@ -188,13 +223,14 @@ impl LayerSweep<'_> {
         let (x, y) = (px + dx, py + dy);
         let index = y * self.w + x;
         let axis = e / 4;
-        let slots = match axis {
-            0 | 1 => &mut self.planes[dz].0[2 * index + axis as usize],
-            _ => &mut self.between.0[index],
+        let (slots, slot) = match axis {
+            0 | 1 => (&mut self.planes[dz], 2 * index + axis as usize),
+            _ => (&mut *self.between, index),
         };
         let end = usize::from(corners[lo as usize] != code);
-        if slots[end] != NONE {
-            return slots[end];
+        let known = slots.get(slot, end);
+        if known != NONE {
+            return known;
         }
         let b = self.builders[code as usize]
             .as_mut()
@@ -204,7 +240,7 @@ impl LayerSweep<'_> {
         let mut p = [x as f32 - 1.0, y as f32 - 1.0, (self.pz + dz) as f32 - 1.0];
         p[axis as usize] += 0.5;
         b.positions.push(p);
-        slots[end] = id;
+        slots.set(slot, end, id);
         id
     }
 }
