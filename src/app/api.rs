@@ -4,6 +4,11 @@
 //! - `loadMesh(bytes: Uint8Array, name): Promise<info>` (the CLI's `info --json` keys), once the
 //!   mesh is open: it opens a stage per frame (`state().loading`), the current model staying open
 //!   until then; a later `loadMesh` before it is open replaces it (its promise rejects)
+//!   A label map (`.nii`, `.nii.gz`, `.nrrd`, `.seg.nrrd`) opens the same way: its structures
+//!   are extracted and the first one becomes the model
+//! - `structures()`: `{file, current, structures: [{label, name, color, voxels, voxel_size,
+//!   vertices, triangles, volume}]}` of the open segmentation, or null when the model is a mesh
+//! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`
 //! - `setFilter(name)`, `setParams(object)` (keys `lambda mu alpha beta passband iterations
 //!   max_displacement`); both throw with the engine's message on a bad name or value
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
@@ -222,6 +227,57 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                 })
             },
         ),
+    )?;
+
+    let d = doc.clone();
+    define(
+        &api,
+        "structures",
+        Closure::<dyn FnMut() -> JsValue>::new(move || {
+            let doc = d.borrow();
+            match doc.session.structures() {
+                Some(s) => to_js(&s.to_json()),
+                None => JsValue::NULL,
+            }
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "selectStructure",
+        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |index: JsValue| {
+            let Some(index) = index.as_f64().filter(|i| *i >= 0.0 && i.fract() == 0.0) else {
+                return settled(Err(
+                    "selectStructure(index): index must be a whole number >= 0".into(),
+                ));
+            };
+            let (d, c) = (d.clone(), c.clone());
+            let mut result = None;
+            let promise = Promise::new(&mut |resolve: Function, reject: Function| {
+                let waiter = Box::new(move |outcome: Result<&crate::session::Session, String>| {
+                    let info = outcome.and_then(|session| {
+                        session
+                            .info_json()
+                            .map(|v| to_js(&v))
+                            .ok_or_else(|| "no report".to_string())
+                    });
+                    let _ = match info {
+                        Ok(v) => resolve.call1(&JsValue::NULL, &v),
+                        Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
+                    };
+                });
+                result = Some(
+                    d.borrow_mut()
+                        .begin_open_structure(index as usize, Some(waiter)),
+                );
+                c.request_repaint();
+            });
+            match result {
+                Some(Err(e)) => settled(Err(e)),
+                _ => promise,
+            }
+        }),
     )?;
 
     define(

@@ -218,6 +218,24 @@ impl Document {
         self.waiting_for_load.extend(waiter);
     }
 
+    /// Starts opening structure `index` of the open segmentation as the model, as a file opens.
+    pub fn begin_open_structure(
+        &mut self,
+        index: usize,
+        waiter: Option<LoadWaiter>,
+    ) -> Result<(), String> {
+        let replaced = self.session.loading().map(|l| l.name);
+        self.session.begin_open_structure(index)?;
+        if let Some(replaced) = replaced {
+            let why = format!("{replaced} was not opened: another structure was chosen first");
+            for w in std::mem::take(&mut self.waiting_for_load) {
+                w(Err(why.clone()));
+            }
+        }
+        self.waiting_for_load.extend(waiter);
+        Ok(())
+    }
+
     /// This frame's work on the file being opened, if one is: whether nothing is being opened,
     /// it is still opening, or it opened (or failed) in this frame. Either of the last two takes
     /// the frame: the engines take up a new model from the next frame on, before the view does.
@@ -336,6 +354,8 @@ impl Document {
         state["brush"] = serde_json::json!({"on": v.brush_on, "pick_ms": v.pick_ms});
         state["view"] = v.rect.to_json();
         state["layout"] = self.panel.to_json();
+        // WebAssembly memory only grows: its size is the page's peak.
+        state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state
     }
 }

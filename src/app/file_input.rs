@@ -11,8 +11,9 @@ use super::read_bytes::{self, OnProgress};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsCast;
 
-/// The extensions `io::load` understands, for the picker's filter.
-const ACCEPT: &str = ".stl,.obj,.ply,.glb,.gltf";
+/// The extensions `io::load` and `io::load_label_map` understand, for the picker's filter
+/// (`.gz` for `.nii.gz`, which the filter cannot name as one extension).
+const ACCEPT: &str = ".stl,.obj,.ply,.glb,.gltf,.nii,.gz,.nrrd";
 
 /// A file whose reading finished (or failed).
 pub struct ArrivedFile {

@@ -355,13 +355,20 @@ impl Shell {
             if ui.button("Help").on_hover_text("H").clicked() {
                 self.help_open = !self.help_open;
             }
-            ui.label("Drop an STL, OBJ, PLY or glTF file on the page to open it.");
+            ui.label(
+                "Drop a mesh (STL, OBJ, PLY, glTF) or a label map (NIfTI, NRRD) on the page to open it.",
+            );
         });
     }
 
     fn smoothing_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
         let timings = doc.timings;
+        if let Some(index) = structure_picker(ui, &doc.session) {
+            if let Err(e) = doc.begin_open_structure(index, None) {
+                log::warn!("{e}");
+            }
+        }
         ui.heading("Smoothing");
         self.controls.filter(ui, &mut doc.session);
         self.drag_params.panel(ui, doc.session.filter());
@@ -580,4 +587,47 @@ fn drop_hint(ctx: &egui::Context) {
         egui::FontId::proportional(28.0),
         egui::Color32::WHITE,
     );
+}
+
+/// The segmentation's structures, when the model is one of them: which one the smoothing acts
+/// on. Returns the structure picked in this frame.
+fn structure_picker(ui: &mut egui::Ui, session: &crate::session::Session) -> Option<usize> {
+    let structures = session.structures()?;
+    let mut picked = None;
+    ui.heading("Structure");
+    let swatch = |ui: &mut egui::Ui, c: [f32; 3]| {
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+        let [r, g, b] = c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
+        ui.painter()
+            .rect_filled(rect, 2.0, egui::Color32::from_rgb(r, g, b));
+    };
+    let current = structures.current();
+    ui.horizontal(|ui| {
+        swatch(ui, current.color);
+        egui::ComboBox::from_id_salt("structure")
+            .selected_text(&current.name)
+            .show_ui(ui, |ui| {
+                for (i, s) in structures.list.iter().enumerate() {
+                    ui.horizontal(|ui| {
+                        swatch(ui, s.color);
+                        let text = format!("{} ({} voxels)", s.name, s.voxels);
+                        if ui.selectable_label(i == structures.current, text).clicked()
+                            && i != structures.current
+                        {
+                            picked = Some(i);
+                        }
+                    });
+                }
+            });
+    })
+    .response
+    .on_hover_text(format!(
+        "{} structures in {}; label {}, {} voxels",
+        structures.list.len(),
+        structures.file,
+        current.label,
+        current.voxels
+    ));
+    ui.separator();
+    picked
 }

@@ -92,13 +92,25 @@ pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
             .zip(&written)
             .map(|(s, file)| structure_json(s, file))
             .collect();
-        let out = serde_json::json!({ "structures": list, "seconds": seconds });
+        let out = serde_json::json!({
+            "structures": list,
+            "seconds": seconds,
+            "peak_memory_bytes": peak_memory_bytes(),
+        });
         println!("{}", super::to_json(&out)?);
     } else {
         print!("{}", table_text(&structures));
         println!("{} structures in {seconds:.3} s", structures.len());
     }
     Ok(())
+}
+
+/// The process's peak resident memory (Linux's VmHWM), where the system tells it.
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 fn destination(output: &Path) -> Result<Destination, String> {

@@ -1,16 +1,22 @@
 //! Opening a file in stages (parse, topology, checks, the original's measures; all but the
-//! parse a part at a time), so a page without threads can draw a frame with the progress between
+//! parse a part at a time; a label map is read, then its structures extracted, and the first
+//! structure opens as the model), so a page without threads can draw a frame with the progress between
 //! them instead of freezing while a large mesh opens. [`Loading::finish`] runs every stage in one
 //! call; the stages are the same.
 
-use super::Model;
-use crate::io::{self, LoadError};
+use std::sync::Arc;
+
+use super::{Model, Structures};
+use crate::io::{self, LabelMapOptions, LoadError};
 use crate::mesh::{Mesh, MeshReport, ReportInParts, Topology, TopologyInParts};
 use crate::metrics::OriginalInParts;
+use crate::segmentation::{self, ExtractOptions, LabelMap};
 
 /// What is left to do, with what the done stages produced.
 enum Stage {
     Parse(Vec<u8>),
+    /// A label map read, its structures to extract.
+    Extract(Box<LabelMap>),
     /// The incidence first (`None`), then the 1-rings a part per step.
     Topology(Mesh, Option<Box<TopologyInParts>>),
     /// The per-vertex checks, then the per-triangle checks, a part per step.
@@ -33,6 +39,16 @@ const STAGES: [&str; 5] = [
     "measuring the original",
 ];
 
+/// The stages of a label map: read, extract, then a mesh's stages after its reading.
+const LABEL_MAP_STAGES: [&str; 6] = [
+    "reading the label map",
+    "extracting the structures",
+    "building the topology",
+    "checking the mesh",
+    "preparing the measures",
+    "measuring the original",
+];
+
 /// How far an opening got: the stage under way (0-based) of [`LoadProgress::total`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadProgress {
@@ -49,6 +65,8 @@ pub struct LoadProgress {
 pub struct Loading {
     name: String,
     stage: Stage,
+    /// The structures of the label map being opened, and which one becomes the model.
+    structures: Option<Structures>,
 }
 
 /// What one stage left.
@@ -56,7 +74,16 @@ pub enum Loaded {
     /// More stages to go.
     Pending(Box<Loading>),
     Done(Box<Model>),
-    Failed(LoadError),
+    Failed(OpenFailure),
+}
+
+/// Why a file could not be opened.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OpenFailure {
+    #[error(transparent)]
+    Load(#[from] LoadError),
+    #[error(transparent)]
+    Extract(#[from] segmentation::ExtractError),
 }
 
 impl Loading {
@@ -65,6 +92,26 @@ impl Loading {
         Self {
             name: name.to_string(),
             stage: Stage::Parse(bytes),
+            structures: None,
+        }
+    }
+
+    /// Opens structure `index` of an extracted segmentation as the model (its mesh's stages).
+    pub fn structure(structures: Structures) -> Self {
+        let s = structures.current();
+        Self {
+            name: format!("{}: {}", structures.file, s.name),
+            stage: Stage::Topology(s.mesh.clone(), None),
+            structures: Some(structures),
+        }
+    }
+
+    /// The stage names of this opening: a label map has two before a mesh's.
+    fn stages(&self) -> &'static [&'static str] {
+        if self.structures.is_some() || io::is_label_map(&self.name) {
+            &LABEL_MAP_STAGES
+        } else {
+            &STAGES
         }
     }
 
@@ -75,28 +122,61 @@ impl Loading {
     pub fn progress(&self) -> LoadProgress {
         let (stage, within) = match &self.stage {
             Stage::Parse(_) => (0, 0.0),
+            Stage::Extract(_) => (1, 0.0),
             Stage::Topology(_, parts) => (1, parts.as_ref().map_or(0.0, |p| p.fraction())),
             Stage::Check(.., parts) => (2, parts.fraction()),
             Stage::Measure(original, ..) if original.preparing() => (3, original.fraction()),
             Stage::Measure(original, ..) => (4, original.fraction()),
         };
+        let stages = self.stages();
+        // A label map's mesh stages come one later (after the extraction).
+        let stage = match &self.stage {
+            Stage::Parse(_) | Stage::Extract(_) => stage,
+            _ => stage + stages.len() - STAGES.len(),
+        };
         LoadProgress {
             name: self.name.clone(),
             stage,
-            total: STAGES.len(),
-            doing: STAGES[stage],
-            fraction: (stage as f32 + within) / STAGES.len() as f32,
+            total: stages.len(),
+            doing: stages[stage],
+            fraction: (stage as f32 + within) / stages.len() as f32,
         }
     }
 
     /// Runs the next stage.
     pub fn step(self) -> Loaded {
-        let Self { name, stage } = self;
+        let Self {
+            mut name,
+            stage,
+            mut structures,
+        } = self;
         let next = match stage {
+            Stage::Parse(bytes) if io::is_label_map(&name) => {
+                match io::load_label_map(&bytes, &name, &LabelMapOptions::default()) {
+                    Ok(map) => Stage::Extract(Box::new(map)),
+                    Err(e) => return Loaded::Failed(OpenFailure::Load(e)),
+                }
+            }
             Stage::Parse(bytes) => match io::load(&bytes, &name) {
                 Ok(mesh) => Stage::Topology(mesh, None),
-                Err(e) => return Loaded::Failed(e),
+                Err(e) => return Loaded::Failed(OpenFailure::Load(e)),
             },
+            Stage::Extract(map) => {
+                match segmentation::extract(&map, &[], &ExtractOptions::default()) {
+                    Ok(list) => {
+                        let mesh = list[0].mesh.clone();
+                        let file = std::mem::take(&mut name);
+                        name = format!("{file}: {}", list[0].name);
+                        structures = Some(Structures {
+                            file,
+                            list: Arc::new(list),
+                            current: 0,
+                        });
+                        Stage::Topology(mesh, None)
+                    }
+                    Err(e) => return Loaded::Failed(OpenFailure::Extract(e)),
+                }
+            }
             Stage::Topology(mesh, None) => {
                 let parts = Box::new(TopologyInParts::new(&mesh));
                 Stage::Topology(mesh, Some(parts))
@@ -123,7 +203,11 @@ impl Loading {
             Stage::Measure(mut original, report, edges) => {
                 if !original.advance(PART) {
                     let stage = Stage::Measure(original, report, edges);
-                    return Loaded::Pending(Box::new(Self { name, stage }));
+                    return Loaded::Pending(Box::new(Self {
+                        name,
+                        stage,
+                        structures,
+                    }));
                 }
                 return Loaded::Done(Box::new(Model {
                     name,
@@ -131,14 +215,19 @@ impl Loading {
                     original: original.finish(),
                     report,
                     edges,
+                    structures,
                 }));
             }
         };
-        Loaded::Pending(Box::new(Self { name, stage: next }))
+        Loaded::Pending(Box::new(Self {
+            name,
+            stage: next,
+            structures,
+        }))
     }
 
     /// Every stage left, in one call.
-    pub fn finish(self) -> Result<Model, LoadError> {
+    pub fn finish(self) -> Result<Model, OpenFailure> {
         let mut loading = self;
         loop {
             match loading.step() {

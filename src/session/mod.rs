@@ -15,16 +15,17 @@ mod weights;
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use cpu_job::CpuProgress;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
-pub use loading::{LoadProgress, Loaded, Loading};
+pub use loading::{LoadProgress, Loaded, Loading, OpenFailure};
 pub use weights::WeightsSummary;
 
 use cpu_job::{CpuJob, Pace};
 
 use crate::export::{self, ExportFormat, ExportOptions};
-use crate::io;
 use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
 use crate::metrics::{Metrics, Original, VertexMeasures};
+use crate::segmentation::Structure;
 use crate::smooth::{Filter, Params};
+use std::sync::Arc;
 
 /// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
 pub const DEFAULT_TAU: f64 = 0.5;
@@ -38,12 +39,50 @@ pub struct Model {
     pub warnings: Vec<String>,
     /// Each edge once (`i < j`), for the wireframe overlay.
     pub edges: Vec<[u32; 2]>,
+    /// Where the model is one structure of a segmentation: all of them, and which it is.
+    pub structures: Option<Structures>,
+}
+
+/// The structures extracted from a label map, and which one is the open model.
+#[derive(Clone, Debug)]
+pub struct Structures {
+    /// The label map's file name.
+    pub file: String,
+    pub list: Arc<Vec<Structure>>,
+    pub current: usize,
+}
+
+impl Structures {
+    pub fn current(&self) -> &Structure {
+        &self.list[self.current]
+    }
+
+    /// The list for `state()` and the page's API: what each structure is, without its mesh.
+    pub fn to_json(&self) -> serde_json::Value {
+        let list: Vec<_> = self
+            .list
+            .iter()
+            .map(|s| {
+                serde_json::json!({
+                    "label": s.label,
+                    "name": s.name,
+                    "color": s.color,
+                    "voxels": s.voxels,
+                    "voxel_size": s.voxel_size,
+                    "vertices": s.mesh.vertex_count(),
+                    "triangles": s.mesh.triangle_count(),
+                    "volume": s.mesh.signed_volume(),
+                })
+            })
+            .collect();
+        serde_json::json!({ "file": self.file, "current": self.current, "structures": list })
+    }
 }
 
 impl Model {
     /// Parses `bytes` (the format chosen by `name`'s extension), builds topology, report and
     /// the original's measures (every stage of [`Loading`] in one call).
-    pub fn load(name: &str, bytes: &[u8]) -> Result<Self, io::LoadError> {
+    pub fn load(name: &str, bytes: &[u8]) -> Result<Self, OpenFailure> {
         Loading::new(name, bytes.to_vec()).finish()
     }
 
@@ -200,6 +239,31 @@ impl Session {
         }
     }
 
+    /// Starts opening structure `index` of the open segmentation as the model, in stages as a
+    /// file opens. Errors when no segmentation is open or it has no such structure.
+    pub fn begin_open_structure(&mut self, index: usize) -> Result<(), String> {
+        let Some(structures) = self.model.as_ref().and_then(|m| m.structures.clone()) else {
+            return Err("no segmentation is open".to_string());
+        };
+        if index >= structures.list.len() {
+            return Err(format!(
+                "structure {index} does not exist: the segmentation has {}",
+                structures.list.len()
+            ));
+        }
+        self.loading = Some(Loading::structure(Structures {
+            current: index,
+            ..structures
+        }));
+        self.open_stages.clear();
+        Ok(())
+    }
+
+    /// The open segmentation's structures, when the model is one of them.
+    pub fn structures(&self) -> Option<&Structures> {
+        self.model.as_ref().and_then(|m| m.structures.as_ref())
+    }
+
     /// Starts opening a file's bytes in stages ([`Self::step_loading`] does the work); the
     /// current model stays open meanwhile. Returns the name of an opening this one replaces.
     pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>) -> Option<String> {
@@ -252,6 +316,11 @@ impl Session {
 
     /// Makes `model` the open model (the previous result is dropped).
     pub fn set_model(&mut self, model: Model) -> &Model {
+        if let Some(structures) = &model.structures {
+            // A structure from a label map knows its voxels: the legend reads in voxel
+            // diagonals and the bound defaults to half of one without the user typing it.
+            self.voxel_size = Some(structures.current().voxel_size);
+        }
         self.error = None;
         self.result = None;
         self.changed();
@@ -474,6 +543,7 @@ impl Session {
             "tau": self.tau,
             "busy": busy,
             "weights": self.weights_summary(),
+            "structures": self.structures().map(Structures::to_json),
             "loading": self.loading().map(|l| serde_json::json!({
                 "name": l.name, "stage": l.stage, "stages": l.total, "doing": l.doing,
             })),

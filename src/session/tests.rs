@@ -1,4 +1,5 @@
 use super::*;
+use crate::io;
 use crate::metrics::{self, DriftingReference};
 
 const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");

@@ -1,0 +1,203 @@
+// End-to-end tests of label maps in the page: a NIfTI or .seg.nrrd opens into named structures
+// (the same the CLI's `extract` makes), one of them the model; a broken one is refused by name.
+//
+//   E2E_MODE=webgpu|cpu node --test tests/e2e/segmentation.test.mjs   (tests/e2e/run.sh runs both)
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import { appendFileSync, readFileSync, writeFileSync } from "node:fs";
+import { gunzipSync, gzipSync } from "node:zlib";
+import { join } from "node:path";
+
+import * as cli from "./lib/cli.mjs";
+import { metricDifferences } from "./lib/compare.mjs";
+import { E2E_OUT, meshPath } from "./lib/paths.mjs";
+import { appSuite } from "./lib/suite.mjs";
+
+const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
+
+const JHU = meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz");
+const PHANTOM_NRRD = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
+const PHANTOM_NIFTI = meshPath("labelmaps/case_phantom_shared.nii.gz");
+const TIMEOUT = 240_000;
+
+/** `meshsmooth extract FILE --json` into a folder of PLYs (`file` of each names its PLY). */
+async function extracted(file) {
+    return (await cli.cliJson("extract", file, "-o", join(E2E_OUT, `extract-${MODE}/`), "--json")).structures;
+}
+
+/** Tolerance of the page's measures against the CLI's, as in app.test.mjs. */
+const METRIC_RTOL = { cpu: 1e-9, webgpu: 1e-4 }[MODE];
+
+/** The page's structure list against the CLI's: labels, names, colours and counts. */
+function assertSameStructures(page, native) {
+    assert.equal(page.length, native.length);
+    page.forEach((s, i) => {
+        const n = native[i];
+        assert.deepEqual([s.label, s.name, s.voxels, s.vertices, s.triangles], [n.label, n.name, n.voxels, n.vertices, n.triangles], `structure ${i}`);
+        s.color.forEach((c, k) => assert.ok(Math.abs(c - n.color[k]) < 1e-6, `structure ${i} colour`));
+        assert.ok(Math.abs(s.volume - n.volume) <= 1e-9 * Math.abs(n.volume), `structure ${i} volume ${s.volume} vs ${n.volume}`);
+    });
+}
+
+test("S1 the JHU atlas opens into its 48 structures, as the CLI extracts them (time printed)", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        const name = "JHU-WhiteMatter-labels-1mm.nii.gz";
+        const bytes = readFileSync(JHU);
+        const run = await app.page.evaluate(
+            async ([base64, name]) => {
+                const text = atob(base64);
+                const data = new Uint8Array(text.length);
+                for (let i = 0; i < text.length; i++) data[i] = text.charCodeAt(i);
+                const start = performance.now();
+                const info = await window.meshsmooth.loadMesh(data, name);
+                const seconds = (performance.now() - start) / 1000;
+                return { info, seconds, structures: window.meshsmooth.structures(), state: window.meshsmooth.state() };
+            },
+            [bytes.toString("base64"), name],
+        );
+        const native = await extracted(JHU);
+        assert.equal(run.structures.file, name);
+        assert.equal(run.structures.current, 0);
+        assertSameStructures(run.structures.structures, native);
+        assert.equal(run.info.vertices, native[0].vertices);
+        assert.equal(run.info.closed, true);
+        assert.equal(run.info.boundary_edges, 0);
+        assert.equal(run.info.nonmanifold_edges, 0);
+        assert.equal(run.state.model, `${name}: label 1`);
+        const stages = run.state.open_stages.map((s) => s.doing);
+        assert.equal(stages[0], "reading the label map");
+        assert.equal(stages[1], "extracting the structures");
+        const stageMs = Object.fromEntries(run.state.open_stages.slice(0, 2).map((s) => [s.doing, Math.round(s.ms)]));
+        const line = { bench: "open-label-map", mode: MODE, backend: await app.backend(), file: name, structures: 48, seconds: run.seconds, stage_ms: stageMs };
+        console.log(JSON.stringify(line));
+        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
+        await app.metrics();
+        await app.screenshot("S1-jhu-first-structure");
+    });
+});
+
+test("S2 the phantom's .seg.nrrd names its structures; picking one makes it the model with its voxel size", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
+        const list = await app.call("structures");
+        const native = await extracted(PHANTOM_NRRD);
+        assertSameStructures(list.structures, native);
+        assert.deepEqual(list.structures.map((s) => s.name), ["liver", "portal_vein", "tumor", "right_kidney"]);
+        const info = await app.call("selectStructure", 2);
+        assert.equal(info.vertices, list.structures[2].vertices);
+        const state = await app.state();
+        assert.equal(state.model, "case_phantom_shared.seg.nrrd: tumor");
+        assert.equal(state.structures.current, 2);
+        // The structure is the model: smoothed, it measures as the CLI measures the same
+        // surface (the PLY that extract wrote) smoothed the same way.
+        const params = { lambda: 0.5, mu: -0.53, iterations: 10 };
+        await app.setFilter("taubin");
+        await app.setParams(params);
+        const metrics = await app.metrics();
+        const reference = await cli.smooth(native[2].file, join(E2E_OUT, `tumor-${MODE}.ply`), "taubin", params);
+        const { problems } = metricDifferences(metrics, reference.metrics, METRIC_RTOL);
+        assert.deepEqual(problems, [], `metrics() of the tumour differ from the CLI's:\n${problems.join("\n")}`);
+        const refused = await app.attempt("selectStructure", 9);
+        assert.equal(refused.ok, false);
+        assert.match(refused.message, /structure 9 does not exist/);
+        await app.screenshot("S2-phantom-tumor");
+    });
+});
+
+test("S3 a broken label map is refused by name and the open structure stays", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NIFTI), "case_phantom_shared.nii.gz");
+        const whole = readFileSync(PHANTOM_NIFTI);
+        const half = whole.subarray(0, whole.length >> 1);
+        const result = await app.attemptLoad(half, "half.nii.gz");
+        assert.equal(result.ok, false);
+        assert.match(result.message, /half\.nii\.gz/);
+        assert.match(result.message, /gzip|ends early|truncated/i);
+        const state = await app.state();
+        assert.equal(state.model, "case_phantom_shared.nii.gz: label 1");
+        assert.equal(state.structures.structures.length, 4);
+    });
+});
+
+/**
+ * A CT-sized label map (512 x 512 x 400 voxels) made from the phantom by nearest-neighbour
+ * upsampling, its structures split by side and height into about a dozen labels; written as
+ * NIfTI-1 .nii.gz. Returns the gzip bytes.
+ */
+function ctSizedLabelMap() {
+    const src = gunzipSync(readFileSync(PHANTOM_NIFTI));
+    const h = Buffer.from(src.subarray(0, 348));
+    const dim = [1, 2, 3].map((k) => h.readInt16LE(40 + 2 * k));
+    assert.equal(h.readInt16LE(70), 2, "the phantom is uint8");
+    assert.ok(h.readInt16LE(254) > 0, "the phantom has an sform");
+    const offset = h.readFloatLE(108);
+    const want = [512, 512, 400];
+    const scale = dim.map((d, k) => d / want[k]);
+    const out = Buffer.alloc(352 + want[0] * want[1] * want[2]);
+    h.copy(out, 0);
+    want.forEach((d, k) => out.writeInt16LE(d, 40 + 2 * (k + 1)));
+    for (let k = 0; k < 3; k++) out.writeFloatLE(h.readFloatLE(80 + 4 * k) * scale[k], 80 + 4 * k);
+    out.writeFloatLE(352, 108);
+    out.writeInt16LE(0, 252); // qform off: the sform alone places the grid
+    for (let r = 0; r < 3; r++) {
+        const row = [0, 1, 2, 3].map((c) => h.readFloatLE(280 + 16 * r + 4 * c));
+        let t = row[3];
+        for (let c = 0; c < 3; c++) {
+            // New voxel i sits at old index (i + 0.5) * s - 0.5.
+            t += row[c] * (0.5 * scale[c] - 0.5);
+            out.writeFloatLE(row[c] * scale[c], 280 + 16 * r + 4 * c);
+        }
+        out.writeFloatLE(t, 280 + 16 * r + 12);
+    }
+    const voxels = src.subarray(offset);
+    let at = 352;
+    for (let k = 0; k < want[2]; k++) {
+        const ks = Math.floor(k * scale[2]);
+        for (let j = 0; j < want[1]; j++) {
+            const js = Math.floor(j * scale[1]);
+            const row = (ks * dim[1] + js) * dim[0];
+            for (let i = 0; i < want[0]; i++) {
+                const label = voxels[row + Math.floor(i * scale[0])];
+                out[at++] = label === 0 ? 0 : label + 4 * ((i >= 256 ? 1 : 0) + (k >= 200 ? 2 : 0));
+            }
+        }
+    }
+    return gzipSync(out, { level: 1 });
+}
+
+test("S4 a CT-sized label map (512 x 512 x 400) opens natively and in the page (times and peak memory printed)", { timeout: 600_000 }, async () => {
+    const bytes = ctSizedLabelMap();
+    const file = join(E2E_OUT, `ct_sized_${MODE}.nii.gz`);
+    writeFileSync(file, bytes);
+    const native = await cli.cliJson("extract", file, "-o", join(E2E_OUT, `ct_sized_${MODE}.glb`), "--json");
+    await withApp(async (app) => {
+        const run = await app.page.evaluate(async (base64) => {
+            const text = atob(base64);
+            const data = new Uint8Array(text.length);
+            for (let i = 0; i < text.length; i++) data[i] = text.charCodeAt(i);
+            const before = window.meshsmooth.state().memory_bytes;
+            const start = performance.now();
+            await window.meshsmooth.loadMesh(data, "ct_sized.nii.gz");
+            const seconds = (performance.now() - start) / 1000;
+            const state = window.meshsmooth.state();
+            return { seconds, before, state, structures: window.meshsmooth.structures() };
+        }, bytes.toString("base64"));
+        assertSameStructures(run.structures.structures, native.structures);
+        const stageMs = Object.fromEntries(run.state.open_stages.slice(0, 2).map((s) => [s.doing, Math.round(s.ms)]));
+        const line = {
+            bench: "open-ct-sized-label-map",
+            mode: MODE,
+            voxels: 512 * 512 * 400,
+            gzip_bytes: bytes.length,
+            structures: native.structures.length,
+            native_extract_seconds: native.seconds,
+            native_peak_memory_mb: native.peak_memory_bytes === null ? null : Math.round(native.peak_memory_bytes / 1e6),
+            page_open_seconds: run.seconds,
+            page_stage_ms: stageMs,
+            page_memory_mb_before: Math.round(run.before / 1e6),
+            page_memory_mb_peak: Math.round(run.state.memory_bytes / 1e6),
+        };
+        console.log(JSON.stringify(line));
+        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
+    });
+});
