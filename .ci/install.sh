@@ -92,6 +92,15 @@ else
     say "wasm-pack present ($(installed_version wasm-pack))"
 fi
 
+if [ "$MODE" = web ]; then
+    : # cargo-fuzz runs the parsers' fuzz targets in the tests only
+elif ! command -v cargo-fuzz >/dev/null 2>&1; then
+    say "cargo-fuzz"
+    cargo install --locked cargo-fuzz
+else
+    say "cargo-fuzz present ($(installed_version cargo-fuzz))"
+fi
+
 if [ "$(installed_version trunk)" != "$TRUNK_VERSION" ]; then
     say "trunk $TRUNK_VERSION (about 13 minutes on 2 cores)"
     cargo install --locked trunk --version "$TRUNK_VERSION" --force

@@ -45,6 +45,8 @@ stage fmt cargo fmt --check
 stage clippy-native cargo clippy --all-targets -- -D warnings
 stage clippy-wasm32 cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
 stage test-native cargo test
+# Every parser's fuzz target, a bounded time each (tests/fuzz/run.sh).
+stage fuzz bash tests/fuzz/run.sh
 # The library's tests, tests/wasm_io.rs and tests/wasm_gpu.rs (the GPU engine on the browser's
 # WebGPU) compiled to wasm32, run in headless Chromium (flags in webdriver.json). The other
 # integration tests read files and start processes: native only, so they are not built for the

@@ -30,4 +30,17 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
         map.segments.iter().all(|s| s.layer < map.layers.len()),
         "segments in a layer"
     );
+    // Small enough maps go on to the surfaces, which must come out closed (or be refused).
+    if voxels <= 1 << 16 {
+        if let Ok(structures) = meshsmooth::segmentation::extract(&map, &[], &Default::default()) {
+            for s in &structures {
+                let report = meshsmooth::mesh::MeshReport::new(
+                    &s.mesh,
+                    &meshsmooth::mesh::Topology::build(&s.mesh),
+                );
+                assert_eq!(report.boundary_edges, 0, "a closed surface");
+                assert_eq!(report.nonmanifold_edges, 0, "a manifold surface");
+            }
+        }
+    }
 });
