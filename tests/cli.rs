@@ -1,33 +1,9 @@
 //! The command-line contract: JSON keys, exit codes, messages on stderr.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+#[path = "common/cli.rs"]
+mod common_cli;
 
-fn data(rel: &str) -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data")).join(rel)
-}
-
-fn meshsmooth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_meshsmooth"))
-        .args(args)
-        .output()
-        .expect("the meshsmooth binary runs")
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("meshsmooth-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
-}
+use common_cli::{data, json, meshsmooth, tmp};
 
 #[test]
 fn info_json_has_the_contract_keys() {

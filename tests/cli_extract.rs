@@ -1,32 +1,13 @@
 //! `meshsmooth extract` and `info` on label maps: what they write and print, and their refusals.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+#[path = "common/cli.rs"]
+mod common_cli;
 
+use common_cli::{json, meshsmooth, tmp};
+
+/// A path below ../shared/data, as an argument.
 fn data(rel: &str) -> String {
-    format!("{}/../shared/data/{rel}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn meshsmooth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_meshsmooth"))
-        .args(args)
-        .output()
-        .expect("the meshsmooth binary runs")
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("meshsmooth-extract-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+    common_cli::data(rel).display().to_string()
 }
 
 /// The JSON chunk of a GLB.

@@ -40,7 +40,7 @@
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
 
-use super::document::SharedDocument;
+use super::document::{LoadWaiter, SharedDocument};
 use crate::export::ExportFormat;
 use eframe::egui;
 use js_sys::{Function, Promise, Uint8Array};
@@ -160,6 +160,23 @@ fn start_suggest(
 
 /// A function of one argument that edits the session, throwing the engine's message when it
 /// refuses, and redraws the page when it accepts.
+/// Settles a promise once a file (or structure) is open: with the model's `info --json` keys,
+/// or with why it did not open.
+fn info_waiter(resolve: Function, reject: Function) -> LoadWaiter {
+    Box::new(move |outcome: Result<&crate::session::Session, String>| {
+        let info = outcome.and_then(|session| {
+            session
+                .info_json()
+                .map(|v| to_js(&v))
+                .ok_or_else(|| "no report".to_string())
+        });
+        let _ = match info {
+            Ok(v) => resolve.call1(&JsValue::NULL, &v),
+            Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
+        };
+    })
+}
+
 fn setter(
     doc: &SharedDocument,
     ctx: &egui::Context,
@@ -209,19 +226,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                 // Opened a stage per frame; the promise settles once it is open (or not).
                 Promise::new(&mut |resolve: Function, reject: Function| {
                     let Some(bytes) = bytes.take() else { return };
-                    let waiter =
-                        Box::new(move |outcome: Result<&crate::session::Session, String>| {
-                            let info = outcome.and_then(|session| {
-                                session
-                                    .info_json()
-                                    .map(|v| to_js(&v))
-                                    .ok_or_else(|| "no report".to_string())
-                            });
-                            let _ = match info {
-                                Ok(v) => resolve.call1(&JsValue::NULL, &v),
-                                Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
-                            };
-                        });
+                    let waiter = info_waiter(resolve, reject);
                     d.borrow_mut().begin_open(&name, bytes, Some(waiter));
                     c.request_repaint();
                 })
@@ -255,18 +260,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
             let (d, c) = (d.clone(), c.clone());
             let mut result = None;
             let promise = Promise::new(&mut |resolve: Function, reject: Function| {
-                let waiter = Box::new(move |outcome: Result<&crate::session::Session, String>| {
-                    let info = outcome.and_then(|session| {
-                        session
-                            .info_json()
-                            .map(|v| to_js(&v))
-                            .ok_or_else(|| "no report".to_string())
-                    });
-                    let _ = match info {
-                        Ok(v) => resolve.call1(&JsValue::NULL, &v),
-                        Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
-                    };
-                });
+                let waiter = info_waiter(resolve, reject);
                 result = Some(
                     d.borrow_mut()
                         .begin_open_structure(index as usize, Some(waiter)),

@@ -7,9 +7,9 @@ use serde_json::{json, Value};
 use super::{ExportError, ExportOptions};
 use crate::mesh::{bounding_box, Mesh};
 
-pub(super) const ARRAY_BUFFER: u32 = 34962;
+const ARRAY_BUFFER: u32 = 34962;
 pub(super) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-pub(super) const FLOAT: u32 = 5126;
+const FLOAT: u32 = 5126;
 const UNSIGNED_BYTE: u32 = 5121;
 pub(super) const UNSIGNED_INT: u32 = 5125;
 pub(super) const TRIANGLES: u32 = 4;
@@ -43,7 +43,7 @@ impl Builder {
     }
 }
 
-pub(super) fn floats(values: &[[f32; 3]]) -> Vec<u8> {
+fn floats(values: &[[f32; 3]]) -> Vec<u8> {
     values
         .iter()
         .flatten()
@@ -54,7 +54,7 @@ pub(super) fn floats(values: &[[f32; 3]]) -> Vec<u8> {
 /// The specification requires NORMAL to be unit length. Normals within rounding of unit length
 /// are kept bit for bit; others are rescaled, and a zero normal (a vertex with no incident
 /// area) becomes +Z.
-pub(super) fn unit_normal(n: [f32; 3]) -> [f32; 3] {
+fn unit_normal(n: [f32; 3]) -> [f32; 3] {
     let len = n.iter().map(|&v| f64::from(v).powi(2)).sum::<f64>().sqrt();
     if (len - 1.0).abs() <= 1e-4 {
         n
@@ -76,29 +76,12 @@ pub(super) fn write(mesh: &Mesh, options: &ExportOptions) -> Result<Vec<u8>, Exp
     if estimate > u64::from(u32::MAX) {
         return Err(too_large());
     }
-    let (min, max) = bounding_box(&mesh.positions).unwrap_or_default();
     let mut b = Builder {
         bin: Vec::with_capacity(estimate as usize),
         views: Vec::new(),
         accessors: Vec::new(),
     };
-    // Min/max as the f64 of each f32, so a reader comparing in either precision sees them equal.
-    let bound = |v: [f32; 3]| v.map(f64::from);
-    let position = b.push(
-        &floats(&mesh.positions),
-        ARRAY_BUFFER,
-        json!({"componentType": FLOAT, "count": n, "type": "VEC3",
-               "min": bound(min), "max": bound(max)}),
-    );
-    let mut attributes = json!({ "POSITION": position });
-    if let Some(normals) = options.normals {
-        let unit: Vec<[f32; 3]> = normals.iter().map(|&v| unit_normal(v)).collect();
-        attributes["NORMAL"] = json!(b.push(
-            &floats(&unit),
-            ARRAY_BUFFER,
-            json!({"componentType": FLOAT, "count": n, "type": "VEC3"}),
-        ));
-    }
+    let mut attributes = geometry(&mut b, mesh, options.normals);
     if let Some(colors) = options.colors {
         attributes["COLOR_0"] = json!(b.push(
             colors.as_flattened(),
@@ -129,6 +112,31 @@ pub(super) fn write(mesh: &Mesh, options: &ExportOptions) -> Result<Vec<u8>, Exp
         "buffers": [{ "byteLength": b.bin.len() }],
     });
     container(&document, b.bin).ok_or_else(too_large)
+}
+
+/// Appends a mesh's POSITION (with the min/max the specification requires) and, when given,
+/// its NORMAL (made unit) to the BIN chunk; returns the primitive's attributes.
+pub(super) fn geometry(b: &mut Builder, mesh: &Mesh, normals: Option<&[[f32; 3]]>) -> Value {
+    let n = mesh.vertex_count();
+    let (min, max) = bounding_box(&mesh.positions).unwrap_or_default();
+    // Min/max as the f64 of each f32, so a reader comparing in either precision sees them equal.
+    let bound = |v: [f32; 3]| v.map(f64::from);
+    let position = b.push(
+        &floats(&mesh.positions),
+        ARRAY_BUFFER,
+        json!({"componentType": FLOAT, "count": n, "type": "VEC3",
+               "min": bound(min), "max": bound(max)}),
+    );
+    let mut attributes = json!({ "POSITION": position });
+    if let Some(normals) = normals {
+        let unit: Vec<[f32; 3]> = normals.iter().map(|&v| unit_normal(v)).collect();
+        attributes["NORMAL"] = json!(b.push(
+            &floats(&unit),
+            ARRAY_BUFFER,
+            json!({"componentType": FLOAT, "count": n, "type": "VEC3"}),
+        ));
+    }
+    attributes
 }
 
 /// The indices of a mesh's triangles as little-endian u32s.

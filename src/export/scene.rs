@@ -9,11 +9,10 @@
 use serde_json::{json, Value};
 
 use super::glb::{
-    container, floats, index_bytes, unit_normal, Builder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER,
-    FLOAT, TRIANGLES, UNSIGNED_INT,
+    container, geometry, index_bytes, Builder, ELEMENT_ARRAY_BUFFER, TRIANGLES, UNSIGNED_INT,
 };
 use super::{check, ExportError, ExportOptions};
-use crate::mesh::{bounding_box, Mesh};
+use crate::mesh::Mesh;
 
 /// Which frame the file's coordinates are in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -114,29 +113,11 @@ pub fn write_scene_glb(
 
 /// The triangle primitive of one surface, its arrays appended to the BIN chunk.
 fn primitive(b: &mut Builder, item: &SceneMesh, material: usize) -> Value {
-    let mesh = item.mesh;
-    let n = mesh.vertex_count();
-    let (min, max) = bounding_box(&mesh.positions).unwrap_or_default();
-    let bound = |v: [f32; 3]| v.map(f64::from);
-    let position = b.push(
-        &floats(&mesh.positions),
-        ARRAY_BUFFER,
-        json!({"componentType": FLOAT, "count": n, "type": "VEC3",
-               "min": bound(min), "max": bound(max)}),
-    );
-    let mut attributes = json!({ "POSITION": position });
-    if let Some(normals) = item.normals {
-        let unit: Vec<[f32; 3]> = normals.iter().map(|&v| unit_normal(v)).collect();
-        attributes["NORMAL"] = json!(b.push(
-            &floats(&unit),
-            ARRAY_BUFFER,
-            json!({"componentType": FLOAT, "count": n, "type": "VEC3"}),
-        ));
-    }
+    let attributes = geometry(b, item.mesh, item.normals);
     let indices = b.push(
-        &index_bytes(mesh),
+        &index_bytes(item.mesh),
         ELEMENT_ARRAY_BUFFER,
-        json!({"componentType": UNSIGNED_INT, "count": 3 * mesh.triangle_count(), "type": "SCALAR"}),
+        json!({"componentType": UNSIGNED_INT, "count": 3 * item.mesh.triangle_count(), "type": "SCALAR"}),
     );
     json!({ "attributes": attributes, "indices": indices, "material": material, "mode": TRIANGLES })
 }

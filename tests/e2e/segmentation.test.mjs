@@ -201,3 +201,19 @@ test("S4 a CT-sized label map (512 x 512 x 400) opens natively and in the page (
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
     });
 });
+
+test("S5 a label map dropped on the page opens as its structures", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.dropFile(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
+        const deadline = Date.now() + 60_000;
+        let state = await app.state();
+        while (!(state.structures && state.loading === null) && Date.now() < deadline) {
+            await new Promise((resolve) => setTimeout(resolve, 200));
+            state = await app.state();
+        }
+        assert.ok(state.structures, "the dropped label map opened as structures");
+        assert.equal(state.model, "case_phantom_shared.seg.nrrd: liver");
+        assert.deepEqual(state.structures.structures.map((s) => s.name), ["liver", "portal_vein", "tumor", "right_kidney"]);
+        await app.screenshot("S5-dropped-seg-nrrd");
+    });
+});

@@ -4,6 +4,7 @@
 use meshsmooth::io::{load_as, Format};
 use meshsmooth::mesh::{MeshReport, Topology};
 
+#[allow(dead_code)]
 pub fn check(data: &[u8], format: Format) {
     let Ok(mesh) = load_as(data, format) else {
         return;
@@ -21,4 +22,40 @@ pub fn check(data: &[u8], format: Format) {
     let topology = Topology::build(&mesh);
     let report = MeshReport::new(&mesh, &topology);
     assert_eq!(report.faces, mesh.triangles.len());
+}
+
+/// What the label-map targets check: a label map with finite affine and codes in range, whose
+/// small enough maps give closed, manifold surfaces (or are refused).
+#[allow(dead_code)]
+pub fn check_label_map(map: &meshsmooth::segmentation::LabelMap) {
+    let voxels = map.voxel_count();
+    assert!(
+        map.affine.0.iter().flatten().all(|v| v.is_finite()),
+        "a finite affine"
+    );
+    assert!(!map.layers.is_empty(), "at least one layer");
+    for layer in &map.layers {
+        assert_eq!(layer.codes.len(), voxels, "a code per voxel");
+        assert_eq!(layer.values[0], 0, "code 0 is background");
+        assert!(
+            layer
+                .codes
+                .iter()
+                .all(|&c| (c as usize) < layer.values.len()),
+            "codes in range"
+        );
+    }
+    assert!(
+        map.segments.iter().all(|s| s.layer < map.layers.len()),
+        "segments in a layer"
+    );
+    if voxels <= 1 << 16 {
+        if let Ok(structures) = meshsmooth::segmentation::extract(map, &[], &Default::default()) {
+            for s in &structures {
+                let report = MeshReport::new(&s.mesh, &Topology::build(&s.mesh));
+                assert_eq!(report.boundary_edges, 0, "a closed surface");
+                assert_eq!(report.nonmanifold_edges, 0, "a manifold surface");
+            }
+        }
+    }
 }
