@@ -33,6 +33,7 @@ mod report_view;
 mod shell;
 mod shortcuts;
 mod status;
+mod structure_picker;
 pub mod viewer;
 
 pub use document::{Backend, Document};

@@ -13,6 +13,7 @@ use super::file_input::FileInput;
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
 use super::shortcuts::{self, Action};
+use super::structure_picker;
 use super::viewer::{self, Viewer};
 use super::{api, download, legend, page, query, report_view, status, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
@@ -364,7 +365,7 @@ impl Shell {
     fn smoothing_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
         let timings = doc.timings;
-        if let Some(index) = structure_picker(ui, &doc.session) {
+        if let Some(index) = structure_picker::show(ui, &doc.session) {
             if let Err(e) = doc.begin_open_structure(index, None) {
                 log::warn!("{e}");
             }
@@ -587,47 +588,4 @@ fn drop_hint(ctx: &egui::Context) {
         egui::FontId::proportional(28.0),
         egui::Color32::WHITE,
     );
-}
-
-/// The segmentation's structures, when the model is one of them: which one the smoothing acts
-/// on. Returns the structure picked in this frame.
-fn structure_picker(ui: &mut egui::Ui, session: &crate::session::Session) -> Option<usize> {
-    let structures = session.structures()?;
-    let mut picked = None;
-    ui.heading("Structure");
-    let swatch = |ui: &mut egui::Ui, c: [f32; 3]| {
-        let (rect, _) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
-        let [r, g, b] = c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
-        ui.painter()
-            .rect_filled(rect, 2.0, egui::Color32::from_rgb(r, g, b));
-    };
-    let current = structures.current();
-    ui.horizontal(|ui| {
-        swatch(ui, current.color);
-        egui::ComboBox::from_id_salt("structure")
-            .selected_text(&current.name)
-            .show_ui(ui, |ui| {
-                for (i, s) in structures.list.iter().enumerate() {
-                    ui.horizontal(|ui| {
-                        swatch(ui, s.color);
-                        let text = format!("{} ({} voxels)", s.name, s.voxels);
-                        if ui.selectable_label(i == structures.current, text).clicked()
-                            && i != structures.current
-                        {
-                            picked = Some(i);
-                        }
-                    });
-                }
-            });
-    })
-    .response
-    .on_hover_text(format!(
-        "{} structures in {}; label {}, {} voxels",
-        structures.list.len(),
-        structures.file,
-        current.label,
-        current.voxels
-    ));
-    ui.separator();
-    picked
 }
