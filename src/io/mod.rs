@@ -20,6 +20,7 @@ mod weld;
 
 pub use color_table::{parse_color_table, LabelEntry};
 pub use error::{LoadError, Location};
+pub use gltf::{GltfNode, GltfScene, Mat4};
 pub use label_map::{is_label_map, load_label_map, LabelMapOptions};
 pub use weld::weld_exact;
 
@@ -78,6 +79,19 @@ impl Format {
     pub fn is_label_map(self) -> bool {
         matches!(self, Format::Nifti | Format::Nrrd)
     }
+}
+
+/// Reads a glTF scene node by node (a case's structures), choosing `.glb` or `.gltf` by the
+/// bytes; `name` names the file in errors' formats only.
+pub fn load_gltf_scene(bytes: &[u8], name: &str) -> Result<GltfScene, LoadError> {
+    let format = match Format::from_name(name) {
+        Some(f @ (Format::Glb | Format::Gltf)) => f,
+        _ => Format::Gltf,
+    };
+    if bytes.is_empty() {
+        return Err(LoadError::Empty { format });
+    }
+    gltf::read_scene(bytes, format)
 }
 
 /// Reads a mesh, choosing the parser by the file name's extension. A label map's name gives an

@@ -6,6 +6,8 @@ use ::gltf::json::validation::Checked;
 use ::gltf::json::Root;
 
 use super::super::{Format, LoadError, Location};
+use std::borrow::Cow;
+
 use super::accessor::{layout, load_buffers, read_indices, read_vectors, Layout};
 use super::scene::{determinant3, transform_point, Instance, IDENTITY};
 use crate::mesh::Mesh;
@@ -46,11 +48,29 @@ pub(super) fn merge(
     format: Format,
 ) -> Result<Mesh, LoadError> {
     let jobs = plan(root, instances, format)?;
+    let needed = check_totals(root, &jobs, format)?;
+    let buffers = load_buffers(root, bin, &needed, format)?;
+    assemble(&jobs, &buffers, format)
+}
 
+/// [`merge`] with every buffer already loaded (a reader that merges node by node).
+pub(super) fn merge_loaded(
+    root: &Root,
+    instances: &[Instance],
+    buffers: &[Option<Cow<[u8]>>],
+    format: Format,
+) -> Result<Mesh, LoadError> {
+    let jobs = plan(root, instances, format)?;
+    check_totals(root, &jobs, format)?;
+    assemble(&jobs, buffers, format)
+}
+
+/// Refuses totals past the caps; returns which buffers the jobs read.
+fn check_totals(root: &Root, jobs: &[Job], format: Format) -> Result<Vec<bool>, LoadError> {
     let mut vertex_total = 0u64;
     let mut triangle_total = 0u64;
     let mut needed = vec![false; root.buffers.len()];
-    for job in &jobs {
+    for job in jobs {
         vertex_total = vertex_total.saturating_add(job.positions.count as u64);
         let refs = job.indices.as_ref().unwrap_or(&job.positions).count;
         triangle_total = triangle_total.saturating_add(max_triangles(job.mode, refs));
@@ -73,7 +93,19 @@ pub(super) fn merge(
             });
         }
     }
-    let buffers = load_buffers(root, bin, &needed, format)?;
+    Ok(needed)
+}
+
+fn assemble(
+    jobs: &[Job],
+    buffers: &[Option<Cow<[u8]>>],
+    format: Format,
+) -> Result<Mesh, LoadError> {
+    let vertex_total: usize = jobs.iter().map(|j| j.positions.count).sum();
+    let triangle_total: u64 = jobs
+        .iter()
+        .map(|j| max_triangles(j.mode, j.indices.as_ref().unwrap_or(&j.positions).count))
+        .sum();
     let data = |l: &Layout| {
         buffers
             .get(l.buffer)
@@ -86,9 +118,9 @@ pub(super) fn merge(
     };
 
     // Both totals are bounded by the caps above.
-    let mut positions: Vec<[f32; 3]> = Vec::with_capacity(vertex_total as usize);
+    let mut positions: Vec<[f32; 3]> = Vec::with_capacity(vertex_total);
     let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(triangle_total as usize);
-    for job in &jobs {
+    for job in jobs {
         let mut points = read_vectors::<3>(&job.positions, data(&job.positions)?, format)?;
         if let Some(v) = points.iter().flatten().find(|v| !v.is_finite()) {
             return Err(LoadError::NonFinite {

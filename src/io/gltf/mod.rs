@@ -8,7 +8,11 @@
 mod accessor;
 mod assemble;
 mod glb;
+mod nodes;
 mod scene;
+
+pub use nodes::{read_scene, GltfNode, GltfScene};
+pub use scene::Mat4;
 
 use ::gltf::json::mesh::Semantic;
 use ::gltf::json::validation::Checked;

@@ -6,7 +6,7 @@ use ::gltf::json::Root;
 use super::super::{Format, LoadError, Location};
 
 /// 4x4 matrix, column-major like glTF: `m[column][row]`.
-pub(super) type Mat4 = [[f64; 4]; 4];
+pub type Mat4 = [[f64; 4]; 4];
 
 pub(super) const IDENTITY: Mat4 = [
     [1.0, 0.0, 0.0, 0.0],
