@@ -1,0 +1,346 @@
+// End-to-end check of the scene GLB the CLI writes for a label map, as other tools see it: the
+// Khronos glTF-Validator passes it with no error or warning, and three.js's GLTFLoader in
+// headless Chromium finds every structure by name, in its colour, in metres with +Y superior.
+// The app is not involved: both modes run the same checks, in the same browser (WebGL2).
+//
+//   E2E_MODE=webgpu|cpu node --test tests/e2e/case_gltf.test.mjs   (tests/e2e/run.sh runs both)
+//
+// The GLBs and a rendering of each (case-<name>.png) go to target/e2e/<mode>/.
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { readFileSync, writeFileSync } from "node:fs";
+import { basename, join } from "node:path";
+
+import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
+import * as cli from "./lib/cli.mjs";
+import { gltfValidator } from "./lib/deps.mjs";
+import { meshPath, outputDir } from "./lib/paths.mjs";
+import { assertNotBlank, colourHistogram, decodePng } from "./lib/png.mjs";
+import { openThreePage, serveThreePage, threeVersion } from "./lib/three.mjs";
+
+const MODE = modeFromEnv();
+const OUT = outputDir(MODE);
+const TIMEOUT = 240_000;
+const VIEWPORT = { width: 960, height: 720 };
+
+/**
+ * The one command under test: writes the scene GLB of `input` (a label map) to `output`, its
+ * labels named by the colour table `colors` when given.
+ */
+function writeCaseGlb(input, output, { colors } = {}) {
+    return cli.cli("extract", input, ...(colors ? ["--colors", colors] : []), "-o", output);
+}
+
+const CASES = [
+    {
+        key: "phantom",
+        what: "the phantom's",
+        input: meshPath("labelmaps/case_phantom_shared.nii.gz"),
+        colors: meshPath("labelmaps/case_phantom_shared_labels.txt"),
+        structures: 4,
+    },
+    {
+        key: "jhu",
+        what: "the JHU atlas's",
+        input: meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz"),
+        colors: meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.txt"),
+        structures: 48,
+    },
+];
+
+// --- what the GLB must hold ---
+
+/**
+ * A colour table's entries by label: `{name, color?}` (sRGB 0..1). Reads the two kinds the
+ * test data has: Slicer/FreeSurfer lines `label name R G B A` and FSL lines `label name`.
+ */
+function readColourTable(path) {
+    const entries = new Map();
+    for (const line of readFileSync(path, "utf8").split(/\r?\n/)) {
+        const fields = line.trim().split(/\s+/);
+        if (fields[0] === "" || fields[0].startsWith("#") || !/^\d+$/.test(fields[0]) || fields.length < 2) {
+            continue;
+        }
+        const rgb = fields.slice(2, 5).map(Number);
+        const entry = { name: fields[1] };
+        if (rgb.length === 3 && rgb.every(Number.isFinite)) {
+            entry.color = rgb.map((c) => c / 255);
+        }
+        entries.set(Number(fields[0]), entry);
+    }
+    return entries;
+}
+
+/**
+ * The structures the GLB must hold, in order: `meshsmooth info --json` of the label map (labels,
+ * default names and colours), renamed and recoloured by the colour table as `--colors` does.
+ * Opaque: info gives no opacity.
+ */
+async function expectedStructures(c) {
+    const info = await cli.info(c.input);
+    const table = c.colors ? readColourTable(c.colors) : new Map();
+    return info.structures.map((s) => {
+        const entry = table.get(s.label) ?? {};
+        return { label: s.label, name: entry.name ?? s.name, color: entry.color ?? s.color, opacity: 1 };
+    });
+}
+
+/** The JSON and binary chunks of a GLB. */
+function readGlb(bytes) {
+    assert.equal(bytes.toString("latin1", 0, 4), "glTF", "GLB magic");
+    assert.equal(bytes.readUInt32LE(4), 2, "GLB version");
+    assert.equal(bytes.readUInt32LE(8), bytes.length, "GLB length");
+    const jsonLength = bytes.readUInt32LE(12);
+    assert.equal(bytes.toString("latin1", 16, 20), "JSON");
+    const json = JSON.parse(bytes.toString("utf8", 20, 20 + jsonLength));
+    const at = 20 + jsonLength;
+    const bin = at < bytes.length ? bytes.subarray(at + 8, at + 8 + bytes.readUInt32LE(at)) : Buffer.alloc(0);
+    return { json, bin };
+}
+
+/**
+ * Every node with a mesh, in scene order (depth first, as three traverses): its name, its
+ * material, and its POSITION data (RAS mm): vertex count, accessor min/max, mean.
+ */
+function glbStructures(bytes) {
+    const { json, bin } = readGlb(bytes);
+    const structures = [];
+    const visit = (index) => {
+        const node = json.nodes[index];
+        if (node.mesh !== undefined) {
+            const primitives = json.meshes[node.mesh].primitives;
+            const min = [Infinity, Infinity, Infinity];
+            const max = [-Infinity, -Infinity, -Infinity];
+            const sum = [0, 0, 0];
+            let count = 0;
+            for (const primitive of primitives) {
+                const accessor = json.accessors[primitive.attributes.POSITION];
+                assert.equal(accessor.componentType, 5126, "POSITION is float");
+                const view = json.bufferViews[accessor.bufferView];
+                const stride = view.byteStride ?? 12;
+                const start = (view.byteOffset ?? 0) + (accessor.byteOffset ?? 0);
+                for (let i = 0; i < accessor.count; i++) {
+                    for (let k = 0; k < 3; k++) sum[k] += bin.readFloatLE(start + i * stride + 4 * k);
+                }
+                count += accessor.count;
+                for (let k = 0; k < 3; k++) {
+                    min[k] = Math.min(min[k], accessor.min[k]);
+                    max[k] = Math.max(max[k], accessor.max[k]);
+                }
+            }
+            const material = json.materials[primitives[0].material] ?? {};
+            structures.push({
+                name: node.name,
+                baseColorFactor: material.pbrMetallicRoughness?.baseColorFactor ?? [1, 1, 1, 1],
+                alphaMode: material.alphaMode ?? "OPAQUE",
+                vertices: count,
+                min,
+                max,
+                mean: sum.map((s) => s / count),
+            });
+        }
+        for (const child of node.children ?? []) visit(child);
+    };
+    for (const root of json.scenes[json.scene ?? 0].nodes) visit(root);
+    return structures;
+}
+
+/** An sRGB component (0..1) in linear light, as three's Color holds it. */
+function srgbToLinear(c) {
+    return c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4;
+}
+
+const written = new Map();
+
+/** The case's GLB (written once per run and mode): `{file, bytes}`. */
+function caseGlb(c) {
+    if (!written.has(c.key)) {
+        const file = join(OUT, `case-${c.key}.glb`);
+        written.set(
+            c.key,
+            writeCaseGlb(c.input, file, { colors: c.colors }).then(() => ({ file, bytes: readFileSync(file) })),
+        );
+    }
+    return written.get(c.key);
+}
+
+// --- the checks ---
+
+/**
+ * The browser is the same in both runs: three's WebGLRenderer needs WebGL, which headless
+ * Chromium does not give with the webgpu mode's flags (ANGLE on SwiftShader Vulkan: "Error
+ * creating WebGL context"); the cpu mode's flags give WebGL2 on SwiftShader. Nothing here
+ * depends on the app's engine.
+ */
+const BROWSER_MODE = "cpu";
+
+let browser;
+let server;
+
+before(async () => {
+    cli.requireCli();
+    const three = threeVersion();
+    server = await serveThreePage();
+    browser = await launchBrowser(BROWSER_MODE);
+    console.log(`e2e: mode ${MODE} (browser flags of ${BROWSER_MODE}), Chromium ${browser.version()}, three ${three} served at ${server.url}`);
+});
+
+after(async () => {
+    await browser?.close();
+    await server?.close();
+});
+
+const SEVERITIES = ["error", "warning", "info", "hint"];
+
+CASES.forEach((c, n) => {
+    test(`GLB${2 * n + 1} ${c.what} scene GLB passes the Khronos glTF-Validator with no error or warning`, { timeout: TIMEOUT }, async (t) => {
+        const { file, bytes } = await caseGlb(c);
+        const report = await gltfValidator.validateBytes(new Uint8Array(bytes), { uri: basename(file), format: "glb" });
+        const { numErrors, numWarnings, numInfos, numHints, messages, truncated } = report.issues;
+        const summary = `${numErrors} errors, ${numWarnings} warnings, ${numInfos} infos, ${numHints} hints`;
+        const listed = messages.map((m) => `  [${SEVERITIES[m.severity]}] ${m.code} ${m.pointer ?? ""}: ${m.message}`);
+        t.diagnostic(`glTF-Validator ${report.validatorVersion}: ${summary}`);
+        console.log(
+            JSON.stringify({
+                e2e: "gltf-validator",
+                mode: MODE,
+                file: basename(file),
+                validator: report.validatorVersion,
+                errors: numErrors,
+                warnings: numWarnings,
+                infos: numInfos,
+                hints: numHints,
+                codes: [...new Set(messages.map((m) => `${SEVERITIES[m.severity]}:${m.code}`))],
+                draw_calls: report.info.drawCallCount,
+                vertices: report.info.totalVertexCount,
+                triangles: report.info.totalTriangleCount,
+            }),
+        );
+        assert.ok(numErrors === 0 && numWarnings === 0, `glTF-Validator on ${file}: ${summary}${truncated ? " (list truncated)" : ""}:\n${listed.join("\n")}`);
+        assert.equal(report.info.drawCallCount, c.structures, "one draw call (mesh primitive) per structure");
+    });
+
+    test(`GLB${2 * n + 2} three.js loads ${c.what} scene GLB in Chromium: names, colours, size in metres, +Y superior (rendered)`, { timeout: TIMEOUT }, async (t) => {
+        const { file, bytes } = await caseGlb(c);
+        const expected = await expectedStructures(c);
+        assert.equal(expected.length, c.structures, `meshsmooth info lists ${c.structures} structures`);
+        const glb = glbStructures(bytes);
+        const name = basename(file);
+        server.files.set(name, bytes);
+        const opened = await openThreePage(browser, server, VIEWPORT);
+        try {
+            const seen = await opened.page.evaluate((url) => window.gltfCheck.load(url), `/files/${name}`);
+            const meshes = seen.meshes;
+            const names = expected.map((s) => s.name);
+
+            // Names: the glTF node names (userData.name), the material names, three's object names.
+            assert.deepEqual(glb.map((s) => s.name), names, "the GLB's mesh nodes are the structures, in order");
+            assert.deepEqual(meshes.map((m) => m.nodeName), names, "three's meshes come from the structures' nodes, in order");
+            assert.deepEqual(meshes.map((m) => m.material), names, "each mesh's material is named after its structure");
+            const sanitised = await opened.page.evaluate((names) => window.gltfCheck.sanitise(names), names);
+            assert.deepEqual(meshes.map((m) => m.name), sanitised, "three names each mesh after its node (sanitised)");
+            assert.deepEqual(meshes.map((m) => m.vertices), glb.map((s) => s.vertices), "vertex counts");
+
+            // Colours (three's Color is linear) and opacity.
+            const problems = [];
+            meshes.forEach((m, i) => {
+                assert.equal(m.colorSpace, "srgb-linear", "three's working colour space");
+                const want = expected[i].color.map(srgbToLinear);
+                const worst = Math.max(...want.map((w, k) => Math.abs(m.color[k] - w)));
+                if (worst > 1 / 255) {
+                    problems.push(`${names[i]}: linear colour ${m.color.map((x) => x.toFixed(4))} (sRGB ${m.colorSrgbHex}), expected ${want.map((x) => x.toFixed(4))} (sRGB ${expected[i].color.map((x) => Math.round(x * 255))})`);
+                }
+                const g = glb[i];
+                if (Math.abs(m.opacity - expected[i].opacity) > 1e-6 || Math.abs(m.opacity - g.baseColorFactor[3]) > 1e-6) {
+                    problems.push(`${names[i]}: opacity ${m.opacity}, expected ${expected[i].opacity} (baseColorFactor alpha ${g.baseColorFactor[3]})`);
+                }
+                if (m.transparent !== (g.alphaMode === "BLEND") || m.transparent !== (expected[i].opacity < 1)) {
+                    problems.push(`${names[i]}: transparent ${m.transparent} with alphaMode ${g.alphaMode} and opacity ${expected[i].opacity}`);
+                }
+            });
+            assert.deepEqual(problems, [], `materials differ from the structures:\n${problems.join("\n")}`);
+
+            // Size and place: the data's extent (RAS mm, from the GLB's POSITION accessors)
+            // in metres, right -> -X, superior -> +Y, anterior -> +Z.
+            const min = [0, 1, 2].map((k) => Math.min(...glb.map((s) => s.min[k])));
+            const max = [0, 1, 2].map((k) => Math.max(...glb.map((s) => s.max[k])));
+            const extentMm = max.map((x, k) => x - min[k]);
+            const wantBox = {
+                min: [-max[0] / 1000, min[2] / 1000, min[1] / 1000],
+                max: [-min[0] / 1000, max[2] / 1000, max[1] / 1000],
+            };
+            const axisOf = ["X (R-L)", "Y (S-I)", "Z (A-P)"];
+            const extentOfAxis = [extentMm[0], extentMm[2], extentMm[1]];
+            const size = seen.box.max.map((x, k) => x - seen.box.min[k]);
+            const boxProblems = [];
+            for (let k = 0; k < 3; k++) {
+                const wantSize = extentOfAxis[k] / 1000;
+                if (Math.abs(size[k] - wantSize) > 0.01 * wantSize) {
+                    boxProblems.push(`${axisOf[k]}: three's box is ${size[k].toFixed(5)} m, the data ${extentOfAxis[k].toFixed(2)} mm`);
+                }
+                for (const end of ["min", "max"]) {
+                    if (Math.abs(seen.box[end][k] - wantBox[end][k]) > 0.01 * wantSize) {
+                        boxProblems.push(`${axisOf[k]}: box ${end} ${seen.box[end][k].toFixed(5)} m, expected ${wantBox[end][k].toFixed(5)} m`);
+                    }
+                }
+            }
+            assert.deepEqual(boxProblems, [], `three's world box differs from the data's extent:\n${boxProblems.join("\n")}`);
+
+            // Orientation, structure by structure: the highest (most superior) structure is
+            // the highest in three's world, and so on for right and anterior.
+            const argmax = (values) => values.reduce((best, v, i) => (v > values[best] ? i : best), 0);
+            const orientation = [
+                ["superior (+S) is +Y", argmax(glb.map((s) => s.mean[2])), argmax(meshes.map((m) => m.meanWorld[1]))],
+                ["anterior (+A) is +Z", argmax(glb.map((s) => s.mean[1])), argmax(meshes.map((m) => m.meanWorld[2]))],
+                ["right (+R) is -X", argmax(glb.map((s) => s.mean[0])), argmax(meshes.map((m) => -m.meanWorld[0]))],
+            ];
+            for (const [what, inData, inThree] of orientation) {
+                assert.equal(names[inThree], names[inData], `${what}: the data's extreme structure is ${names[inData]}, three's is ${names[inThree]}`);
+            }
+            const tolerance = 1e-3 * Math.max(...extentMm);
+            meshes.forEach((m, i) => {
+                const [r, a, s] = glb[i].mean;
+                const want = [-r, s, a];
+                const off = Math.max(...want.map((w, k) => Math.abs(m.meanWorld[k] * 1000 - w)));
+                assert.ok(off <= tolerance, `${names[i]}: centre in three's world ${m.meanWorld.map((x) => (x * 1000).toFixed(2))} mm, expected (-R, S, A) = ${want.map((x) => x.toFixed(2))} mm`);
+            });
+
+            // One rendering, seen from the front (+Z, anterior) with superior up.
+            const rendered = await opened.page.evaluate(([w, h]) => window.gltfCheck.render(w, h), [VIEWPORT.width, VIEWPORT.height]);
+            await opened.page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+            const png = await opened.page.screenshot();
+            const shot = join(OUT, `case-${c.key}.png`);
+            writeFileSync(shot, png);
+            const image = decodePng(png);
+            assertNotBlank(image, shot);
+            const background = colourHistogram(image)[0][1] / (image.width * image.height);
+            t.diagnostic(`rendered with WebGL${rendered.webgl} on ${rendered.renderer}: ${shot}`);
+
+            assert.deepEqual(opened.foreignRequests(), [], "the page requested something outside its own origin");
+            assert.deepEqual(opened.pageErrors.map(String), [], "uncaught errors in the page");
+            const threeWarnings = opened.console.filter((l) => (l.type === "warning" || l.type === "error") && /THREE/.test(l.text));
+            assert.deepEqual(threeWarnings, [], "three.js warned about the file");
+            console.log(
+                JSON.stringify({
+                    e2e: "three-gltf",
+                    mode: MODE,
+                    file: name,
+                    three: seen.revision,
+                    meshes: meshes.length,
+                    vertices: meshes.reduce((n, m) => n + m.vertices, 0),
+                    box_size_m: size.map((x) => Number(x.toFixed(6))),
+                    data_extent_mm_ras: extentMm.map((x) => Number(x.toFixed(3))),
+                    top: names[argmax(meshes.map((m) => m.meanWorld[1]))],
+                    colours: meshes.slice(0, 6).map((m) => `${m.name} ${m.colorSrgbHex}`),
+                    webgl: rendered.renderer,
+                    screenshot_background_share: Number(background.toFixed(3)),
+                    requests: opened.requests.map((u) => new URL(u).pathname),
+                    console: opened.console.map((l) => `[${l.type}] ${l.text}`),
+                }),
+            );
+        } finally {
+            await opened.close();
+            server.files.delete(name);
+        }
+    });
+});
