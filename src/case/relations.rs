@@ -1,0 +1,260 @@
+//! Spatial relations between the structures of a case: which lie inside which, and which
+//! reach into another's material. Each structure is smoothed on its own, so a tumour can come
+//! out of its organ or two neighbours can push into each other; comparing the relations before
+//! and after smoothing shows the author where.
+//!
+//! A structure is a closed, outward-wound surface that may have several shells: a structure
+//! carved out of another leaves that one an inward-facing cavity shell. "Inside" asks whether
+//! one surface lies within the other's outermost extent (its material or its cavities, i.e.
+//! inside at least one of its shells); "crossing" asks how deep one surface reaches into the
+//! other's material (inside by parity over all of its triangles). Neighbours in a label map
+//! share faces exactly, so points within a tolerance of the other surface count as inside it,
+//! and depths up to the tolerance are not crossings.
+
+mod rays;
+#[cfg(test)]
+mod tests;
+
+use std::collections::HashMap;
+
+use rayon::prelude::*;
+
+use crate::mesh::{to_f64, Mesh};
+use crate::metrics::TriangleBvh;
+use rays::{Location, RayBvh};
+
+/// What one pair of structures does, in one state (original or smoothed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairRelation {
+    /// Index of the first structure; always below `b`.
+    pub a: usize,
+    pub b: usize,
+    /// Every vertex of `a` lies inside a shell of `b` (its material or a cavity) or within the
+    /// pair's enclosure tolerance of `b`'s surface.
+    pub a_inside_b: bool,
+    pub b_inside_a: bool,
+    /// Deepest vertex of either surface inside the other's material (mm), 0 when none.
+    pub overlap_depth: f64,
+    /// `overlap_depth` exceeds the pair's crossing tolerance.
+    pub crosses: bool,
+}
+
+/// The changes an author must see between two states of a case.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct RelationChanges {
+    /// `(inner, outer)`: the inner structure lay inside the outer one before and no longer does.
+    pub left_inside: Vec<(usize, usize)>,
+    /// `(a, b)`: pairs that cross now and did not before.
+    pub new_crossings: Vec<(usize, usize)>,
+}
+
+/// Relations of every pair whose bounding boxes, grown by the pair's enclosure tolerance, meet;
+/// pairs that are apart are left out. `tolerance[i]` is how far structure `i`'s surface may lie
+/// from its true boundary (mm; half its voxel diagonal for a label-map structure). A pair
+/// crosses when one surface reaches deeper than the larger of its two tolerances into the
+/// other's material. A vertex counts as enclosed within the sum of the two of the other's
+/// surface: the staircases of a true boundary nested against another can lie that far apart
+/// (the phantom's tumour touches the background where the liver's voxels stop one layer short).
+/// Every position of a mesh counts as one of its vertices. Meshes should be closed; a mesh
+/// without vertices meets nothing.
+///
+/// # Panics
+/// When `tolerance` and `meshes` differ in length.
+pub fn relations(meshes: &[&Mesh], tolerance: &[f64]) -> Vec<PairRelation> {
+    assert_eq!(meshes.len(), tolerance.len(), "one tolerance per structure");
+    let boxes: Vec<Option<Box3>> = meshes.iter().map(|m| Box3::of(&m.positions)).collect();
+    let tolerance: Vec<f64> = tolerance.iter().map(|t| t.max(0.0)).collect();
+    let mut pairs = Vec::new();
+    for a in 0..meshes.len() {
+        for b in a + 1..meshes.len() {
+            let tol = Tolerance {
+                crossing: tolerance[a].max(tolerance[b]),
+                enclosure: tolerance[a] + tolerance[b],
+            };
+            if let (Some(ba), Some(bb)) = (&boxes[a], &boxes[b]) {
+                if ba.grown(tol.enclosure).meets(bb) {
+                    pairs.push((a, b, tol));
+                }
+            }
+        }
+    }
+    let mut used = vec![false; meshes.len()];
+    for &(a, b, _) in &pairs {
+        used[a] = true;
+        used[b] = true;
+    }
+    let solids: Vec<Option<Solid>> = meshes
+        .par_iter()
+        .zip(&boxes)
+        .zip(&used)
+        .map(|((mesh, bounds), &used)| match bounds {
+            Some(bounds) if used => Some(Solid::new(mesh, *bounds)),
+            _ => None,
+        })
+        .collect();
+    pairs
+        .par_iter()
+        .filter_map(|&(a, b, tol)| {
+            let (sa, sb) = (solids[a].as_ref()?, solids[b].as_ref()?);
+            let (ab, ba) = rayon::join(
+                || reach(&meshes[a].positions, sa.bounds, sb, tol.enclosure),
+                || reach(&meshes[b].positions, sb.bounds, sa, tol.enclosure),
+            );
+            let overlap_depth = ab.depth.max(ba.depth);
+            Some(PairRelation {
+                a,
+                b,
+                a_inside_b: ab.enclosed,
+                b_inside_a: ba.enclosed,
+                overlap_depth,
+                crosses: overlap_depth > tol.crossing,
+            })
+        })
+        .collect()
+}
+
+/// What changed from `before` to `after` (both from [`relations`] over the same structures):
+/// a pair missing from `after` has come apart, so an inside relation it had is left.
+pub fn changes(before: &[PairRelation], after: &[PairRelation]) -> RelationChanges {
+    let then: HashMap<(usize, usize), &PairRelation> =
+        before.iter().map(|r| ((r.a, r.b), r)).collect();
+    let now: HashMap<(usize, usize), &PairRelation> =
+        after.iter().map(|r| ((r.a, r.b), r)).collect();
+    let mut out = RelationChanges::default();
+    for r in before {
+        let still = now.get(&(r.a, r.b));
+        if r.a_inside_b && !still.is_some_and(|s| s.a_inside_b) {
+            out.left_inside.push((r.a, r.b));
+        }
+        if r.b_inside_a && !still.is_some_and(|s| s.b_inside_a) {
+            out.left_inside.push((r.b, r.a));
+        }
+    }
+    for s in after {
+        if s.crosses && !then.get(&(s.a, s.b)).is_some_and(|r| r.crosses) {
+            out.new_crossings.push((s.a, s.b));
+        }
+    }
+    out
+}
+
+/// A pair's tolerances (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Tolerance {
+    /// Depth into the other's material that is not yet a crossing.
+    crossing: f64,
+    /// Distance outside the other within which a vertex still counts as enclosed.
+    enclosure: f64,
+}
+
+/// An axis-aligned box (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Box3 {
+    min: [f64; 3],
+    max: [f64; 3],
+}
+
+impl Box3 {
+    fn of(positions: &[[f32; 3]]) -> Option<Self> {
+        crate::mesh::bounding_box(positions).map(|(min, max)| Self {
+            min: to_f64(min),
+            max: to_f64(max),
+        })
+    }
+
+    fn grown(&self, by: f64) -> Self {
+        Self {
+            min: self.min.map(|x| x - by),
+            max: self.max.map(|x| x + by),
+        }
+    }
+
+    fn meets(&self, other: &Self) -> bool {
+        (0..3).all(|k| self.min[k] <= other.max[k] && other.min[k] <= self.max[k])
+    }
+
+    fn holds(&self, p: [f64; 3]) -> bool {
+        (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])
+    }
+
+    fn holds_box(&self, other: &Self) -> bool {
+        self.holds(other.min) && self.holds(other.max)
+    }
+}
+
+/// A structure made ready to be asked about points: rays for inside, a tree for distances.
+struct Solid {
+    bounds: Box3,
+    rays: RayBvh,
+    distance: TriangleBvh,
+}
+
+impl Solid {
+    fn new(mesh: &Mesh, bounds: Box3) -> Self {
+        let (rays, distance) = rayon::join(
+            || RayBvh::new(&mesh.positions, &mesh.triangles),
+            || TriangleBvh::new(&mesh.positions, &mesh.triangles),
+        );
+        Self {
+            bounds,
+            rays,
+            distance,
+        }
+    }
+}
+
+/// How one surface lies against another structure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Reach {
+    /// Every vertex is inside a shell of the other or within the tolerance of its surface.
+    enclosed: bool,
+    /// Deepest vertex in the other's material (mm), 0 when none.
+    depth: f64,
+}
+
+/// How the surface with vertices `positions` (bounded by `bounds`) lies against `other`, a
+/// vertex within `tol` of its surface counting as enclosed.
+fn reach(positions: &[[f32; 3]], bounds: Box3, other: &Solid, tol: f64) -> Reach {
+    // Only a surface within the other's grown box can be enclosed; below that, only vertices
+    // in its box need rays, and distances only when they decide something.
+    let reachable = other.bounds.grown(tol);
+    let may_enclose = reachable.holds_box(&bounds);
+    let within =
+        |p: [f64; 3]| may_enclose && other.distance.closest_within(p, tol.next_up()).is_some();
+    positions
+        .par_iter()
+        .with_min_len(128)
+        .map(|&p| {
+            let p = to_f64(p);
+            if !other.bounds.holds(p) {
+                return Reach {
+                    enclosed: reachable.holds(p) && within(p),
+                    depth: 0.0,
+                };
+            }
+            match other.rays.locate(p) {
+                Location::OnSurface => Reach {
+                    enclosed: true,
+                    depth: 0.0,
+                },
+                Location::Within { shells } if shells % 2 == 1 => Reach {
+                    enclosed: true,
+                    depth: other.distance.distance(p).unwrap_or(0.0),
+                },
+                Location::Within { shells } => Reach {
+                    enclosed: shells > 0 || within(p),
+                    depth: 0.0,
+                },
+            }
+        })
+        .reduce(
+            || Reach {
+                enclosed: true,
+                depth: 0.0,
+            },
+            |x, y| Reach {
+                enclosed: x.enclosed && y.enclosed,
+                depth: x.depth.max(y.depth),
+            },
+        )
+}

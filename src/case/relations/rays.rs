@@ -1,0 +1,428 @@
+//! Where a point lies against a closed surface, shell by shell: rays cast through a bounding
+//! volume hierarchy over the surface's triangles, counting crossings per connected shell.
+//!
+//! Label-map surfaces are staircases: axis-aligned faces, edges and vertices on a grid, and
+//! neighbouring structures share faces exactly. So rays leave along tilted, irrational-ish
+//! directions that no grid line follows, and the ray-triangle test is watertight (Woop, Benthin
+//! and Wald 2013, in f64): each edge's sign comes from the same transformed corners in both of
+//! its triangles, so a ray passing between two triangles is counted by exactly one. A ray whose
+//! edge signs are too close to call (it grazes an edge or a vertex) is thrown away and another
+//! one cast; a ray that meets the surface at its start means the point is on the surface.
+
+use crate::mesh::to_f64;
+
+/// Triangles per leaf, as in the distance tree.
+const LEAF_SIZE: usize = 4;
+/// Deeper than any median-split tree over `u32` triangle counts can grow.
+const STACK_DEPTH: usize = 64;
+/// A point this close (mm) to a triangle along a ray lies on the surface.
+pub(super) const ON_SURFACE: f64 = 1e-6;
+/// An edge function below this fraction of its two products may have the wrong sign.
+const SIGN_DOUBT: f64 = 1e-13;
+/// Node boxes grow by this fraction of their coordinates (plus as much in mm), so rounding in
+/// the slab test never culls a flat box (an axis-aligned staircase face) that a ray touches.
+const BOX_PAD: f64 = 1e-9;
+/// Tilts of a ray's two minor components off its main axis: irrational-ish and all different,
+/// so no ray runs along a grid line or a staircase face, and no two rays are parallel.
+pub(super) const TILTS: [[f64; 2]; 8] = [
+    [std::f64::consts::FRAC_1_PI, 0.271_828_182_845_904_5],
+    [-0.223_606_797_749_979, 0.414_213_562_373_095],
+    [0.173_205_080_756_887_7, -0.381_966_011_250_105_1],
+    [-0.367_879_441_171_442_3, -0.141_421_356_237_309_5],
+    [0.447_213_595_499_957_9, 0.112_340_410_127_702_5],
+    [-0.096_573_683_284_412_7, 0.333_978_211_634_927_4],
+    [0.261_799_387_799_149_4, -0.193_147_180_559_945_3],
+    [-0.405_465_108_108_164_4, -0.289_254_654_737_201_4],
+];
+
+/// Where a point lies against a surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Location {
+    /// Within [`ON_SURFACE`] of it (or every ray grazed an edge, which only a point on the
+    /// surface makes likely).
+    OnSurface,
+    /// Inside this many of its closed shells: 0 outside, odd in its material, even and more
+    /// than 0 in a cavity.
+    Within { shells: usize },
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: [f64; 3],
+    max: [f64; 3],
+    /// Leaf: first triangle in leaf order. Inner node: index of the left child (right = left + 1).
+    first: u32,
+    /// Triangles in a leaf; 0 marks an inner node.
+    count: u32,
+}
+
+/// A closed surface made ready for rays: its triangles in a tree, each knowing its shell.
+#[derive(Clone, Debug, Default)]
+pub(super) struct RayBvh {
+    nodes: Vec<Node>,
+    /// Triangle corners in leaf order.
+    corners: Vec<[[f32; 3]; 3]>,
+    /// Connected shell of each entry of `corners`.
+    shells: Vec<u32>,
+}
+
+/// What one ray saw.
+#[derive(Debug, PartialEq, Eq)]
+pub(super) enum Cast {
+    OnSurface,
+    /// It grazed an edge or a vertex: its count means nothing.
+    Doubtful,
+    /// The shells it crossed an odd number of times, sorted.
+    Crossed(Vec<u32>),
+}
+
+/// What one triangle does to one ray.
+enum Hit {
+    Miss,
+    Behind,
+    Ahead,
+    OnSurface,
+    Doubtful,
+}
+
+impl RayBvh {
+    /// Builds the tree over `triangles` (indices into `positions`, which must be in range).
+    pub(super) fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
+        let shell_of = triangle_shells(positions.len(), triangles);
+        let mut items: Vec<(u32, [f64; 3])> = triangles
+            .iter()
+            .enumerate()
+            .map(|(t, tri)| {
+                let mut c = [0.0; 3];
+                for &v in tri {
+                    for (ck, pk) in c.iter_mut().zip(positions[v as usize]) {
+                        *ck += pk as f64 / 3.0;
+                    }
+                }
+                (t as u32, c)
+            })
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
+        if !items.is_empty() {
+            nodes.push(Node {
+                min: [0.0; 3],
+                max: [0.0; 3],
+                first: 0,
+                count: 0,
+            });
+            build(&mut nodes, 0, &mut items, 0, positions, triangles);
+        }
+        Self {
+            nodes,
+            corners: items
+                .iter()
+                .map(|&(t, _)| triangles[t as usize].map(|v| positions[v as usize]))
+                .collect(),
+            shells: items.iter().map(|&(t, _)| shell_of[t as usize]).collect(),
+        }
+    }
+
+    /// Where `p` lies: inside how many shells, by the majority of three rays (two that agree
+    /// suffice), each shell counted by its own parity. Rays leave along the axis whose side of
+    /// the surface's box is nearest, so they cross little of the tree.
+    pub(super) fn locate(&self, p: [f64; 3]) -> Location {
+        let Some(root) = self.nodes.first() else {
+            return Location::Within { shells: 0 };
+        };
+        let (axis, sign) = nearest_side(root, p);
+        let mut clean: Vec<Vec<u32>> = Vec::with_capacity(3);
+        for tilt in TILTS {
+            match self.cast(p, direction(axis, sign, tilt)) {
+                Cast::OnSurface => return Location::OnSurface,
+                Cast::Doubtful => continue,
+                Cast::Crossed(odd) => clean.push(odd),
+            }
+            if clean.len() == 3 || (clean.len() == 2 && clean[0] == clean[1]) {
+                break;
+            }
+        }
+        if clean.is_empty() {
+            return Location::OnSurface;
+        }
+        let rays = clean.len();
+        let mut all = clean.concat();
+        all.sort_unstable();
+        let shells = all
+            .chunk_by(|a, b| a == b)
+            .filter(|votes| 2 * votes.len() > rays)
+            .count();
+        Location::Within { shells }
+    }
+
+    /// Casts one ray from `origin` along the unit vector `dir`.
+    pub(super) fn cast(&self, origin: [f64; 3], dir: [f64; 3]) -> Cast {
+        let ray = Ray::new(origin, dir);
+        let mut odd: Vec<u32> = Vec::new();
+        let mut stack = [0u32; STACK_DEPTH];
+        let mut top = 0usize;
+        let mut index = 0usize;
+        loop {
+            let node = &self.nodes[index];
+            if ray.enters(node) {
+                if node.count > 0 {
+                    let start = node.first as usize;
+                    let end = start + node.count as usize;
+                    for (tri, &shell) in self.corners[start..end]
+                        .iter()
+                        .zip(&self.shells[start..end])
+                    {
+                        match ray.hit(tri) {
+                            Hit::Miss | Hit::Behind => {}
+                            Hit::OnSurface => return Cast::OnSurface,
+                            Hit::Doubtful => return Cast::Doubtful,
+                            Hit::Ahead => match odd.iter().position(|&s| s == shell) {
+                                Some(k) => {
+                                    odd.swap_remove(k);
+                                }
+                                None => odd.push(shell),
+                            },
+                        }
+                    }
+                } else {
+                    // Median splits keep the depth below 33, one entry per level at most.
+                    stack[top] = node.first + 1;
+                    top += 1;
+                    index = node.first as usize;
+                    continue;
+                }
+            }
+            if top == 0 {
+                odd.sort_unstable();
+                return Cast::Crossed(odd);
+            }
+            top -= 1;
+            index = stack[top] as usize;
+        }
+    }
+}
+
+/// A ray in the sheared frame of the watertight test: the ray runs along +z' from the origin.
+struct Ray {
+    origin: [f64; 3],
+    inverse: [f64; 3],
+    /// Axes that become x', y' and z'.
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    /// Shear of x' and y' by z, and the scale of z'.
+    sx: f64,
+    sy: f64,
+    sz: f64,
+}
+
+impl Ray {
+    fn new(origin: [f64; 3], dir: [f64; 3]) -> Self {
+        let kz = (0..3)
+            .max_by(|&a, &b| dir[a].abs().total_cmp(&dir[b].abs()))
+            .unwrap_or(2);
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if dir[kz] < 0.0 {
+            // Keeps the winding, as the paper does; parity would not mind.
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Self {
+            origin,
+            inverse: dir.map(|d| 1.0 / d),
+            kx,
+            ky,
+            kz,
+            sx: dir[kx] / dir[kz],
+            sy: dir[ky] / dir[kz],
+            sz: 1.0 / dir[kz],
+        }
+    }
+
+    /// Whether the ray (from slightly behind its origin, to catch a surface through it) meets
+    /// the node's box.
+    #[inline]
+    fn enters(&self, node: &Node) -> bool {
+        let (mut near, mut far) = (-ON_SURFACE, f64::INFINITY);
+        for k in 0..3 {
+            let a = (node.min[k] - self.origin[k]) * self.inverse[k];
+            let b = (node.max[k] - self.origin[k]) * self.inverse[k];
+            near = near.max(a.min(b));
+            far = far.min(a.max(b));
+        }
+        near <= far
+    }
+
+    /// A corner in the sheared frame. Every triangle that shares the corner gets the very same
+    /// numbers, which is what makes the test watertight.
+    #[inline]
+    fn corner(&self, p: [f32; 3]) -> [f64; 3] {
+        let a = [
+            p[0] as f64 - self.origin[0],
+            p[1] as f64 - self.origin[1],
+            p[2] as f64 - self.origin[2],
+        ];
+        [
+            a[self.kx] - self.sx * a[self.kz],
+            a[self.ky] - self.sy * a[self.kz],
+            self.sz * a[self.kz],
+        ]
+    }
+
+    #[inline]
+    fn hit(&self, tri: &[[f32; 3]; 3]) -> Hit {
+        let [a, b, c] = tri.map(|p| self.corner(p));
+        let u = edge(b, c);
+        let v = edge(c, a);
+        let w = edge(a, b);
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return Hit::Miss;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            // The ray runs in the triangle's plane.
+            return Hit::Doubtful;
+        }
+        let t = (u * a[2] + v * b[2] + w * c[2]) / det;
+        if t.abs() <= ON_SURFACE {
+            Hit::OnSurface
+        } else if t < 0.0 {
+            Hit::Behind
+        } else if u == 0.0 || v == 0.0 || w == 0.0 {
+            Hit::Doubtful
+        } else {
+            Hit::Ahead
+        }
+    }
+}
+
+/// The edge function of `p`→`q` at the origin: `q` and `p` swapped give exactly its negation.
+/// Zero when its sign is in doubt.
+#[inline]
+fn edge(p: [f64; 3], q: [f64; 3]) -> f64 {
+    let (l, r) = (q[0] * p[1], q[1] * p[0]);
+    let e = l - r;
+    if e.abs() <= SIGN_DOUBT * (l.abs() + r.abs()) {
+        0.0
+    } else {
+        e
+    }
+}
+
+/// The unit direction along `axis` (towards `sign`), tilted by `tilt` on the other two axes.
+pub(super) fn direction(axis: usize, sign: f64, tilt: [f64; 2]) -> [f64; 3] {
+    let mut d = [0.0; 3];
+    d[axis] = sign;
+    d[(axis + 1) % 3] = tilt[0];
+    d[(axis + 2) % 3] = tilt[1];
+    let n = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+    d.map(|x| x / n)
+}
+
+/// The axis and sign of the side of `node`'s box nearest to `p`.
+fn nearest_side(node: &Node, p: [f64; 3]) -> (usize, f64) {
+    let mut best = (2, 1.0, f64::INFINITY);
+    for (k, ((&x, &lo), &hi)) in p.iter().zip(&node.min).zip(&node.max).enumerate() {
+        for (sign, gap) in [(-1.0, x - lo), (1.0, hi - x)] {
+            if gap.abs() < best.2 {
+                best = (k, sign, gap.abs());
+            }
+        }
+    }
+    (best.0, best.1)
+}
+
+/// The connected shell of each triangle (triangles sharing a vertex are one shell), numbered
+/// from 0.
+fn triangle_shells(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..vertex_count as u32).collect();
+    fn root(parent: &mut [u32], mut v: u32) -> u32 {
+        while parent[v as usize] != v {
+            let up = parent[parent[v as usize] as usize];
+            parent[v as usize] = up;
+            v = up;
+        }
+        v
+    }
+    for tri in triangles {
+        let r0 = root(&mut parent, tri[0]);
+        for &v in &tri[1..] {
+            let r = root(&mut parent, v);
+            if r != r0 {
+                parent[r as usize] = r0;
+            }
+        }
+    }
+    let mut number = vec![u32::MAX; vertex_count];
+    let mut shells = 0u32;
+    triangles
+        .iter()
+        .map(|tri| {
+            let r = root(&mut parent, tri[0]) as usize;
+            if number[r] == u32::MAX {
+                number[r] = shells;
+                shells += 1;
+            }
+            number[r]
+        })
+        .collect()
+}
+
+/// Fills `nodes[index]` for `items` (whose leaf order starts at `offset`) and recurses.
+/// Depth is bounded by log2 of the triangle count because every split halves the set.
+fn build(
+    nodes: &mut Vec<Node>,
+    index: usize,
+    items: &mut [(u32, [f64; 3])],
+    offset: usize,
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+) {
+    let (mut min, mut max) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let (mut cmin, mut cmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for (t, c) in items.iter() {
+        for &v in &triangles[*t as usize] {
+            let p = to_f64(positions[v as usize]);
+            for k in 0..3 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        for k in 0..3 {
+            cmin[k] = cmin[k].min(c[k]);
+            cmax[k] = cmax[k].max(c[k]);
+        }
+    }
+    let min = min.map(|x| x - BOX_PAD * (1.0 + x.abs()));
+    let max = max.map(|x| x + BOX_PAD * (1.0 + x.abs()));
+    if items.len() <= LEAF_SIZE {
+        nodes[index] = Node {
+            min,
+            max,
+            first: offset as u32,
+            count: items.len() as u32,
+        };
+        return;
+    }
+    let axis = (0..3)
+        .max_by(|&a, &b| (cmax[a] - cmin[a]).total_cmp(&(cmax[b] - cmin[b])))
+        .unwrap_or(0);
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |a, b| a.1[axis].total_cmp(&b.1[axis]));
+    let left = nodes.len();
+    let placeholder = Node {
+        min: [0.0; 3],
+        max: [0.0; 3],
+        first: 0,
+        count: 0,
+    };
+    nodes.push(placeholder);
+    nodes.push(placeholder);
+    nodes[index] = Node {
+        min,
+        max,
+        first: left as u32,
+        count: 0,
+    };
+    let (lo, hi) = items.split_at_mut(mid);
+    build(nodes, left, lo, offset, positions, triangles);
+    build(nodes, left + 1, hi, offset + mid, positions, triangles);
+}

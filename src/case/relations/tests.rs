@@ -1,0 +1,381 @@
+use std::collections::HashMap;
+
+use super::rays::{direction, Cast, Location, RayBvh, TILTS};
+use super::*;
+
+/// An outward-wound box from `min` to `max`: 8 corners, 12 triangles.
+fn cube(min: [f32; 3], max: [f32; 3]) -> Mesh {
+    let positions = (0..8)
+        .map(|v| [0, 1, 2].map(|k| if v >> k & 1 == 1 { max[k] } else { min[k] }))
+        .collect();
+    let quads = [
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+    ];
+    let triangles = quads
+        .iter()
+        .flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]])
+        .collect();
+    Mesh::new(positions, triangles)
+}
+
+/// `outer` with `inner` as an inward-facing cavity shell: one structure, two shells.
+fn with_cavity(outer: Mesh, inner: Mesh) -> Mesh {
+    let offset = outer.positions.len() as u32;
+    let mut mesh = outer;
+    mesh.positions.extend(inner.positions);
+    mesh.triangles.extend(
+        inner
+            .triangles
+            .iter()
+            .map(|t| [t[0] + offset, t[2] + offset, t[1] + offset]),
+    );
+    mesh
+}
+
+/// The staircase surface of the unit voxels of `grid` (indexed `[x][y][z]`) that hold `label`,
+/// welded, as a label map's extraction makes it: neighbouring labels share faces exactly.
+fn voxel_surface(grid: &[Vec<Vec<u8>>], label: u8) -> Mesh {
+    let n = [grid.len(), grid[0].len(), grid[0][0].len()];
+    let at = |p: [i64; 3]| -> u8 {
+        if (0..3).all(|k| p[k] >= 0 && (p[k] as usize) < n[k]) {
+            grid[p[0] as usize][p[1] as usize][p[2] as usize]
+        } else {
+            0
+        }
+    };
+    let mut index: HashMap<[i64; 3], u32> = HashMap::new();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut vertex = |p: [i64; 3]| {
+        *index.entry(p).or_insert_with(|| {
+            positions.push(p.map(|x| x as f32));
+            positions.len() as u32 - 1
+        })
+    };
+    for x in 0..n[0] as i64 {
+        for y in 0..n[1] as i64 {
+            for z in 0..n[2] as i64 {
+                let v = [x, y, z];
+                if at(v) != label {
+                    continue;
+                }
+                for axis in 0..3 {
+                    for side in [0i64, 1] {
+                        let mut next = v;
+                        next[axis] += 2 * side - 1;
+                        if at(next) == label {
+                            continue;
+                        }
+                        // The face's corners in order around the outward normal.
+                        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+                        let mut corner = |du: i64, dw: i64| {
+                            let mut p = v;
+                            p[axis] += side;
+                            p[u] += du;
+                            p[w] += dw;
+                            vertex(p)
+                        };
+                        let q = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)];
+                        let q = if side == 1 {
+                            q
+                        } else {
+                            [q[0], q[3], q[2], q[1]]
+                        };
+                        triangles.push([q[0], q[1], q[2]]);
+                        triangles.push([q[0], q[2], q[3]]);
+                    }
+                }
+            }
+        }
+    }
+    Mesh::new(positions, triangles)
+}
+
+/// A grid of `n` voxels a side, labelled by `label(x, y, z)`.
+fn grid(n: usize, label: impl Fn(usize, usize, usize) -> u8) -> Vec<Vec<Vec<u8>>> {
+    (0..n)
+        .map(|x| {
+            (0..n)
+                .map(|y| (0..n).map(|z| label(x, y, z)).collect())
+                .collect()
+        })
+        .collect()
+}
+
+fn pair(list: &[PairRelation], a: usize, b: usize) -> PairRelation {
+    *list
+        .iter()
+        .find(|r| (r.a, r.b) == (a, b))
+        .unwrap_or_else(|| panic!("no pair ({a}, {b}) in {list:?}"))
+}
+
+/// Moves every vertex of `mesh` away from its centroid by `by` mm.
+fn push_out(mesh: &Mesh, by: f64) -> Mesh {
+    let n = mesh.positions.len() as f64;
+    let c = [0, 1, 2].map(|k| mesh.positions.iter().map(|p| p[k] as f64).sum::<f64>() / n);
+    let positions = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let d = [0, 1, 2].map(|k| p[k] as f64 - c[k]);
+            let r = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+            [0, 1, 2].map(|k| (c[k] + d[k] * (r + by) / r) as f32)
+        })
+        .collect();
+    Mesh::new(positions, mesh.triangles.clone())
+}
+
+#[test]
+fn test_meshes_are_closed_and_outward() {
+    assert_eq!(cube([0.0; 3], [1.0; 3]).signed_volume(), 1.0);
+    let hollow = with_cavity(cube([0.0; 3], [3.0; 3]), cube([1.0; 3], [2.0; 3]));
+    assert_eq!(hollow.signed_volume(), 26.0);
+    let g = grid(4, |x, y, z| u8::from(x < 2 && y < 3 && z < 4));
+    assert_eq!(voxel_surface(&g, 1).signed_volume(), 24.0);
+}
+
+#[test]
+fn rays_tell_inside_outside_and_on_a_staircase_at_centres_corners_and_edges() {
+    // A voxel ball: every grid corner and edge midpoint on its surface is a staircase vertex
+    // or edge, where rays are most likely to go wrong.
+    let n = 10;
+    let ball = |x: usize, y: usize, z: usize| {
+        let d = [x, y, z].map(|c| c as f64 + 0.5 - n as f64 / 2.0);
+        u8::from(d.iter().map(|v| v * v).sum::<f64>() < 12.0)
+    };
+    let mesh = voxel_surface(&grid(n, ball), 1);
+    let rays = RayBvh::new(&mesh.positions, &mesh.triangles);
+    let filled = |v: [i64; 3]| {
+        v.iter().all(|&c| (0..n as i64).contains(&c))
+            && ball(v[0] as usize, v[1] as usize, v[2] as usize) == 1
+    };
+    let mut checked = 0;
+    // Points at half-voxel steps: a voxel centre, a face centre, an edge midpoint or a corner.
+    for x in -2..=2 * n as i64 + 2 {
+        for y in -2..=2 * n as i64 + 2 {
+            for z in -2..=2 * n as i64 + 2 {
+                let h = [x, y, z];
+                // The voxels the point touches: one for a centre, up to 8 for a corner.
+                let spans = h.map(|c| {
+                    if c % 2 == 0 {
+                        vec![c / 2 - 1, c / 2]
+                    } else {
+                        vec![c / 2]
+                    }
+                });
+                let mut count = (0, 0);
+                for &i in &spans[0] {
+                    for &j in &spans[1] {
+                        for &k in &spans[2] {
+                            count.0 += usize::from(filled([i, j, k]));
+                            count.1 += 1;
+                        }
+                    }
+                }
+                let expected = match count {
+                    (0, _) => Location::Within { shells: 0 },
+                    (f, all) if f == all => Location::Within { shells: 1 },
+                    _ => Location::OnSurface,
+                };
+                let p = h.map(|c| c as f64 / 2.0);
+                assert_eq!(rays.locate(p), expected, "at {p:?}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 10_000);
+}
+
+#[test]
+fn a_ray_through_an_edge_or_a_vertex_is_doubted_and_another_one_cast() {
+    let box_ = cube([0.0; 3], [10.0; 3]);
+    let rays = RayBvh::new(&box_.positions, &box_.triangles);
+    // Dyadic tilts make the arithmetic exact, so these rays meet the edge, the corner and the
+    // quad's diagonal exactly at x = 10, where counting the two (or more) triangles that touch
+    // the ray once or twice would be a guess.
+    let up = [1.0, 0.5, 0.25];
+    let down = [1.0, 0.5, -0.25];
+    let grazing = [
+        ([2.0, 6.0, 3.0], up),   // edge (10, 10, 5)
+        ([2.0, 6.0, 8.0], up),   // corner (10, 10, 10)
+        ([2.0, 1.0, 2.0], down), // edge (10, 5, 0)
+        ([2.0, 1.0, 3.0], up),   // diagonal of the x = 10 face, (10, 5, 5)
+    ];
+    for (origin, dir) in grazing {
+        assert_eq!(rays.cast(origin, dir), Cast::Doubtful, "from {origin:?}");
+        assert_eq!(rays.locate(origin), Location::Within { shells: 1 });
+    }
+    // Through a face's interior it is a plain crossing of the one shell.
+    assert_eq!(rays.cast([2.0, 1.0, 2.0], up), Cast::Crossed(vec![0]));
+    assert_eq!(
+        rays.cast([2.0, 1.0, 2.0], direction(0, 1.0, TILTS[0])),
+        Cast::Crossed(vec![0])
+    );
+}
+
+#[test]
+fn cubes_apart_are_left_out_unless_the_tolerance_bridges_them() {
+    let a = cube([0.0; 3], [1.0; 3]);
+    let b = cube([5.0; 3], [6.0; 3]);
+    assert!(relations(&[&a, &b], &[0.5, 0.5]).is_empty());
+    // Grown by 5 mm the boxes meet, but no corner of one comes within 5 mm of the other.
+    let near = relations(&[&a, &b], &[0.5, 5.0]);
+    let r = pair(&near, 0, 1);
+    assert!(!r.a_inside_b && !r.b_inside_a && !r.crosses, "{r:?}");
+    assert_eq!(r.overlap_depth, 0.0);
+}
+
+#[test]
+fn a_cube_in_another_s_material_is_inside_and_crosses_it() {
+    let inner = cube([2.0; 3], [4.0; 3]);
+    let outer = cube([0.0; 3], [10.0; 3]);
+    let r = pair(&relations(&[&inner, &outer], &[0.1, 0.1]), 0, 1);
+    assert!(r.a_inside_b, "{r:?}");
+    assert!(!r.b_inside_a, "{r:?}");
+    // Nested without a cavity, its surface lies in the outer one's material: its corner at 4
+    // is deepest.
+    assert!((r.overlap_depth - 4.0).abs() < 1e-9, "{r:?}");
+    assert!(r.crosses);
+}
+
+#[test]
+fn a_cube_in_a_cavity_is_inside_without_crossing_and_one_in_the_wall_crosses() {
+    let hollow = with_cavity(cube([0.0; 3], [10.0; 3]), cube([2.0; 3], [8.0; 3]));
+    let in_cavity = cube([3.0; 3], [7.0; 3]);
+    let in_wall = cube([0.5; 3], [1.5; 3]);
+    let list = relations(&[&hollow, &in_cavity, &in_wall], &[0.1; 3]);
+    let r = pair(&list, 0, 1);
+    assert!(r.b_inside_a && !r.a_inside_b, "{r:?}");
+    assert_eq!(r.overlap_depth, 0.0, "{r:?}");
+    assert!(!r.crosses);
+    let r = pair(&list, 0, 2);
+    assert!(r.b_inside_a && !r.a_inside_b, "{r:?}");
+    // Its corner at 1.5 is deepest: 0.5 from the cavity's corner along each axis.
+    assert!((r.overlap_depth - 0.75f64.sqrt()).abs() < 1e-9, "{r:?}");
+    assert!(r.crosses);
+    assert_eq!(list.len(), 2, "the small cubes are apart: {list:?}");
+}
+
+#[test]
+fn overlapping_cubes_cross_by_the_depth_of_the_deepest_vertex() {
+    let a = cube([0.0; 3], [10.0; 3]);
+    let b = cube([7.0, -5.0, -5.0], [20.0, 15.0, 15.0]);
+    let r = pair(&relations(&[&a, &b], &[0.5, 0.5]), 0, 1);
+    assert!(!r.a_inside_b && !r.b_inside_a, "{r:?}");
+    assert!((r.overlap_depth - 3.0).abs() < 1e-9, "{r:?}");
+    assert!(r.crosses);
+    // The pair takes the larger tolerance: 4 mm covers the 3 mm overlap.
+    let r = pair(&relations(&[&a, &b], &[0.5, 4.0]), 0, 1);
+    assert!((r.overlap_depth - 3.0).abs() < 1e-9, "{r:?}");
+    assert!(!r.crosses);
+}
+
+#[test]
+fn structures_sharing_staircase_faces_touch_without_crossing() {
+    // An organ (1) with a tumour (2) carved out of it and a neighbour (3) against one side,
+    // all sharing faces exactly, as a label map's extraction gives them.
+    let labels = grid(12, |x, y, z| {
+        let core = (4..6).contains(&x) && (4..6).contains(&y) && (4..6).contains(&z);
+        let organ = (1..9).contains(&x) && (1..9).contains(&y) && (1..9).contains(&z);
+        let side = (9..11).contains(&x) && (2..6).contains(&y) && (2..6).contains(&z);
+        match (core, organ, side) {
+            (true, _, _) => 2,
+            (_, true, _) => 1,
+            (_, _, true) => 3,
+            _ => 0,
+        }
+    });
+    let organ = voxel_surface(&labels, 1);
+    let tumour = voxel_surface(&labels, 2);
+    let side = voxel_surface(&labels, 3);
+    let tol = [0.5; 3];
+    let list = relations(&[&organ, &tumour, &side], &tol);
+    let r = pair(&list, 0, 1);
+    assert!(r.b_inside_a && !r.a_inside_b, "{r:?}");
+    let r = pair(&list, 0, 2);
+    assert!(!r.a_inside_b && !r.b_inside_a, "{r:?}");
+    assert!(
+        list.iter().all(|r| r.overlap_depth == 0.0 && !r.crosses),
+        "{list:?}"
+    );
+
+    // Within the tolerance the tumour stays inside without crossing; beyond it, it crosses.
+    let list = relations(&[&organ, &push_out(&tumour, 0.3), &side], &tol);
+    let r = pair(&list, 0, 1);
+    assert!(r.b_inside_a && !r.crosses, "{r:?}");
+    assert!(
+        r.overlap_depth > 0.1 && r.overlap_depth <= 0.3 + 1e-6,
+        "{r:?}"
+    );
+    let grown = relations(&[&organ, &push_out(&tumour, 1.0), &side], &tol);
+    let r = pair(&grown, 0, 1);
+    assert!(r.b_inside_a && r.crosses, "{r:?}");
+    assert!(
+        r.overlap_depth > 0.5 && r.overlap_depth <= 1.0 + 1e-6,
+        "{r:?}"
+    );
+    let change = changes(&list, &grown);
+    assert_eq!(change.new_crossings, vec![(0, 1)]);
+    assert!(change.left_inside.is_empty(), "{change:?}");
+
+    // Pushed out beyond the organ's wall (3 voxels), it no longer lies inside.
+    let out = relations(&[&organ, &push_out(&tumour, 6.0), &side], &tol);
+    let change = changes(&list, &out);
+    assert_eq!(change.left_inside, vec![(1, 0)]);
+}
+
+#[test]
+fn a_tumour_in_a_dent_open_by_a_voxel_layer_still_lies_inside() {
+    // As in the phantom, the organ's voxels stop one layer short over the tumour: the tumour's
+    // top touches the background, 1 mm from the organ's surface at most. That is over either
+    // tolerance but within their sum, which is how far apart the staircases of two touching
+    // true boundaries can lie.
+    let labels = grid(10, |x, y, z| {
+        let core = (4..6).contains(&x) && (4..6).contains(&y) && (4..7).contains(&z);
+        let organ = (1..9).contains(&x) && (1..9).contains(&y) && (1..7).contains(&z);
+        match (core, organ) {
+            (true, _) => 2,
+            (_, true) => 1,
+            _ => 0,
+        }
+    });
+    let organ = voxel_surface(&labels, 1);
+    let tumour = voxel_surface(&labels, 2);
+    let r = pair(&relations(&[&organ, &tumour], &[0.6, 0.6]), 0, 1);
+    assert!(r.b_inside_a && !r.a_inside_b && !r.crosses, "{r:?}");
+    let r = pair(&relations(&[&organ, &tumour], &[0.45, 0.45]), 0, 1);
+    assert!(!r.b_inside_a, "{r:?}");
+}
+
+#[test]
+fn changes_report_left_insides_and_new_crossings_only() {
+    let rel = |a, b, a_inside_b, b_inside_a, crosses| PairRelation {
+        a,
+        b,
+        a_inside_b,
+        b_inside_a,
+        overlap_depth: if crosses { 1.0 } else { 0.0 },
+        crosses,
+    };
+    let before = [
+        rel(0, 1, true, false, false),
+        rel(0, 2, false, true, false),
+        rel(1, 2, false, false, true),
+        rel(2, 3, true, false, false),
+    ];
+    let after = [
+        rel(0, 1, false, false, true),
+        rel(1, 2, false, false, true),
+        rel(2, 3, true, false, false),
+        rel(3, 4, false, false, true),
+    ];
+    let c = changes(&before, &after);
+    assert_eq!(c.left_inside, vec![(0, 1), (2, 0)]);
+    assert_eq!(c.new_crossings, vec![(0, 1), (3, 4)]);
+    assert_eq!(changes(&after, &after), RelationChanges::default());
+}
