@@ -5,6 +5,7 @@
 //! (native) and the web app (wasm32) sit on top and own no algorithm. [`view`] is the 3D view's
 //! camera and shading record, kept apart from the app so it is tested natively.
 
+pub mod case;
 pub mod export;
 pub mod gpu;
 pub mod io;

@@ -85,10 +85,10 @@ fn extract_to_glb_gives_a_named_node_per_structure_in_metres_with_y_up() {
         .iter()
         .filter_map(|n| n["name"].as_str())
         .collect();
-    assert_eq!(names, ["segmentation", "liver", "tumor"]);
+    assert_eq!(names, ["case", "liver", "tumor"]);
     assert_eq!(doc["nodes"][0]["matrix"][0], -0.001);
     assert_eq!(doc["materials"].as_array().expect("materials").len(), 2);
-    assert_eq!(doc["nodes"][2]["extras"]["label"], 3);
+    assert_eq!(doc["nodes"][2]["extras"]["meshsmooth"]["label"], 3);
     // Millimetres when asked: no root transform.
     let raw = tmp("phantom_mm.glb");
     let out = meshsmooth(&[

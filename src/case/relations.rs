@@ -33,6 +33,13 @@ pub struct PairRelation {
     /// pair's enclosure tolerance of `b`'s surface.
     pub a_inside_b: bool,
     pub b_inside_a: bool,
+    /// How far the farthest vertex of `a` lies outside every shell of `b` (mm): 0 when all are
+    /// enclosed, infinite past the enclosure tolerance plus the crossing tolerance.
+    pub a_outside_b: f64,
+    pub b_outside_a: f64,
+    /// The pair's crossing tolerance (mm): also how much farther out a surface that lay inside
+    /// may reach before it counts as having left.
+    pub tolerance: f64,
     /// Deepest vertex of either surface inside the other's material (mm), 0 when none.
     pub overlap_depth: f64,
     /// `overlap_depth` exceeds the pair's crossing tolerance.
@@ -96,16 +103,20 @@ pub fn relations(meshes: &[&Mesh], tolerance: &[f64]) -> Vec<PairRelation> {
         .par_iter()
         .filter_map(|&(a, b, tol)| {
             let (sa, sb) = (solids[a].as_ref()?, solids[b].as_ref()?);
+            let cap = tol.enclosure + tol.crossing;
             let (ab, ba) = rayon::join(
-                || reach(&meshes[a].positions, sa.bounds, sb, tol.enclosure),
-                || reach(&meshes[b].positions, sb.bounds, sa, tol.enclosure),
+                || reach(&meshes[a].positions, sa.bounds, sb, cap),
+                || reach(&meshes[b].positions, sb.bounds, sa, cap),
             );
             let overlap_depth = ab.depth.max(ba.depth);
             Some(PairRelation {
                 a,
                 b,
-                a_inside_b: ab.enclosed,
-                b_inside_a: ba.enclosed,
+                a_inside_b: ab.outside <= tol.enclosure,
+                b_inside_a: ba.outside <= tol.enclosure,
+                a_outside_b: ab.outside,
+                b_outside_a: ba.outside,
+                tolerance: tol.crossing,
                 overlap_depth,
                 crosses: overlap_depth > tol.crossing,
             })
@@ -113,8 +124,11 @@ pub fn relations(meshes: &[&Mesh], tolerance: &[f64]) -> Vec<PairRelation> {
         .collect()
 }
 
-/// What changed from `before` to `after` (both from [`relations`] over the same structures):
-/// a pair missing from `after` has come apart, so an inside relation it had is left.
+/// What changed from `before` to `after` (both from [`relations`] over the same structures).
+/// A structure that lay inside another has left it when it now reaches farther outside it than
+/// it did by more than the pair's tolerance: a staircase that already touched the outside (a
+/// tumour under a thin layer the voxels did not resolve) is not flagged for staying there. A
+/// pair missing from `after` has come apart, so an inside relation it had is left.
 pub fn changes(before: &[PairRelation], after: &[PairRelation]) -> RelationChanges {
     let then: HashMap<(usize, usize), &PairRelation> =
         before.iter().map(|r| ((r.a, r.b), r)).collect();
@@ -123,10 +137,13 @@ pub fn changes(before: &[PairRelation], after: &[PairRelation]) -> RelationChang
     let mut out = RelationChanges::default();
     for r in before {
         let still = now.get(&(r.a, r.b));
-        if r.a_inside_b && !still.is_some_and(|s| s.a_inside_b) {
+        let left = |was: f64, is: fn(&PairRelation) -> f64| {
+            still.is_none_or(|s| is(s) > was + r.tolerance)
+        };
+        if r.a_inside_b && left(r.a_outside_b, |s| s.a_outside_b) {
             out.left_inside.push((r.a, r.b));
         }
-        if r.b_inside_a && !still.is_some_and(|s| s.b_inside_a) {
+        if r.b_inside_a && left(r.b_outside_a, |s| s.b_outside_a) {
             out.left_inside.push((r.b, r.a));
         }
     }
@@ -206,21 +223,29 @@ impl Solid {
 /// How one surface lies against another structure.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Reach {
-    /// Every vertex is inside a shell of the other or within the tolerance of its surface.
-    enclosed: bool,
+    /// How far the farthest vertex lies outside every shell of the other (mm), 0 when none
+    /// does, infinite past the cap.
+    outside: f64,
     /// Deepest vertex in the other's material (mm), 0 when none.
     depth: f64,
 }
 
-/// How the surface with vertices `positions` (bounded by `bounds`) lies against `other`, a
-/// vertex within `tol` of its surface counting as enclosed.
-fn reach(positions: &[[f32; 3]], bounds: Box3, other: &Solid, tol: f64) -> Reach {
-    // Only a surface within the other's grown box can be enclosed; below that, only vertices
-    // in its box need rays, and distances only when they decide something.
-    let reachable = other.bounds.grown(tol);
+/// How the surface with vertices `positions` (bounded by `bounds`) lies against `other`;
+/// distances outside it are measured up to `cap`.
+fn reach(positions: &[[f32; 3]], bounds: Box3, other: &Solid, cap: f64) -> Reach {
+    // Only a surface within the other's grown box can come within the cap; below that, only
+    // vertices in its box need rays, and distances only when they decide something.
+    let reachable = other.bounds.grown(cap);
     let may_enclose = reachable.holds_box(&bounds);
-    let within =
-        |p: [f64; 3]| may_enclose && other.distance.closest_within(p, tol.next_up()).is_some();
+    let outside = |p: [f64; 3]| {
+        if !may_enclose {
+            return f64::INFINITY;
+        }
+        match other.distance.closest_within(p, cap.next_up()) {
+            Some(c) => c.distance,
+            None => f64::INFINITY,
+        }
+    };
     positions
         .par_iter()
         .with_min_len(128)
@@ -228,32 +253,36 @@ fn reach(positions: &[[f32; 3]], bounds: Box3, other: &Solid, tol: f64) -> Reach
             let p = to_f64(p);
             if !other.bounds.holds(p) {
                 return Reach {
-                    enclosed: reachable.holds(p) && within(p),
+                    outside: if reachable.holds(p) {
+                        outside(p)
+                    } else {
+                        f64::INFINITY
+                    },
                     depth: 0.0,
                 };
             }
             match other.rays.locate(p) {
                 Location::OnSurface => Reach {
-                    enclosed: true,
+                    outside: 0.0,
                     depth: 0.0,
                 },
                 Location::Within { shells } if shells % 2 == 1 => Reach {
-                    enclosed: true,
+                    outside: 0.0,
                     depth: other.distance.distance(p).unwrap_or(0.0),
                 },
                 Location::Within { shells } => Reach {
-                    enclosed: shells > 0 || within(p),
+                    outside: if shells > 0 { 0.0 } else { outside(p) },
                     depth: 0.0,
                 },
             }
         })
         .reduce(
             || Reach {
-                enclosed: true,
+                outside: 0.0,
                 depth: 0.0,
             },
             |x, y| Reach {
-                enclosed: x.enclosed && y.enclosed,
+                outside: x.outside.max(y.outside),
                 depth: x.depth.max(y.depth),
             },
         )

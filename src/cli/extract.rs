@@ -1,7 +1,8 @@
 //! `meshsmooth extract LABELMAP... -o OUT`: one surface per structure of a segmentation, as PLY
 //! files in a folder or one GLB with a named node per structure.
 
-use crate::export::{self, ExportFormat, ExportOptions, SceneFrame, SceneMesh};
+use crate::case::Case;
+use crate::export::{self, CaseGltfOptions, ExportFormat, ExportOptions, SceneFrame};
 use crate::mesh::vertex_normals;
 use crate::segmentation::{self, ExtractOptions, NamedBytes, OpenOptions, Structure};
 use std::path::{Path, PathBuf};
@@ -71,6 +72,11 @@ pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
         },
         level: args.level,
     };
+    // Only a file's name goes into the record, never its folder or header.
+    let source = match args.inputs.as_slice() {
+        [one] => one.file_name().map(|n| n.to_string_lossy().into_owned()),
+        _ => None,
+    };
     let started = Instant::now();
     let structures = segmentation::open(&files, table, &options).map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
@@ -82,7 +88,7 @@ pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
             } else {
                 SceneFrame::Gltf
             };
-            write_glb(path, &structures, frame)?;
+            write_glb(path, &structures, source.as_deref(), frame)?;
             vec![path.display().to_string(); structures.len()]
         }
     };
@@ -175,28 +181,20 @@ fn file_stem(name: &str) -> String {
     }
 }
 
-fn write_glb(path: &Path, structures: &[Structure], frame: SceneFrame) -> Result<(), String> {
-    let normals: Vec<Vec<[f32; 3]>> = structures
-        .iter()
-        .map(|s| vertex_normals(&s.mesh.positions, &s.mesh.triangles))
-        .collect();
-    let items: Vec<SceneMesh> = structures
-        .iter()
-        .zip(&normals)
-        .map(|(s, n)| SceneMesh {
-            name: &s.name,
-            color: [s.color[0], s.color[1], s.color[2], 1.0],
-            mesh: &s.mesh,
-            normals: Some(n),
-            extras: Some(serde_json::json!({
-                "label": s.label,
-                "voxels": s.voxels,
-                "voxel_size": s.voxel_size,
-            })),
-        })
-        .collect();
-    let bytes = export::write_scene_glb(&items, None, frame)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+/// The structures as an unsmoothed case: the same glTF `case build` writes.
+fn write_glb(
+    path: &Path,
+    structures: &[Structure],
+    source: Option<&str>,
+    frame: SceneFrame,
+) -> Result<(), String> {
+    let case = Case::from_label_map(structures.to_vec(), source);
+    let options = CaseGltfOptions {
+        frame,
+        ..Default::default()
+    };
+    let bytes =
+        export::write_case(&case, &options).map_err(|e| format!("{}: {e}", path.display()))?;
     super::write_file(path, &bytes)
 }
 

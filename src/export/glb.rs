@@ -7,9 +7,9 @@ use serde_json::{json, Value};
 use super::{ExportError, ExportOptions};
 use crate::mesh::{bounding_box, Mesh};
 
-const ARRAY_BUFFER: u32 = 34962;
+pub(super) const ARRAY_BUFFER: u32 = 34962;
 pub(super) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-const FLOAT: u32 = 5126;
+pub(super) const FLOAT: u32 = 5126;
 const UNSIGNED_BYTE: u32 = 5121;
 pub(super) const UNSIGNED_INT: u32 = 5125;
 pub(super) const TRIANGLES: u32 = 4;
@@ -43,7 +43,7 @@ impl Builder {
     }
 }
 
-fn floats(values: &[[f32; 3]]) -> Vec<u8> {
+pub(super) fn floats(values: &[[f32; 3]]) -> Vec<u8> {
     values
         .iter()
         .flatten()
@@ -129,14 +129,18 @@ pub(super) fn geometry(b: &mut Builder, mesh: &Mesh, normals: Option<&[[f32; 3]]
     );
     let mut attributes = json!({ "POSITION": position });
     if let Some(normals) = normals {
-        let unit: Vec<[f32; 3]> = normals.iter().map(|&v| unit_normal(v)).collect();
         attributes["NORMAL"] = json!(b.push(
-            &floats(&unit),
+            &floats(&unit_normals(normals)),
             ARRAY_BUFFER,
             json!({"componentType": FLOAT, "count": n, "type": "VEC3"}),
         ));
     }
     attributes
+}
+
+/// Normals made unit length, as the specification requires of NORMAL.
+pub(super) fn unit_normals(normals: &[[f32; 3]]) -> Vec<[f32; 3]> {
+    normals.iter().map(|&v| unit_normal(v)).collect()
 }
 
 /// The indices of a mesh's triangles as little-endian u32s.

@@ -1,14 +1,17 @@
 //! Writers: an indexed mesh out as bytes (binary PLY, binary STL, OBJ, GLB), vertex order kept,
-//! and several named surfaces as one GLB scene.
+//! and a case (several named, coloured structures) as one glTF scene.
 //! Nothing from an input file's header is ever written (STL headers often carry patient names).
 
+mod case_gltf;
 mod glb;
 mod obj;
 mod ply;
-mod scene;
 mod stl;
 
-pub use scene::{srgb_to_linear, write_scene_glb, SceneFrame, SceneMesh};
+pub use case_gltf::{
+    linear_to_srgb, srgb_to_linear, write_case, CaseGltfOptions, Container, SceneFrame,
+    RAS_MM_TO_GLTF,
+};
 
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;

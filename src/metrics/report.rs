@@ -8,7 +8,7 @@ use super::score::ScoreTerms;
 use super::Original;
 use crate::mesh::to_f64;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::cell::RefCell;
 
 /// Vertices per parallel work item. Partial sums are combined in chunk order, so every result
@@ -17,7 +17,7 @@ const CHUNK: usize = 2048;
 
 /// The measures of a smoothed mesh against its original. Serialises to the keys of
 /// `meshsmooth measure --json`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     /// Enclosed volume V (mesh units cubed); `null` for an open mesh.
     pub volume: Option<f64>,

@@ -354,11 +354,15 @@ fn a_tumour_in_a_dent_open_by_a_voxel_layer_still_lies_inside() {
 
 #[test]
 fn changes_report_left_insides_and_new_crossings_only() {
+    let far = |inside: bool| if inside { 0.0 } else { f64::INFINITY };
     let rel = |a, b, a_inside_b, b_inside_a, crosses| PairRelation {
         a,
         b,
         a_inside_b,
         b_inside_a,
+        a_outside_b: far(a_inside_b),
+        b_outside_a: far(b_inside_a),
+        tolerance: 0.5,
         overlap_depth: if crosses { 1.0 } else { 0.0 },
         crosses,
     };
@@ -378,4 +382,15 @@ fn changes_report_left_insides_and_new_crossings_only() {
     assert_eq!(c.left_inside, vec![(0, 1), (2, 0)]);
     assert_eq!(c.new_crossings, vec![(0, 1), (3, 4)]);
     assert_eq!(changes(&after, &after), RelationChanges::default());
+
+    // A structure already touching the outside (within the enclosure tolerance, 2 mm out)
+    // has not left for reaching 0.4 mm farther; 0.6 mm farther is more than the tolerance.
+    let touching = |outside: f64| PairRelation {
+        a_outside_b: outside,
+        ..rel(0, 1, true, false, false)
+    };
+    let c = changes(&[touching(2.0)], &[touching(2.4)]);
+    assert!(c.left_inside.is_empty(), "{c:?}");
+    let c = changes(&[touching(2.0)], &[touching(2.6)]);
+    assert_eq!(c.left_inside, vec![(0, 1)]);
 }

@@ -1,0 +1,174 @@
+//! The case: the document an author edits and a student opens. A title, a description and an
+//! ordered list of structures (liver, vessels, tumour), each with its own filter, parameters
+//! and measures, smoothed independently and written as one glTF.
+//!
+//! Layout: the document here; smoothing and "Suggest all" in `pipeline`; the quality record
+//! the glTF carries (and reads back) in `record`; checks between structures in `relations`.
+
+mod checks;
+mod open;
+mod pipeline;
+mod record;
+pub mod relations;
+
+pub use checks::{check, checks_json, checks_text};
+pub use open::{open, CaseOpenError};
+pub use pipeline::{smooth_structure, suggest_all, SuggestAllOptions, SuggestAllProgress};
+pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
+
+use crate::mesh::Mesh;
+use crate::metrics::Metrics;
+use crate::segmentation::Structure;
+use crate::smooth::{Filter, Params};
+
+/// The filter structures start with: Laplace+HC keeps volume best on staircase surfaces.
+pub const DEFAULT_FILTER: Filter = Filter::Hc;
+
+/// A case: what one glTF holds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Case {
+    pub title: String,
+    pub description: String,
+    pub structures: Vec<CaseStructure>,
+}
+
+/// One structure of a case.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CaseStructure {
+    pub name: String,
+    /// Display (sRGB) colour and opacity, each in [0, 1].
+    pub color: [f32; 4],
+    pub visible: bool,
+    /// The group the structure is listed under ("Vessels"), if any.
+    pub group: Option<String>,
+    /// The name of the file it came from (never anything of the file's header).
+    pub source: Option<String>,
+    /// Its label value, when it came from a label map.
+    pub label: Option<i64>,
+    /// Voxel size along i, j, k (mm), when it came from a label map.
+    pub voxel_size: Option<[f64; 3]>,
+    /// The surface as opened (the staircase of a label map), in world millimetres.
+    pub original: Mesh,
+    /// The structure's own filter and parameters, bound included.
+    pub params: Params,
+    /// Target smoothness its parameters were suggested for, and its score weight.
+    pub tau: f64,
+    /// Per-vertex weights (0 locks a vertex); `None` = all 1.
+    pub weights: Option<Vec<f32>>,
+    /// The result of smoothing with `params`; `None` until smoothed.
+    pub smoothed: Option<Smoothed>,
+}
+
+/// A structure's smoothed surface and its measures against the original.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Smoothed {
+    pub positions: Vec<[f32; 3]>,
+    pub metrics: Metrics,
+    /// Per-vertex local error (mm), when measured here (a reopened case may lack it).
+    pub local_error: Option<Vec<f32>>,
+}
+
+impl CaseStructure {
+    /// A structure from a surface, with the default filter and no bound.
+    pub fn from_mesh(name: &str, mesh: Mesh, color: [f32; 3]) -> Self {
+        Self {
+            name: name.to_string(),
+            color: [color[0], color[1], color[2], 1.0],
+            visible: true,
+            group: None,
+            source: None,
+            label: None,
+            voxel_size: None,
+            original: mesh,
+            params: Params::defaults(DEFAULT_FILTER),
+            tau: 0.5,
+            weights: None,
+            smoothed: None,
+        }
+    }
+
+    /// A structure extracted from a label map: it knows its voxel size, so it smooths with the
+    /// displacement bound at half its voxel diagonal (Gibson's constraint: the true boundary
+    /// lies within that distance of the staircase), which keeps thin structures whole.
+    pub fn from_label_map(structure: Structure, source: Option<&str>) -> Self {
+        let mut s = Self::from_mesh(&structure.name, structure.mesh, structure.color);
+        s.source = source.map(str::to_string);
+        s.label = Some(structure.label);
+        s.voxel_size = Some(structure.voxel_size);
+        s.params.max_displacement = s.default_bound();
+        s
+    }
+
+    /// Half the voxel diagonal (mm), the default bound of a label-map structure.
+    pub fn default_bound(&self) -> Option<f32> {
+        self.voxel_diagonal().map(|d| (0.5 * d) as f32)
+    }
+
+    /// The voxel diagonal (mm), the unit its errors are also reported in.
+    pub fn voxel_diagonal(&self) -> Option<f64> {
+        self.voxel_size
+            .map(|s| s.iter().map(|v| v * v).sum::<f64>().sqrt())
+    }
+
+    /// Sets the filter, keeping the bound and taking the filter's default parameters.
+    pub fn set_filter(&mut self, filter: Filter) {
+        let bound = self.params.max_displacement;
+        self.params = Params::defaults(filter);
+        self.params.max_displacement = bound;
+        self.smoothed = None;
+    }
+
+    /// The surface as shown: smoothed when it has been, else the original.
+    pub fn surface(&self) -> Mesh {
+        match &self.smoothed {
+            Some(s) => Mesh::new(s.positions.clone(), self.original.triangles.clone()),
+            None => self.original.clone(),
+        }
+    }
+
+    /// The positions as shown.
+    pub fn positions(&self) -> &[[f32; 3]] {
+        match &self.smoothed {
+            Some(s) => &s.positions,
+            None => &self.original.positions,
+        }
+    }
+}
+
+impl Case {
+    /// A case of the structures of a label map named `source`.
+    pub fn from_label_map(structures: Vec<Structure>, source: Option<&str>) -> Self {
+        Self {
+            structures: structures
+                .into_iter()
+                .map(|s| CaseStructure::from_label_map(s, source))
+                .collect(),
+            ..Self::default()
+        }
+    }
+
+    /// Adds the structures of another case (another file opened into this one).
+    pub fn add(&mut self, other: Case) {
+        if self.title.is_empty() {
+            self.title = other.title;
+        }
+        if self.description.is_empty() {
+            self.description = other.description;
+        }
+        self.structures.extend(other.structures);
+    }
+
+    /// The structures' groups in the order they first appear.
+    pub fn groups(&self) -> Vec<&str> {
+        let mut out: Vec<&str> = Vec::new();
+        for g in self.structures.iter().filter_map(|s| s.group.as_deref()) {
+            if !out.contains(&g) {
+                out.push(g);
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests;

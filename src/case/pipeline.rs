@@ -1,0 +1,157 @@
+//! Smoothing a case's structures: one structure with its own parameters, and "Suggest all",
+//! the suggestion for every structure at one target smoothness followed by smoothing with it.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+
+use super::{Case, CaseStructure, Smoothed};
+use crate::mesh::Topology;
+use crate::metrics::{measure_vertices, smooth_drifting, Original};
+use crate::smooth::Filter;
+use crate::suggest::{suggest, SearchMethod, SuggestError, Suggestion};
+
+/// Smooths a structure from its original with its parameters and weights and measures the
+/// result (with the drifting reference, as every other caller does).
+pub fn smooth_structure(structure: &mut CaseStructure) {
+    let topology = Topology::build(&structure.original);
+    let original = Original::new(&structure.original, &topology);
+    structure.smoothed = Some(smooth_on(structure, &original));
+}
+
+fn smooth_on(structure: &CaseStructure, original: &Original) -> Smoothed {
+    let weights = structure.weights.as_deref();
+    let (positions, reference) = smooth_drifting(original, &structure.params, weights);
+    let (metrics, vertex) = measure_vertices(original, &positions, &reference, structure.tau);
+    Smoothed {
+        positions,
+        metrics,
+        local_error: Some(vertex.local_error),
+    }
+}
+
+/// What "Suggest all" does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SuggestAllOptions {
+    pub tau: f64,
+    /// Every structure's filter becomes this one first; `None` keeps each structure's own.
+    pub filter: Option<Filter>,
+    pub method: SearchMethod,
+}
+
+/// How far "Suggest all" has come: structures finished, of all, and parameter sets measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SuggestAllProgress {
+    pub structures_done: usize,
+    pub structures: usize,
+    pub evaluations: usize,
+}
+
+/// Suggests each structure's parameters at `options.tau` with its own filter and bound, then
+/// smooths it with them. Structures run in parallel (most are small, and one structure's
+/// passes use few threads). `on_progress` returns `false` to cancel: structures already
+/// finished keep their new parameters, the others are left as they were. Returns each
+/// structure's suggestion, in order; a structure with nothing to smooth (no vertices) gets
+/// `None` and is left alone.
+pub fn suggest_all(
+    case: &mut Case,
+    options: &SuggestAllOptions,
+    on_progress: &(dyn Fn(SuggestAllProgress) -> bool + Sync),
+) -> Result<Vec<Option<Suggestion>>, SuggestError> {
+    let total = case.structures.len();
+    let cancelled = AtomicBool::new(false);
+    let done = AtomicUsize::new(0);
+    let evaluations = AtomicUsize::new(0);
+    let report = Mutex::new(());
+    let tell = |finished: bool| {
+        let _one_at_a_time = report.lock();
+        if finished {
+            done.fetch_add(1, Ordering::Relaxed);
+        }
+        let p = SuggestAllProgress {
+            structures_done: done.load(Ordering::Relaxed),
+            structures: total,
+            evaluations: evaluations.load(Ordering::Relaxed),
+        };
+        if !on_progress(p) {
+            cancelled.store(true, Ordering::Relaxed);
+        }
+        !cancelled.load(Ordering::Relaxed)
+    };
+    // The largest first, so the pool is not left waiting on one big structure at the end.
+    let mut order: Vec<usize> = (0..total).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(case.structures[i].original.vertex_count()));
+    let work: Vec<(usize, CaseStructure)> = order
+        .into_iter()
+        .map(|i| (i, case.structures[i].clone()))
+        .collect();
+    let results: Vec<(usize, Outcome)> = work
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|(i, mut s)| {
+            if cancelled.load(Ordering::Relaxed) {
+                return (i, Ok(None));
+            }
+            if let Some(filter) = options.filter {
+                s.set_filter(filter);
+            }
+            let outcome = suggest_one(&mut s, options, &mut |_| {
+                evaluations.fetch_add(1, Ordering::Relaxed);
+                tell(false)
+            });
+            if matches!(outcome, Ok(Some(_))) {
+                tell(true);
+            }
+            (i, outcome.map(|o| o.map(|sg| (sg, s))))
+        })
+        .collect();
+    let mut suggestions = vec![None; total];
+    let mut first_error = None;
+    for (i, result) in results {
+        match result {
+            Ok(Some((suggestion, structure))) => {
+                case.structures[i] = structure;
+                suggestions[i] = Some(suggestion);
+            }
+            Ok(None) => {}
+            Err(SuggestError::Cancelled) => {}
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    match first_error {
+        Some(e) => Err(e),
+        None => Ok(suggestions),
+    }
+}
+
+/// A structure's suggestion and the structure smoothed with it; `None` when cancelled or empty.
+type Outcome = Result<Option<(Suggestion, CaseStructure)>, SuggestError>;
+
+/// One structure's suggestion, applied and smoothed; `None` when it has no vertices.
+fn suggest_one(
+    s: &mut CaseStructure,
+    options: &SuggestAllOptions,
+    on_progress: &mut dyn FnMut(crate::suggest::Progress) -> bool,
+) -> Result<Option<Suggestion>, SuggestError> {
+    if s.original.vertex_count() == 0 {
+        return Ok(None);
+    }
+    let topology = Topology::build(&s.original);
+    let original = Original::new(&s.original, &topology);
+    let weights = s.weights.as_deref();
+    let suggestion = suggest(
+        &original,
+        weights,
+        &s.params,
+        options.tau,
+        options.method,
+        on_progress,
+    )?;
+    s.params = suggestion.params;
+    s.tau = options.tau;
+    s.smoothed = Some(smooth_on(s, &original));
+    Ok(Some(suggestion))
+}

@@ -1,0 +1,78 @@
+use super::*;
+
+fn tetra() -> Mesh {
+    Mesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ],
+        vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    )
+}
+
+#[test]
+fn a_surface_mesh_has_no_bound_and_a_label_map_structure_half_its_voxel_diagonal() {
+    let mesh = CaseStructure::from_mesh("skull", tetra(), [1.0, 1.0, 1.0]);
+    assert_eq!(mesh.params.max_displacement, None);
+    assert_eq!(mesh.default_bound(), None);
+    let labelled = CaseStructure::from_label_map(
+        Structure {
+            label: 3,
+            layer: 0,
+            name: "vessel".into(),
+            color: [0.0, 0.5, 1.0],
+            voxels: 1,
+            voxel_size: [0.7, 0.7, 2.0],
+            mesh: tetra(),
+        },
+        Some("ct.nii.gz"),
+    );
+    let half = 0.5 * (0.7f64 * 0.7 * 2.0 + 4.0).sqrt();
+    assert_eq!(labelled.params.max_displacement, Some(half as f32));
+    assert_eq!(labelled.label, Some(3));
+    assert_eq!(labelled.color, [0.0, 0.5, 1.0, 1.0]);
+}
+
+#[test]
+fn changing_the_filter_keeps_the_bound_and_drops_the_result() {
+    let mut s = CaseStructure::from_mesh("a", tetra(), [1.0, 0.0, 0.0]);
+    s.params.max_displacement = Some(0.25);
+    pipeline::smooth_structure(&mut s);
+    assert!(s.smoothed.is_some());
+    s.set_filter(Filter::Taubin);
+    assert_eq!(s.params.filter, Filter::Taubin);
+    assert_eq!(s.params.max_displacement, Some(0.25));
+    assert_eq!(s.params.lambda, Params::defaults(Filter::Taubin).lambda);
+    assert!(s.smoothed.is_none());
+}
+
+#[test]
+fn groups_are_listed_once_in_the_order_they_first_appear() {
+    let mut case = Case::default();
+    for (name, group) in [
+        ("a", Some("Vessels")),
+        ("b", None),
+        ("c", Some("Organs")),
+        ("d", Some("Vessels")),
+    ] {
+        let mut s = CaseStructure::from_mesh(name, tetra(), [1.0; 3]);
+        s.group = group.map(str::to_string);
+        case.structures.push(s);
+    }
+    assert_eq!(case.groups(), ["Vessels", "Organs"]);
+    let mut other = Case {
+        title: "second".into(),
+        ..Case::default()
+    };
+    other
+        .structures
+        .push(CaseStructure::from_mesh("e", tetra(), [1.0; 3]));
+    case.add(other);
+    assert_eq!(
+        case.title, "second",
+        "an untitled case takes the added one's title"
+    );
+    assert_eq!(case.structures.len(), 5);
+}

@@ -1,0 +1,320 @@
+//! The case glTF: one scene holding every structure of a case, as a learning platform shows it.
+//!
+//! A root node carries the data's RAS millimetres into glTF's metres with +Y up: it scales by
+//! 1/1000 and turns superior to +Y and anterior to +Z (a viewer at +Z faces the patient), which
+//! leaves the patient's left at +X, a proper rotation, so no winding changes. Under it a node
+//! per group, and under those (or the root) a named node, mesh and material per structure.
+//! Positions stay in millimetres inside the meshes, so reading a case back is exact.
+//!
+//! Each structure's node carries its quality record in `extras` (see `case::record`); the
+//! original staircase can ride along as a morph target (a viewer's weight slides from the
+//! segmentation to the smoothed surface, and a reopened case can be smoothed again), and the
+//! local error as the vertex attribute `_LOCAL_ERROR`.
+
+use base64::Engine as _;
+use serde_json::{json, Value};
+
+use super::glb::{
+    container, floats, geometry, index_bytes, Builder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT,
+    TRIANGLES, UNSIGNED_INT,
+};
+use super::{check, ExportError, ExportOptions};
+use crate::case::{structure_record, Case, CaseStructure, CASE_KEY};
+use crate::mesh::{bounding_box, vertex_normals, Mesh};
+
+/// Which frame the file's coordinates are in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneFrame {
+    /// Metres with +Y up, as glTF defines (the root node converts RAS millimetres).
+    Gltf,
+    /// The data's own RAS millimetres, untouched (for pipelines that expect them).
+    Millimetres,
+}
+
+impl SceneFrame {
+    pub fn name(self) -> &'static str {
+        match self {
+            SceneFrame::Gltf => "gltf",
+            SceneFrame::Millimetres => "millimetres",
+        }
+    }
+}
+
+/// `.glb`, or `.gltf` with its buffer embedded as a data URI.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Container {
+    Glb,
+    Gltf,
+}
+
+/// What a case glTF carries beyond the structures' surfaces, materials and records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CaseGltfOptions {
+    pub frame: SceneFrame,
+    pub container: Container,
+    /// The original surface as each smoothed structure's morph target.
+    pub original_as_morph_target: bool,
+    /// The local error (mm) as the vertex attribute `_LOCAL_ERROR`, where measured.
+    pub local_error: bool,
+    /// `KHR_materials_unlit`: colours show exactly as chosen, without lighting.
+    pub unlit: bool,
+}
+
+impl Default for CaseGltfOptions {
+    fn default() -> Self {
+        Self {
+            frame: SceneFrame::Gltf,
+            container: Container::Glb,
+            original_as_morph_target: true,
+            local_error: false,
+            unlit: false,
+        }
+    }
+}
+
+/// The root node's matrix (column-major) from RAS millimetres to glTF metres, +Y up.
+pub const RAS_MM_TO_GLTF: [f64; 16] = [
+    -0.001, 0.0, 0.0, 0.0, // R -> -X
+    0.0, 0.0, 0.001, 0.0, // A -> +Z
+    0.0, 0.001, 0.0, 0.0, // S -> +Y
+    0.0, 0.0, 0.0, 1.0,
+];
+
+/// Converts a display (sRGB) channel to glTF's linear factor.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Converts glTF's linear factor back to a display (sRGB) channel.
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Serialises the case.
+pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, ExportError> {
+    if case.structures.is_empty() {
+        return Err(ExportError::NoTriangles);
+    }
+    let estimate: u64 = case
+        .structures
+        .iter()
+        .map(|s| s.original.vertex_count() as u64 * 44 + s.original.triangle_count() as u64 * 12)
+        .sum();
+    if estimate > u64::from(u32::MAX) {
+        return Err(too_large());
+    }
+    let mut b = Builder::default();
+    let mut nodes = vec![json!({})];
+    let mut meshes = Vec::new();
+    let mut materials = Vec::new();
+    let mut root_children = Vec::new();
+    let mut group_nodes: Vec<(&str, usize)> = Vec::new();
+    for s in &case.structures {
+        let index = meshes.len();
+        meshes.push(structure_mesh(&mut b, s, index, options)?);
+        materials.push(material(s, options.unlit));
+        let mut record = structure_record(s);
+        if let Some(color) = s.color.get(..3) {
+            record["color"] = json!([color[0], color[1], color[2], s.color[3]]);
+        }
+        nodes.push(json!({ "name": s.name, "mesh": index, "extras": { CASE_KEY: record } }));
+        let node = nodes.len() - 1;
+        match s.group.as_deref() {
+            None => root_children.push(node),
+            Some(group) => match group_nodes.iter().find(|(g, _)| *g == group) {
+                Some(&(_, g)) => push_child(&mut nodes[g], node),
+                None => {
+                    nodes.push(json!({ "name": group, "children": [node] }));
+                    group_nodes.push((group, nodes.len() - 1));
+                    root_children.push(nodes.len() - 1);
+                }
+            },
+        }
+    }
+    let title = if case.title.is_empty() {
+        "case"
+    } else {
+        &case.title
+    };
+    let mut root = json!({ "name": title, "children": root_children });
+    if options.frame == SceneFrame::Gltf {
+        root["matrix"] = json!(RAS_MM_TO_GLTF);
+    }
+    nodes[0] = root;
+    let scene = json!({
+        "name": title,
+        "nodes": [0],
+        "extras": { CASE_KEY: {
+            "title": case.title,
+            "description": case.description,
+            "frame": options.frame.name(),
+            "units": "mm",
+            "structures": case.structures.len(),
+        }},
+    });
+    let mut document = json!({
+        "asset": { "version": "2.0", "generator": concat!("meshsmooth ", env!("CARGO_PKG_VERSION")) },
+        "scene": 0,
+        "scenes": [scene],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+    });
+    if options.unlit {
+        document["extensionsUsed"] = json!(["KHR_materials_unlit"]);
+    }
+    match options.container {
+        Container::Glb => {
+            document["buffers"] = json!([{ "byteLength": b.bin.len() }]);
+            container(&document, b.bin).ok_or_else(too_large)
+        }
+        Container::Gltf => {
+            let data = base64::engine::general_purpose::STANDARD.encode(&b.bin);
+            document["buffers"] = json!([{
+                "byteLength": b.bin.len(),
+                "uri": format!("data:application/octet-stream;base64,{data}"),
+            }]);
+            serde_json::to_vec_pretty(&document).map_err(|e| ExportError::TooLarge {
+                format: "glTF",
+                detail: e.to_string(),
+            })
+        }
+    }
+}
+
+fn too_large() -> ExportError {
+    ExportError::TooLarge {
+        format: "GLB",
+        detail: "the file would exceed the 4 GiB a GLB header can describe".into(),
+    }
+}
+
+fn push_child(node: &mut Value, child: usize) {
+    if let Some(children) = node["children"].as_array_mut() {
+        children.push(json!(child));
+    }
+}
+
+/// A structure's mesh: the surface as shown, its normals, and the optional morph target and
+/// local error.
+fn structure_mesh(
+    b: &mut Builder,
+    s: &CaseStructure,
+    material: usize,
+    options: &CaseGltfOptions,
+) -> Result<Value, ExportError> {
+    let shown = Mesh::new(s.positions().to_vec(), s.original.triangles.clone());
+    let normals = vertex_normals(&shown.positions, &shown.triangles);
+    check(
+        &shown,
+        &ExportOptions {
+            normals: Some(&normals),
+            ..Default::default()
+        },
+    )?;
+    let mut attributes = geometry(b, &shown, Some(&normals));
+    let n = shown.vertex_count();
+    if let (true, Some(errors)) = (
+        options.local_error,
+        s.smoothed.as_ref().and_then(|m| m.local_error.as_ref()),
+    ) {
+        let bytes: Vec<u8> = errors.iter().flat_map(|v| v.to_le_bytes()).collect();
+        attributes["_LOCAL_ERROR"] = json!(b.push(
+            &bytes,
+            ARRAY_BUFFER,
+            json!({"componentType": FLOAT, "count": n, "type": "SCALAR"}),
+        ));
+    }
+    let indices = b.push(
+        &index_bytes(&shown),
+        ELEMENT_ARRAY_BUFFER,
+        json!({"componentType": UNSIGNED_INT, "count": 3 * shown.triangle_count(), "type": "SCALAR"}),
+    );
+    let mut primitive = json!({
+        "attributes": attributes, "indices": indices, "material": material, "mode": TRIANGLES,
+    });
+    let mut mesh = json!({ "name": s.name });
+    if let (true, Some(_)) = (options.original_as_morph_target, &s.smoothed) {
+        primitive["targets"] = json!([morph_target(b, &s.original, &shown, &normals)]);
+        mesh["weights"] = json!([0.0]);
+        mesh["extras"] = json!({ "targetNames": ["segmentation"] });
+    }
+    mesh["primitives"] = json!([primitive]);
+    Ok(mesh)
+}
+
+/// The original as displacements from the shown surface (positions and normals).
+fn morph_target(b: &mut Builder, original: &Mesh, shown: &Mesh, normals: &[[f32; 3]]) -> Value {
+    let delta = |a: &[[f32; 3]], b: &[[f32; 3]]| -> Vec<[f32; 3]> {
+        a.iter()
+            .zip(b)
+            .map(|(p, q)| [p[0] - q[0], p[1] - q[1], p[2] - q[2]])
+            .collect()
+    };
+    let moves: Vec<[f32; 3]> = original
+        .positions
+        .iter()
+        .zip(&shown.positions)
+        .map(|(o, s)| std::array::from_fn(|k| displacement(s[k], o[k])))
+        .collect();
+    let (min, max) = bounding_box(&moves).unwrap_or_default();
+    let position = b.push(
+        &floats(&moves),
+        ARRAY_BUFFER,
+        json!({"componentType": FLOAT, "count": moves.len(), "type": "VEC3",
+               "min": min.map(f64::from), "max": max.map(f64::from)}),
+    );
+    let unit = super::glb::unit_normals(&vertex_normals(&original.positions, &original.triangles));
+    let turns = delta(&unit, &super::glb::unit_normals(normals));
+    let normal = b.push(
+        &floats(&turns),
+        ARRAY_BUFFER,
+        json!({"componentType": FLOAT, "count": turns.len(), "type": "VEC3"}),
+    );
+    json!({ "POSITION": position, "NORMAL": normal })
+}
+
+/// The f32 step from `shown` to `original` that a reader adding it in f32 lands exactly on
+/// `original` with, where one exists (the plain difference misses by an ulp now and then; near
+/// zero no step may hit it, and the nearest is kept).
+fn displacement(shown: f32, original: f32) -> f32 {
+    let d = original - shown;
+    [d, d.next_up(), d.next_down()]
+        .into_iter()
+        .find(|&step| shown + step == original)
+        .unwrap_or(d)
+}
+
+/// A structure's material: its colour as glTF's linear base colour, blended when translucent.
+fn material(s: &CaseStructure, unlit: bool) -> Value {
+    let [r, g, b, a] = s.color;
+    let alpha = a.clamp(0.0, 1.0);
+    let mut m = json!({
+        "name": s.name,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [srgb_to_linear(r), srgb_to_linear(g), srgb_to_linear(b), alpha],
+            "metallicFactor": 0.0,
+            "roughnessFactor": 0.6,
+        },
+        "doubleSided": alpha < 1.0,
+    });
+    if alpha < 1.0 {
+        m["alphaMode"] = json!("BLEND");
+    }
+    if unlit {
+        m["extensions"] = json!({ "KHR_materials_unlit": {} });
+    }
+    m
+}
