@@ -4,6 +4,7 @@
 mod backend;
 mod bench;
 mod bench_load;
+mod case;
 mod convert;
 mod extract;
 mod info;
@@ -43,6 +44,9 @@ enum Command {
     },
     /// One closed surface per structure of a segmentation (NIfTI, NRRD, 3D Slicer .seg.nrrd).
     Extract(extract::ExtractArgs),
+    /// Cases: every structure of a segmentation smoothed and written as one glTF.
+    #[command(subcommand)]
+    Case(case::CaseCommand),
     /// Convert any supported input to .ply (binary), .stl (binary), .obj or .glb, keeping vertex order.
     Convert { input: PathBuf, output: PathBuf },
     /// Smooth from the original and write the result; prints the quality measures.
@@ -117,6 +121,7 @@ pub fn main() -> ExitCode {
         Command::Info { file, json } => info::run(&file, json),
         Command::Convert { input, output } => convert::run(&input, &output),
         Command::Extract(args) => extract::run(&args),
+        Command::Case(command) => case::run(&command),
         Command::Smooth {
             file,
             output,

@@ -1,0 +1,316 @@
+//! `meshsmooth case build INPUTS... -o case.glb`: the fixed pipeline for a whole segmentation
+//! (every structure suggested and smoothed, one case glTF), and `meshsmooth case info`.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use super::params::filter as parse_filter;
+use super::progress::ProgressLine;
+use super::suggest::parse_search;
+use crate::case::{self, Case, SuggestAllOptions, SuggestAllProgress};
+use crate::export::{self, CaseGltfOptions, Container, SceneFrame};
+use crate::segmentation::{ExtractOptions, NamedBytes, OpenOptions};
+use crate::smooth::Filter;
+use crate::suggest::{Progress, SearchMethod};
+
+#[derive(clap::Subcommand)]
+pub(super) enum CaseCommand {
+    /// Suggest and smooth every structure, then write one case glTF (.glb, or .gltf with the
+    /// buffer embedded).
+    Build(BuildArgs),
+    /// Print a case glTF's structures, parameters and measures.
+    Info {
+        file: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(clap::Args)]
+pub(super) struct BuildArgs {
+    /// A label map (.nii, .nii.gz, .nrrd, .seg.nrrd) or several masks, surface meshes (.ply,
+    /// .stl, .obj) and case glTFs (.glb, .gltf), in any mix.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// The case glTF to write: .glb, or .gltf (one file, buffer embedded).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Target smoothness: the weight of smoothness against accuracy in the score, [0, 1].
+    #[arg(long, default_value_t = 0.5)]
+    tau: f64,
+    /// One filter for every structure (laplace | taubin | hc | sinc); else each keeps its own
+    /// (hc for new structures).
+    #[arg(long, value_parser = parse_filter)]
+    filter: Option<Filter>,
+    /// grid (every grid point) or local (faster).
+    #[arg(long, default_value = "grid", value_parser = parse_search)]
+    search: SearchMethod,
+    /// Lift the displacement bound label-map structures get (half their voxel diagonal).
+    #[arg(long)]
+    no_bound: bool,
+    #[arg(long)]
+    title: Option<String>,
+    #[arg(long)]
+    description: Option<String>,
+    /// A colour table naming the label map's labels.
+    #[arg(long)]
+    colors: Option<PathBuf>,
+    /// Only these label values of the label map, comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    labels: Vec<i64>,
+    /// Drop voxel components smaller than this (specks).
+    #[arg(long, default_value_t = 0)]
+    min_voxels: usize,
+    /// The level at which a float image becomes a mask.
+    #[arg(long)]
+    level: Option<f64>,
+    /// Leave out the original surface (the morph target a viewer slides to, and what a
+    /// reopened case smooths again from).
+    #[arg(long)]
+    no_original: bool,
+    /// Add each vertex's local error (mm) as the attribute _LOCAL_ERROR.
+    #[arg(long)]
+    local_error: bool,
+    /// Unlit materials (KHR_materials_unlit): colours show exactly as chosen.
+    #[arg(long)]
+    unlit: bool,
+    /// Keep the data's RAS millimetres instead of glTF's metres with +Y up.
+    #[arg(long)]
+    millimetres: bool,
+    #[arg(long)]
+    json: bool,
+}
+
+pub(super) fn run(command: &CaseCommand) -> Result<(), String> {
+    match command {
+        CaseCommand::Build(args) => build(args),
+        CaseCommand::Info { file, json } => info(file, *json),
+    }
+}
+
+fn build(args: &BuildArgs) -> Result<(), String> {
+    super::check_tau(args.tau)?;
+    let container = container(&args.output)?;
+    super::check_destination(&args.output)?;
+    let started = Instant::now();
+    let mut case = open(args)?;
+    if let Some(t) = &args.title {
+        case.title = t.clone();
+    }
+    if let Some(d) = &args.description {
+        case.description = d.clone();
+    }
+    if args.no_bound {
+        for s in &mut case.structures {
+            s.params.max_displacement = None;
+        }
+    }
+    let opened = started.elapsed().as_secs_f64();
+    let before = case::check(&case, false);
+
+    let options = SuggestAllOptions {
+        tau: args.tau,
+        filter: args.filter,
+        method: args.search,
+    };
+    let what = format!(
+        "suggesting and smoothing {} structures",
+        case.structures.len()
+    );
+    let line = Mutex::new(ProgressLine::on_terminal(&what, false));
+    let suggest_started = Instant::now();
+    let report = |p: SuggestAllProgress| {
+        if let Ok(mut line) = line.lock() {
+            line.update(Progress {
+                done: p.structures_done,
+                total: p.structures,
+            });
+        }
+        true
+    };
+    let suggestions = case::suggest_all(&mut case, &options, &report);
+    if let Ok(line) = line.into_inner() {
+        line.finish();
+    }
+    let suggestions = suggestions.map_err(|e| e.to_string())?;
+    let suggest_seconds = suggest_started.elapsed().as_secs_f64();
+    let after = case::check(&case, true);
+    let changes = case::relations::changes(&before, &after);
+
+    let gltf = CaseGltfOptions {
+        frame: if args.millimetres {
+            SceneFrame::Millimetres
+        } else {
+            SceneFrame::Gltf
+        },
+        container,
+        original_as_morph_target: !args.no_original,
+        local_error: args.local_error,
+        unlit: args.unlit,
+    };
+    let bytes =
+        export::write_case(&case, &gltf).map_err(|e| format!("{}: {e}", args.output.display()))?;
+    super::write_file(&args.output, &bytes)?;
+
+    let evaluations: usize = suggestions.iter().flatten().map(|s| s.evaluations).sum();
+    let checks = case::checks_json(&case, &after, &changes);
+    if args.json {
+        let mut out = case_json(&case);
+        out["checks"] = checks;
+        out["evaluations"] = serde_json::json!(evaluations);
+        out["open_seconds"] = serde_json::json!(opened);
+        out["suggest_seconds"] = serde_json::json!(suggest_seconds);
+        out["seconds"] = serde_json::json!(started.elapsed().as_secs_f64());
+        out["bytes"] = serde_json::json!(bytes.len());
+        println!("{}", super::to_json(&out)?);
+    } else {
+        print!("{}", table(&case));
+        print!("{}", case::checks_text(&case, &before, &after, &changes));
+        println!(
+            "{} structures, {evaluations} parameter sets, suggested and smoothed in {:.2} s; \
+             {} written ({} bytes)",
+            case.structures.len(),
+            suggest_seconds,
+            args.output.display(),
+            bytes.len()
+        );
+    }
+    Ok(())
+}
+
+fn container(output: &Path) -> Result<Container, String> {
+    let name = output.to_string_lossy().to_ascii_lowercase();
+    if name.ends_with(".glb") {
+        Ok(Container::Glb)
+    } else if name.ends_with(".gltf") {
+        Ok(Container::Gltf)
+    } else {
+        Err(format!(
+            "{}: a case is written as .glb or .gltf",
+            output.display()
+        ))
+    }
+}
+
+fn read(path: &Path) -> Result<Vec<u8>, String> {
+    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn open(args: &BuildArgs) -> Result<Case, String> {
+    let contents: Vec<Vec<u8>> = args
+        .inputs
+        .iter()
+        .map(|p| read(p))
+        .collect::<Result<_, _>>()?;
+    let names: Vec<String> = args
+        .inputs
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let files: Vec<NamedBytes> = names
+        .iter()
+        .zip(&contents)
+        .map(|(name, bytes)| NamedBytes { name, bytes })
+        .collect();
+    let table_bytes = args.colors.as_deref().map(read).transpose()?;
+    let table_name = args.colors.as_ref().map(|p| p.display().to_string());
+    let table = table_bytes
+        .as_deref()
+        .zip(table_name.as_deref())
+        .map(|(bytes, name)| NamedBytes { name, bytes });
+    let options = OpenOptions {
+        extract: ExtractOptions {
+            labels: args.labels.clone(),
+            min_voxels: args.min_voxels,
+        },
+        level: args.level,
+    };
+    case::open(&files, table, &options).map_err(|e| e.to_string())
+}
+
+fn info(file: &Path, json: bool) -> Result<(), String> {
+    let bytes = read(file)?;
+    let name = file.display().to_string();
+    let scene = crate::io::load_gltf_scene(&bytes, &name).map_err(|e| format!("{name}: {e}"))?;
+    let case = case::from_gltf_scene(scene, &name).map_err(|e| format!("{name}: {e}"))?;
+    if json {
+        println!("{}", super::to_json(&case_json(&case))?);
+    } else {
+        if !case.title.is_empty() {
+            println!("{}", case.title);
+        }
+        if !case.description.is_empty() {
+            println!("{}", case.description);
+        }
+        print!("{}", table(&case));
+    }
+    Ok(())
+}
+
+/// The case as JSON: title, description and each structure's record with its name.
+fn case_json(case: &Case) -> serde_json::Value {
+    let structures: Vec<_> = case
+        .structures
+        .iter()
+        .map(|s| {
+            let mut r = case::structure_record(s);
+            r["name"] = serde_json::json!(s.name);
+            r
+        })
+        .collect();
+    serde_json::json!({
+        "title": case.title,
+        "description": case.description,
+        "structures": structures,
+    })
+}
+
+fn table(case: &Case) -> String {
+    let mut out = format!(
+        "{:<28} {:<7} {:>5} {:>8} {:>9} {:>16} {:>16} {:>8}\n",
+        "structure",
+        "filter",
+        "iter",
+        "bound mm",
+        "volume %",
+        "mean error mm/vd",
+        "max error mm/vd",
+        "vertices"
+    );
+    for s in &case.structures {
+        let bound = s
+            .params
+            .max_displacement
+            .map_or("-".into(), |b| format!("{b:.3}"));
+        let (volume, mean, max) = match &s.smoothed {
+            Some(m) => {
+                let vd = s.voxel_diagonal();
+                let both = |mm: f64| match vd {
+                    Some(d) => format!("{mm:.3}/{:.2}", mm / d),
+                    None => format!("{mm:.3}"),
+                };
+                (
+                    m.metrics
+                        .volume_change
+                        .map_or("-".into(), |v| format!("{:+.2}", 100.0 * v)),
+                    both(m.metrics.mean_error),
+                    both(m.metrics.max_error),
+                )
+            }
+            None => ("-".into(), "-".into(), "-".into()),
+        };
+        out += &format!(
+            "{:<28} {:<7} {:>5} {:>8} {:>9} {:>16} {:>16} {:>8}\n",
+            s.name,
+            s.params.filter.name(),
+            s.params.iterations,
+            bound,
+            volume,
+            mean,
+            max,
+            s.original.vertex_count()
+        );
+    }
+    out
+}
