@@ -70,6 +70,7 @@ fn roundtrip(mesh: &Mesh, name: &str) {
         normals: Some(&normals),
         colors: Some(&colors),
         extras: Some(json!({"source": "roundtrip"})),
+        millimetres: false,
     };
     for (export, import) in [
         (ExportFormat::Ply, Format::Ply),
@@ -177,6 +178,7 @@ fn glb_normals_colours_and_extras_survive() {
         normals: Some(&normals),
         colors: Some(&colors),
         extras: Some(extras.clone()),
+        ..Default::default()
     };
     let bytes = write(&mesh, ExportFormat::Glb, &options).expect("writes");
 
@@ -210,6 +212,23 @@ fn glb_normals_colours_and_extras_survive() {
     let doc: serde_json::Value = serde_json::from_slice(&glb.json).expect("JSON");
     assert_eq!(doc["meshes"][0]["extras"], extras);
     assert_eq!(doc["asset"]["generator"], "meshsmooth");
+    // Metres with +Y up for viewers (superior up, anterior towards +Z) on a root node; the mesh
+    // keeps millimetres, so reading it back here gives the positions written (above).
+    assert_eq!(doc["nodes"][0]["matrix"][6], 0.001);
+    assert_eq!(doc["nodes"][0]["matrix"][9], 0.001);
+    assert_eq!(doc["nodes"][0]["children"], json!([1]));
+    let raw = write(
+        &mesh,
+        ExportFormat::Glb,
+        &ExportOptions {
+            millimetres: true,
+            ..Default::default()
+        },
+    )
+    .expect("writes");
+    let raw = gltf::Glb::from_slice(&raw).expect("a GLB container");
+    let raw: serde_json::Value = serde_json::from_slice(&raw.json).expect("JSON");
+    assert!(raw["nodes"][0].get("matrix").is_none());
     let text = String::from_utf8_lossy(&glb.json);
     assert!(!text.contains("\"name\""), "no names are written: {text}");
 }

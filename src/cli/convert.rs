@@ -3,12 +3,17 @@
 use crate::export::{self, ExportFormat, ExportOptions};
 use std::path::Path;
 
-pub(super) fn run(input: &Path, output: &Path) -> Result<(), String> {
+/// `millimetres`: a GLB keeps the data's millimetres instead of metres with +Y up.
+pub(super) fn run(input: &Path, output: &Path, millimetres: bool) -> Result<(), String> {
     let format = output_format(output)?;
     super::check_destination(output)?;
     let mesh = super::load_file(input)?;
-    let bytes = export::write(&mesh, format, &ExportOptions::default())
-        .map_err(|e| format!("{}: {e}", output.display()))?;
+    let options = ExportOptions {
+        millimetres,
+        ..Default::default()
+    };
+    let bytes =
+        export::write(&mesh, format, &options).map_err(|e| format!("{}: {e}", output.display()))?;
     super::write_file(output, &bytes)
 }
 

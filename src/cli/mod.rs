@@ -48,7 +48,13 @@ enum Command {
     #[command(subcommand)]
     Case(case::CaseCommand),
     /// Convert any supported input to .ply (binary), .stl (binary), .obj or .glb, keeping vertex order.
-    Convert { input: PathBuf, output: PathBuf },
+    Convert {
+        input: PathBuf,
+        output: PathBuf,
+        /// A .glb keeps the data's millimetres instead of glTF's metres with +Y up.
+        #[arg(long)]
+        millimetres: bool,
+    },
     /// Smooth from the original and write the result; prints the quality measures.
     Smooth {
         file: PathBuf,
@@ -69,6 +75,9 @@ enum Command {
         /// cpu, or gpu (the native wgpu engine smooths, measures and searches).
         #[arg(long, default_value = "cpu", value_parser = backend::parse_backend)]
         backend: backend::Backend,
+        /// A .glb keeps the data's millimetres instead of glTF's metres with +Y up.
+        #[arg(long)]
+        millimetres: bool,
         #[arg(long)]
         json: bool,
     },
@@ -119,7 +128,11 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info { file, json } => info::run(&file, json),
-        Command::Convert { input, output } => convert::run(&input, &output),
+        Command::Convert {
+            input,
+            output,
+            millimetres,
+        } => convert::run(&input, &output, millimetres),
         Command::Extract(args) => extract::run(&args),
         Command::Case(command) => case::run(&command),
         Command::Smooth {
@@ -130,6 +143,7 @@ pub fn main() -> ExitCode {
             auto,
             search,
             backend,
+            millimetres,
             json,
         } => {
             let how = smooth::How {
@@ -137,6 +151,7 @@ pub fn main() -> ExitCode {
                 auto: auto.then_some(search),
                 backend,
                 json,
+                millimetres,
             };
             smooth::run(&file, &output, &params, &how)
         }

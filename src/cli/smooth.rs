@@ -18,6 +18,8 @@ pub(super) struct How {
     pub auto: Option<SearchMethod>,
     pub backend: Backend,
     pub json: bool,
+    /// GLB: keep the data's millimetres (no conversion to metres with +Y up).
+    pub millimetres: bool,
 }
 
 pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> Result<(), String> {
@@ -59,6 +61,7 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
         normals: normals.as_deref(),
         colors: None,
         extras: Some(report_json(&params, &metrics, seconds)),
+        millimetres: how.millimetres,
     };
     let bytes = export::write(&smoothed, format, &options)
         .map_err(|e| format!("{}: {e}", output.display()))?;

@@ -4,7 +4,9 @@
 
 use serde_json::{json, Value};
 
+use super::case_gltf::{SceneFrame, RAS_MM_TO_GLTF};
 use super::{ExportError, ExportOptions};
+use crate::case::CASE_KEY;
 use crate::mesh::{bounding_box, Mesh};
 
 pub(super) const ARRAY_BUFFER: u32 = 34962;
@@ -101,11 +103,21 @@ pub(super) fn write(mesh: &Mesh, options: &ExportOptions) -> Result<Vec<u8>, Exp
     if let Some(extras) = &options.extras {
         gltf_mesh["extras"] = extras.clone();
     }
+    // Like a case: millimetres inside the mesh, the frame on a root node, and a record saying
+    // so, which lets the reader here give the stored positions back.
+    let (frame, nodes) = if options.millimetres {
+        (SceneFrame::Millimetres, json!([{ "mesh": 0 }]))
+    } else {
+        (
+            SceneFrame::Gltf,
+            json!([{ "matrix": RAS_MM_TO_GLTF, "children": [1] }, { "mesh": 0 }]),
+        )
+    };
     let document = json!({
         "asset": { "version": "2.0", "generator": "meshsmooth" },
         "scene": 0,
-        "scenes": [{ "nodes": [0] }],
-        "nodes": [{ "mesh": 0 }],
+        "scenes": [{ "nodes": [0], "extras": { CASE_KEY: { "frame": frame.name(), "units": "mm" } } }],
+        "nodes": nodes,
         "meshes": [gltf_mesh],
         "accessors": b.accessors,
         "bufferViews": b.views,

@@ -75,6 +75,9 @@ pub struct ExportOptions<'a> {
     pub colors: Option<&'a [[u8; 4]]>,
     /// JSON stored as the GLB mesh's `extras` (filter, parameters, measures).
     pub extras: Option<serde_json::Value>,
+    /// GLB only: keep the data's millimetres as glTF's units, without the root node that turns
+    /// RAS millimetres into metres with +Y up (for pipelines that expect the raw frame).
+    pub millimetres: bool,
 }
 
 /// Why a mesh could not be written.

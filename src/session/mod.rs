@@ -526,6 +526,7 @@ impl Session {
             normals: Some(&normals),
             colors,
             extras,
+            millimetres: false,
         };
         export::write(&mesh, format, &options).map_err(|e| e.to_string())
     }

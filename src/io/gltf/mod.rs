@@ -37,8 +37,27 @@ pub(super) fn parse(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
         (Format::Gltf, bytes, 0, None)
     };
     let root = document(json, json_offset, format)?;
-    let instances = scene::instances(&root, format)?;
+    let mut instances = scene::instances(&root, format)?;
+    if written_here(&root) {
+        // Our files keep millimetres inside the meshes and the frame on the root: read the
+        // positions as stored, so that what was exported reopens where it was.
+        for i in &mut instances {
+            i.matrix = scene::IDENTITY;
+        }
+    }
     assemble::merge(&root, &instances, bin, format)
+}
+
+/// Whether the scene carries meshsmooth's record of its frame (a file written here).
+fn written_here(root: &Root) -> bool {
+    let scene = root.scene.map_or(0, |s| s.value());
+    let Some(extras) = root.scenes.get(scene).and_then(|s| s.extras.as_deref()) else {
+        return false;
+    };
+    serde_json::from_str::<serde_json::Value>(extras.get())
+        .ok()
+        .and_then(|v| v.get("meshsmooth")?.get("frame").cloned())
+        .is_some()
 }
 
 /// Deserialises and validates the JSON document.
