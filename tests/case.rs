@@ -229,6 +229,7 @@ fn suggest_all_gives_each_structure_its_own_parameters_and_can_be_cancelled() {
         tau: 0.5,
         filter: None,
         method: SearchMethod::Local,
+        max_volume_change: None,
     };
     let cancelled = suggest_all(&mut case, &options, &|_| false).expect("no error");
     assert!(cancelled.iter().all(Option::is_none));
@@ -371,6 +372,7 @@ fn suggest_all_at_tau_half_brings_every_phantom_surface_closer_to_the_truth() {
         tau: 0.5,
         filter: None,
         method: SearchMethod::Grid,
+        max_volume_change: Some(0.05),
     };
     suggest_all(&mut case, &options, &|_| true).expect("suggests");
     let after = case::check(&case, true);
@@ -392,6 +394,7 @@ fn suggest_all_at_tau_half_brings_every_phantom_surface_closer_to_the_truth() {
             100.0 * dv
         );
         assert!(e < e0, "{}: true error {e} mm, unsmoothed {e0} mm", s.name);
+        assert!(dv.abs() <= 0.05, "{}: volume change {dv}", s.name);
     }
     let tumour_in_liver = before
         .iter()

@@ -10,7 +10,9 @@ use super::{Case, CaseStructure, Smoothed};
 use crate::mesh::Topology;
 use crate::metrics::{measure_vertices, smooth_drifting, Original};
 use crate::smooth::Filter;
-use crate::suggest::{suggest, SearchMethod, SuggestError, Suggestion};
+use crate::suggest::{
+    search_evaluator, suggest_for_goal, Goal, SearchMethod, SuggestError, Suggestion,
+};
 
 /// Smooths a structure from its original with its parameters and weights and measures the
 /// result (with the drifting reference, as every other caller does).
@@ -38,6 +40,8 @@ pub struct SuggestAllOptions {
     /// Every structure's filter becomes this one first; `None` keeps each structure's own.
     pub filter: Option<Filter>,
     pub method: SearchMethod,
+    /// Each structure's suggestion changes its volume by at most this fraction, when given.
+    pub max_volume_change: Option<f64>,
 }
 
 /// How far "Suggest all" has come: structures finished, of all, and parameter sets measured.
@@ -142,14 +146,13 @@ fn suggest_one(
     let topology = Topology::build(&s.original);
     let original = Original::new(&s.original, &topology);
     let weights = s.weights.as_deref();
-    let suggestion = suggest(
-        &original,
-        weights,
-        &s.params,
-        options.tau,
-        options.method,
-        on_progress,
-    )?;
+    let mut evaluator = search_evaluator(&original, weights, s.params.filter, options.method)?;
+    let goal = Goal {
+        tau: options.tau,
+        max_volume_change: options.max_volume_change,
+    };
+    let suggestion =
+        suggest_for_goal(&mut evaluator, &s.params, goal, options.method, on_progress)?;
     s.params = suggestion.params;
     s.tau = options.tau;
     s.smoothed = Some(smooth_on(s, &original));

@@ -46,6 +46,11 @@ pub(super) struct BuildArgs {
     /// grid (every grid point) or local (faster).
     #[arg(long, default_value = "grid", value_parser = parse_search)]
     search: SearchMethod,
+    /// The most volume a structure's suggestion may take off or add, in percent of its
+    /// original volume, or `none`: thin structures (vessels) lose volume faster than the
+    /// score weighs it.
+    #[arg(long, default_value = "5", value_parser = parse_percent)]
+    max_volume_change: Percent,
     /// Lift the displacement bound label-map structures get (half their voxel diagonal).
     #[arg(long)]
     no_bound: bool,
@@ -113,6 +118,7 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         tau: args.tau,
         filter: args.filter,
         method: args.search,
+        max_volume_change: args.max_volume_change.0.map(|p| p / 100.0),
     };
     let what = format!(
         "suggesting and smoothing {} structures",
@@ -177,6 +183,20 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// A percentage, or none.
+#[derive(Clone, Copy, Debug)]
+struct Percent(Option<f64>);
+
+fn parse_percent(text: &str) -> Result<Percent, String> {
+    if text == "none" {
+        return Ok(Percent(None));
+    }
+    match text.parse::<f64>() {
+        Ok(v) if v >= 0.0 && v.is_finite() => Ok(Percent(Some(v))),
+        _ => Err(format!("'{text}' is not a percentage >= 0 or 'none'")),
+    }
 }
 
 fn container(output: &Path) -> Result<Container, String> {

@@ -4,8 +4,8 @@
 use super::mesh_evaluator::{MeshEvaluator, WeightsError};
 use super::space::GRID_ITERATION_STEP;
 use super::{
-    run, Cancelled, Evaluator, GridMinimum, LocalSearch, Progress, QualityGraphs, QualitySweep,
-    SearchMethod, Suggestion,
+    run, Cancelled, Evaluator, Goal, GridMinimum, LocalSearch, Progress, QualityGraphs,
+    QualitySweep, SearchMethod, Suggestion,
 };
 use crate::mesh::{Mesh, Topology};
 use crate::metrics::Original;
@@ -20,6 +20,8 @@ pub enum SuggestError {
     Weights(#[from] WeightsError),
     #[error("tau = {0} is out of range: [0, 1]")]
     Tau(f64),
+    #[error("the volume change limit {0} is not a fraction >= 0")]
+    VolumeLimit(f64),
     #[error("cancelled")]
     Cancelled,
     #[error("the mesh has no vertices")]
@@ -114,14 +116,29 @@ pub fn suggest_on(
     method: SearchMethod,
     on_progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Suggestion, SuggestError> {
-    check_tau(tau)?;
+    suggest_for_goal(evaluator, base, tau.into(), method, on_progress)
+}
+
+/// [`suggest_on`] for a [`Goal`] that may also limit the volume change.
+pub fn suggest_for_goal(
+    evaluator: &mut dyn Evaluator,
+    base: &Params,
+    goal: Goal,
+    method: SearchMethod,
+    on_progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<Suggestion, SuggestError> {
+    check_tau(goal.tau)?;
+    if let Some(limit) = goal.max_volume_change.filter(|l| l.is_nan() || *l < 0.0) {
+        return Err(SuggestError::VolumeLimit(limit));
+    }
+    let (tau, limit) = (goal.tau, goal.max_volume_change);
     let suggestion = match method {
         SearchMethod::Grid => {
-            let task = GridMinimum::new(base.filter, base, tau)?;
+            let task = GridMinimum::new(base.filter, base, tau)?.limiting_volume(limit);
             Some(run(task, evaluator, on_progress)?)
         }
         SearchMethod::Local => {
-            let task = LocalSearch::new(base.filter, base, tau)?;
+            let task = LocalSearch::new(base.filter, base, tau)?.limiting_volume(limit);
             Some(run(task, evaluator, on_progress)?.suggestion)
         }
     };

@@ -16,7 +16,7 @@
 use super::grid::{lowest, plan_grid};
 use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
-use super::{Evaluator, Progress, Rank, SearchMethod, Suggestion, Task, Terms};
+use super::{Evaluator, Goal, Progress, Rank, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
 use std::collections::BTreeMap;
 
@@ -37,6 +37,7 @@ pub struct GridMinimum {
     pending: Option<Run>,
     finished: bool,
     total: usize,
+    max_volume_change: Option<f64>,
 }
 
 impl GridMinimum {
@@ -54,17 +55,33 @@ impl GridMinimum {
             exact: Measured::default(),
             pending: None,
             finished: false,
+            max_volume_change: None,
         })
+    }
+
+    /// Looks only among the sets that change the volume by at most `limit` (a fraction), when
+    /// given. Bounds measure the volume exactly, so they still rule out what they ruled out.
+    pub fn limiting_volume(mut self, limit: Option<f64>) -> Self {
+        self.max_volume_change = limit;
+        self
+    }
+
+    fn goal(&self) -> Goal {
+        Goal {
+            tau: self.tau,
+            max_volume_change: self.max_volume_change,
+        }
     }
 
     /// The points still in question, lowest bound first (ties: the weaker smoothing): those
     /// measured only by bound whose bound does not exceed the best full score.
     fn open_points(&self) -> Vec<GridPoint> {
-        let best = lowest(&self.space, self.tau, self.exact.iter()).map(|(_, t)| t.rank(self.tau));
+        let best =
+            lowest(&self.space, self.goal(), self.exact.iter()).map(|(_, t)| t.rank(self.goal()));
         let mut open: Vec<(GridPoint, Rank)> = self
             .bounds
             .iter()
-            .map(|(&p, t)| (p, t.rank(self.tau)))
+            .map(|(&p, t)| (p, t.rank(self.goal())))
             .filter(|&(_, r)| best.is_none_or(|b| r <= b))
             .collect();
         open.sort_by(|(pa, ra), (pb, rb)| {
@@ -163,7 +180,7 @@ impl Task for GridMinimum {
         if !self.finished {
             return None;
         }
-        let (point, terms) = lowest(&self.space, self.tau, self.exact.iter())?;
+        let (point, terms) = lowest(&self.space, self.goal(), self.exact.iter())?;
         Some(Suggestion {
             filter: self.space.filter,
             params: self.space.params_at(&self.base, point),

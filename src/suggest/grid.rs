@@ -5,7 +5,7 @@
 
 use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
-use super::{Evaluator, Progress, SearchMethod, Suggestion, Task, Terms};
+use super::{Evaluator, Goal, Progress, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
 use serde::{Deserialize, Serialize};
 
@@ -13,12 +13,13 @@ use serde::{Deserialize, Serialize};
 /// do not roughen the mesh); ties go to the weaker smoothing.
 pub(crate) fn lowest(
     space: &ParamSpace,
-    tau: f64,
+    goal: impl Into<Goal>,
     candidates: impl IntoIterator<Item = (GridPoint, Terms)>,
 ) -> Option<(GridPoint, Terms)> {
+    let goal = goal.into();
     candidates.into_iter().min_by(|(pa, ta), (pb, tb)| {
-        ta.rank(tau)
-            .cmp(&tb.rank(tau))
+        ta.rank(goal)
+            .cmp(&tb.rank(goal))
             .then_with(|| space.weakness_key(*pa).cmp(&space.weakness_key(*pb)))
     })
 }

@@ -12,7 +12,7 @@
 use super::grid::{check_base, lowest};
 use super::points::{plan_runs, prefetch, Measured, Run};
 use super::space::{GridPoint, ParamSpace};
-use super::{Evaluator, Progress, Rank, SearchMethod, Suggestion, Task, Terms};
+use super::{Evaluator, Goal, Progress, Rank, SearchMethod, Suggestion, Task, Terms};
 use crate::smooth::{Filter, ParamError, Params};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -40,6 +40,7 @@ pub struct LocalSearch {
     centre: GridPoint,
     paths: Vec<Vec<GridPoint>>,
     total: usize,
+    max_volume_change: Option<f64>,
 }
 
 impl LocalSearch {
@@ -58,7 +59,22 @@ impl LocalSearch {
             phase: Phase::Start,
             centre: GridPoint([0; 3]),
             paths: Vec::new(),
+            max_volume_change: None,
         })
+    }
+
+    /// Looks only among the sets that change the volume by at most `limit` (a fraction), when
+    /// given: the search walks out of the sets past it towards it.
+    pub fn limiting_volume(mut self, limit: Option<f64>) -> Self {
+        self.max_volume_change = limit;
+        self
+    }
+
+    fn goal(&self) -> Goal {
+        Goal {
+            tau: self.tau,
+            max_volume_change: self.max_volume_change,
+        }
     }
 
     fn queue(&mut self, points: &[GridPoint]) {
@@ -67,7 +83,7 @@ impl LocalSearch {
     }
 
     fn rank(&self, p: GridPoint) -> Option<Rank> {
-        self.measured.get(p).map(|t| t.rank(self.tau))
+        self.measured.get(p).map(|t| t.rank(self.goal()))
     }
 
     /// Advances the state machine until a run is due or the search is over.
@@ -96,14 +112,14 @@ impl LocalSearch {
                     let around = self.space.neighbours(&self.base, self.centre);
                     let best = lowest(
                         &self.space,
-                        self.tau,
+                        self.goal(),
                         around
                             .iter()
                             .filter_map(|&p| self.measured.get(p).map(|t| (p, t))),
                     );
                     let centre = self.rank(self.centre);
                     match best {
-                        Some((p, t)) if centre.is_none_or(|c| t.rank(self.tau) < c) => {
+                        Some((p, t)) if centre.is_none_or(|c| t.rank(self.goal()) < c) => {
                             self.centre = p;
                             if let Some(path) = self.paths.last_mut() {
                                 path.push(p);
@@ -155,7 +171,7 @@ impl Task for LocalSearch {
             .filter_map(|path| path.last())
             .filter_map(|&p| self.measured.get(p).map(|t| (p, t)))
             .collect();
-        let (point, terms) = lowest(&self.space, self.tau, minima.iter().copied())?;
+        let (point, terms) = lowest(&self.space, self.goal(), minima.iter().copied())?;
         let evaluations = self.measured.len();
         let suggestion = Suggestion {
             filter: self.space.filter,

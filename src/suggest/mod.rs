@@ -23,8 +23,8 @@ mod space;
 mod sweep;
 
 pub use auto::{
-    quality_graphs, quality_graphs_on, search_evaluator, suggest, suggest_for_mesh, suggest_on,
-    SuggestError, LOCAL_SEARCH_STATE_BYTES,
+    quality_graphs, quality_graphs_on, search_evaluator, suggest, suggest_for_goal,
+    suggest_for_mesh, suggest_on, SuggestError, LOCAL_SEARCH_STATE_BYTES,
 };
 pub use bounded::GridMinimum;
 pub use grid::{EvaluatedGrid, GridSearch};
@@ -53,6 +53,25 @@ pub struct Terms {
     /// part of S: above 1 the filter amplified what it should damp (it is unstable at these
     /// parameters on this mesh), and [`Terms::rank`] puts the set after every one that smooths.
     pub roughness_ratio: f64,
+}
+
+/// What a search looks for: the lowest S(tau), among the sets that change the volume by at
+/// most `max_volume_change` (a fraction) when one is given. Thin structures (vessels) lose
+/// volume to smoothing faster than the score weighs it; an author of a case can hold them to
+/// a limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Goal {
+    pub tau: f64,
+    pub max_volume_change: Option<f64>,
+}
+
+impl From<f64> for Goal {
+    fn from(tau: f64) -> Self {
+        Goal {
+            tau,
+            max_volume_change: None,
+        }
+    }
 }
 
 /// Where a measured parameter set stands in a search (lower is better): every set that does
@@ -139,15 +158,28 @@ impl Terms {
             || !self.roughens() && (self.curvature_ratio.is_nan() || self.mean_error.is_nan())
     }
 
-    /// The set's [`Rank`] at `tau`.
-    pub fn rank(&self, tau: f64) -> Rank {
-        let score = self.score(tau);
+    /// The set's [`Rank`] for a goal (a `tau`, or a [`Goal`] that also limits the volume
+    /// change): the sets within the limit by S, then those past it by their volume change (a
+    /// search that starts among them walks towards the limit), then those that roughen the
+    /// mesh, then the failed ones.
+    pub fn rank(&self, goal: impl Into<Goal>) -> Rank {
+        let goal = goal.into();
+        let score = self.score(goal.tau);
+        let past_limit = match (goal.max_volume_change, self.volume_change) {
+            (Some(limit), Some(change)) => change.abs() > limit,
+            _ => false,
+        };
         if self.failed() || score.is_nan() && !self.roughens() {
-            Rank { class: 2, key: 0.0 }
+            Rank { class: 3, key: 0.0 }
         } else if self.roughens() {
             Rank {
-                class: 1,
+                class: 2,
                 key: self.roughness_ratio,
+            }
+        } else if past_limit {
+            Rank {
+                class: 1,
+                key: self.volume_change.map_or(0.0, f64::abs),
             }
         } else {
             Rank {
@@ -380,6 +412,36 @@ mod tests {
         );
         assert!(Terms::roughened(1.0 + 1e-9).roughens());
         assert_eq!(smooths(0.4).rank(1.0), good.rank(1.0));
+    }
+
+    #[test]
+    fn a_volume_limit_puts_the_sets_past_it_after_those_within_by_their_change() {
+        let set = |k: f64, dv: f64| Terms {
+            curvature_ratio: k,
+            mean_error: 0.1,
+            volume_change: Some(dv),
+            roughness_ratio: 0.3,
+        };
+        let (strong, mild) = (set(0.1, -0.07), set(0.6, -0.02));
+        assert!(
+            strong.rank(0.5) < mild.rank(0.5),
+            "without a limit S decides"
+        );
+        let goal = Goal {
+            tau: 0.5,
+            max_volume_change: Some(0.05),
+        };
+        let nearer = set(0.05, 0.06);
+        let ranks = [mild, nearer, strong, Terms::roughened(1.5)].map(|t| t.rank(goal));
+        for pair in ranks.windows(2) {
+            assert!(pair[0] < pair[1], "{pair:?}");
+        }
+        // An open mesh has no volume to hold.
+        let open = Terms {
+            volume_change: None,
+            ..strong
+        };
+        assert_eq!(open.rank(goal), open.rank(0.5));
     }
 
     #[test]
