@@ -18,7 +18,41 @@ const PALETTE: [[f32; 3]; 12] = [
     [0.60, 0.62, 0.65], // grey
 ];
 
-/// The default colour of the `ordinal`-th structure.
+/// How each further round of the palette is shaded: towards white (positive) or black, by
+/// that fraction, so an atlas of dozens of structures does not repeat a colour every twelve.
+const ROUNDS: [f32; 6] = [0.0, 0.4, -0.35, 0.65, -0.55, 0.2];
+
+/// The default colour of the `ordinal`-th structure: distinct for the first 72.
 pub fn default_color(ordinal: usize) -> [f32; 3] {
-    PALETTE[ordinal % PALETTE.len()]
+    let base = PALETTE[ordinal % PALETTE.len()];
+    let shade = ROUNDS[(ordinal / PALETTE.len()) % ROUNDS.len()];
+    base.map(|c| {
+        if shade >= 0.0 {
+            c + (1.0 - c) * shade
+        } else {
+            c * (1.0 + shade)
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_seventy_two_colours_differ_visibly() {
+        let colors: Vec<[f32; 3]> = (0..72).map(default_color).collect();
+        for (i, a) in colors.iter().enumerate() {
+            assert!(a.iter().all(|c| (0.0..=1.0).contains(c)), "{i}: {a:?}");
+            for (j, b) in colors.iter().enumerate().skip(i + 1) {
+                let distance = a
+                    .iter()
+                    .zip(b)
+                    .map(|(x, y)| (x - y).abs())
+                    .fold(0.0, f32::max);
+                assert!(distance > 4.0 / 255.0, "{i} and {j}: {a:?} {b:?}");
+            }
+        }
+        assert_eq!(default_color(0), PALETTE[0]);
+    }
 }
