@@ -107,6 +107,12 @@ fn structure(
     };
     let matrix = if ours { IDENTITY } else { node.matrix };
     let shown = place(&node.mesh, &matrix);
+    let finite = |m: &Mesh| m.positions.iter().flatten().all(|v| v.is_finite());
+    if !finite(&shown) {
+        return Err(fail(
+            "a position is not finite after the node's transform".into(),
+        ));
+    }
     let original = match &node.morph_target {
         Some(target) => {
             let moved: Vec<[f32; 3]> = node
@@ -120,6 +126,7 @@ fn structure(
                 &Mesh::new(moved, node.mesh.triangles.clone()),
                 &matrix,
             ))
+            .filter(finite)
         }
         None => None,
     };
