@@ -13,14 +13,45 @@ const STACK_DEPTH: usize = 64;
 /// treated as a sliver: its plane is numerically unreliable, so only its edges count.
 pub(crate) const SLIVER_SINE: f64 = 1e-8;
 
+/// A node of a triangle tree: its box, and its leaf range or children.
 #[derive(Clone, Copy, Debug)]
-struct Node {
-    min: [f32; 3],
-    max: [f32; 3],
+pub(crate) struct Node {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
     /// Leaf: first triangle in leaf order. Inner node: index of the left child (right = left + 1).
-    first: u32,
+    pub first: u32,
     /// Triangles in a leaf; 0 marks an inner node.
-    count: u32,
+    pub count: u32,
+}
+
+/// The median-split tree over `triangles` (indices into `positions`, which must be in range):
+/// its nodes, root first, and the mesh's triangle indices in leaf order. Shared by the distance
+/// queries here and the ray casts of the checks between a case's structures.
+pub(crate) fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec<u32>) {
+    let mut items: Vec<(u32, [f32; 3])> = triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let mut c = [0.0f32; 3];
+            for &v in tri {
+                for (k, ck) in c.iter_mut().enumerate() {
+                    *ck += positions[v as usize][k] / 3.0;
+                }
+            }
+            (t as u32, c)
+        })
+        .collect();
+    let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
+    if !items.is_empty() {
+        nodes.push(Node {
+            min: [0.0; 3],
+            max: [0.0; 3],
+            first: 0,
+            count: 0,
+        });
+        build(&mut nodes, 0, &mut items, 0, positions, triangles);
+    }
+    (nodes, items.iter().map(|&(t, _)| t).collect())
 }
 
 /// The closest point of a mesh to a query point.
@@ -44,30 +75,7 @@ pub struct TriangleBvh {
 impl TriangleBvh {
     /// Builds the tree over `triangles` (indices into `positions`, which must be in range).
     pub fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
-        let mut items: Vec<(u32, [f32; 3])> = triangles
-            .iter()
-            .enumerate()
-            .map(|(t, tri)| {
-                let mut c = [0.0f32; 3];
-                for &v in tri {
-                    for (k, ck) in c.iter_mut().enumerate() {
-                        *ck += positions[v as usize][k] / 3.0;
-                    }
-                }
-                (t as u32, c)
-            })
-            .collect();
-        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
-        if !items.is_empty() {
-            nodes.push(Node {
-                min: [0.0; 3],
-                max: [0.0; 3],
-                first: 0,
-                count: 0,
-            });
-            build(&mut nodes, 0, &mut items, 0, positions, triangles);
-        }
-        let ids: Vec<u32> = items.iter().map(|&(t, _)| t).collect();
+        let (nodes, ids) = build_tree(positions, triangles);
         let corners = ids
             .iter()
             .map(|&t| triangles[t as usize].map(|v| positions[v as usize]))

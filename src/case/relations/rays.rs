@@ -9,10 +9,8 @@
 //! edge signs are too close to call (it grazes an edge or a vertex) is thrown away and another
 //! one cast; a ray that meets the surface at its start means the point is on the surface.
 
-use crate::mesh::to_f64;
+use crate::metrics::build_tree;
 
-/// Triangles per leaf, as in the distance tree.
-const LEAF_SIZE: usize = 4;
 /// Deeper than any median-split tree over `u32` triangle counts can grow.
 const STACK_DEPTH: usize = 64;
 /// A point this close (mm) to a triangle along a ray lies on the surface.
@@ -89,36 +87,29 @@ impl RayBvh {
     /// Builds the tree over `triangles` (indices into `positions`, which must be in range).
     pub(super) fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
         let shell_of = triangle_shells(positions.len(), triangles);
-        let mut items: Vec<(u32, [f64; 3])> = triangles
+        let (tree, order) = build_tree(positions, triangles);
+        // The shared tree's boxes, widened a hair so that a ray along a box face is not lost
+        // to rounding.
+        let nodes = tree
             .iter()
-            .enumerate()
-            .map(|(t, tri)| {
-                let mut c = [0.0; 3];
-                for &v in tri {
-                    for (ck, pk) in c.iter_mut().zip(positions[v as usize]) {
-                        *ck += pk as f64 / 3.0;
-                    }
-                }
-                (t as u32, c)
+            .map(|n| Node {
+                min: n
+                    .min
+                    .map(|x| f64::from(x) - BOX_PAD * (1.0 + f64::from(x).abs())),
+                max: n
+                    .max
+                    .map(|x| f64::from(x) + BOX_PAD * (1.0 + f64::from(x).abs())),
+                first: n.first,
+                count: n.count,
             })
             .collect();
-        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
-        if !items.is_empty() {
-            nodes.push(Node {
-                min: [0.0; 3],
-                max: [0.0; 3],
-                first: 0,
-                count: 0,
-            });
-            build(&mut nodes, 0, &mut items, 0, positions, triangles);
-        }
         Self {
             nodes,
-            corners: items
+            corners: order
                 .iter()
-                .map(|&(t, _)| triangles[t as usize].map(|v| positions[v as usize]))
+                .map(|&t| triangles[t as usize].map(|v| positions[v as usize]))
                 .collect(),
-            shells: items.iter().map(|&(t, _)| shell_of[t as usize]).collect(),
+            shells: order.iter().map(|&t| shell_of[t as usize]).collect(),
         }
     }
 
@@ -364,65 +355,4 @@ fn triangle_shells(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<u32> {
             number[r]
         })
         .collect()
-}
-
-/// Fills `nodes[index]` for `items` (whose leaf order starts at `offset`) and recurses.
-/// Depth is bounded by log2 of the triangle count because every split halves the set.
-fn build(
-    nodes: &mut Vec<Node>,
-    index: usize,
-    items: &mut [(u32, [f64; 3])],
-    offset: usize,
-    positions: &[[f32; 3]],
-    triangles: &[[u32; 3]],
-) {
-    let (mut min, mut max) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    let (mut cmin, mut cmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for (t, c) in items.iter() {
-        for &v in &triangles[*t as usize] {
-            let p = to_f64(positions[v as usize]);
-            for k in 0..3 {
-                min[k] = min[k].min(p[k]);
-                max[k] = max[k].max(p[k]);
-            }
-        }
-        for k in 0..3 {
-            cmin[k] = cmin[k].min(c[k]);
-            cmax[k] = cmax[k].max(c[k]);
-        }
-    }
-    let min = min.map(|x| x - BOX_PAD * (1.0 + x.abs()));
-    let max = max.map(|x| x + BOX_PAD * (1.0 + x.abs()));
-    if items.len() <= LEAF_SIZE {
-        nodes[index] = Node {
-            min,
-            max,
-            first: offset as u32,
-            count: items.len() as u32,
-        };
-        return;
-    }
-    let axis = (0..3)
-        .max_by(|&a, &b| (cmax[a] - cmin[a]).total_cmp(&(cmax[b] - cmin[b])))
-        .unwrap_or(0);
-    let mid = items.len() / 2;
-    items.select_nth_unstable_by(mid, |a, b| a.1[axis].total_cmp(&b.1[axis]));
-    let left = nodes.len();
-    let placeholder = Node {
-        min: [0.0; 3],
-        max: [0.0; 3],
-        first: 0,
-        count: 0,
-    };
-    nodes.push(placeholder);
-    nodes.push(placeholder);
-    nodes[index] = Node {
-        min,
-        max,
-        first: left as u32,
-        count: 0,
-    };
-    let (lo, hi) = items.split_at_mut(mid);
-    build(nodes, left, lo, offset, positions, triangles);
-    build(nodes, left + 1, hi, offset + mid, positions, triangles);
 }
