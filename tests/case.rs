@@ -13,10 +13,10 @@ use serde_json::Value;
 const PHANTOM: &str = "labelmaps/case_phantom_shared.nii.gz";
 const TABLE: &str = "labelmaps/case_phantom_shared_labels.txt";
 
-fn read(path: &str) -> Vec<u8> {
-    let full = format!("{}/../shared/data/{path}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read(&full).unwrap_or_else(|e| panic!("{full}: {e}"))
-}
+#[path = "common/label_maps.rs"]
+mod label_maps;
+
+use label_maps::{inside_shape, read};
 
 fn phantom() -> Case {
     let (bytes, table) = (read(PHANTOM), read(TABLE));
@@ -312,29 +312,6 @@ impl Truth {
         }
         best
     }
-}
-
-fn inside_shape(shape: &Value, p: [f64; 3]) -> bool {
-    let v = |x: &Value| -> [f64; 3] { std::array::from_fn(|k| x[k].as_f64().expect("number")) };
-    let list = |key: &str| shape[key].as_array().cloned().unwrap_or_default();
-    let ellipsoid = list("ellipsoids").iter().any(|e| {
-        let (c, r) = (v(&e[0]), v(&e[1]));
-        (0..3).map(|k| ((p[k] - c[k]) / r[k]).powi(2)).sum::<f64>() <= 1.0
-    });
-    let sphere = list("spheres").iter().any(|s| {
-        let (c, r) = (v(&s[0]), s[1].as_f64().expect("radius"));
-        (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f64>() <= r * r
-    });
-    let capsule = list("capsules").iter().any(|s| {
-        let (a, b, r) = (v(&s[0]), v(&s[1]), s[2].as_f64().expect("radius"));
-        let ab: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
-        let ap: [f64; 3] = std::array::from_fn(|k| p[k] - a[k]);
-        let t =
-            (0..3).map(|k| ab[k] * ap[k]).sum::<f64>() / (0..3).map(|k| ab[k] * ab[k]).sum::<f64>();
-        let t = t.clamp(0.0, 1.0);
-        (0..3).map(|k| (ap[k] - t * ab[k]).powi(2)).sum::<f64>() <= r * r
-    });
-    ellipsoid || sphere || capsule
 }
 
 /// The mean over (at most about 3000, evenly strided) vertices.

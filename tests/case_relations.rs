@@ -6,32 +6,13 @@ use std::time::Instant;
 
 use meshsmooth::case::relations::{changes, relations, PairRelation};
 use meshsmooth::mesh::{Mesh, Topology};
-use meshsmooth::segmentation::{self, NamedBytes, OpenOptions, Structure};
+use meshsmooth::segmentation::Structure;
 use meshsmooth::smooth::{smooth, Filter, NoObserver, Params};
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/");
+#[path = "common/label_maps.rs"]
+mod label_maps;
 
-fn read(path: &str) -> Vec<u8> {
-    std::fs::read(format!("{DATA}{path}")).unwrap_or_else(|e| panic!("{path}: {e}"))
-}
-
-/// The label map's structures, named by its colour table when it has one.
-fn open(path: &str, table: Option<&str>) -> Vec<Structure> {
-    let bytes = read(path);
-    let table_bytes = table.map(read);
-    let table = table
-        .zip(table_bytes.as_deref())
-        .map(|(name, bytes)| NamedBytes { name, bytes });
-    segmentation::open(
-        &[NamedBytes {
-            name: path,
-            bytes: &bytes,
-        }],
-        table,
-        &OpenOptions::default(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-}
+use label_maps::open;
 
 /// Half each structure's voxel diagonal: how far the true boundary may lie from the staircase.
 fn tolerances(structures: &[Structure]) -> Vec<f64> {

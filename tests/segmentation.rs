@@ -6,28 +6,10 @@ use meshsmooth::mesh::{MeshReport, Topology};
 use meshsmooth::segmentation::{self, NamedBytes, OpenOptions, Structure};
 use serde_json::Value;
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/");
+#[path = "common/label_maps.rs"]
+mod label_maps;
 
-fn read(path: &str) -> Vec<u8> {
-    std::fs::read(format!("{DATA}{path}")).unwrap_or_else(|e| panic!("{path}: {e}"))
-}
-
-fn open(path: &str, table: Option<&str>) -> Vec<Structure> {
-    let bytes = read(path);
-    let table_bytes = table.map(read);
-    let table = table
-        .zip(table_bytes.as_deref())
-        .map(|(name, bytes)| NamedBytes { name, bytes });
-    segmentation::open(
-        &[NamedBytes {
-            name: path,
-            bytes: &bytes,
-        }],
-        table,
-        &OpenOptions::default(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-}
+use label_maps::{inside_shape, open, read};
 
 /// Closed, manifold, outward, no degenerate or duplicate faces; returns the report.
 fn assert_sound(file: &str, s: &Structure) -> MeshReport {
@@ -126,30 +108,6 @@ fn the_phantom_reads_the_same_from_nifti_and_seg_nrrd() {
     }
     let names: Vec<&str> = nifti.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(names, ["liver", "portal_vein", "tumor", "right_kidney"]);
-}
-
-/// Inside test of one phantom shape in its own frame (mm).
-fn inside_shape(shape: &Value, p: [f64; 3]) -> bool {
-    let v = |x: &Value| -> [f64; 3] { std::array::from_fn(|k| x[k].as_f64().expect("number")) };
-    let list = |key: &str| shape[key].as_array().cloned().unwrap_or_default();
-    let ellipsoid = list("ellipsoids").iter().any(|e| {
-        let (c, r) = (v(&e[0]), v(&e[1]));
-        (0..3).map(|k| ((p[k] - c[k]) / r[k]).powi(2)).sum::<f64>() <= 1.0
-    });
-    let sphere = list("spheres").iter().any(|s| {
-        let (c, r) = (v(&s[0]), s[1].as_f64().expect("radius"));
-        (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f64>() <= r * r
-    });
-    let capsule = list("capsules").iter().any(|s| {
-        let (a, b, r) = (v(&s[0]), v(&s[1]), s[2].as_f64().expect("radius"));
-        let ab: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
-        let ap: [f64; 3] = std::array::from_fn(|k| p[k] - a[k]);
-        let t =
-            (0..3).map(|k| ab[k] * ap[k]).sum::<f64>() / (0..3).map(|k| ab[k] * ab[k]).sum::<f64>();
-        let t = t.clamp(0.0, 1.0);
-        (0..3).map(|k| (ap[k] - t * ab[k]).powi(2)).sum::<f64>() <= r * r
-    });
-    ellipsoid || sphere || capsule
 }
 
 /// Every vertex of every phantom structure has the structure's true surface within half a

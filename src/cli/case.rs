@@ -5,12 +5,13 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
+use super::inputs::Inputs;
 use super::params::filter as parse_filter;
 use super::progress::ProgressLine;
 use super::suggest::parse_search;
 use crate::case::{self, Case, SuggestAllOptions, SuggestAllProgress};
 use crate::export::{self, CaseGltfOptions, Container, SceneFrame};
-use crate::segmentation::{ExtractOptions, NamedBytes, OpenOptions};
+use crate::segmentation::{ExtractOptions, OpenOptions};
 use crate::smooth::Filter;
 use crate::suggest::{Progress, SearchMethod};
 
@@ -213,32 +214,8 @@ fn container(output: &Path) -> Result<Container, String> {
     }
 }
 
-fn read(path: &Path) -> Result<Vec<u8>, String> {
-    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
-}
-
 fn open(args: &BuildArgs) -> Result<Case, String> {
-    let contents: Vec<Vec<u8>> = args
-        .inputs
-        .iter()
-        .map(|p| read(p))
-        .collect::<Result<_, _>>()?;
-    let names: Vec<String> = args
-        .inputs
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect();
-    let files: Vec<NamedBytes> = names
-        .iter()
-        .zip(&contents)
-        .map(|(name, bytes)| NamedBytes { name, bytes })
-        .collect();
-    let table_bytes = args.colors.as_deref().map(read).transpose()?;
-    let table_name = args.colors.as_ref().map(|p| p.display().to_string());
-    let table = table_bytes
-        .as_deref()
-        .zip(table_name.as_deref())
-        .map(|(bytes, name)| NamedBytes { name, bytes });
+    let inputs = Inputs::read(&args.inputs, args.colors.as_deref())?;
     let options = OpenOptions {
         extract: ExtractOptions {
             labels: args.labels.clone(),
@@ -246,11 +223,11 @@ fn open(args: &BuildArgs) -> Result<Case, String> {
         },
         level: args.level,
     };
-    case::open(&files, table, &options).map_err(|e| e.to_string())
+    case::open(&inputs.files(), inputs.table(), &options).map_err(|e| e.to_string())
 }
 
 fn info(file: &Path, json: bool) -> Result<(), String> {
-    let bytes = read(file)?;
+    let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
     let name = file.display().to_string();
     let scene = crate::io::load_gltf_scene(&bytes, &name).map_err(|e| format!("{name}: {e}"))?;
     let case = case::from_gltf_scene(scene, &name).map_err(|e| format!("{name}: {e}"))?;

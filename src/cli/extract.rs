@@ -1,10 +1,11 @@
 //! `meshsmooth extract LABELMAP... -o OUT`: one surface per structure of a segmentation, as PLY
 //! files in a folder or one GLB with a named node per structure.
 
+use super::inputs::Inputs;
 use crate::case::Case;
 use crate::export::{self, CaseGltfOptions, ExportFormat, ExportOptions, SceneFrame};
 use crate::mesh::vertex_normals;
-use crate::segmentation::{self, ExtractOptions, NamedBytes, OpenOptions, Structure};
+use crate::segmentation::{self, ExtractOptions, OpenOptions, Structure};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -43,28 +44,7 @@ enum Destination {
 
 pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
     let destination = destination(&args.output)?;
-    let read = |p: &Path| std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()));
-    let contents: Vec<Vec<u8>> = args
-        .inputs
-        .iter()
-        .map(|p| read(p))
-        .collect::<Result<_, _>>()?;
-    let names: Vec<String> = args
-        .inputs
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect();
-    let files: Vec<NamedBytes> = names
-        .iter()
-        .zip(&contents)
-        .map(|(name, bytes)| NamedBytes { name, bytes })
-        .collect();
-    let table_bytes = args.colors.as_deref().map(read).transpose()?;
-    let table_name = args.colors.as_ref().map(|p| p.display().to_string());
-    let table = table_bytes
-        .as_deref()
-        .zip(table_name.as_deref())
-        .map(|(bytes, name)| NamedBytes { name, bytes });
+    let inputs = Inputs::read(&args.inputs, args.colors.as_deref())?;
     let options = OpenOptions {
         extract: ExtractOptions {
             labels: args.labels.clone(),
@@ -78,7 +58,8 @@ pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
         _ => None,
     };
     let started = Instant::now();
-    let structures = segmentation::open(&files, table, &options).map_err(|e| e.to_string())?;
+    let structures =
+        segmentation::open(&inputs.files(), inputs.table(), &options).map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     let written = match &destination {
         Destination::Folder(dir) => write_folder(dir, &structures)?,

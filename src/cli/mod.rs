@@ -8,6 +8,7 @@ mod case;
 mod convert;
 mod extract;
 mod info;
+mod inputs;
 mod measure;
 mod output;
 mod params;

@@ -1,0 +1,37 @@
+//! The files a segmentation command reads: its inputs and the colour table, named as given.
+
+use crate::segmentation::NamedBytes;
+use std::path::{Path, PathBuf};
+
+pub(super) struct Inputs {
+    files: Vec<(String, Vec<u8>)>,
+    table: Option<(String, Vec<u8>)>,
+}
+
+fn read(path: &Path) -> Result<(String, Vec<u8>), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok((path.display().to_string(), bytes))
+}
+
+impl Inputs {
+    /// Reads every input and the table; an error names the file.
+    pub(super) fn read(inputs: &[PathBuf], table: Option<&Path>) -> Result<Self, String> {
+        Ok(Self {
+            files: inputs.iter().map(|p| read(p)).collect::<Result<_, _>>()?,
+            table: table.map(read).transpose()?,
+        })
+    }
+
+    pub(super) fn files(&self) -> Vec<NamedBytes<'_>> {
+        self.files
+            .iter()
+            .map(|(name, bytes)| NamedBytes { name, bytes })
+            .collect()
+    }
+
+    pub(super) fn table(&self) -> Option<NamedBytes<'_>> {
+        self.table
+            .as_ref()
+            .map(|(name, bytes)| NamedBytes { name, bytes })
+    }
+}
