@@ -6,6 +6,7 @@
 //! camera and shading record, kept apart from the app so it is tested natively.
 
 pub mod case;
+pub mod evaluate;
 pub mod export;
 pub mod gpu;
 pub mod io;

@@ -15,11 +15,11 @@ use super::readback::Staging;
 use super::smoother::Segment;
 use super::work::{iteration_cost, measure_part_cost, plan_segment, AdaptiveSize};
 use super::{Advance, GpuError, GpuMesh, GpuSmoother};
-use crate::metrics::{metrics_from_sums, Original};
-use crate::smooth::Params;
-use crate::suggest::{
+use crate::evaluate::{
     failed_terms, is_cumulative, terms_of, unchanged_terms, ModelRef, Offload, Request, Terms,
 };
+use crate::metrics::{metrics_from_sums, Original};
+use crate::smooth::Params;
 
 /// Vertex-steps in a segment at first and at least (about one iteration of a 206k-vertex
 /// mesh, two whole 50-iteration runs of the 2,296-vertex sample), and at most. The floor
@@ -120,7 +120,7 @@ struct InFlight {
     full: bool,
 }
 
-/// The GPU engine as an evaluator for [`crate::suggest`]'s tasks, on the device handed in. It
+/// The GPU engine as an evaluator for the searches' tasks, on the device handed in. It
 /// keeps its own copy of the model on the device (uploaded once per model id), so it never
 /// disturbs what a renderer draws.
 pub struct GpuEvaluator {

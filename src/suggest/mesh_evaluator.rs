@@ -2,8 +2,10 @@
 //! along the run, and measure against the original.
 
 use super::run_states::RunStates;
-use super::{is_cumulative, Evaluator, Terms};
-use crate::metrics::{measure, measure_shape, DriftState, DriftingReference, Metrics, Original};
+use crate::evaluate::{is_cumulative, unchanged_terms, Evaluator, Terms};
+// pub(super) for the sibling modules that import it from here.
+pub(super) use crate::evaluate::terms_of;
+use crate::metrics::{measure, measure_shape, DriftState, DriftingReference, Original};
 use crate::smooth::{self, smooth, Follower, Params, StepObserver};
 
 /// Per-vertex weights that do not fit the mesh.
@@ -29,20 +31,6 @@ pub fn check_weights(weights: &[f32], vertices: usize) -> Result<(), WeightsErro
             value: weights[index],
         }),
         None => Ok(()),
-    }
-}
-
-/// The score terms of a measured mesh whose roughness is `roughness_ratio` times the
-/// original's ([`Terms::roughened`] when above 1: what a blown-up mesh measures means nothing).
-pub fn terms_of(metrics: &Metrics, roughness_ratio: f64) -> Terms {
-    if roughness_ratio > 1.0 {
-        return Terms::roughened(roughness_ratio);
-    }
-    Terms {
-        curvature_ratio: metrics.score_terms().curvature_ratio,
-        mean_error: metrics.mean_error,
-        volume_change: metrics.volume_change.map(f64::abs),
-        roughness_ratio,
     }
 }
 
@@ -84,7 +72,7 @@ impl<'a> MeshEvaluator<'a> {
 
     /// The terms of the unchanged mesh (no volume term when it is open).
     pub(crate) fn unchanged(&self) -> Terms {
-        super::unchanged_terms(self.original)
+        unchanged_terms(self.original)
     }
 }
 

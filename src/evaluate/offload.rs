@@ -20,8 +20,8 @@ pub struct ModelRef<'a> {
 pub trait Offload {
     /// The terms of `params` after each count in `at` on `model`; `None` while the run is under
     /// way (ask again with the same request). A request that differs from the one under way
-    /// abandons it. When the evaluator fails (a lost device) it answers NaN terms, which rank
-    /// last, and [`Offload::failure`] says why.
+    /// abandons it. When the evaluator fails (a lost device) it answers NaN terms
+    /// ([`super::failed_terms`]), which rank last, and [`Offload::failure`] says why.
     fn measure(&mut self, model: &ModelRef<'_>, params: &Params, at: &[u32]) -> Option<Vec<Terms>>;
 
     /// The requests that will follow the next one for `model` (see [`Evaluator::prefetch`]).
@@ -58,25 +58,4 @@ impl Evaluator for Offloaded<'_> {
     fn prefetch(&mut self, requests: &[Request]) {
         self.offload.prefetch(&self.model, requests);
     }
-}
-
-/// The terms of the unchanged mesh (no volume term when it is open): what zero iterations give.
-pub fn unchanged_terms(original: &Original) -> Terms {
-    Terms {
-        volume_change: original.volume().map(|_| 0.0),
-        ..Terms::UNCHANGED
-    }
-}
-
-/// What a failed evaluation answers: NaN terms, which every comparison ranks last.
-pub fn failed_terms(count: usize) -> Vec<Terms> {
-    vec![
-        Terms {
-            curvature_ratio: f64::NAN,
-            mean_error: f64::NAN,
-            volume_change: None,
-            roughness_ratio: f64::NAN,
-        };
-        count
-    ]
 }
