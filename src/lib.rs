@@ -17,6 +17,7 @@ pub mod session;
 pub mod smooth;
 pub mod suggest;
 pub mod view;
+pub mod worker;
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod cli;

@@ -314,23 +314,23 @@ impl Document {
         self.busy() || self.session.guidance_busy() || self.session.loading().is_some()
     }
 
-    /// The CPU engine's share of this frame: works on the current parameters' result for
-    /// about [`FRAME_BUDGET_MS`], so a long run is spread over frames and the page stays live.
+    /// The CPU engine's share of this frame: asks its workers for the current parameters'
+    /// result, or takes it once it came.
     pub fn compute_on_cpu(&mut self) {
-        if let Some(t) = self.session.step_cpu(&now_ms, FRAME_BUDGET_MS) {
+        if let Some(t) = self.session.compute_cpu() {
             self.timings = Some(EngineTimings::Cpu(t));
         }
     }
 
-    /// The background work's share of this frame (graphs, suggestions, the gallery):
-    /// `budget_ms` of CPU time, or on the GPU engine's evaluator when one is lent (a run per
-    /// frame goes to the device). With the CPU engine it waits until the current parameters'
-    /// result is there: what the user is looking at comes first.
-    pub fn compute_guidance(&mut self, budget_ms: f64, offload: Option<&mut dyn Offload>) {
+    /// The background work's share of this frame (graphs, suggestions, the gallery): hands
+    /// its runs to the CPU engine's workers, or to the GPU engine's evaluator when one is lent.
+    /// With the CPU engine it waits until the current parameters' result is there: what the
+    /// user is looking at comes first.
+    pub fn compute_guidance(&mut self, offload: Option<&mut dyn Offload>) {
         if self.backend == Backend::Cpu && self.busy() {
             return;
         }
-        self.session.step_guidance_on(&now_ms, budget_ms, offload);
+        self.session.step_guidance_on(&now_ms, offload);
     }
 
     /// What the API's `state()` returns.

@@ -35,6 +35,7 @@ mod shortcuts;
 mod status;
 mod structure_picker;
 pub mod viewer;
+mod workers;
 
 pub use document::{Backend, Document};
 
@@ -44,6 +45,10 @@ pub const SAMPLE_BYTES: &[u8] = include_bytes!("../../web/sample/bent_tube_stair
 
 /// Entry point of the wasm32 binary.
 pub fn start() {
+    // The engine workers load this same module: they have no window and no app to start.
+    if web_sys::window().is_none() {
+        return;
+    }
     // Fails only when a logger is already installed, which is then kept.
     let _ = eframe::WebLogger::init(log::LevelFilter::Info);
     page::install_crash_message_hook();

@@ -8,13 +8,18 @@ pub struct ModelUrl {
     pub name: String,
 }
 
+/// The page's query parameter `name`, if it has one.
+pub fn param(name: &str) -> Option<String> {
+    let search = web_sys::window()?.location().search().ok()?;
+    web_sys::UrlSearchParams::new_with_str(&search)
+        .ok()?
+        .get(name)
+}
+
 /// The `model` query parameter, if there is one; an error when it names another origin.
 pub fn model_url() -> Option<Result<ModelUrl, String>> {
     let location = web_sys::window()?.location();
-    let search = location.search().ok()?;
-    let wanted = web_sys::UrlSearchParams::new_with_str(&search)
-        .ok()?
-        .get("model")?;
+    let wanted = param("model")?;
     Some(resolve(
         &wanted,
         &location.href().ok()?,

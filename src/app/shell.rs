@@ -5,9 +5,7 @@
 use super::bottom_panel::BottomPanel;
 use super::brush::Brush;
 use super::controls::{self, Controls};
-use super::document::{
-    now_ms, Backend, Document, Opening, SharedDocument, ViewReport, FRAME_BUDGET_MS,
-};
+use super::document::{Backend, Document, Opening, SharedDocument, ViewReport};
 use super::drag_params::DragParams;
 use super::file_input::FileInput;
 use super::gpu_engine::{GpuEngine, Sent};
@@ -15,10 +13,13 @@ use super::guide::Guide;
 use super::shortcuts::{self, Action};
 use super::structure_picker;
 use super::viewer::{self, Viewer};
-use super::{api, download, legend, page, query, report_view, status, SAMPLE_BYTES, SAMPLE_NAME};
+use super::{
+    api, download, legend, page, query, report_view, status, workers, SAMPLE_BYTES, SAMPLE_NAME,
+};
 use crate::export::ExportFormat;
 use crate::session::{ColorField, Legend};
 use crate::smooth::Filter;
+use crate::worker::Pool;
 use eframe::egui;
 use eframe::egui_wgpu;
 use std::cell::RefCell;
@@ -47,18 +48,9 @@ pub struct Shell {
     view: Option<(Viewer, egui_wgpu::RenderState)>,
     /// What the view shows now, so it is re-uploaded only when that changes.
     shown: Shown,
-    /// Frame pacing for the background work: when this frame started, and the time the
-    /// last frame spent outside our computing (drawing, the browser), smoothed.
-    frame_start_ms: f64,
-    compute_ms: f64,
-    draw_ms: f64,
     /// Whether the last frame asked for the next at once.
     repainting: bool,
 }
-
-/// The background work gets as much time per frame as drawing a frame takes (so the frame rate
-/// at most halves while it runs), within these bounds (ms).
-const GUIDANCE_BUDGET_MS: std::ops::RangeInclusive<f64> = FRAME_BUDGET_MS..=250.0;
 
 /// Where the view's positions come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -96,6 +88,17 @@ impl Shell {
             Backend::Cpu
         };
         let doc = Rc::new(RefCell::new(Document::new(backend)));
+        // The CPU engine runs in workers; without them (a page that cannot start any) it runs
+        // here, blocking frames, rather than not at all.
+        match workers::WebWorkers::start(workers::pool_size(), &cc.egui_ctx) {
+            Ok(w) => {
+                log::info!("CPU engine: {} workers", w.workers());
+                doc.borrow_mut()
+                    .session
+                    .set_cpu_engine(Pool::new(Box::new(w)));
+            }
+            Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
+        }
         let view = cc.wgpu_render_state.as_ref().map(|rs| {
             let mut viewer = Viewer::new(rs);
             viewer.wireframe = page::query_flag("wireframe");
@@ -126,9 +129,6 @@ impl Shell {
             gpu_fallback: None,
             view,
             shown: Shown::default(),
-            frame_start_ms: 0.0,
-            compute_ms: 0.0,
-            draw_ms: 0.0,
             repainting: false,
         }
     }
@@ -490,27 +490,17 @@ impl eframe::App for Shell {
         for action in shortcuts::pressed(&ctx) {
             self.apply(action);
         }
-        let start = now_ms();
-        // Only back-to-back frames tell how long drawing takes (else the page waited for input).
-        if self.frame_start_ms > 0.0 && self.repainting {
-            let other = (start - self.frame_start_ms - self.compute_ms).max(0.0);
-            self.draw_ms = 0.8 * self.draw_ms + 0.2 * other;
-        }
-        self.frame_start_ms = start;
         // A file still opening takes the frame (the model it replaces needs no more work), and
         // so does the one that opens it; uploading it to the GPU takes the next.
         let opening = self.doc.borrow_mut().step_loading();
         let loading = opening != Opening::Idle;
         let uploading = !loading && self.compute();
-        let budget = self
-            .draw_ms
-            .clamp(*GUIDANCE_BUDGET_MS.start(), *GUIDANCE_BUDGET_MS.end());
         if !loading && !uploading {
             let mut doc = self.doc.borrow_mut();
             let vertices = doc.session.model().map_or(0, |m| m.mesh().vertex_count());
             let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
             doc.guidance_on_gpu = offload.is_some();
-            doc.compute_guidance(budget, offload);
+            doc.compute_guidance(offload);
             if let Some(gpu) = self.gpu.as_mut() {
                 gpu.guidance_sent();
             }
@@ -518,7 +508,6 @@ impl eframe::App for Shell {
                 doc.session.guidance_engine_failed(&why);
             }
         }
-        self.compute_ms = now_ms() - start;
         self.bottom.update(&ctx, &mut self.doc.borrow_mut());
         // The view takes up a new model once the engines have (a frame later).
         if opening != Opening::Done && !uploading {

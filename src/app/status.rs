@@ -25,8 +25,6 @@ pub fn progress(ui: &mut egui::Ui, doc: &Document, reading: &[Reading]) {
             220.0,
             format!("reading {:.0}%", 100.0 * fraction),
         );
-    } else if let Some(p) = doc.session.progress() {
-        bar(ui, p.fraction(), 160.0, p.describe());
     } else if doc.busy() || !reading.is_empty() {
         ui.spinner();
     }

@@ -23,7 +23,7 @@ pub const NONE: u32 = u32::MAX;
 
 /// Indexed triangle mesh: positions in the file's units (mm for medical meshes) and
 /// counter-clockwise triangles (seen from outside).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
     pub triangles: Vec<[u32; 3]>,

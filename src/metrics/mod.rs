@@ -15,7 +15,6 @@ mod prism_rows;
 mod report;
 mod roughness;
 mod score;
-mod sinc_drifting;
 #[cfg(target_arch = "x86_64")]
 mod wide;
 
@@ -30,7 +29,6 @@ pub use report::{
 };
 pub use roughness::{roughness, roughness_ratio};
 pub use score::ScoreTerms;
-pub use sinc_drifting::SincDrifting;
 
 // What the GPU engine's measure pass shares with the CPU's.
 pub(crate) use report::{metrics as metrics_from_sums, Sums};

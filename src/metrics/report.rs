@@ -62,7 +62,7 @@ impl Metrics {
 }
 
 /// Per-vertex measures for colour-coding, one entry per vertex of the mesh.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct VertexMeasures {
     /// Local error (mesh units); 0 for vertices no triangle uses.
     pub local_error: Vec<f32>,

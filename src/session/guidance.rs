@@ -3,10 +3,9 @@
 //! smoothness tau (grid or local search), and a gallery of the model smoothed as suggested at
 //! several tau values.
 //!
-//! Every job runs on [`Sliced`](crate::suggest::Sliced) evaluators (the CPU engine: a call to [`Session::step_guidance`]
-//! works for about the budget it is given and the job goes on at the next call) or, when the
-//! caller lends one, on an [`Offload`] (the GPU engine: a run goes to the device and its
-//! measures come back by a later call), so the page never blocks. A job
+//! Every job runs on the CPU engine's workers or, when the caller lends one, on an [`Offload`]
+//! (the GPU engine): a run goes out and its measures come back by a later call to
+//! [`Session::step_guidance`], so the page never blocks. A job
 //! belongs to the model, filter, weights and displacement bound it was started for: when one of
 //! them changes it is dropped (the graphs also when any parameter changes) and its result no
 //! longer shown as current.
@@ -17,6 +16,7 @@ use crate::suggest::{
     EvaluatedGrid, GridSearch, LocalOutcome, LocalSearch, ModelRef, Offload, Progress,
     QualityGraphs, QualitySweep, SearchMethod, Suggestion, Task, TermsMemo,
 };
+use crate::worker::Pool;
 
 /// The tau values of the gallery, from accuracy to smoothness.
 pub const GALLERY_TAUS: [f64; 5] = [0.1, 0.3, 0.5, 0.7, 0.9];
@@ -294,7 +294,7 @@ impl Session {
             key,
             suggested,
             search: None,
-            smoothing: Running::new(()),
+            smoothing: None,
             picks: Vec::new(),
             problem: None,
         });
@@ -379,43 +379,47 @@ impl Session {
         self.guidance.graphs_wanted && self.model.is_some() && !self.graphs_current()
     }
 
-    /// Works on the background jobs for about `budget_ms` on the CPU engine: the suggestion
-    /// first (the user asked and waits), then the gallery, then the graphs. Returns whether a
-    /// job finished.
-    pub fn step_guidance(&mut self, clock: &dyn Fn() -> f64, budget_ms: f64) -> bool {
-        self.step_guidance_on(clock, budget_ms, None)
+    /// Works on the background jobs on the CPU engine's workers: the suggestion first (the
+    /// user asked and waits), then the gallery, then the graphs. Returns whether a job finished.
+    pub fn step_guidance(&mut self, clock: &dyn Fn() -> f64) -> bool {
+        self.step_guidance_on(clock, None)
     }
 
     /// [`Self::step_guidance`] with the smoothing runs of the searches and graphs on `offload`
-    /// when given (the GPU engine): this returns as soon as a run is on the device, and the
-    /// next call collects it. The gallery's final smoothings stay on the CPU.
+    /// when given (the GPU engine). It returns as soon as a job waits for a run, and a later
+    /// call collects it. The gallery's final smoothings stay on the CPU engine.
     pub fn step_guidance_on(
         &mut self,
         clock: &dyn Fn() -> f64,
-        budget_ms: f64,
         mut offload: Option<&mut dyn Offload>,
     ) -> bool {
-        let deadline = clock() + budget_ms;
+        let mut cpu = std::mem::take(&mut self.cpu);
         let mut finished = false;
-        // A task step is at most one smoothing run: on a small mesh many fit in the budget.
-        loop {
+        // A task step asks for at most one run; what the engines already answered goes on
+        // (a bound on the steps keeps a job that never waits from holding the frame).
+        for _ in 0..10_000 {
+            cpu.clear_waiting();
             // Reborrowed for this call only (a `dyn` object's lifetime shortens here, not
             // inside an Option).
             let lent = offload.as_mut().map(|o| &mut **o as &mut dyn Offload);
-            finished |= self.step_guidance_once(clock, deadline - clock(), lent);
-            let waiting = offload.as_deref().is_some_and(|o| o.waiting());
-            if waiting || !self.guidance_busy() || clock() >= deadline {
-                return finished;
+            finished |= self.step_guidance_once(clock, &mut cpu, lent);
+            let waiting = cpu.waiting() || offload.as_deref().is_some_and(|o| o.waiting());
+            if waiting || !self.guidance_busy() {
+                break;
             }
         }
+        if !self.guidance_busy() || offload.is_some() {
+            cpu.clear_guidance();
+        }
+        self.cpu = cpu;
+        finished
     }
 
-    /// One task step within `budget_ms`, with the memo of measured terms for this model,
-    /// weights and engine.
+    /// One task step, with the memo of measured terms for this model, weights and engine.
     fn step_guidance_once(
         &mut self,
         clock: &dyn Fn() -> f64,
-        budget_ms: f64,
+        cpu: &mut Pool,
         offload: Option<&mut dyn Offload>,
     ) -> bool {
         let memo_for = Some((self.model_id, self.weights_version, offload.is_some()));
@@ -424,7 +428,7 @@ impl Session {
             self.guidance.memo_for = memo_for;
         }
         let mut memo = std::mem::take(&mut self.guidance.memo);
-        let finished = self.step_job(clock, budget_ms, offload, &mut memo);
+        let finished = self.step_job(clock, cpu, offload, &mut memo);
         self.guidance.memo = memo;
         finished
     }
@@ -433,7 +437,7 @@ impl Session {
     fn step_job(
         &mut self,
         clock: &dyn Fn() -> f64,
-        budget_ms: f64,
+        cpu: &mut Pool,
         offload: Option<&mut dyn Offload>,
         memo: &mut TermsMemo,
     ) -> bool {
@@ -470,17 +474,14 @@ impl Session {
                 weights_version: self.weights_version,
             },
             clock,
-            budget_ms,
+            cpu,
             offload,
             memo,
         };
         let guidance = &mut self.guidance;
 
         if let Some(job) = guidance.search.as_mut() {
-            let Some((task, mut ev)) = job.running.evaluator(&mut engine) else {
-                guidance.search = None;
-                return false;
-            };
+            let (task, mut ev) = job.running.evaluator(&mut engine);
             let finished = match task {
                 Search::Grid(t) => t.step(&mut ev),
                 Search::Local(t) => t.step(&mut ev),
@@ -547,10 +548,7 @@ impl Session {
         let Some((_, _, running)) = guidance.sweep.as_mut() else {
             return false;
         };
-        let Some((task, mut ev)) = running.evaluator(&mut engine) else {
-            guidance.sweep = None;
-            return false;
-        };
+        let (task, mut ev) = running.evaluator(&mut engine);
         if !task.step(&mut ev) {
             return false;
         }

@@ -7,24 +7,22 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod colors;
-mod cpu_job;
 mod guidance;
 mod loading;
 mod weights;
 
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
-pub use cpu_job::CpuProgress;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use loading::{LoadProgress, Loaded, Loading, OpenFailure};
 pub use weights::WeightsSummary;
-
-use cpu_job::{CpuJob, Pace};
 
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
 use crate::metrics::{Metrics, Original, VertexMeasures};
 use crate::segmentation::Structure;
 use crate::smooth::{Filter, Params};
+use crate::evaluate::ModelRef;
+use crate::worker::{metrics_of, Pool, Reply, SmoothJob};
 use std::sync::Arc;
 
 /// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
@@ -127,9 +125,9 @@ pub struct Session {
     voxel_size: Option<[f64; 3]>,
     revision: u64,
     result: Option<Smoothed>,
-    job: Option<CpuJob>,
-    /// The CPU engine's pace on the open model.
-    cpu_pace: Pace,
+    /// The CPU engine: its workers, and the smoothing of the revision asked of them.
+    cpu: Pool,
+    cpu_job: Option<(u64, SmoothJob)>,
     /// Why the last file could not be opened; cleared by the next successful open.
     error: Option<String>,
     /// Counts the models opened, so background results of another model are told apart.
@@ -155,8 +153,8 @@ impl Default for Session {
             voxel_size: None,
             revision: 0,
             result: None,
-            job: None,
-            cpu_pace: Pace::default(),
+            cpu: Pool::in_thread(1),
+            cpu_job: None,
             error: None,
             model_id: 0,
             weights: None,
@@ -325,7 +323,7 @@ impl Session {
         self.result = None;
         self.changed();
         self.model_id += 1;
-        self.cpu_pace = Pace::default();
+        self.cpu_job = None;
         self.weights = None;
         self.weights_version += 1;
         self.reset_guidance();
@@ -399,49 +397,104 @@ impl Session {
         Ok(())
     }
 
-    /// Smooths and measures the current revision on the CPU engine (the reference) in one go,
-    /// unless its result is already there. `clock` gives milliseconds (the caller's timer:
-    /// wasm32 has no `Instant`); the time each half took comes back.
-    pub fn smooth_cpu(&mut self, clock: &dyn Fn() -> f64) -> Option<Timings> {
-        self.step_cpu(clock, f64::INFINITY)
-    }
-
-    /// Works on the current revision's result for about `budget_ms` (at least one iteration),
-    /// continuing where the last call stopped: a page without threads spreads a long run over
-    /// frames this way. Returns the timings once the result is there (then
-    /// [`Self::result`] has it); [`Self::progress`] tells how far it got meanwhile.
-    pub fn step_cpu(&mut self, clock: &dyn Fn() -> f64, budget_ms: f64) -> Option<Timings> {
-        if !self.needs_smoothing() {
-            return None;
+    /// A session whose CPU engine is `cpu` (the page's workers; by default one on this thread).
+    pub fn with_cpu_engine(cpu: Pool) -> Self {
+        Self {
+            cpu,
+            ..Self::default()
         }
-        let model = self.model.as_ref()?;
-        let mut job = match self.job.take() {
-            Some(job) if job.revision == self.revision => job,
-            _ => CpuJob::new(self.revision, model),
-        };
-        let settings = (
-            &self.params[slot(self.filter)],
-            self.weights.as_deref(),
-            self.tau,
-        );
-        let (result, timings) =
-            match job.step(model, settings, clock, budget_ms, &mut self.cpu_pace) {
-                Some(done) => done,
-                None => {
-                    self.job = Some(job);
-                    return None;
-                }
-            };
-        self.result = Some(result);
-        Some(timings)
     }
 
-    /// How far the CPU engine got with the current revision, while a run is under way.
-    pub fn progress(&self) -> Option<CpuProgress> {
-        self.job
-            .as_ref()
-            .filter(|j| j.revision == self.revision && self.needs_smoothing())
-            .map(|j| j.progress(self.params()))
+    /// Makes `cpu` the CPU engine (the page's workers); a run under way is asked again.
+    pub fn set_cpu_engine(&mut self, cpu: Pool) {
+        self.cpu = cpu;
+        self.cpu_job = None;
+    }
+
+    /// Smooths and measures the current revision on the CPU engine until its result is there
+    /// (at once with workers on this thread); the time each half took comes back.
+    pub fn smooth_cpu(&mut self) -> Option<Timings> {
+        loop {
+            if let Some(timings) = self.compute_cpu() {
+                return Some(timings);
+            }
+            if !self.smoothing_on_cpu() {
+                return None;
+            }
+        }
+    }
+
+    /// The CPU engine's share of a frame: asks the workers for the current revision's result
+    /// unless it is there or asked, and takes it once it came (then [`Self::result`] has it
+    /// and its timings come back). A newer revision supersedes an older one still waiting.
+    pub fn compute_cpu(&mut self) -> Option<Timings> {
+        let mut done = None;
+        if let Some((revision, job)) = self.cpu_job {
+            match self.cpu.take_smoothed(job) {
+                Some(reply) => {
+                    self.cpu_job = None;
+                    done = self.accept_reply(revision, reply);
+                }
+                // Superseded below.
+                None if revision != self.revision => {}
+                None => return None,
+            }
+        }
+        let asked = self.cpu_job.is_some_and(|(r, _)| r == self.revision);
+        if self.needs_smoothing() && !asked {
+            let (params, tau) = (*self.params(), self.tau);
+            if let Some(m) = &self.model {
+                let model = ModelRef {
+                    original: &m.original,
+                    id: self.model_id,
+                    weights: self.weights.as_deref(),
+                    weights_version: self.weights_version,
+                };
+                let job = self.cpu.smooth(&model, &params, tau, true);
+                if let Some((_, old)) = self.cpu_job.replace((self.revision, job)) {
+                    self.cpu.forget(old);
+                }
+            }
+        }
+        done
+    }
+
+    /// Takes a worker's smoothing of `revision`; the timings when it is the current one.
+    fn accept_reply(&mut self, revision: u64, reply: Reply) -> Option<Timings> {
+        match reply {
+            Reply::Smoothed {
+                positions,
+                metrics,
+                vertex,
+                smooth_ms,
+                measure_ms,
+                ..
+            } => {
+                let metrics = match metrics_of(&metrics) {
+                    Ok(m) => m,
+                    Err(why) => {
+                        self.error = Some(why);
+                        return None;
+                    }
+                };
+                self.accept_measured(revision, positions, metrics, vertex)
+                    .then_some(Timings {
+                        smooth_ms,
+                        measure_ms,
+                    })
+            }
+            Reply::Failed { why, .. } => {
+                self.error = Some(format!("The CPU engine failed: {why}"));
+                None
+            }
+            Reply::Terms { .. } => None,
+        }
+    }
+
+    /// Whether the CPU engine is working on the current revision's result.
+    pub fn smoothing_on_cpu(&self) -> bool {
+        self.cpu_job
+            .is_some_and(|(r, job)| r == self.revision && self.cpu.pending(job))
     }
 
     /// Accepts a result measured elsewhere (the GPU engine's smoothing and measure pass) for
@@ -543,6 +596,7 @@ impl Session {
             "params": self.params().to_json(),
             "tau": self.tau,
             "busy": busy,
+            "cpu_engine": self.cpu.to_json(),
             "weights": self.weights_summary(),
             "structures": self.structures().map(Structures::to_json),
             "loading": self.loading().map(|l| serde_json::json!({

@@ -34,7 +34,7 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
     s.set_params_json(&serde_json::json!({"lambda": 0.6, "mu": -0.65, "iterations": 12}))
         .unwrap();
     assert!(s.needs_smoothing());
-    s.smooth_cpu(&|| 0.0);
+    s.smooth_cpu();
     let r = s.result().expect("a result for the current revision");
 
     let model = s.model().unwrap();
@@ -58,7 +58,7 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
 #[test]
 fn every_change_makes_the_result_stale_and_late_results_are_refused() {
     let mut s = sample_session();
-    s.smooth_cpu(&|| 0.0);
+    s.smooth_cpu();
     assert!(!s.needs_smoothing());
     let old = s.revision();
     let r = s.result().unwrap().clone();
@@ -118,7 +118,7 @@ fn exports_carry_the_smoothing_and_read_back() {
     let mut s = sample_session();
     s.set_params_json(&serde_json::json!({"iterations": 5}))
         .unwrap();
-    s.smooth_cpu(&|| 0.0);
+    s.smooth_cpu();
     let r = s.result().unwrap().clone();
     for format in [
         ExportFormat::Ply,
@@ -149,7 +149,7 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     let mut s = sample_session();
     s.set_params_json(&serde_json::json!({"iterations": 0}))
         .unwrap();
-    s.smooth_cpu(&|| 0.0);
+    s.smooth_cpu();
     let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
     assert_eq!(colors.len(), s.model().unwrap().mesh().vertex_count());
     assert!(
@@ -160,7 +160,7 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     s.set_voxel_size(Some([1.0, 1.0, 1.0])).unwrap();
     s.set_params_json(&serde_json::json!({"iterations": 10}))
         .unwrap();
-    s.smooth_cpu(&|| 0.0);
+    s.smooth_cpu();
     let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
     assert!(colors.iter().any(|c| *c != legend.bar[0]));
     assert_eq!(legend.min, 0.0);
@@ -183,86 +183,40 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
 }
 
 #[test]
-fn a_run_spread_over_steps_equals_the_run_in_one_go() {
+fn every_filter_gives_what_the_cli_computes() {
     for filter in ["laplace", "taubin", "hc", "sinc"] {
-        let mut whole = sample_session();
-        whole.set_filter_name(filter).unwrap();
-        whole.smooth_cpu(&|| 0.0);
-
-        let mut steps = sample_session();
-        steps.set_filter_name(filter).unwrap();
-        // A clock that runs 1 ms per reading: a budget of 0 ms means one iteration per call.
-        let t = std::cell::Cell::new(0.0);
-        let clock = || {
-            t.set(t.get() + 1.0);
-            t.get()
-        };
-        // Smoothing one iteration per call (windowed sinc: a term per call, then a drift step
-        // per call), then the measure pass one part per call.
-        let (mut smoothing, mut measuring, mut last_done) = (0, 0, 0);
-        while steps.step_cpu(&clock, 0.0).is_none() {
-            match steps.progress().expect("under way") {
-                CpuProgress::Smoothing { done, total } => {
-                    assert_eq!(measuring, 0, "{filter}: smoothing after measuring");
-                    smoothing += 1;
-                    assert_eq!(total, steps.params().iterations, "{filter}");
-                    if filter == "sinc" {
-                        assert!(
-                            done >= last_done && done <= total,
-                            "{filter}: {done}/{total}"
-                        );
-                        last_done = done;
-                    } else {
-                        assert_eq!(done, smoothing, "{filter}");
-                    }
-                }
-                CpuProgress::Measuring { done, total } => {
-                    measuring += 1;
-                    assert!(done < total, "{filter}: {done}/{total}");
-                }
-            }
-        }
-        let iterations = steps.params().iterations;
-        if filter == "sinc" {
-            // A neighbour pass or a drift step per call: 19 calls for the passes after the
-            // first (which starts the run with the second), then 20 for the drift steps.
-            assert_eq!(smoothing, 2 * iterations - 1, "{filter}");
-        } else {
-            assert_eq!(smoothing, iterations, "{filter}");
-        }
-        // The sample's 2296 vertices are two parts of the measure pass: the first call
-        // measures one, the call that measures the other returns the result.
-        assert_eq!(measuring, 1, "{filter}");
-        assert_eq!(steps.progress(), None);
-        let (a, b) = (whole.result().unwrap(), steps.result().unwrap());
-        assert_eq!(a.positions, b.positions, "{filter}");
-        assert_eq!(a.metrics, b.metrics, "{filter}");
+        let mut s = sample_session();
+        s.set_filter_name(filter).unwrap();
+        let timings = s.smooth_cpu().expect("smoothed");
+        assert!(timings.smooth_ms >= 0.0 && timings.measure_ms >= 0.0);
+        let original = &s.model().unwrap().original;
+        let (positions, reference) = crate::metrics::smooth_drifting(original, s.params(), None);
+        let expected = crate::metrics::measure(original, &positions, &reference, s.tau());
+        let result = s.result().unwrap();
+        assert_eq!(result.positions, positions, "{filter}");
+        assert_eq!(result.metrics, expected, "{filter}");
+        assert!(!s.smoothing_on_cpu());
     }
 }
 
 #[test]
-fn a_change_mid_run_starts_over() {
+fn a_change_while_a_run_is_out_takes_only_the_newer_result() {
     let mut s = sample_session();
-    let clock = || 0.0;
-    assert!(s.step_cpu(&clock, -1.0).is_none());
-    assert_eq!(
-        s.progress(),
-        Some(CpuProgress::Smoothing { done: 1, total: 10 })
-    );
+    assert!(s.compute_cpu().is_none(), "asked, not back yet");
+    assert!(s.smoothing_on_cpu());
     s.set_params_json(&serde_json::json!({"iterations": 4}))
         .unwrap();
-    assert_eq!(s.progress(), None, "the old run is for other parameters");
-    assert!(s.step_cpu(&clock, -1.0).is_none());
-    assert_eq!(
-        s.progress(),
-        Some(CpuProgress::Smoothing { done: 1, total: 4 })
-    );
+    assert!(!s.smoothing_on_cpu(), "the run out is for other parameters");
+    assert!(s.compute_cpu().is_none(), "the old result is refused");
+    assert!(s.result().is_none() && s.last_result().is_none());
+    assert!(s.compute_cpu().is_some());
+    assert_eq!(s.result().unwrap().params.iterations, 4);
 }
 
 #[test]
 fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
     let mut s = sample_session();
-    s.smooth_cpu(&|| 0.0);
+    s.smooth_cpu();
     let r = s.result().unwrap().clone();
     let old = s.revision();
     s.set_params_json(&serde_json::json!({"iterations": 2}))
@@ -359,44 +313,4 @@ fn a_bad_file_opened_in_stages_keeps_the_model_and_a_later_file_replaces_an_earl
     assert_eq!(s.step_loading(&|| 0.0, f64::INFINITY), Some(Ok(())));
     assert_eq!(s.model().unwrap().name, "second.ply");
     assert_eq!(s.error(), None);
-}
-
-#[test]
-fn a_new_run_sizes_its_first_piece_by_the_pace_seen_before() {
-    // A clock that runs 1 ms per reading: an iteration "takes" 1 ms between the readings
-    // around it, and every reading costs a millisecond of the budget.
-    let t = std::cell::Cell::new(0.0);
-    let clock = || {
-        t.set(t.get() + 1.0);
-        t.get()
-    };
-    // The iterations one call of 12 ms gets through.
-    let smoothed_in_one_call = |s: &mut Session| {
-        assert!(s.step_cpu(&clock, 12.0).is_none(), "not done in one call");
-        match s.progress() {
-            Some(CpuProgress::Smoothing { done, .. }) => done,
-            Some(CpuProgress::Measuring { .. }) => s.params().iterations,
-            None => panic!("no run under way"),
-        }
-    };
-    let mut s = sample_session();
-    s.set_params_json(&serde_json::json!({"iterations": 40}))
-        .unwrap();
-    // Without a pace the first piece is one iteration; the readings around each piece then
-    // leave room for few more.
-    let blind = smoothed_in_one_call(&mut s);
-    // A new run (other parameters) on the same model starts with the pace of the last one.
-    s.set_params_json(&serde_json::json!({"iterations": 39}))
-        .unwrap();
-    let paced = smoothed_in_one_call(&mut s);
-    assert!(
-        blind < 10,
-        "{blind} of 40 iterations in one call without a pace"
-    );
-    assert!(paced >= 2 * blind, "{paced} with the pace, {blind} without");
-    // Another model starts blind again.
-    s.open("bent_tube_staircase.ply", SAMPLE).unwrap();
-    s.set_params_json(&serde_json::json!({"iterations": 40}))
-        .unwrap();
-    assert_eq!(smoothed_in_one_call(&mut s), blind);
 }

@@ -17,11 +17,9 @@ mod params;
 mod rings;
 mod sinc;
 mod sinc_coefficients;
-mod sinc_parts;
 mod umbrella;
 
 pub use params::{shortest, Filter, ParamError, Params};
-pub use sinc_parts::SincInParts;
 // The GPU engine evaluates the same windowed-sinc series.
 pub(crate) use sinc_coefficients::sinc_coefficients;
 
@@ -264,92 +262,9 @@ impl Advance<'_> {
                 constraint,
                 observer,
             ),
-            // Not resumable: `run` and `SincInParts` take it whole.
+            // Not resumable: `run` takes it whole.
             Filter::Sinc => false,
         }
-    }
-}
-
-/// A Laplace, Taubin or HC run spread over calls that keeps its buffers laid out for the
-/// kernels between them: a call costs its iterations and little more, where each [`resume`]
-/// lays the positions out, makes its buffers again and lays the result out (the web app's
-/// CPU engine runs a few iterations per frame). Its results are [`smooth`]'s, bit for bit.
-pub struct RunInParts {
-    params: Params,
-    done: u32,
-    fields: Fields,
-    /// The positions after `points_at` iterations, laid out for the caller (`None`: nothing
-    /// laid out yet).
-    points: Vec<[f32; 3]>,
-    points_at: Option<u32>,
-}
-
-impl RunInParts {
-    /// A run of `params` from `mesh`'s positions; `None` for windowed sinc, whose terms are not
-    /// shorter runs' results ([`SincInParts`] spreads it).
-    pub fn new(mesh: &Mesh, params: &Params) -> Option<Self> {
-        (params.filter != Filter::Sinc).then(|| Self {
-            params: *params,
-            done: 0,
-            fields: Fields::from_points(&mesh.positions),
-            points: Vec::new(),
-            points_at: None,
-        })
-    }
-
-    /// Iterations done so far.
-    pub fn done(&self) -> u32 {
-        self.done
-    }
-
-    /// Runs up to `more` further iterations (no further than the parameters' count), the
-    /// observer seeing them as in [`smooth`]; whether the run is complete. `mesh` and
-    /// `topology` must be the run's; if they do not fit it, nothing moves and the run is
-    /// complete.
-    pub fn advance(
-        &mut self,
-        mesh: &Mesh,
-        topology: &Topology,
-        weights: Option<&[f32]>,
-        more: u32,
-        observer: &mut dyn StepObserver,
-    ) -> bool {
-        let more = more.min(self.params.iterations.saturating_sub(self.done));
-        let n = self.fields.q.vertices().len();
-        let rings = Rings::new(topology, n).filter(|_| mesh.vertex_count() == n);
-        match rings {
-            Some(rings) if more > 0 => {
-                let step = Advance {
-                    rings,
-                    original: &mesh.positions,
-                    params: &self.params,
-                    weights,
-                };
-                let counts = (self.done, more);
-                if step.advance(&mut self.fields, &mut self.points, counts, observer) {
-                    self.points_at = Some(self.done + more);
-                }
-                self.done += more;
-            }
-            Some(_) => {}
-            None => self.done = self.params.iterations,
-        }
-        self.done >= self.params.iterations
-    }
-
-    /// The positions after the iterations done so far.
-    pub fn positions(&mut self) -> &[[f32; 3]] {
-        if self.points_at != Some(self.done) {
-            self.fields.q.write_points(&mut self.points);
-            self.points_at = Some(self.done);
-        }
-        &self.points
-    }
-
-    /// The positions after the iterations done so far, taken.
-    pub fn into_positions(mut self) -> Vec<[f32; 3]> {
-        self.positions();
-        self.points
     }
 }
 
@@ -383,35 +298,6 @@ mod tests {
         (mesh, topology, weights)
     }
 
-    #[test]
-    fn windowed_sinc_in_parts_equals_the_whole_run() {
-        let (mesh, topology, weights) = sample_with_weights();
-        let mut p = Params::defaults(Filter::Sinc);
-        for (iterations, bound, w) in [(20, None, None), (7, Some(0.4), Some(&weights[..]))] {
-            p.iterations = iterations;
-            p.max_displacement = bound;
-            let expected = smooth(&mesh, &topology, &p, w, &mut NoObserver);
-            for more in [1, 3, u32::MAX] {
-                let mut parts = SincInParts::new(&mesh, &topology, &p).expect("sinc");
-                assert_eq!(parts.progress(), (1, iterations));
-                let mut calls = 0;
-                while !parts.advance(&mesh, &topology, more) {
-                    calls += 1;
-                    assert!(parts.progress().0 < iterations);
-                }
-                assert_eq!(calls, (iterations - 1).div_ceil(more.min(iterations)) - 1);
-                assert_eq!(parts.progress(), (iterations, iterations));
-                let got = parts.finish(&mesh, &p, w);
-                assert_eq!(got, expected, "{iterations} iterations, {more} per call");
-            }
-        }
-        p.iterations = 0;
-        let nothing = SincInParts::new(&mesh, &topology, &p).expect("sinc");
-        assert_eq!(nothing.finish(&mesh, &p, None), mesh.positions);
-        let laplace = Params::defaults(Filter::Laplace);
-        assert!(SincInParts::new(&mesh, &topology, &laplace).is_none());
-    }
-
     /// Seven iterations of `filter`'s defaults with a bound and `weights`: the parameters,
     /// the steps the observer saw, the result.
     fn seven_bounded(
@@ -426,40 +312,6 @@ mod tests {
         let mut whole = Steps::default();
         let expected = smooth(mesh, topology, &p, Some(weights), &mut whole);
         (p, whole, expected)
-    }
-
-    #[test]
-    fn a_run_in_parts_equals_the_whole_run() {
-        let (mesh, topology, weights) = sample_with_weights();
-        for filter in [Filter::Laplace, Filter::Taubin, Filter::Hc] {
-            let (p, whole, expected) = seven_bounded(filter, &mesh, &topology, &weights);
-            let mut shorter = p;
-            shorter.iterations = 5;
-            let after_five = smooth(&mesh, &topology, &shorter, Some(&weights), &mut NoObserver);
-
-            let mut run = RunInParts::new(&mesh, &p).expect("not sinc");
-            assert_eq!(run.positions(), &mesh.positions[..]);
-            let mut parts = Steps::default();
-            // One, none, four (the observer watching), then past the end.
-            assert!(!run.advance(&mesh, &topology, Some(&weights), 1, &mut NoObserver));
-            assert!(!run.advance(&mesh, &topology, Some(&weights), 0, &mut NoObserver));
-            assert!(!run.advance(&mesh, &topology, Some(&weights), 4, &mut parts));
-            assert_eq!(run.done(), 5);
-            assert_eq!(run.positions(), &after_five[..], "{filter}");
-            assert!(run.advance(&mesh, &topology, Some(&weights), 9, &mut parts));
-            assert_eq!(run.done(), 7);
-            assert_eq!(parts.1, (2..=7).collect::<Vec<_>>(), "{filter}");
-            let steps = whole.0.len() / 7;
-            assert_eq!(parts.0, whole.0[steps..], "{filter}: the same steps");
-            assert_eq!(run.into_positions(), expected, "{filter}");
-        }
-        assert!(RunInParts::new(&mesh, &Params::defaults(Filter::Sinc)).is_none());
-        // Another mesh's topology: nothing moves, and the run is over.
-        let p = Params::defaults(Filter::Hc);
-        let other = Topology::build(&crate::mesh::fixtures::double_cone(5));
-        let mut run = RunInParts::new(&mesh, &p).expect("not sinc");
-        assert!(run.advance(&mesh, &other, None, 1, &mut NoObserver));
-        assert_eq!(run.into_positions(), mesh.positions);
     }
 
     #[test]

@@ -148,11 +148,6 @@ impl Terms {
         self.k == last
     }
 
-    /// `(terms summed, terms)`, counting the first two as one neighbour pass.
-    pub(crate) fn progress(&self) -> (u32, u32) {
-        (self.k as u32, (self.c.len() - 1) as u32)
-    }
-
     /// The estimate through the weights and the bound, once every term is summed.
     pub(crate) fn finish<C: Constrain>(
         self,

@@ -17,7 +17,6 @@ mod memo;
 mod mesh_evaluator;
 mod points;
 mod run_states;
-mod sliced;
 mod space;
 mod sweep;
 
@@ -30,7 +29,6 @@ pub use grid::{EvaluatedGrid, GridSearch};
 pub use local::{LocalOutcome, LocalSearch};
 pub use memo::{Memoized, TermsMemo};
 pub use mesh_evaluator::{check_weights, MeshEvaluator, WeightsError};
-pub use sliced::{Sliced, SlicedRuns};
 pub use space::{Axis, GridPoint, Param, ParamSpace};
 pub use sweep::{Curve, QualityGraphs, QualitySweep, Sample};
 

@@ -2,9 +2,10 @@
 //! an evaluated grid's answers), then the model smoothed and measured with each.
 
 use super::{Engine, Running, SearchKey, GALLERY_TAUS};
-use crate::metrics::{self, VertexMeasures};
+use crate::metrics::VertexMeasures;
 use crate::smooth::Params;
-use crate::suggest::{LocalSearch, Sliced, Task, Terms};
+use crate::suggest::{LocalSearch, Task, Terms};
+use crate::worker::{metrics_of, Reply, SmoothJob};
 
 /// The model smoothed as suggested for one tau, with its measures.
 #[derive(Clone, Debug)]
@@ -24,7 +25,8 @@ pub(super) struct GalleryJob {
     /// Suggested parameters and terms, in [`GALLERY_TAUS`] order, as they are found.
     pub(super) suggested: Vec<(Params, Terms)>,
     pub(super) search: Option<Running<LocalSearch>>,
-    pub(super) smoothing: Running<()>,
+    /// The next pick's smoothing, asked of the CPU engine's workers.
+    pub(super) smoothing: Option<SmoothJob>,
     pub(super) picks: Vec<GalleryPick>,
     pub(super) problem: Option<String>,
 }
@@ -53,9 +55,7 @@ pub(super) fn step_gallery(job: &mut GalleryJob, engine: &mut Engine<'_, '_>) ->
         let Some(running) = job.search.as_mut() else {
             return true;
         };
-        let Some((task, mut ev)) = running.evaluator(engine) else {
-            return true;
-        };
+        let (task, mut ev) = running.evaluator(engine);
         if task.step(&mut ev) {
             if let Some(outcome) = job.search.take().and_then(|r| r.task.into_output()) {
                 let s = outcome.suggestion;
@@ -71,28 +71,45 @@ pub(super) fn step_gallery(job: &mut GalleryJob, engine: &mut Engine<'_, '_>) ->
         return true;
     };
     let tau = GALLERY_TAUS[job.picks.len()];
-    // The pick's positions and per-vertex measures are wanted here: a CPU run, sliced.
-    let original = engine.model.original;
-    let Ok(mut ev) = Sliced::new(
-        original,
-        engine.model.weights,
-        &mut job.smoothing.runs,
-        engine.clock,
-        engine.budget_ms,
-    ) else {
-        return true;
+    // The pick's positions and per-vertex measures are wanted here: a run on the CPU engine.
+    let asked = match job.smoothing {
+        Some(asked) => asked,
+        None => {
+            let asked = engine.cpu.smooth(&engine.model, &params, tau, false);
+            job.smoothing = Some(asked);
+            asked
+        }
     };
-    let Some((positions, reference)) = ev.smoothed(&params) else {
+    let Some(reply) = engine.cpu.take_smoothed(asked) else {
         return false;
     };
-    let (measured, vertex) = metrics::measure_vertices(original, &positions, &reference, tau);
+    job.smoothing = None;
+    let (positions, metrics, vertex) = match reply {
+        Reply::Smoothed {
+            positions,
+            metrics,
+            vertex,
+            ..
+        } => match metrics_of(&metrics) {
+            Ok(m) => (positions, m, vertex),
+            Err(why) => return gave_up(job, why),
+        },
+        Reply::Failed { why, .. } => return gave_up(job, why),
+        Reply::Terms { .. } => return gave_up(job, "a terms reply to a smoothing".into()),
+    };
     job.picks.push(GalleryPick {
         tau,
         params,
         terms,
-        volume_change: measured.volume_change,
+        volume_change: metrics.volume_change,
         positions,
         vertex,
     });
     job.picks.len() == n
+}
+
+/// Ends the gallery with what it has, saying why.
+fn gave_up(job: &mut GalleryJob, why: String) -> bool {
+    job.problem = Some(format!("No gallery: {why}"));
+    true
 }

@@ -28,7 +28,7 @@ fn settle_on(s: &mut Session, mut offload: Option<&mut dyn Offload>) -> usize {
     let mut calls = 0;
     while s.guidance_busy() {
         let lent = offload.as_mut().map(|o| &mut **o as &mut dyn Offload);
-        s.step_guidance_on(&clock, 20.0, lent);
+        s.step_guidance_on(&clock, lent);
         calls += 1;
         assert!(calls < 1_000_000, "the background never settles");
     }
@@ -40,8 +40,7 @@ fn a_loaded_model_gets_the_local_search_suggestion() {
     let mut s = Session::default();
     s.open("sample.ply", SAMPLE).unwrap();
     assert!(s.suggesting(), "a search starts with the model");
-    let calls = settle(&mut s);
-    assert!(calls > 10, "spread over {calls} calls");
+    settle(&mut s);
     let got = s.suggestion().expect("a suggestion").suggestion;
     assert_eq!(got, local_suggestion(&s.model().unwrap().original, &s));
 }
@@ -156,10 +155,9 @@ fn a_search_for_another_filter_or_model_is_dropped() {
         ticks.get()
     };
     s.start_suggest(SearchMethod::Local);
-    s.step_guidance(&clock, 1.0);
     assert!(s.suggesting());
     s.set_filter_name("sinc").unwrap();
-    s.step_guidance(&clock, 1.0);
+    s.step_guidance(&clock);
     assert!(!s.suggesting());
     s.set_filter_name("hc").unwrap();
     s.start_gallery();

@@ -1,0 +1,156 @@
+//! The page's engine workers: dedicated module workers (`web/worker.js`), each running this
+//! very wasm, which answer the CPU engine's requests ([`crate::worker`]) in messages with
+//! transferred buffers. No SharedArrayBuffer, so no cross-origin isolation is needed and the
+//! page works inside any iframe. Replies land in an inbox the frame drains, and wake egui.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use eframe::egui;
+use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsCast;
+
+use crate::worker::{decode, encode, Carrier, Reply, Request};
+
+type Inbox = Rc<RefCell<Vec<(usize, Reply)>>>;
+
+/// The workers, with the message handlers that must live as long as they do.
+pub struct WebWorkers {
+    workers: Vec<web_sys::Worker>,
+    inbox: Inbox,
+    _handlers: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
+}
+
+/// How many workers to start: one per core, leaving a core to the page, at least one; the
+/// page's `?workers=N` overrides it (benchmarks compare pool sizes).
+pub fn pool_size() -> usize {
+    let asked = super::query::param("workers").and_then(|n| n.parse::<usize>().ok());
+    let cores = web_sys::window().map_or(1.0, |w| w.navigator().hardware_concurrency());
+    asked
+        .unwrap_or((cores as usize).saturating_sub(1))
+        .clamp(1, 16)
+}
+
+impl WebWorkers {
+    pub fn workers(&self) -> usize {
+        self.workers.len()
+    }
+
+    /// Starts `count` workers on the page's own wasm, waking `ctx` when a reply comes.
+    pub fn start(count: usize, ctx: &egui::Context) -> Result<Self, String> {
+        let (glue, wasm) = own_module_urls()?;
+        let inbox: Inbox = Rc::default();
+        let mut workers = Vec::new();
+        let mut handlers = Vec::new();
+        for index in 0..count.max(1) {
+            let options = web_sys::WorkerOptions::new();
+            options.set_type(web_sys::WorkerType::Module);
+            options.set_name(&format!("meshsmooth engine {}", index + 1));
+            let worker = web_sys::Worker::new_with_options("worker.js", &options).map_err(|e| {
+                format!("cannot start a worker: {}", super::page::js_error_text(&e))
+            })?;
+            let handler = reply_handler(index, inbox.clone(), ctx.clone());
+            worker.set_onmessage(Some(handler.as_ref().unchecked_ref()));
+            let start = js_sys::Object::new();
+            let set = |k: &str, v: &str| js_sys::Reflect::set(&start, &k.into(), &v.into());
+            set("glue", &glue).and_then(|_| set("wasm", &wasm)).ok();
+            worker.post_message(&start).map_err(|e| {
+                format!("cannot start a worker: {}", super::page::js_error_text(&e))
+            })?;
+            workers.push(worker);
+            handlers.push(handler);
+        }
+        Ok(Self {
+            workers,
+            inbox,
+            _handlers: handlers,
+        })
+    }
+}
+
+/// The handler of worker `index`'s messages: a reply's bytes, or why the worker failed.
+fn reply_handler(
+    index: usize,
+    inbox: Inbox,
+    ctx: egui::Context,
+) -> Closure<dyn FnMut(web_sys::MessageEvent)> {
+    Closure::new(move |event: web_sys::MessageEvent| {
+        let data = event.data();
+        if let Some(buffer) = data.dyn_ref::<js_sys::ArrayBuffer>() {
+            let bytes = js_sys::Uint8Array::new(buffer).to_vec();
+            match decode::<Reply>(&bytes) {
+                Ok(reply) => inbox.borrow_mut().push((index, reply)),
+                Err(why) => log::error!("engine worker {}: {why}", index + 1),
+            }
+        } else {
+            let why = js_sys::JSON::stringify(&data).map_or_else(|_| "?".into(), String::from);
+            log::error!("engine worker {} failed: {why}", index + 1);
+        }
+        ctx.request_repaint();
+    })
+}
+
+/// The URLs of the page's wasm-bindgen glue and wasm, as the build linked them (hashed names).
+fn own_module_urls() -> Result<(String, String), String> {
+    let document = web_sys::window()
+        .and_then(|w| w.document())
+        .ok_or("no document")?;
+    let href = |selector: &str| {
+        document
+            .query_selector(selector)
+            .ok()
+            .flatten()
+            .and_then(|e| e.get_attribute("href"))
+            .and_then(|h| web_sys::Url::new_with_base(&h, &document.base_uri().ok()??).ok())
+            .map(|u| u.href())
+    };
+    let glue = href("link[rel=modulepreload][href$='.js']");
+    let wasm = href("link[rel=preload][href$='.wasm']");
+    glue.zip(wasm)
+        .ok_or_else(|| "the page does not name its wasm module".to_string())
+}
+
+impl Carrier for WebWorkers {
+    fn workers(&self) -> usize {
+        self.workers.len()
+    }
+
+    fn post(&mut self, worker: usize, request: &Request) {
+        let bytes = js_sys::Uint8Array::from(encode(request).as_slice());
+        let buffer = bytes.buffer();
+        let transfer = js_sys::Array::of1(&buffer);
+        if let Err(e) = self.workers[worker].post_message_with_transfer(&buffer, &transfer) {
+            log::error!(
+                "engine worker {}: {}",
+                worker + 1,
+                super::page::js_error_text(&e)
+            );
+        }
+    }
+
+    fn take_replies(&mut self) -> Vec<(usize, Reply)> {
+        std::mem::take(&mut self.inbox.borrow_mut())
+    }
+
+    fn threaded(&self) -> bool {
+        true
+    }
+}
+
+thread_local! {
+    /// The engine state of this worker (in a worker's wasm instance).
+    static ENGINE: RefCell<crate::worker::Worker> = RefCell::default();
+}
+
+/// Called by `web/worker.js` with each request's bytes: the reply's bytes, if any.
+#[wasm_bindgen]
+pub fn worker_handle(request: &[u8]) -> Option<Vec<u8>> {
+    let reply = match decode::<Request>(request) {
+        Ok(request) => ENGINE.with(|e| e.borrow_mut().handle(request, &crate::worker::clock_ms)),
+        Err(why) => {
+            log::error!("{why}");
+            None
+        }
+    };
+    reply.map(|r| encode(&r))
+}

@@ -1,0 +1,191 @@
+//! What one of the page's engine workers does: the CPU engine's jobs as plain blocking calls, the
+//! very calls the CLI makes, asked and answered in messages. Free of any web API: the page's
+//! workers (`app::workers`) carry the bytes, the native tests hand them to [`Worker::handle`]
+//! on their own thread ([`InThread`]). [`Pool`] keeps the queue on the asking side.
+
+mod pool;
+
+pub use pool::{Carrier, InThread, Pool, SmoothJob};
+
+use serde::{Deserialize, Serialize};
+
+use crate::mesh::{Mesh, Topology};
+use crate::metrics::{self, Metrics, Original, VertexMeasures};
+use crate::smooth::Params;
+use crate::suggest::MeshEvaluator;
+use crate::evaluate::{Evaluator, Terms};
+
+/// A message to a worker.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub enum Request {
+    /// Hold `mesh` as model `model` (its topology and the original's measures are built here),
+    /// dropping any other.
+    Open { model: u64, mesh: Mesh },
+    /// The per-vertex weights of `model` from now on (`None`: all 1), known as `version`.
+    Weights {
+        model: u64,
+        version: u64,
+        weights: Option<Vec<f32>>,
+    },
+    /// Smooth the model with `params` and measure the result at `tau`.
+    Smooth { job: u64, params: Params, tau: f64 },
+    /// The terms of `params` after each count of `at` ([`Evaluator::measure`]).
+    Terms {
+        job: u64,
+        params: Params,
+        at: Vec<u32>,
+    },
+}
+
+/// A worker's answer to [`Request::Smooth`] or [`Request::Terms`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub enum Reply {
+    Smoothed {
+        job: u64,
+        positions: Vec<[f32; 3]>,
+        /// [`Metrics`] as JSON: its optional exact-error fields are left out when absent,
+        /// which a binary format cannot express.
+        metrics: String,
+        vertex: VertexMeasures,
+        /// Milliseconds the smoothing (with the drifting reference) and the measures took.
+        smooth_ms: f64,
+        measure_ms: f64,
+    },
+    Terms {
+        job: u64,
+        terms: Vec<Terms>,
+        ms: f64,
+    },
+    /// The job could not be done (no model, weights of another length).
+    Failed { job: u64, why: String },
+}
+
+impl Reply {
+    /// The job this answers.
+    pub fn job(&self) -> u64 {
+        match self {
+            Reply::Smoothed { job, .. } | Reply::Terms { job, .. } | Reply::Failed { job, .. } => {
+                *job
+            }
+        }
+    }
+}
+
+/// Encodes a message for the wire.
+pub fn encode<T: Serialize>(message: &T) -> Vec<u8> {
+    postcard::to_allocvec(message).expect("postcard serializes every message type here")
+}
+
+/// Decodes a message from the wire.
+pub fn decode<'a, T: Deserialize<'a>>(bytes: &'a [u8]) -> Result<T, String> {
+    postcard::from_bytes(bytes).map_err(|e| format!("a worker message did not decode: {e}"))
+}
+
+/// The model a worker holds, with its weights.
+struct Held {
+    id: u64,
+    original: Original,
+    weights: Option<Vec<f32>>,
+}
+
+/// A worker's state: the model it holds. Requests come one at a time and each is done whole.
+#[derive(Default)]
+pub struct Worker {
+    held: Option<Held>,
+}
+
+impl Worker {
+    /// Does `request`; `clock` gives milliseconds. Open and Weights answer nothing.
+    pub fn handle(&mut self, request: Request, clock: &dyn Fn() -> f64) -> Option<Reply> {
+        match request {
+            Request::Open { model, mesh } => {
+                let topology = Topology::build(&mesh);
+                self.held = Some(Held {
+                    id: model,
+                    original: Original::new(&mesh, &topology),
+                    weights: None,
+                });
+                None
+            }
+            Request::Weights { model, weights, .. } => {
+                if let Some(held) = self.held.as_mut().filter(|h| h.id == model) {
+                    held.weights = weights;
+                }
+                None
+            }
+            Request::Smooth { job, params, tau } => Some(self.smooth(job, &params, tau, clock)),
+            Request::Terms { job, params, at } => Some(self.terms(job, &params, &at, clock)),
+        }
+    }
+
+    fn smooth(&self, job: u64, params: &Params, tau: f64, clock: &dyn Fn() -> f64) -> Reply {
+        let Some(held) = &self.held else {
+            return no_model(job);
+        };
+        let start = clock();
+        let (positions, reference) =
+            metrics::smooth_drifting(&held.original, params, held.weights.as_deref());
+        let smoothed = clock();
+        let (measured, vertex) =
+            metrics::measure_vertices(&held.original, &positions, &reference, tau);
+        let measure_ms = clock() - smoothed;
+        Reply::Smoothed {
+            job,
+            positions,
+            metrics: serde_json::to_string(&measured).unwrap_or_default(),
+            vertex,
+            smooth_ms: smoothed - start,
+            measure_ms,
+        }
+    }
+
+    fn terms(&self, job: u64, params: &Params, at: &[u32], clock: &dyn Fn() -> f64) -> Reply {
+        let Some(held) = &self.held else {
+            return no_model(job);
+        };
+        let start = clock();
+        match MeshEvaluator::new(&held.original, held.weights.as_deref()) {
+            Ok(mut evaluator) => Reply::Terms {
+                job,
+                terms: evaluator.measure(params, at).unwrap_or_default(),
+                ms: clock() - start,
+            },
+            Err(e) => Reply::Failed {
+                job,
+                why: e.to_string(),
+            },
+        }
+    }
+}
+
+fn no_model(job: u64) -> Reply {
+    Reply::Failed {
+        job,
+        why: "the worker holds no model".to_string(),
+    }
+}
+
+/// Milliseconds from a fixed moment, for the timings the replies carry.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn clock_ms() -> f64 {
+    static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+    START
+        .get_or_init(std::time::Instant::now)
+        .elapsed()
+        .as_secs_f64()
+        * 1000.0
+}
+
+/// Milliseconds from a fixed moment (wasm32 has no `Instant`; this works in workers too).
+#[cfg(target_arch = "wasm32")]
+pub fn clock_ms() -> f64 {
+    js_sys::Date::now()
+}
+
+/// [`Reply::Smoothed`]'s metrics back from JSON.
+pub fn metrics_of(json: &str) -> Result<Metrics, String> {
+    serde_json::from_str(json).map_err(|e| format!("a worker's measures did not decode: {e}"))
+}
+
+#[cfg(test)]
+mod tests;

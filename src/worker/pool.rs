@@ -1,0 +1,381 @@
+//! The asking side of the engine workers: the queue, which worker does what, and the answers.
+//! Jobs are handed out one per worker at a time, so a job that a newer one supersedes while it
+//! waits is simply never handed out; a worker is never interrupted. The model and weights go to
+//! every worker once (each holds the model), so a search's parameter sets spread over the pool.
+
+use std::collections::{HashMap, VecDeque};
+
+use super::{Reply, Request, Worker};
+use crate::smooth::Params;
+use crate::evaluate::{failed_terms, ModelRef, Offload, Request as TermsRequest, Terms};
+
+/// Carries requests to workers and brings their replies back.
+pub trait Carrier {
+    /// How many workers there are (at least one).
+    fn workers(&self) -> usize;
+    /// Sends `request` to worker `worker` (they do their requests in order).
+    fn post(&mut self, worker: usize, request: &Request);
+    /// The replies that arrived since the last call, with the worker each came from.
+    fn take_replies(&mut self) -> Vec<(usize, Reply)>;
+    /// Whether the workers run on other threads (else each request blocks its caller).
+    fn threaded(&self) -> bool;
+}
+
+/// Workers on the calling thread: each request is done as it is posted. The native tests and
+/// the CLI-like callers use it; the page has real workers.
+pub struct InThread {
+    workers: Vec<Worker>,
+    replies: Vec<(usize, Reply)>,
+}
+
+impl InThread {
+    pub fn new(workers: usize) -> Self {
+        Self {
+            workers: (0..workers.max(1)).map(|_| Worker::default()).collect(),
+            replies: Vec::new(),
+        }
+    }
+}
+
+impl Carrier for InThread {
+    fn workers(&self) -> usize {
+        self.workers.len()
+    }
+
+    fn post(&mut self, worker: usize, request: &Request) {
+        // Through the wire format, as the page's messages go.
+        let Ok(request) = super::decode::<Request>(&super::encode(request)) else {
+            return;
+        };
+        if let Some(reply) = self.workers[worker].handle(request, &super::clock_ms) {
+            self.replies.push((worker, reply));
+        }
+    }
+
+    fn take_replies(&mut self) -> Vec<(usize, Reply)> {
+        std::mem::take(&mut self.replies)
+    }
+
+    fn threaded(&self) -> bool {
+        false
+    }
+}
+
+/// A smoothing job: the model smoothed and measured (the view's result, a gallery pick).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SmoothJob(u64);
+
+/// A terms request as a key: the model, its weights and the request's encoding.
+type TermsKey = (u64, u64, Vec<u8>);
+
+struct QueuedSmooth {
+    job: u64,
+    params: Params,
+    tau: f64,
+    /// Dropped from the queue by the next superseding job.
+    supersedable: bool,
+}
+
+/// What a worker is doing.
+enum Flight {
+    Smooth,
+    Terms(TermsKey),
+}
+
+/// The engine workers seen from the page: a queue of smoothing jobs (first) and the guidance's
+/// terms requests (the one asked, then the ones it said come next), handed out to idle workers.
+pub struct Pool {
+    carrier: Box<dyn Carrier>,
+    /// The job each worker is doing.
+    busy: Vec<Option<u64>>,
+    /// The model and weights version every worker was sent.
+    sent: Option<(u64, u64)>,
+    next_job: u64,
+    smooths: VecDeque<QueuedSmooth>,
+    /// The terms request asked last and those to come, in order.
+    asked: Option<TermsKey>,
+    upcoming: Vec<TermsKey>,
+    in_flight: HashMap<u64, Flight>,
+    smoothed: HashMap<u64, Reply>,
+    terms: HashMap<TermsKey, Result<Vec<Terms>, String>>,
+    /// Whether the last terms request was not answered yet.
+    waiting: bool,
+    failure: Option<String>,
+}
+
+/// One worker on this thread.
+impl Default for Pool {
+    fn default() -> Self {
+        Self::in_thread(1)
+    }
+}
+
+impl Pool {
+    pub fn new(carrier: Box<dyn Carrier>) -> Self {
+        let workers = carrier.workers().max(1);
+        Self {
+            carrier,
+            busy: vec![None; workers],
+            sent: None,
+            next_job: 0,
+            smooths: VecDeque::new(),
+            asked: None,
+            upcoming: Vec::new(),
+            in_flight: HashMap::new(),
+            smoothed: HashMap::new(),
+            terms: HashMap::new(),
+            waiting: false,
+            failure: None,
+        }
+    }
+
+    /// A pool of `workers` on this thread.
+    pub fn in_thread(workers: usize) -> Self {
+        Self::new(Box::new(InThread::new(workers)))
+    }
+
+    pub fn workers(&self) -> usize {
+        self.busy.len()
+    }
+
+    /// What `state()` says of the CPU engine: its workers and whether they are threads.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({ "workers": self.workers(), "threaded": self.carrier.threaded() })
+    }
+
+    /// Whether any worker is doing something or anything waits to be handed out.
+    pub fn busy(&self) -> bool {
+        self.busy.iter().any(Option::is_some) || !self.smooths.is_empty()
+    }
+
+    /// Queues smoothing `model` with `params` and measuring the result at `tau`. A
+    /// `supersedable` job replaces the supersedable ones still waiting (the view's result for
+    /// older parameters).
+    pub fn smooth(
+        &mut self,
+        model: &ModelRef<'_>,
+        params: &Params,
+        tau: f64,
+        supersedable: bool,
+    ) -> SmoothJob {
+        self.sync(model);
+        if supersedable {
+            self.smooths.retain(|s| !s.supersedable);
+        }
+        let job = self.new_job();
+        self.smooths.push_back(QueuedSmooth {
+            job,
+            params: *params,
+            tau,
+            supersedable,
+        });
+        self.pump();
+        SmoothJob(job)
+    }
+
+    /// The reply to `job` once it is there ([`Reply::Smoothed`] or [`Reply::Failed`]).
+    pub fn take_smoothed(&mut self, job: SmoothJob) -> Option<Reply> {
+        self.pump();
+        let reply = self.smoothed.remove(&job.0);
+        self.waiting = reply.is_none();
+        reply
+    }
+
+    /// Whether the last answer asked of the pool (terms or a smoothing) is still to come.
+    pub fn waiting(&self) -> bool {
+        self.waiting
+    }
+
+    /// Whether `job` is waiting, under way, or answered and not taken yet.
+    pub fn pending(&self, job: SmoothJob) -> bool {
+        self.smooths.iter().any(|s| s.job == job.0)
+            || self.in_flight.contains_key(&job.0)
+            || self.smoothed.contains_key(&job.0)
+    }
+
+    /// Stops waiting for `job` (its reply, should it come, is dropped).
+    pub fn forget(&mut self, job: SmoothJob) {
+        self.smooths.retain(|s| s.job != job.0);
+        self.in_flight.remove(&job.0);
+        self.smoothed.remove(&job.0);
+    }
+
+    /// Forgets that an answer is awaited (a caller about to ask again).
+    pub fn clear_waiting(&mut self) {
+        self.waiting = false;
+    }
+
+    /// Forgets the terms requests asked and to come: the guidance has no job.
+    pub fn clear_guidance(&mut self) {
+        self.asked = None;
+        self.upcoming.clear();
+        self.waiting = false;
+    }
+
+    fn new_job(&mut self) -> u64 {
+        self.next_job += 1;
+        self.next_job
+    }
+
+    /// Sends the model and weights to every worker when they are not the ones sent last.
+    fn sync(&mut self, model: &ModelRef<'_>) {
+        let want = (model.id, model.weights_version);
+        if self.sent == Some(want) {
+            return;
+        }
+        if self.sent.map(|s| s.0) != Some(model.id) {
+            let open = Request::Open {
+                model: model.id,
+                mesh: model.original.mesh().clone(),
+            };
+            self.broadcast(&open);
+            // Whatever waits is for another model.
+            self.smooths.clear();
+            self.in_flight.clear();
+            self.smoothed.clear();
+            self.terms.clear();
+        }
+        if self.sent.is_none_or(|s| s.1 != model.weights_version) {
+            let weights = Request::Weights {
+                model: model.id,
+                version: model.weights_version,
+                weights: model.weights.map(<[f32]>::to_vec),
+            };
+            self.broadcast(&weights);
+            self.terms.clear();
+            self.asked = None;
+            self.upcoming.clear();
+        }
+        self.sent = Some(want);
+    }
+
+    fn broadcast(&mut self, request: &Request) {
+        for worker in 0..self.busy.len() {
+            self.carrier.post(worker, request);
+        }
+    }
+
+    /// Collects the replies and hands out work to the idle workers.
+    pub fn pump(&mut self) {
+        loop {
+            for (worker, reply) in self.carrier.take_replies() {
+                self.receive(worker, reply);
+            }
+            let Some(worker) = self.busy.iter().position(Option::is_none) else {
+                return;
+            };
+            if !self.hand_out(worker) {
+                return;
+            }
+        }
+    }
+
+    fn receive(&mut self, worker: usize, reply: Reply) {
+        if let Some(slot) = self.busy.get_mut(worker) {
+            *slot = None;
+        }
+        match self.in_flight.remove(&reply.job()) {
+            Some(Flight::Smooth) => {
+                self.smoothed.insert(reply.job(), reply);
+            }
+            Some(Flight::Terms(key)) => {
+                let answer = match reply {
+                    Reply::Terms { terms, .. } => Ok(terms),
+                    Reply::Failed { why, .. } => Err(why),
+                    Reply::Smoothed { .. } => Err("a smoothing answered a terms request".into()),
+                };
+                self.terms.insert(key, answer);
+            }
+            // Superseded or for another model.
+            None => {}
+        }
+    }
+
+    /// Gives `worker` the next job: a smoothing first, then the terms asked, then those to
+    /// come. Returns whether there was one.
+    fn hand_out(&mut self, worker: usize) -> bool {
+        if let Some(s) = self.smooths.pop_front() {
+            let request = Request::Smooth {
+                job: s.job,
+                params: s.params,
+                tau: s.tau,
+            };
+            self.start(worker, s.job, Flight::Smooth, &request);
+            return true;
+        }
+        let in_flight: Vec<&TermsKey> = self
+            .in_flight
+            .values()
+            .filter_map(|f| match f {
+                Flight::Terms(k) => Some(k),
+                Flight::Smooth => None,
+            })
+            .collect();
+        let next = self
+            .asked
+            .iter()
+            .chain(&self.upcoming)
+            .find(|k| !self.terms.contains_key(*k) && !in_flight.contains(k))
+            .cloned();
+        let Some(key) = next else {
+            return false;
+        };
+        let Ok((params, at)) = super::decode::<TermsRequest>(&key.2) else {
+            return false;
+        };
+        let job = self.new_job();
+        let request = Request::Terms { job, params, at };
+        self.start(worker, job, Flight::Terms(key), &request);
+        true
+    }
+
+    fn start(&mut self, worker: usize, job: u64, flight: Flight, request: &Request) {
+        self.busy[worker] = Some(job);
+        self.in_flight.insert(job, flight);
+        self.carrier.post(worker, request);
+    }
+
+    fn key(model: &ModelRef<'_>, params: &Params, at: &[u32]) -> TermsKey {
+        let request: TermsRequest = (*params, at.to_vec());
+        (model.id, model.weights_version, super::encode(&request))
+    }
+}
+
+impl Offload for Pool {
+    fn measure(&mut self, model: &ModelRef<'_>, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
+        self.sync(model);
+        let key = Self::key(model, params, at);
+        self.asked = Some(key.clone());
+        self.pump();
+        let answer = self.terms.remove(&key);
+        self.waiting = answer.is_none();
+        match answer? {
+            Ok(terms) => Some(terms),
+            Err(why) => {
+                self.failure = Some(why);
+                Some(failed_terms(at.len()))
+            }
+        }
+    }
+
+    fn prefetch(&mut self, model: &ModelRef<'_>, requests: &[TermsRequest]) {
+        self.sync(model);
+        self.upcoming = requests
+            .iter()
+            .map(|(params, at)| Self::key(model, params, at))
+            .collect();
+        self.pump();
+    }
+
+    fn wants_prefetch(&self) -> bool {
+        true
+    }
+
+    fn waiting(&self) -> bool {
+        Pool::waiting(self)
+    }
+
+    fn failure(&self) -> Option<String> {
+        self.failure.clone()
+    }
+}

@@ -1,0 +1,164 @@
+use super::*;
+use crate::io;
+use crate::smooth::Filter;
+use crate::evaluate::{ModelRef, Offload};
+
+const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+
+fn sample() -> Original {
+    let mesh = io::load(SAMPLE, "bent_tube_staircase.ply").unwrap();
+    let topology = Topology::build(&mesh);
+    Original::new(&mesh, &topology)
+}
+
+fn model<'a>(original: &'a Original, weights: Option<&'a [f32]>, version: u64) -> ModelRef<'a> {
+    ModelRef {
+        original,
+        id: 7,
+        weights,
+        weights_version: version,
+    }
+}
+
+fn params(filter: Filter, iterations: u32) -> Params {
+    Params {
+        iterations,
+        ..Params::defaults(filter)
+    }
+}
+
+/// Asks until the pool answers (the in-thread pool answers on the next call).
+fn measure(pool: &mut Pool, model: &ModelRef<'_>, p: &Params, at: &[u32]) -> Vec<Terms> {
+    for _ in 0..4 {
+        if let Some(terms) = pool.measure(model, p, at) {
+            return terms;
+        }
+    }
+    panic!("the pool never answered {p:?} at {at:?}");
+}
+
+#[test]
+fn a_smoothing_job_answers_what_the_cli_computes() {
+    let original = sample();
+    let mut pool = Pool::in_thread(2);
+    let p = params(Filter::Hc, 12);
+    let job = pool.smooth(&model(&original, None, 0), &p, 0.5, true);
+    let Some(Reply::Smoothed {
+        positions,
+        metrics,
+        vertex,
+        ..
+    }) = pool.take_smoothed(job)
+    else {
+        panic!("no smoothing came back");
+    };
+    let (expected, reference) = metrics::smooth_drifting(&original, &p, None);
+    let (measured, expected_vertex) =
+        metrics::measure_vertices(&original, &expected, &reference, 0.5);
+    assert_eq!(positions, expected);
+    assert_eq!(metrics_of(&metrics).unwrap(), measured);
+    assert_eq!(vertex, expected_vertex);
+    assert!(!pool.busy());
+}
+
+#[test]
+fn terms_spread_over_the_workers_equal_the_evaluators() {
+    let original = sample();
+    let weights: Vec<f32> = (0..original.mesh().vertex_count())
+        .map(|i| if i % 3 == 0 { 0.0 } else { 1.0 })
+        .collect();
+    let mut pool = Pool::in_thread(3);
+    for (w, version) in [(None, 1), (Some(weights.as_slice()), 2)] {
+        let m = model(&original, w, version);
+        let requests: Vec<(Params, Vec<u32>)> = [Filter::Laplace, Filter::Hc, Filter::Sinc]
+            .iter()
+            .map(|&f| (params(f, 0), vec![if f == Filter::Sinc { 10 } else { 5 }]))
+            .collect();
+        pool.prefetch(&m, &requests[1..]);
+        for (p, at) in &requests {
+            let mut direct = MeshEvaluator::new(&original, w).unwrap();
+            let expected = direct.measure(p, at).unwrap();
+            assert_eq!(
+                measure(&mut pool, &m, p, at),
+                expected,
+                "{p:?} weights {version}"
+            );
+        }
+    }
+    assert_eq!(pool.failure(), None);
+}
+
+#[test]
+fn a_newer_view_job_supersedes_one_still_waiting() {
+    /// Holds every request until told to deliver, as busy workers do.
+    struct Held {
+        inner: InThread,
+        posted: Vec<(usize, Request)>,
+        deliver: std::rc::Rc<std::cell::Cell<bool>>,
+    }
+    impl Carrier for Held {
+        fn workers(&self) -> usize {
+            1
+        }
+        fn post(&mut self, worker: usize, request: &Request) {
+            self.posted.push((worker, request.clone()));
+        }
+        fn take_replies(&mut self) -> Vec<(usize, Reply)> {
+            if !self.deliver.get() {
+                return Vec::new();
+            }
+            for (w, r) in std::mem::take(&mut self.posted) {
+                self.inner.post(w, &r);
+            }
+            self.inner.take_replies()
+        }
+        fn threaded(&self) -> bool {
+            false
+        }
+    }
+    let original = sample();
+    let m = model(&original, None, 0);
+    let deliver = std::rc::Rc::new(std::cell::Cell::new(false));
+    let mut pool = Pool::new(Box::new(Held {
+        inner: InThread::new(1),
+        posted: Vec::new(),
+        deliver: deliver.clone(),
+    }));
+    // The first goes out at once; the second waits behind it and the third replaces it.
+    let first = pool.smooth(&m, &params(Filter::Laplace, 2), 0.5, true);
+    let second = pool.smooth(&m, &params(Filter::Laplace, 3), 0.5, true);
+    let gallery = pool.smooth(&m, &params(Filter::Hc, 4), 0.5, false);
+    let third = pool.smooth(&m, &params(Filter::Laplace, 4), 0.5, true);
+    assert!(!pool.pending(second), "superseded while it waited");
+    assert!(pool.pending(first) && pool.pending(gallery) && pool.pending(third));
+    deliver.set(true);
+    let mut answered = Vec::new();
+    for _ in 0..8 {
+        for job in [first, gallery, third] {
+            if let Some(reply) = pool.take_smoothed(job) {
+                assert!(matches!(reply, Reply::Smoothed { .. }), "{reply:?}");
+                answered.push(job);
+            }
+        }
+    }
+    assert_eq!(answered, [first, gallery, third]);
+    assert!(pool.take_smoothed(second).is_none());
+}
+
+#[test]
+fn a_worker_without_a_model_says_so() {
+    let mut worker = Worker::default();
+    let reply = worker.handle(
+        Request::Smooth {
+            job: 3,
+            params: params(Filter::Hc, 2),
+            tau: 0.5,
+        },
+        &clock_ms,
+    );
+    assert!(
+        matches!(reply, Some(Reply::Failed { job: 3, .. })),
+        "{reply:?}"
+    );
+    assert!(decode::<Request>(b"\xff\xff\xff").is_err());
+}
