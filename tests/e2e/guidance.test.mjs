@@ -259,5 +259,38 @@ async function framesWhileGraphsCompute(query) {
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
         assert.ok(idle.frames > 0 && drawing.frames > 0 && graphs.frames > 0 && withInteraction.frames > 0);
         assert.ok(graphsBusy.some((what) => what.startsWith("Quality graphs")), `graphs computing: ${graphsBusy}`);
+        if (guidanceEngine === "cpu") {
+            // The graphs run in the engine's workers: no frame waits for them longer than
+            // drawing this mesh takes, with 50 ms to spare.
+            assert.ok(graphs.max_ms <= drawing.max_ms + 50, `longest frame while the graphs compute ${graphs.max_ms} ms, orbiting ${drawing.max_ms} ms`);
+        }
     }, { query });
 }
+
+test("G5 benchmark: the HC grid suggestion on the 206k-vertex mesh with one and two workers, against the CLI on two threads (printed)", { timeout: TIMEOUT, skip: MODE !== "cpu" && "CPU mode only" }, async () => {
+    const pages = {};
+    for (const workers of [1, 2]) {
+        await withApp(async (app) => {
+            await app.call("setFilter", "hc");
+            await app.loadMesh(readFileSync(BRAIN), "brain.ply");
+            await app.call("metrics");
+            const engine = (await state(app)).cpu_engine;
+            assert.deepEqual(engine, { workers, threaded: true }, "the page runs the CPU engine in its workers");
+            pages[workers] = await app.call("suggest", { tau: 0.5, search: "grid" });
+        }, { query: `?workers=${workers}` });
+    }
+    const want = await cli.cliJson("suggest", BRAIN, "--filter", "hc", "--tau", "0.5", "--search", "grid", "--json");
+    for (const got of Object.values(pages)) {
+        assert.deepEqual(got.params, want.params, "the page's grid suggestion is the CLI's");
+    }
+    const line = {
+        bench: "page-grid-suggestion", mesh: "seg_mni152 206k", filter: "hc", tau: 0.5,
+        page_one_worker_s: pages[1].seconds, page_two_workers_s: pages[2].seconds,
+        cli_two_threads_s: want.seconds,
+        pool_speedup: pages[1].seconds / pages[2].seconds,
+        one_worker_vs_cli: pages[1].seconds / want.seconds,
+        two_workers_vs_cli: pages[2].seconds / want.seconds,
+    };
+    console.log(JSON.stringify(line));
+    appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
+});
