@@ -1,245 +1,18 @@
-//! The CPU engine against naive f64 references written straight from ALGORITHMS.md, against
-//! VTK's windowed sinc (fixtures from tests/peers/sinc_reference.py), and its contract:
-//! isolated vertices, weights, the displacement bound, observer calls, volume under HC.
+//! The CPU engine against the plain f64 reference written straight from ALGORITHMS.md
+//! (`smooth::reference`), against VTK's windowed sinc (fixtures from
+//! tests/peers/sinc_reference.py), and its contract: isolated vertices, weights, the
+//! displacement bound, observer calls, volume under HC.
 
 #[path = "common/ply.rs"]
 mod ply;
 
-use std::collections::BTreeMap;
-
 use meshsmooth::mesh::{Mesh, Topology};
-use meshsmooth::smooth::{smooth, Filter, NoObserver, Params, StepObserver};
+use meshsmooth::smooth::{reference, smooth, Filter, NoObserver, Params, StepObserver};
 
 type V = [f64; 3];
 
-// ---------------------------------------------------------------- naive references (f64)
-
-/// Smoothing neighbourhoods from the triangles alone: the 1-ring, or for a vertex on an edge
-/// used by one triangle, only its neighbours across such edges.
-fn reference_rings(mesh: &Mesh) -> Vec<Vec<usize>> {
-    let mut uses: BTreeMap<(usize, usize), usize> = BTreeMap::new();
-    for t in &mesh.triangles {
-        let mut edges: Vec<(usize, usize)> = (0..3)
-            .map(|k| (t[k] as usize, t[(k + 1) % 3] as usize))
-            .filter(|(a, b)| a != b)
-            .map(|(a, b)| (a.min(b), a.max(b)))
-            .collect();
-        edges.sort();
-        edges.dedup();
-        for e in edges {
-            *uses.entry(e).or_default() += 1;
-        }
-    }
-    let n = mesh.positions.len();
-    let mut all = vec![Vec::new(); n];
-    let mut boundary = vec![Vec::new(); n];
-    for (&(a, b), &count) in &uses {
-        all[a].push(b);
-        all[b].push(a);
-        if count == 1 {
-            boundary[a].push(b);
-            boundary[b].push(a);
-        }
-    }
-    all.into_iter()
-        .zip(boundary)
-        .map(|(a, b)| if b.is_empty() { a } else { b })
-        .collect()
-}
-
-fn mean(ring: &[usize], q: &[V]) -> V {
-    let mut s = [0.0; 3];
-    for &j in ring {
-        for k in 0..3 {
-            s[k] += q[j][k];
-        }
-    }
-    s.map(|x| x / ring.len() as f64)
-}
-
-/// Weight, then the ball of radius `d_max` around the original.
-fn constrain(i: usize, cur: V, prop: V, w: Option<&[f32]>, d_max: Option<f32>, o: &[V]) -> V {
-    let w = w.map_or(1.0, |w| w[i] as f64);
-    let mut p: V = std::array::from_fn(|k| cur[k] + w * (prop[k] - cur[k]));
-    if let Some(d) = d_max {
-        let d = d as f64;
-        let off: V = std::array::from_fn(|k| p[k] - o[i][k]);
-        let len = off.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if len > d {
-            p = std::array::from_fn(|k| o[i][k] + off[k] * d / len);
-        }
-    }
-    p
-}
-
 fn to_f64(p: &[[f32; 3]]) -> Vec<V> {
     p.iter().map(|p| p.map(|x| x as f64)).collect()
-}
-
-fn reference(mesh: &Mesh, p: &Params, w: Option<&[f32]>) -> Vec<V> {
-    let rings = reference_rings(mesh);
-    let o = to_f64(&mesh.positions);
-    let d_max = p.max_displacement;
-    let mut q = o.clone();
-    let steps: Vec<f64> = match p.filter {
-        Filter::Laplace => vec![p.lambda as f64],
-        Filter::Taubin => vec![p.lambda as f64, p.mu as f64],
-        Filter::Hc => return reference_hc(&rings, &o, p, w),
-        Filter::Sinc => return reference_sinc(&rings, &o, p, w),
-    };
-    for _ in 0..p.iterations {
-        for &f in &steps {
-            q = (0..q.len())
-                .map(|i| {
-                    if rings[i].is_empty() {
-                        return q[i];
-                    }
-                    let m = mean(&rings[i], &q);
-                    let prop = std::array::from_fn(|k| q[i][k] + f * (m[k] - q[i][k]));
-                    constrain(i, q[i], prop, w, d_max, &o)
-                })
-                .collect();
-        }
-    }
-    q
-}
-
-fn reference_hc(rings: &[Vec<usize>], o: &[V], p: &Params, w: Option<&[f32]>) -> Vec<V> {
-    let (alpha, beta) = (p.alpha as f64, p.beta as f64);
-    let n = o.len();
-    let mut q = o.to_vec();
-    for _ in 0..p.iterations {
-        let pp: Vec<V> = (0..n)
-            .map(|i| {
-                if rings[i].is_empty() {
-                    q[i]
-                } else {
-                    mean(&rings[i], &q)
-                }
-            })
-            .collect();
-        let b: Vec<V> = (0..n)
-            .map(|i| {
-                std::array::from_fn(|k| pp[i][k] - (alpha * o[i][k] + (1.0 - alpha) * q[i][k]))
-            })
-            .collect();
-        q = (0..n)
-            .map(|i| {
-                if rings[i].is_empty() {
-                    return q[i];
-                }
-                let mb = mean(&rings[i], &b);
-                let prop =
-                    std::array::from_fn(|k| pp[i][k] - (beta * b[i][k] + (1.0 - beta) * mb[k]));
-                constrain(i, q[i], prop, w, p.max_displacement, o)
-            })
-            .collect();
-    }
-    q
-}
-
-/// Windowed-sinc coefficients derived afresh: Nuttall-windowed ideal low-pass with cut-off
-/// `theta + sigma`; sigma by VTK's Newton-like search for unit gain at the pass-band edge, whose
-/// slope is the x-derivative of the series without its top term plus half its unhalved `d_0`
-/// (written here in closed form, `T_n'(cos t) = n sin(n t) / sin t`); unit-DC fallback.
-fn reference_coefficients(n: usize, passband: f64) -> Vec<f64> {
-    use std::f64::consts::PI;
-    let theta = (1.0 - passband / 2.0).acos();
-    let a = [0.355768, 0.487396, 0.144232, 0.012604];
-    let coef = |sigma: f64| -> Vec<f64> {
-        (0..=n)
-            .map(|i| {
-                let x = PI * i as f64 / (n + 1) as f64;
-                let w = a[0] + a[1] * x.cos() + a[2] * (2.0 * x).cos() + a[3] * (3.0 * x).cos();
-                let t = theta + sigma;
-                w * if i == 0 {
-                    t / PI
-                } else {
-                    2.0 * (i as f64 * t).sin() / (i as f64 * PI)
-                }
-            })
-            .collect()
-    };
-    let mut sigma = 0.0;
-    let mut c = coef(0.0);
-    let mut found = false;
-    for _ in 0..if n >= 2 { 500 } else { 0 } {
-        let gain: f64 = (0..=n).map(|i| c[i] * (i as f64 * theta).cos()).sum();
-        if (gain - 1.0).abs() < 1e-3 {
-            found = true;
-            break;
-        }
-        let slope: f64 = (1..n)
-            .map(|i| {
-                let fi = i as f64;
-                c[i] * fi * (fi * theta).sin() / theta.sin()
-                    + if i % 2 == 1 { fi * c[i] } else { 0.0 }
-            })
-            .sum();
-        sigma -= (gain - 1.0) / slope;
-        if !sigma.is_finite() {
-            break;
-        }
-        c = coef(sigma);
-    }
-    let dc: f64 = c.iter().sum();
-    if !found || (dc - 1.0).abs() > 1e-2 {
-        c = coef(0.0);
-        let dc: f64 = c.iter().sum();
-        c.iter_mut().for_each(|x| *x /= dc);
-    }
-    c
-}
-
-fn reference_sinc(rings: &[Vec<usize>], o: &[V], p: &Params, w: Option<&[f32]>) -> Vec<V> {
-    let n = p.iterations as usize;
-    let c = reference_coefficients(n, p.passband as f64);
-    let centre: V = std::array::from_fn(|k| {
-        let lo = o.iter().map(|v| v[k]).fold(f64::INFINITY, f64::min);
-        let hi = o.iter().map(|v| v[k]).fold(f64::NEG_INFINITY, f64::max);
-        (lo + hi) / 2.0
-    });
-    // M y = y + L y / 2 with L y = mean_N y - y (0 on isolated vertices).
-    let half_step = |y: &[V]| -> Vec<V> {
-        (0..y.len())
-            .map(|i| {
-                if rings[i].is_empty() {
-                    return y[i];
-                }
-                let m = mean(&rings[i], y);
-                std::array::from_fn(|k| y[i][k] + 0.5 * (m[k] - y[i][k]))
-            })
-            .collect()
-    };
-    let mut t0: Vec<V> = o
-        .iter()
-        .map(|v| std::array::from_fn(|k| v[k] - centre[k]))
-        .collect();
-    let mut t1 = half_step(&t0);
-    let mut sum: Vec<V> = (0..o.len())
-        .map(|i| std::array::from_fn(|k| c[0] * t0[i][k] + c[1] * t1[i][k]))
-        .collect();
-    for ck in c.iter().skip(2) {
-        let m = half_step(&t1);
-        let t2: Vec<V> = (0..o.len())
-            .map(|i| std::array::from_fn(|k| 2.0 * m[i][k] - t0[i][k]))
-            .collect();
-        for (s, t) in sum.iter_mut().zip(&t2) {
-            for k in 0..3 {
-                s[k] += ck * t[k];
-            }
-        }
-        (t0, t1) = (t1, t2);
-    }
-    (0..o.len())
-        .map(|i| {
-            if rings[i].is_empty() {
-                return o[i];
-            }
-            let est = std::array::from_fn(|k| centre[k] + sum[i][k]);
-            constrain(i, o[i], est, w, p.max_displacement, o)
-        })
-        .collect()
 }
 
 // ---------------------------------------------------------------- test meshes
@@ -353,7 +126,7 @@ fn check_against_reference(name: &str, mesh: &Mesh) {
                 p.max_displacement = Some(0.4);
             }
             let ours = run(mesh, &p, weights);
-            let gap = relative_gap(mesh, &ours, &reference(mesh, &p, weights));
+            let gap = relative_gap(mesh, &ours, &reference::smooth(mesh, &p, weights));
             println!("{name:>26} {filter:>7} odd={odd:<5} constrained={constrained:<5} gap/diag {gap:.2e}");
             assert!(
                 gap < 1e-5,
@@ -438,6 +211,11 @@ fn sinc_matches_vtk() {
             moved > 100.0 * gap,
             "the fixture must differ from the input"
         );
+        // The reference is right too, not merely equal to the engine.
+        let plain = reference::smooth(mesh, &p, None);
+        let gap = relative_gap(mesh, &fixture_f32(fixture), &plain);
+        println!("tube {name}: reference vs VTK {gap:.2e} of the diagonal");
+        assert!(gap < 1e-5, "{name}: reference {gap:e}");
     }
 }
 

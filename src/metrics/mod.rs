@@ -12,6 +12,7 @@ mod exact_distance;
 mod local_error;
 mod original;
 mod prism_rows;
+pub mod reference;
 mod report;
 mod roughness;
 mod score;

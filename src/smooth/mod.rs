@@ -14,6 +14,7 @@
 mod constraint;
 mod hc;
 mod params;
+pub mod reference;
 mod rings;
 mod sinc;
 mod sinc_coefficients;
