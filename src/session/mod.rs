@@ -16,12 +16,12 @@ pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use loading::{LoadProgress, Loaded, Loading, OpenFailure};
 pub use weights::WeightsSummary;
 
+use crate::evaluate::ModelRef;
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
 use crate::metrics::{Metrics, Original, VertexMeasures};
 use crate::segmentation::Structure;
 use crate::smooth::{Filter, Params};
-use crate::evaluate::ModelRef;
 use crate::worker::{metrics_of, Pool, Reply, SmoothJob};
 use std::sync::Arc;
 

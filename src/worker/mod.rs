@@ -9,11 +9,11 @@ pub use pool::{Carrier, InThread, Pool, SmoothJob};
 
 use serde::{Deserialize, Serialize};
 
+use crate::evaluate::{Evaluator, Terms};
 use crate::mesh::{Mesh, Topology};
 use crate::metrics::{self, Metrics, Original, VertexMeasures};
 use crate::smooth::Params;
 use crate::suggest::MeshEvaluator;
-use crate::evaluate::{Evaluator, Terms};
 
 /// A message to a worker.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -6,8 +6,8 @@
 use std::collections::{HashMap, VecDeque};
 
 use super::{Reply, Request, Worker};
-use crate::smooth::Params;
 use crate::evaluate::{failed_terms, ModelRef, Offload, Request as TermsRequest, Terms};
+use crate::smooth::Params;
 
 /// Carries requests to workers and brings their replies back.
 pub trait Carrier {

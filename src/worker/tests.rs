@@ -1,7 +1,7 @@
 use super::*;
+use crate::evaluate::{ModelRef, Offload};
 use crate::io;
 use crate::smooth::Filter;
-use crate::evaluate::{ModelRef, Offload};
 
 const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
 
