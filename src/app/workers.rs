@@ -85,6 +85,8 @@ fn reply_handler(
         } else {
             let why = js_sys::JSON::stringify(&data).map_or_else(|_| "?".into(), String::from);
             log::error!("engine worker {} failed: {why}", index + 1);
+            let why = format!("engine worker {} failed: {why}", index + 1);
+            inbox.borrow_mut().push((index, Reply::Broken { why }));
         }
         ctx.request_repaint();
     })

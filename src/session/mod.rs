@@ -487,7 +487,7 @@ impl Session {
                 self.error = Some(format!("The CPU engine failed: {why}"));
                 None
             }
-            Reply::Terms { .. } => None,
+            Reply::Terms { .. } | Reply::Broken { .. } => None,
         }
     }
 

@@ -58,15 +58,19 @@ pub enum Reply {
     },
     /// The job could not be done (no model, weights of another length).
     Failed { job: u64, why: String },
+    /// The worker stopped in the middle of its job (a trap in its module): whatever it was
+    /// doing fails. The page's carrier makes this of a worker's error message.
+    Broken { why: String },
 }
 
 impl Reply {
-    /// The job this answers.
-    pub fn job(&self) -> u64 {
+    /// The job this answers (`None`: the worker's job under way, see [`Reply::Broken`]).
+    pub fn job(&self) -> Option<u64> {
         match self {
             Reply::Smoothed { job, .. } | Reply::Terms { job, .. } | Reply::Failed { job, .. } => {
-                *job
+                Some(*job)
             }
+            Reply::Broken { .. } => None,
         }
     }
 }

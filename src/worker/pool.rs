@@ -271,18 +271,27 @@ impl Pool {
     }
 
     fn receive(&mut self, worker: usize, reply: Reply) {
-        if let Some(slot) = self.busy.get_mut(worker) {
-            *slot = None;
-        }
-        match self.in_flight.remove(&reply.job()) {
+        let doing = self.busy.get_mut(worker).and_then(Option::take);
+        // A broken worker's job fails; the worker stays, and fails again if it cannot go on.
+        let (job, reply) = match reply {
+            Reply::Broken { why } => match doing {
+                Some(job) => (job, Reply::Failed { job, why }),
+                None => return,
+            },
+            other => match other.job() {
+                Some(job) => (job, other),
+                None => return,
+            },
+        };
+        match self.in_flight.remove(&job) {
             Some(Flight::Smooth) => {
-                self.smoothed.insert(reply.job(), reply);
+                self.smoothed.insert(job, reply);
             }
             Some(Flight::Terms(key)) => {
                 let answer = match reply {
                     Reply::Terms { terms, .. } => Ok(terms),
                     Reply::Failed { why, .. } => Err(why),
-                    Reply::Smoothed { .. } => Err("a smoothing answered a terms request".into()),
+                    _ => Err("a smoothing answered a terms request".into()),
                 };
                 self.terms.insert(key, answer);
             }

@@ -162,3 +162,54 @@ fn a_worker_without_a_model_says_so() {
     );
     assert!(decode::<Request>(b"\xff\xff\xff").is_err());
 }
+
+#[test]
+fn a_broken_worker_fails_its_job_instead_of_holding_it() {
+    /// A worker that traps in its first job, then works.
+    struct Trapping {
+        inner: InThread,
+        trapped: bool,
+        replies: Vec<(usize, Reply)>,
+    }
+    impl Carrier for Trapping {
+        fn workers(&self) -> usize {
+            1
+        }
+        fn post(&mut self, worker: usize, request: &Request) {
+            if matches!(request, Request::Smooth { .. } | Request::Terms { .. }) && !self.trapped {
+                self.trapped = true;
+                let why = "unreachable executed".to_string();
+                self.replies.push((worker, Reply::Broken { why }));
+                return;
+            }
+            self.inner.post(worker, request);
+        }
+        fn take_replies(&mut self) -> Vec<(usize, Reply)> {
+            let mut replies = std::mem::take(&mut self.replies);
+            replies.extend(self.inner.take_replies());
+            replies
+        }
+        fn threaded(&self) -> bool {
+            false
+        }
+    }
+    let original = sample();
+    let m = model(&original, None, 0);
+    let mut pool = Pool::new(Box::new(Trapping {
+        inner: InThread::new(1),
+        trapped: false,
+        replies: Vec::new(),
+    }));
+    let broken = pool.smooth(&m, &params(Filter::Hc, 3), 0.5, false);
+    let reply = pool.take_smoothed(broken);
+    assert!(
+        matches!(&reply, Some(Reply::Failed { why, .. }) if why.contains("unreachable")),
+        "{reply:?}"
+    );
+    assert!(!pool.busy(), "the worker is free again");
+    let next = pool.smooth(&m, &params(Filter::Hc, 3), 0.5, false);
+    assert!(matches!(
+        pool.take_smoothed(next),
+        Some(Reply::Smoothed { .. })
+    ));
+}

@@ -95,7 +95,9 @@ pub(super) fn step_gallery(job: &mut GalleryJob, engine: &mut Engine<'_, '_>) ->
             Err(why) => return gave_up(job, why),
         },
         Reply::Failed { why, .. } => return gave_up(job, why),
-        Reply::Terms { .. } => return gave_up(job, "a terms reply to a smoothing".into()),
+        Reply::Terms { .. } | Reply::Broken { .. } => {
+            return gave_up(job, "a terms reply to a smoothing".into())
+        }
     };
     job.picks.push(GalleryPick {
         tau,
