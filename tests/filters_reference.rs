@@ -3,9 +3,12 @@
 //! tests/peers/sinc_reference.py), and its contract: isolated vertices, weights, the
 //! displacement bound, observer calls, volume under HC.
 
+#[path = "common/fixtures.rs"]
+mod fixtures;
 #[path = "common/ply.rs"]
 mod ply;
 
+use fixtures::{grid_triangles, Rng};
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::smooth::{reference, smooth, Filter, NoObserver, Params, StepObserver};
 
@@ -16,17 +19,6 @@ fn to_f64(p: &[[f32; 3]]) -> Vec<V> {
 }
 
 // ---------------------------------------------------------------- test meshes
-
-/// Deterministic pseudo-random numbers in [0, 1) (xorshift), so fixtures need no crate.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 /// An open patch: a `nx` x `ny` grid with jittered vertices and noisy heights.
 fn noisy_grid(nx: u32, ny: u32) -> Mesh {
@@ -42,14 +34,7 @@ fn noisy_grid(nx: u32, ny: u32) -> Mesh {
             ]);
         }
     }
-    let mut triangles = Vec::new();
-    for y in 0..ny - 1 {
-        for x in 0..nx - 1 {
-            let v = y * nx + x;
-            triangles.push([v, v + 1, v + nx + 1]);
-            triangles.push([v, v + nx + 1, v + nx]);
-        }
-    }
+    let triangles = grid_triangles(nx, ny);
     Mesh::new(positions, triangles)
 }
 

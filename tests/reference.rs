@@ -7,6 +7,8 @@
 //! about ten times above the largest gap these meshes give (the runs print them), and far
 //! below what a wrong formula gives.
 
+#[path = "common/fixtures.rs"]
+mod fixtures;
 #[path = "common/ply.rs"]
 mod ply;
 #[path = "common_metrics/shapes.rs"]
@@ -14,6 +16,7 @@ mod shapes;
 
 use std::collections::BTreeMap;
 
+use fixtures::{grid_triangles, Rng};
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::metrics::reference as plain;
 use meshsmooth::metrics::{self, DriftingReference, Original, TriangleBvh};
@@ -47,17 +50,6 @@ const CHAIN_GAP: f64 = 2e-5;
 
 // ---------------------------------------------------------------- test meshes
 
-/// Deterministic pseudo-random numbers in [0, 1) (xorshift), so fixtures need no crate.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
 /// An open `nx` x `ny` grid with jittered vertices and noisy heights, and one isolated vertex.
 fn noisy_grid(nx: u32, ny: u32) -> Mesh {
     let mut rng = Rng(0x2545f4914f6cdd1d);
@@ -68,14 +60,7 @@ fn noisy_grid(nx: u32, ny: u32) -> Mesh {
             positions.push([x as f32 + jitter(), y as f32 + jitter(), 2.0 * jitter()]);
         }
     }
-    let mut triangles = Vec::new();
-    for y in 0..ny - 1 {
-        for x in 0..nx - 1 {
-            let v = y * nx + x;
-            triangles.push([v, v + 1, v + nx + 1]);
-            triangles.push([v, v + nx + 1, v + nx]);
-        }
-    }
+    let triangles = grid_triangles(nx, ny);
     positions.push([3.0, -4.0, 5.0]);
     Mesh::new(positions, triangles)
 }
