@@ -7,6 +7,7 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod colors;
+mod cpu;
 mod guidance;
 mod loading;
 mod weights;
@@ -16,13 +17,12 @@ pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use loading::{LoadProgress, Loaded, Loading, OpenFailure};
 pub use weights::WeightsSummary;
 
-use crate::evaluate::ModelRef;
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
 use crate::metrics::{Metrics, Original, VertexMeasures};
 use crate::segmentation::Structure;
 use crate::smooth::{Filter, Params};
-use crate::worker::{metrics_of, Pool, Reply, SmoothJob};
+use crate::worker::{Pool, SmoothJob};
 use std::sync::Arc;
 
 /// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
@@ -395,136 +395,6 @@ impl Session {
         }
         self.voxel_size = size;
         Ok(())
-    }
-
-    /// A session whose CPU engine is `cpu` (the page's workers; by default one on this thread).
-    pub fn with_cpu_engine(cpu: Pool) -> Self {
-        Self {
-            cpu,
-            ..Self::default()
-        }
-    }
-
-    /// Makes `cpu` the CPU engine (the page's workers); a run under way is asked again.
-    pub fn set_cpu_engine(&mut self, cpu: Pool) {
-        self.cpu = cpu;
-        self.cpu_job = None;
-    }
-
-    /// Smooths and measures the current revision on the CPU engine until its result is there
-    /// (at once with workers on this thread); the time each half took comes back.
-    pub fn smooth_cpu(&mut self) -> Option<Timings> {
-        loop {
-            if let Some(timings) = self.compute_cpu() {
-                return Some(timings);
-            }
-            if !self.smoothing_on_cpu() {
-                return None;
-            }
-        }
-    }
-
-    /// The CPU engine's share of a frame: asks the workers for the current revision's result
-    /// unless it is there or asked, and takes it once it came (then [`Self::result`] has it
-    /// and its timings come back). A newer revision supersedes an older one still waiting.
-    pub fn compute_cpu(&mut self) -> Option<Timings> {
-        let mut done = None;
-        if let Some((revision, job)) = self.cpu_job {
-            match self.cpu.take_smoothed(job) {
-                Some(reply) => {
-                    self.cpu_job = None;
-                    done = self.accept_reply(revision, reply);
-                }
-                // Superseded below.
-                None if revision != self.revision => {}
-                None => return None,
-            }
-        }
-        let asked = self.cpu_job.is_some_and(|(r, _)| r == self.revision);
-        if self.needs_smoothing() && !asked {
-            let (params, tau) = (*self.params(), self.tau);
-            if let Some(m) = &self.model {
-                let model = ModelRef {
-                    original: &m.original,
-                    id: self.model_id,
-                    weights: self.weights.as_deref(),
-                    weights_version: self.weights_version,
-                };
-                let job = self.cpu.smooth(&model, &params, tau, true);
-                if let Some((_, old)) = self.cpu_job.replace((self.revision, job)) {
-                    self.cpu.forget(old);
-                }
-            }
-        }
-        done
-    }
-
-    /// Takes a worker's smoothing of `revision`; the timings when it is the current one.
-    fn accept_reply(&mut self, revision: u64, reply: Reply) -> Option<Timings> {
-        match reply {
-            Reply::Smoothed {
-                positions,
-                metrics,
-                vertex,
-                smooth_ms,
-                measure_ms,
-                ..
-            } => {
-                let metrics = match metrics_of(&metrics) {
-                    Ok(m) => m,
-                    Err(why) => {
-                        self.error = Some(why);
-                        return None;
-                    }
-                };
-                self.accept_measured(revision, positions, metrics, vertex)
-                    .then_some(Timings {
-                        smooth_ms,
-                        measure_ms,
-                    })
-            }
-            Reply::Failed { why, .. } => {
-                self.error = Some(format!("The CPU engine failed: {why}"));
-                None
-            }
-            Reply::Terms { .. } | Reply::Broken { .. } => None,
-        }
-    }
-
-    /// Whether the CPU engine is working on the current revision's result.
-    pub fn smoothing_on_cpu(&self) -> bool {
-        self.cpu_job
-            .is_some_and(|(r, job)| r == self.revision && self.cpu.pending(job))
-    }
-
-    /// Accepts a result measured elsewhere (the GPU engine's smoothing and measure pass) for
-    /// `revision`. Returns false, and keeps nothing, when the session moved on since or the
-    /// arrays do not fit the model.
-    pub fn accept_measured(
-        &mut self,
-        revision: u64,
-        positions: Vec<[f32; 3]>,
-        metrics: Metrics,
-        vertex: VertexMeasures,
-    ) -> bool {
-        let Some(model) = &self.model else {
-            return false;
-        };
-        let n = model.mesh().vertex_count();
-        let fits = positions.len() == n
-            && vertex.local_error.len() == n
-            && vertex.gaussian_curvature.len() == n;
-        if revision != self.revision || !fits {
-            return false;
-        }
-        self.result = Some(Smoothed {
-            revision,
-            params: *self.params(),
-            positions,
-            metrics,
-            vertex,
-        });
-        true
     }
 
     /// The mesh report of the open model as the CLI's `info --json` prints it.
