@@ -44,17 +44,21 @@ stage install bash .ci/install.sh
 stage fmt cargo fmt --check
 stage clippy-native cargo clippy --all-targets -- -D warnings
 stage clippy-wasm32 cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
-stage test-native cargo test
+# cargo-nextest runs the test binaries side by side (cargo test runs them one after another).
+stage test-native cargo nextest run --no-fail-fast
 # Every parser's fuzz target, a bounded time each (tests/fuzz/run.sh).
-stage fuzz bash tests/fuzz/run.sh
+stage fuzz env FUZZ_SECONDS="${FUZZ_SECONDS:-10}" bash tests/fuzz/run.sh
 # The library's tests, tests/wasm_io.rs and tests/wasm_gpu.rs (the GPU engine on the browser's
-# WebGPU) compiled to wasm32, run in headless Chromium (flags in webdriver.json). The other
-# integration tests read files and start processes: native only, so they are not built for the
-# browser.
-stage test-wasm32-browser wasm-pack test --headless --chrome -- --lib --test wasm_io --test wasm_gpu
+# WebGPU) compiled to wasm32 and run in headless Chromium by wasm-bindgen's test runner (the
+# runner in .cargo/config.toml, flags in webdriver.json): what `wasm-pack test --headless
+# --chrome` runs, without the second build of the library it makes first. The other integration
+# tests read files and start processes: native only, so they are not built for the browser.
+stage test-wasm32-browser env CHROMEDRIVER="${CHROMEDRIVER:-/usr/bin/chromedriver}" \
+    cargo test --target wasm32-unknown-unknown --lib --test wasm_io --test wasm_gpu
 stage web-build trunk build --release
 # End-to-end tests of the built app (dist/) in headless Chromium, with WebGPU and without, against
-# the CLI's numbers; screenshots in target/e2e/.
+# the CLI's numbers; screenshots in target/e2e/. (The browser benchmarks are a command of their
+# own: bash tests/e2e/run.sh --bench.)
 stage e2e bash tests/e2e/run.sh
 
 echo

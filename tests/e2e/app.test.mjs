@@ -5,7 +5,7 @@
 // `webgpu`: WebGPU on SwiftShader, the app smooths on its GPU engine. `cpu`: no WebGPU, eframe
 // draws with WebGL2 and the app smooths with its CPU engine. The native CLI is the reference for
 // every number. Screenshots go to target/e2e/<mode>/.
-import { test } from "node:test";
+import { after } from "node:test";
 import assert from "node:assert/strict";
 import { appendFileSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
@@ -17,21 +17,13 @@ import { jsonDifferences, metricDifferences, relativeDifference } from "./lib/co
 import { gltfValidator } from "./lib/deps.mjs";
 import { colourAt, colourHistogram, flatBoxes } from "./lib/png.mjs";
 import { E2E_OUT, meshPath } from "./lib/paths.mjs";
-import { appSuite } from "./lib/suite.mjs";
+import { CPU_RUN, EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
-let tmp;
+const tmp = mkdtempSync(join(tmpdir(), "meshsmooth-e2e-"));
+after(() => rmSync(tmp, { recursive: true, force: true }));
 
 // The start itself is under test here: pages are handed over before their API is up.
-const { MODE, OUT, withApp } = appSuite({
-    beforeAll: () => {
-        cli.requireCli();
-        tmp = mkdtempSync(join(tmpdir(), "meshsmooth-e2e-"));
-    },
-    afterAll: () => {
-        if (tmp) rmSync(tmp, { recursive: true, force: true });
-    },
-    waitForApi: false,
-});
+const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli(), waitForApi: false });
 
 const SAMPLE = { name: "bent_tube_staircase.ply", vertices: 2296, faces: 4588 };
 const TORUS = meshPath("synthetic/synthetic_torus_R24_r8.ply");
@@ -105,7 +97,7 @@ function redPixels(image) {
 
 // --- 1: start-up ---
 
-test("1a the page starts with the bundled sample within seconds", { timeout: 120_000 }, async () => {
+testIn(EVERY_RUN, "1a the page starts with the bundled sample within seconds", { timeout: 120_000 }, async () => {
     await withApp(async (app) => {
         assert.ok(
             app.startSeconds <= START_LIMIT_S,
@@ -122,7 +114,7 @@ test("1a the page starts with the bundled sample within seconds", { timeout: 120
     });
 });
 
-test("1b the API reports the sample and the engine backend", { timeout: 120_000 }, async () => {
+testIn(EVERY_RUN, "1b the API reports the sample and the engine backend", { timeout: 120_000 }, async () => {
     await withApp(async (app) => {
         const state = await app.state();
         assert.equal(state.model, SAMPLE.name, "state().model");
@@ -136,7 +128,7 @@ test("1b the API reports the sample and the engine backend", { timeout: 120_000 
 
 // --- 2: privacy ---
 
-test("2 every request the page makes goes to its own origin", { timeout: 120_000 }, async () => {
+testIn(WEBGPU_RUN, "2 every request the page makes goes to its own origin", { timeout: 120_000 }, async () => {
     await withApp(async (app) => {
         await app.waitForConsole(openedLog(SAMPLE.name));
         await app.page.waitForLoadState("networkidle");
@@ -162,7 +154,7 @@ test("2 every request the page makes goes to its own origin", { timeout: 120_000
 
 // --- 3: the Open button and the file input ---
 
-test("3 Open… opens the file chooser, and the chosen torus is loaded", { timeout: API_TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "3 Open… opens the file chooser, and the chosen torus is loaded", { timeout: API_TIMEOUT }, async () => {
     await withApp(async (app) => {
         // Listen first: Playwright starts intercepting file choosers when the listener is added,
         // asynchronously; a click right after it sometimes opened a chooser nobody caught.
@@ -196,7 +188,7 @@ test("3 Open… opens the file chooser, and the chosen torus is loaded", { timeo
 
 // --- 4: loading through the API ---
 
-test("4 loadMesh resolves with the CLI's info --json", { timeout: API_TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "4 loadMesh resolves with the CLI's info --json", { timeout: API_TIMEOUT }, async () => {
     await withApp(async (app) => {
         const [info, expected] = await Promise.all([
             app.loadMesh(readFileSync(SCALP), "fsaverage_head_scalp_mne.ply"),
@@ -216,7 +208,7 @@ test("4 loadMesh resolves with the CLI's info --json", { timeout: API_TIMEOUT },
 // --- 5: smoothing and measures against the CLI ---
 
 for (const [filter, params] of Object.entries(FILTER_CASES)) {
-    test(`5 ${filter}: metrics() equals the CLI's smooth --json for ${JSON.stringify(params)}`, { timeout: API_TIMEOUT }, async (t) => {
+    testIn(EVERY_RUN, `5 ${filter}: metrics() equals the CLI's smooth --json for ${JSON.stringify(params)}`, { timeout: API_TIMEOUT }, async (t) => {
         const reference = cli.smooth(SCALP, join(tmp, `scalp-${filter}.ply`), filter, params);
         await withLoaded(SCALP, async (app) => {
             await app.setFilter(filter);
@@ -247,7 +239,7 @@ for (const [filter, params] of Object.entries(FILTER_CASES)) {
     });
 }
 
-test("5 setFilter and setParams refuse bad values with the engine's message", { timeout: API_TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "5 setFilter and setParams refuse bad values with the engine's message", { timeout: API_TIMEOUT }, async () => {
     const rangeMessage = await cli.refusal("smooth", SCALP, "-o", join(tmp, "refused.ply"), "--iterations", "1000");
     await withApp(async (app) => {
         const unknown = await app.attempt("setFilter", "bilateral");
@@ -270,7 +262,7 @@ test("5 setFilter and setParams refuse bad values with the engine's message", { 
 
 // --- 6: exports ---
 
-test("6 every export format reads back with the CLI; the GLB is valid glTF", { timeout: API_TIMEOUT }, async (t) => {
+testIn(EVERY_RUN, "6 every export format reads back with the CLI; the GLB is valid glTF", { timeout: API_TIMEOUT }, async (t) => {
     const expected = await cli.info(SCALP);
     await withLoaded(SCALP, async (app) => {
         await app.setFilter("hc");
@@ -302,7 +294,7 @@ test("6 every export format reads back with the CLI; the GLB is valid glTF", { t
     });
 });
 
-test("6 no export carries the input STL's header text (a patient name)", { timeout: API_TIMEOUT }, async (t) => {
+testIn(WEBGPU_RUN, "6 no export carries the input STL's header text (a patient name)", { timeout: API_TIMEOUT }, async (t) => {
     const stl = join(tmp, "jane.stl");
     await cli.cli("convert", TORUS, stl);
     const bytes = readFileSync(stl);
@@ -330,7 +322,7 @@ test("6 no export carries the input STL's header text (a patient name)", { timeo
 
 const BROKEN = Buffer.from("solid\x00\x01\x02\x03\x04", "latin1"); // 10 bytes: no STL
 
-test("7a a bad file dropped on the page is reported on screen and the sample stays", { timeout: 120_000 }, async () => {
+testIn(WEBGPU_RUN, "7a a bad file dropped on the page is reported on screen and the sample stays", { timeout: 120_000 }, async () => {
     await withApp(async (app) => {
         await app.waitForConsole(openedLog(SAMPLE.name));
         const before = await app.screenshot("07-before-drop");
@@ -351,7 +343,7 @@ test("7a a bad file dropped on the page is reported on screen and the sample sta
     });
 });
 
-test("7b after a bad drop state() names the file and keeps the model; loadMesh of garbage rejects", { timeout: API_TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "7b after a bad drop state() names the file and keeps the model; loadMesh of garbage rejects", { timeout: API_TIMEOUT }, async () => {
     const brokenFile = join(tmp, "broken.stl");
     writeFileSync(brokenFile, BROKEN);
     const garbage = Buffer.from("hello, this is not a mesh\n");
@@ -402,7 +394,7 @@ function middleShowsSomething(image) {
     return histogram.length >= 32 && 1 - histogram[0][1] / total >= 0.05;
 }
 
-test("8 the 3D view draws the mesh: the sample at start, the scalp smoothed and colour-coded", { timeout: API_TIMEOUT }, async () => {
+testIn(EVERY_RUN, "8 the 3D view draws the mesh: the sample at start, the scalp smoothed and colour-coded", { timeout: API_TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.screenshotWhen("08-view-sample", middleShowsSomething, "the sample mesh in the middle of the page", 30_000);
         await app.loadMesh(readFileSync(SCALP), "fsaverage_head_scalp_mne.ply");
@@ -428,93 +420,9 @@ test("8 the 3D view draws the mesh: the sample at start, the scalp smoothed and 
     });
 });
 
-// --- 9: benchmark, printed and never asserted ---
-
-test("9 benchmark: HC, 20 iterations, on the 206k-vertex segmentation (printed)", { timeout: 20 * 60_000 }, async () => {
-    const native = await cli.cliJson("bench", BRAIN, "--filter", "hc", "--iterations", "20", "--repeat", "3", "--json");
-    const lines = [
-        {
-            bench: "native",
-            backend: native.backend,
-            threads: native.threads,
-            mesh: "seg_mni152_gm_plus_wm_p0.5_1mm.ply",
-            vertices: native.vertices,
-            filter: "hc",
-            iterations: 20,
-            smooth_seconds: native.seconds,
-            measure_seconds: native.measure_seconds,
-            drift_seconds: native.drift_seconds,
-        },
-    ];
-    const emit = (line) => {
-        console.log(JSON.stringify(line));
-        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
-    };
-    emit(lines[0]);
-    const reference = cli.smooth(BRAIN, join(tmp, "brain-hc20.ply"), "hc", { iterations: 20 });
-    await withLoaded(BRAIN, async (app, info) => {
-        await app.setFilter("hc");
-        await app.metrics(); // the default 10 iterations first: load-time work stays out of the timing
-        const { seconds, metrics } = await app.page.evaluate(async () => {
-            const start = performance.now();
-            await window.meshsmooth.setParams({ iterations: 20 });
-            const metrics = await window.meshsmooth.metrics();
-            return { seconds: (performance.now() - start) / 1000, metrics };
-        });
-        // Not a speed assertion: the timing counts only if it timed the 20-iteration result.
-        const { problems } = metricDifferences(metrics, (await reference).metrics, METRIC_RTOL);
-        assert.deepEqual(problems, [], `the timed metrics() are not HC with 20 iterations:\n${problems.join("\n")}`);
-        // The CPU engine's own time in its worker for that result: the latency's floor.
-        const timings = (await app.state()).timings;
-        const engineMs = timings && timings.smooth_ms !== undefined ? timings.smooth_ms + timings.measure_ms : null;
-        emit({
-            bench: "browser",
-            mode: MODE,
-            backend: await app.backend(),
-            mesh: "seg_mni152_gm_plus_wm_p0.5_1mm.ply",
-            vertices: info.vertices,
-            filter: "hc",
-            iterations: 20,
-            seconds_set_params_and_metrics: seconds,
-            engine_ms: engineMs,
-            latency_vs_engine: engineMs ? (seconds * 1e3) / engineMs : null,
-        });
-        if (MODE === "cpu") {
-            // The wasm CPU engine against the native one on one thread, each its best of 3:
-            // state().timings counts the engine's own work (smoothing with the drift, and the
-            // measure pass), not the frames drawn between its slices. Beta moves by 0.01 between
-            // runs so each is a new run of the same work.
-            let wasm = null;
-            for (const beta of [0.51, 0.5, 0.51]) {
-                await app.setParams({ beta });
-                await app.metrics();
-                const t = (await app.state()).timings;
-                wasm = wasm ? { smooth_ms: Math.min(wasm.smooth_ms, t.smooth_ms), measure_ms: Math.min(wasm.measure_ms, t.measure_ms) } : t;
-            }
-            const one = await cli.cliWithEnv({ RAYON_NUM_THREADS: "1" }, "bench", BRAIN, "--filter", "hc", "--iterations", "20", "--repeat", "3", "--json").then(JSON.parse);
-            const nativeSmoothMs = (one.seconds + one.drift_seconds) * 1e3;
-            const nativeMeasureMs = one.measure_seconds * 1e3;
-            emit({
-                bench: "wasm-vs-native-one-thread",
-                mesh: "seg_mni152_gm_plus_wm_p0.5_1mm.ply",
-                filter: "hc",
-                iterations: 20,
-                native_threads: one.threads,
-                native_smooth_and_drift_ms: nativeSmoothMs,
-                wasm_smooth_and_drift_ms: wasm.smooth_ms,
-                native_measure_ms: nativeMeasureMs,
-                wasm_measure_ms: wasm.measure_ms,
-                wasm_speed_vs_native_smoothing: nativeSmoothMs / wasm.smooth_ms,
-                wasm_speed_vs_native_measure: nativeMeasureMs / wasm.measure_ms,
-            });
-        }
-        await app.screenshot("09-brain-smoothed-hc");
-    });
-});
-
 // --- 10: a large mesh opens over several frames ---
 
-test("10 the 206k-vertex mesh opens over several frames: state() shows the stages, the old model stays meanwhile (stage times printed)", { timeout: API_TIMEOUT }, async () => {
+testIn(CPU_RUN, "10 the 206k-vertex mesh opens over several frames: state() shows the stages, the old model stays meanwhile (stage times printed)", { timeout: API_TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.api();
         const before = (await app.state()).model;

@@ -1,12 +1,12 @@
 // End-to-end check of the case GLB `meshsmooth case build` writes for a label map, as other tools see it: the
 // Khronos glTF-Validator passes it with no error or warning, and three.js's GLTFLoader in
 // headless Chromium finds every structure by name, in its colour, in metres with +Y superior.
-// The app is not involved: both modes run the same checks, in the same browser (WebGL2).
+// The app is not involved, so only the webgpu run takes these checks (in WebGL2: see BROWSER_MODE).
 //
-//   E2E_MODE=webgpu|cpu node --test tests/e2e/case_gltf.test.mjs   (tests/e2e/run.sh runs both)
+//   node --test tests/e2e/case_gltf.test.mjs   (tests/e2e/run.sh runs it)
 //
 // The GLBs and a rendering of each (case-<name>.png) go to target/e2e/<mode>/.
-import { after, before, test } from "node:test";
+import { after } from "node:test";
 import assert from "node:assert/strict";
 import { readFileSync, writeFileSync } from "node:fs";
 import { basename, join } from "node:path";
@@ -16,6 +16,7 @@ import * as cli from "./lib/cli.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
 import { meshPath, outputDir } from "./lib/paths.mjs";
 import { assertNotBlank, colourHistogram, decodePng } from "./lib/png.mjs";
+import { WEBGPU_RUN, testIn } from "./lib/suite.mjs";
 import { openThreePage, serveThreePage, threeVersion } from "./lib/three.mjs";
 
 const MODE = modeFromEnv();
@@ -177,18 +178,22 @@ function caseGlb(c) {
  */
 const BROWSER_MODE = "cpu";
 
-let browser;
-let server;
-
-before(async () => {
-    cli.requireCli();
-    const three = threeVersion();
-    server = await serveThreePage();
-    browser = await launchBrowser(BROWSER_MODE);
-    console.log(`e2e: mode ${MODE} (browser flags of ${BROWSER_MODE}), Chromium ${browser.version()}, three ${three} served at ${server.url}`);
-});
+/** The page server and browser, started with the first check that renders. */
+let started = null;
+function threePage() {
+    started ??= (async () => {
+        const three = threeVersion();
+        const server = await serveThreePage();
+        const browser = await launchBrowser(BROWSER_MODE);
+        console.log(`e2e: mode ${MODE} (browser flags of ${BROWSER_MODE}), Chromium ${browser.version()}, three ${three} served at ${server.url}`);
+        return { server, browser };
+    })();
+    return started;
+}
 
 after(async () => {
+    if (!started) return;
+    const { server, browser } = await started.catch(() => ({}));
     await browser?.close();
     await server?.close();
 });
@@ -196,7 +201,7 @@ after(async () => {
 const SEVERITIES = ["error", "warning", "info", "hint"];
 
 CASES.forEach((c, n) => {
-    test(`GLB${2 * n + 1} ${c.what} scene GLB passes the Khronos glTF-Validator with no error or warning`, { timeout: TIMEOUT }, async (t) => {
+    testIn(WEBGPU_RUN, `GLB${2 * n + 1} ${c.what} scene GLB passes the Khronos glTF-Validator with no error or warning`, { timeout: TIMEOUT }, async (t) => {
         const { file, bytes } = await caseGlb(c);
         const report = await gltfValidator.validateBytes(new Uint8Array(bytes), { uri: basename(file), format: "glb" });
         const { numErrors, numWarnings, numInfos, numHints, messages, truncated } = report.issues;
@@ -223,12 +228,13 @@ CASES.forEach((c, n) => {
         assert.equal(report.info.drawCallCount, c.structures, "one draw call (mesh primitive) per structure");
     });
 
-    test(`GLB${2 * n + 2} three.js loads ${c.what} scene GLB in Chromium: names, colours, size in metres, +Y superior (rendered)`, { timeout: TIMEOUT }, async (t) => {
+    testIn(WEBGPU_RUN, `GLB${2 * n + 2} three.js loads ${c.what} scene GLB in Chromium: names, colours, size in metres, +Y superior (rendered)`, { timeout: TIMEOUT }, async (t) => {
         const { file, bytes } = await caseGlb(c);
         const expected = await expectedStructures(c);
         assert.equal(expected.length, c.structures, `meshsmooth info lists ${c.structures} structures`);
         const glb = glbStructures(bytes);
         const name = basename(file);
+        const { server, browser } = await threePage();
         server.files.set(name, bytes);
         const opened = await openThreePage(browser, server, VIEWPORT);
         try {

@@ -1,19 +1,17 @@
-// End-to-end tests of the guidance features (issue 7): suggestions, quality graphs, the gallery,
-// and the frame rate while the background computes. Run by tests/e2e/run.sh in both modes.
-import { test } from "node:test";
+// End-to-end tests of the guidance features: suggestions, quality graphs and the gallery (the
+// frame rate while they compute is a benchmark: speed.bench.mjs).
 import assert from "node:assert/strict";
-import { appendFileSync, mkdtempSync, readFileSync } from "node:fs";
+import { mkdtempSync, readFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
 import * as cli from "./lib/cli.mjs";
 import { jsonDifferences, metricDifferences } from "./lib/compare.mjs";
-import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
-import { appSuite } from "./lib/suite.mjs";
+import { ROOT } from "./lib/paths.mjs";
+import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
-const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
+const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 const SAMPLE = join(ROOT, "web/sample/bent_tube_staircase.ply");
-const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
 /** The background searches run the same Rust code on the CPU in both modes (wasm: one thread,
  * so f64 sums may differ in order from the native CLI's: 1e-9 relative allows that). */
 const RTOL = 1e-9;
@@ -33,7 +31,7 @@ function assertClose(actual, expected, what) {
     assert.deepEqual(diffs, [], `${what}: app and CLI differ`);
 }
 
-test("G1 suggest() equals the CLI's suggest --json for the same mesh, filter and tau", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "G1 suggest() equals the CLI's suggest --json for the same mesh, filter and tau", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.call("setFilter", "laplace");
         for (const search of ["local", "grid"]) {
@@ -66,7 +64,7 @@ test("G1 suggest() equals the CLI's suggest --json for the same mesh, filter and
     });
 });
 
-test("G1b on WebGPU with ?guidance=gpu, suggest() runs on the GPU engine and equals the CLI's", { timeout: TIMEOUT, skip: MODE !== "webgpu" && "WebGPU mode only" }, async () => {
+testIn(WEBGPU_RUN, "G1b on WebGPU with ?guidance=gpu, suggest() runs on the GPU engine and equals the CLI's", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.call("setFilter", "laplace");
         for (const search of ["local", "grid"]) {
@@ -81,7 +79,7 @@ test("G1b on WebGPU with ?guidance=gpu, suggest() runs on the GPU engine and equ
     }, { query: "?guidance=gpu" });
 });
 
-test("G2 sweep() equals the CLI's sweep --json; a click in a graph sets the parameter", { timeout: TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "G2 sweep() equals the CLI's sweep --json; a click in a graph sets the parameter", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         const got = await app.call("sweep");
         const want = await cli.cliJson("sweep", SAMPLE, "--filter", "hc", "--json");
@@ -122,7 +120,7 @@ test("G2 sweep() equals the CLI's sweep --json; a click in a graph sets the para
     });
 });
 
-test("G3 the gallery shows five results; a click on one takes its tau and parameters", { timeout: TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "G3 the gallery shows five results; a click on one takes its tau and parameters", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.call("setFilter", "laplace");
         const picks = await app.call("gallery");
@@ -158,139 +156,3 @@ test("G3 the gallery shows five results; a click on one takes its tau and parame
     });
 });
 
-test("G4 benchmark: frame times on the 206k-vertex mesh with nothing in the background (still, and orbiting), while the quality graphs compute, and while they compute under interaction (printed)", { timeout: TIMEOUT }, async () => {
-    // On WebGPU the background runs where the app puts it (the CPU, on this software adapter),
-    // then on the GPU engine as ?guidance=gpu asks.
-    for (const query of MODE === "webgpu" ? ["", "?guidance=gpu"] : [""]) {
-        await framesWhileGraphsCompute(query);
-    }
-});
-
-/** G4 for the page opened with `query`: prints one "guidance-frames" line. */
-async function framesWhileGraphsCompute(query) {
-    await withApp(async (app) => {
-        // HC, whose alpha the interaction below drives.
-        await app.call("setFilter", "hc");
-        await app.loadMesh(readFileSync(BRAIN), "brain.ply");
-        await app.call("metrics");
-        // Frame times over 8 s; with `whileBusy`, only while something runs in the background
-        // (looked at four times a second): the graphs may finish sooner.
-        const frames = (whileBusy = false) =>
-            app.page.evaluate(
-                ({ ms, whileBusy }) =>
-                    new Promise((resolve) => {
-                        const times = [];
-                        const start = performance.now();
-                        let looked = start;
-                        let busy = true;
-                        const tick = (now) => {
-                            times.push(now);
-                            if (whileBusy && now - looked >= 250) {
-                                looked = now;
-                                busy = window.meshsmooth.state().guidance.activities.length > 0;
-                            }
-                            if (now - start < ms && busy) requestAnimationFrame(tick);
-                            else {
-                                const d = times.slice(1).map((t, i) => t - times[i]).sort((a, b) => a - b);
-                                const q = (f) => d[Math.min(d.length - 1, Math.floor(f * d.length))];
-                                resolve({ frames: d.length, p50_ms: q(0.5), p95_ms: q(0.95), max_ms: d[d.length - 1], window_ms: Math.round(now - start) });
-                            }
-                        };
-                        requestAnimationFrame(tick);
-                    }),
-                { ms: 8000, whileBusy },
-            );
-        const busy = async () => (await state(app)).guidance.activities.map((a) => `${a.what} (${Math.round(100 * a.fraction)}%)`);
-        // Escape cancels the suggestion made on opening, G closes the graphs: nothing left in
-        // the background, so the frames are what drawing this mesh costs.
-        const { view } = await state(app);
-        await app.page.mouse.click(view.x + view.width / 2, view.y + view.height / 2);
-        await app.page.keyboard.press("Escape");
-        await app.page.keyboard.press("g");
-        await app.page.waitForFunction(() => window.meshsmooth.state().guidance.activities.length === 0, null, { timeout: 30_000 });
-        const idle = await frames();
-        // Orbiting the view (a left drag) redraws every frame: what drawing this mesh costs.
-        const cx = view.x + view.width / 2;
-        const cy = view.y + view.height / 2;
-        await app.page.mouse.move(cx, cy);
-        await app.page.mouse.down();
-        let orbit = true;
-        const orbiting = (async () => {
-            for (let k = 0; orbit; k++) {
-                await app.page.mouse.move(cx + 80 * Math.sin(k / 10), cy + 40 * Math.cos(k / 10));
-                await new Promise((r) => setTimeout(r, 30));
-            }
-        })();
-        const drawing = await frames();
-        orbit = false;
-        await orbiting;
-        await app.page.mouse.up();
-        // G opens the graphs again: they compute in the background.
-        await app.page.keyboard.press("g");
-        await app.page.waitForFunction(() => window.meshsmooth.state().guidance.activities.length > 0, null, { timeout: 30_000 });
-        const graphsBusy = await busy();
-        const graphs = await frames(true);
-        // Interaction while they compute: a parameter change every half second (each one
-        // starts the graphs again, for the new parameters).
-        const interacting = app.page.evaluate(async () => {
-            let last = 0;
-            for (let k = 0; k < 12; k++) {
-                window.meshsmooth.setParams({ alpha: 0.05 + 0.01 * k });
-                last = performance.now();
-                await new Promise((r) => setTimeout(r, 500));
-            }
-            return last;
-        });
-        const withInteraction = await frames();
-        const lastChange = await interacting;
-        const interactionBusy = await busy();
-        // How long the graphs take to be current for the last parameters (null: not within a
-        // minute).
-        const refreshed = await app.page
-            .waitForFunction(() => window.meshsmooth.state().guidance.graphs_current, null, { timeout: 60_000, polling: 100 })
-            .then(() => true, () => false);
-        const now = await app.page.evaluate(() => performance.now());
-        const graphsRefreshSeconds = refreshed ? (now - lastChange) / 1000 : null;
-        // The view's adapter and sample count, as the app logs them.
-        const adapter = app.console.find((l) => l.text.includes("3D view on"))?.text ?? "not logged";
-        const guidanceEngine = (await state(app)).guidance.engine;
-        const line = { test: "guidance-frames", mode: MODE, query, guidanceEngine, mesh: "seg_mni152 206k", adapter, idle, drawing, graphs, withInteraction, graphsBusy, interactionBusy, graphsRefreshSeconds };
-        console.log(JSON.stringify(line));
-        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
-        assert.ok(idle.frames > 0 && drawing.frames > 0 && graphs.frames > 0 && withInteraction.frames > 0);
-        assert.ok(graphsBusy.some((what) => what.startsWith("Quality graphs")), `graphs computing: ${graphsBusy}`);
-        if (guidanceEngine === "cpu") {
-            // The graphs run in the engine's workers: no frame waits for them longer than
-            // drawing this mesh takes, with 50 ms to spare.
-            assert.ok(graphs.max_ms <= drawing.max_ms + 50, `longest frame while the graphs compute ${graphs.max_ms} ms, orbiting ${drawing.max_ms} ms`);
-        }
-    }, { query });
-}
-
-test("G5 benchmark: the HC grid suggestion on the 206k-vertex mesh with one and two workers, against the CLI on two threads (printed)", { timeout: TIMEOUT, skip: MODE !== "cpu" && "CPU mode only" }, async () => {
-    const pages = {};
-    for (const workers of [1, 2]) {
-        await withApp(async (app) => {
-            await app.call("setFilter", "hc");
-            await app.loadMesh(readFileSync(BRAIN), "brain.ply");
-            await app.call("metrics");
-            const engine = (await state(app)).cpu_engine;
-            assert.deepEqual(engine, { workers, threaded: true }, "the page runs the CPU engine in its workers");
-            pages[workers] = await app.call("suggest", { tau: 0.5, search: "grid" });
-        }, { query: `?workers=${workers}` });
-    }
-    const want = await cli.cliJson("suggest", BRAIN, "--filter", "hc", "--tau", "0.5", "--search", "grid", "--json");
-    for (const got of Object.values(pages)) {
-        assert.deepEqual(got.params, want.params, "the page's grid suggestion is the CLI's");
-    }
-    const line = {
-        bench: "page-grid-suggestion", mesh: "seg_mni152 206k", filter: "hc", tau: 0.5,
-        page_one_worker_s: pages[1].seconds, page_two_workers_s: pages[2].seconds,
-        cli_two_threads_s: want.seconds,
-        pool_speedup: pages[1].seconds / pages[2].seconds,
-        one_worker_vs_cli: pages[1].seconds / want.seconds,
-        two_workers_vs_cli: pages[2].seconds / want.seconds,
-    };
-    console.log(JSON.stringify(line));
-    appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
-});

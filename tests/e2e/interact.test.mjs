@@ -4,69 +4,23 @@
 // target/e2e/<mode>/.
 //
 //   bash tests/e2e/run.sh --test-name-pattern='^interact'
-import { test } from "node:test";
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 
+import { brushOn, drag, frames, settled, viewCentre } from "./lib/input.mjs";
 import { meshPath } from "./lib/paths.mjs";
-import { appSuite } from "./lib/suite.mjs";
+import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
-const { MODE, OUT, withApp } = appSuite();
+const { MODE, withApp } = appSuite();
 
 const SPHERE = meshPath("synthetic/synthetic_sphere_r20.ply");
-const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
 
 /** src/view/param_drag.rs: a parameter's whole range over this many points of travel. */
 const POINTS_PER_RANGE = 400;
 
 const API_TIMEOUT = 5 * 60_000;
 
-/** Waits for the next two frames the page paints (input is handled once per frame). */
-const frames = (app) =>
-    app.page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
-
-/** The 3D view's rectangle and its centre (CSS pixels), from `state().view`. */
-async function viewCentre(app) {
-    const { view } = await app.state();
-    assert.ok(view && view.width > 200 && view.height > 200, `state().view: ${JSON.stringify(view)}`);
-    return { x: view.x + view.width / 2, y: view.y + view.height / 2, view };
-}
-
-/**
- * Drags with `button` from `from` by `by` in `steps` moves, a frame apart (as a hand does);
- * `during(app)` runs before the button is released.
- */
-async function drag(app, button, from, by, { steps = 12, during } = {}) {
-    const mouse = app.page.mouse;
-    await mouse.move(from.x, from.y);
-    await frames(app);
-    await mouse.down({ button });
-    await frames(app);
-    for (let k = 1; k <= steps; k++) {
-        await mouse.move(from.x + (by.x * k) / steps, from.y + (by.y * k) / steps);
-        await frames(app);
-    }
-    await during?.(app);
-    await mouse.up({ button });
-    await frames(app);
-}
-
-/** Clicks the view (so the canvas has the keyboard) and presses P, the brush's key. */
-async function brushOn(app, centre) {
-    await app.page.mouse.click(centre.x, centre.y);
-    await frames(app);
-    await app.page.keyboard.press("p");
-    await frames(app);
-}
-
-/** The current parameters once the page has taken every event (its measures computed). */
-async function settled(app) {
-    const metrics = await app.metrics();
-    const state = await app.state();
-    return { metrics, state };
-}
-
-test("interact 1 a right drag drives the filter's two parameters: right and up increase", { timeout: API_TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "interact 1 a right drag drives the filter's two parameters: right and up increase", { timeout: API_TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.setFilter("hc");
         await app.setParams({ alpha: 0.1, beta: 0.5, iterations: 10 });
@@ -107,7 +61,7 @@ test("interact 1 a right drag drives the filter's two parameters: right and up i
     });
 });
 
-test("interact 2 a brush stroke locks the vertices under it: they stay, the measures change", { timeout: API_TIMEOUT }, async () => {
+testIn(EVERY_RUN, "interact 2 a brush stroke locks the vertices under it: they stay, the measures change", { timeout: API_TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(SPHERE), "synthetic_sphere_r20.ply");
         await app.setFilter("laplace");
@@ -152,31 +106,6 @@ test("interact 2 a brush stroke locks the vertices under it: they stay, the meas
         const cleared = await settled(app);
         assert.equal(cleared.state.weights, null);
         assert.deepEqual(cleared.metrics, free.metrics);
-    });
-});
-
-test("interact 3 picking under the brush on the 206k-vertex segmentation (time printed)", { timeout: 10 * 60_000 }, async () => {
-    await withApp(async (app) => {
-        await app.loadMesh(readFileSync(BRAIN), "seg_mni152_gm_plus_wm_p0.5_1mm.ply");
-        await app.setParams({ iterations: 0 });
-        await settled(app);
-        const centre = await viewCentre(app);
-        await brushOn(app, centre);
-        const times = [];
-        for (let k = 0; k < 10; k++) {
-            await app.page.mouse.move(centre.x + 10 * k, centre.y + 5 * k);
-            await frames(app);
-            const { brush } = await app.state();
-            assert.equal(brush.on, true);
-            if (brush.pick_ms !== null) times.push(brush.pick_ms);
-        }
-        assert.ok(times.length >= 5, `picks recorded: ${times}`);
-        times.sort((a, b) => a - b);
-        const median = times[Math.floor(times.length / 2)];
-        console.log(`interact ${MODE}: pick on 414,236 triangles: median ${median.toFixed(2)} ms, max ${times.at(-1).toFixed(2)} ms (${times.length} picks)`);
-        // A pick per mouse move must leave most of a 60 Hz frame.
-        assert.ok(median < 16, `picking takes ${median} ms`);
-        await app.screenshot("interact-3-brain-brush");
     });
 });
 

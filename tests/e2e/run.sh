@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# End-to-end tests of the built web app in headless Chromium, run twice:
-#   webgpu  WebGPU on SwiftShader (the app's GPU engine),
-#   cpu     no WebGPU: eframe falls back to WebGL2 and the app uses its CPU engine.
+# End-to-end tests of the built web app in headless Chromium, in two runs:
+#   webgpu  WebGPU on SwiftShader (the app's GPU engine): every test;
+#   cpu     no WebGPU: eframe falls back to WebGL2 and the app uses its CPU engine: the tests
+#           whose outcome the engine or the renderer changes (testIn in lib/suite.mjs).
 # Both runs always happen; the script fails if either failed.
 #
 #   bash tests/e2e/run.sh              (after `trunk build --release` made dist/)
 #   E2E_MODES=cpu bash tests/e2e/run.sh
 #   bash tests/e2e/run.sh --test-name-pattern='^5 '   (extra arguments go to node --test)
+#   bash tests/e2e/run.sh --bench      the browser benchmarks (*.bench.mjs) instead of the tests
 #
 # Screenshots and exported files: target/e2e/<mode>/; benchmark lines: target/e2e/bench.json.
 # Needs: web/node_modules (npm ci in web/, .ci/install.sh), /usr/bin/chromium, ../shared/data.
@@ -27,16 +29,27 @@ if [ ! -d web/node_modules/playwright-core ] || [ ! -d web/node_modules/gltf-val
     exit 1
 fi
 
-# The CLI is the reference for every number the app reports; cargo skips the build when it is
-# up to date.
+files=(tests/e2e/*.test.mjs)
+# The CLI is the reference for every number the app reports. The tests take the build that
+# `cargo test` made (the test profile optimises as release does), so the test command compiles
+# the CLI once; the benchmarks time it, so they take the release build. Cargo skips a build that
+# is up to date.
+profile=test
+profile_dir=debug
+if [ "${1:-}" = "--bench" ]; then
+    shift
+    files=(tests/e2e/*.bench.mjs)
+    profile=release
+    profile_dir=release
+fi
 if [ -z "${MESHSMOOTH_CLI:-}" ]; then
-    cargo build --release --quiet
+    cargo build --profile "$profile" --bin meshsmooth --quiet
     target_dir="${CARGO_TARGET_DIR:-target}"
     case "$target_dir" in
         /*) ;;
         *) target_dir="$PWD/$target_dir" ;;
     esac
-    export MESHSMOOTH_CLI="$target_dir/release/meshsmooth"
+    export MESHSMOOTH_CLI="$target_dir/$profile_dir/meshsmooth"
 fi
 
 rm -rf target/e2e
@@ -46,7 +59,7 @@ failed=()
 for mode in ${E2E_MODES:-webgpu cpu}; do
     echo
     echo "=== e2e ($mode)"
-    if ! E2E_MODE="$mode" node --test --test-reporter=spec "$@" tests/e2e/*.test.mjs; then
+    if ! E2E_MODE="$mode" node --test --test-reporter=spec "$@" "${files[@]}"; then
         failed+=("$mode")
     fi
 done
@@ -56,4 +69,4 @@ if [ ${#failed[@]} -gt 0 ]; then
     echo "tests/e2e/run.sh: failed in: ${failed[*]} (screenshots in target/e2e/)" >&2
     exit 1
 fi
-echo "tests/e2e/run.sh: both modes passed (screenshots in target/e2e/)"
+echo "tests/e2e/run.sh: ${E2E_MODES:-webgpu cpu}: passed (screenshots in target/e2e/)"

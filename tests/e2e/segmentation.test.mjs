@@ -2,7 +2,6 @@
 // (the same the CLI's `extract` makes), one of them the model; a broken one is refused by name.
 //
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/segmentation.test.mjs   (tests/e2e/run.sh runs both)
-import { test } from "node:test";
 import assert from "node:assert/strict";
 import { appendFileSync, readFileSync, writeFileSync } from "node:fs";
 import { gunzipSync, gzipSync } from "node:zlib";
@@ -11,7 +10,7 @@ import { join } from "node:path";
 import * as cli from "./lib/cli.mjs";
 import { metricDifferences } from "./lib/compare.mjs";
 import { E2E_OUT, meshPath } from "./lib/paths.mjs";
-import { appSuite } from "./lib/suite.mjs";
+import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 
@@ -39,7 +38,7 @@ function assertSameStructures(page, native) {
     });
 }
 
-test("S1 the JHU atlas opens into its 48 structures, as the CLI extracts them (time printed)", { timeout: TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "S1 the JHU atlas opens into its 48 structures, as the CLI extracts them (time printed)", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         const name = "JHU-WhiteMatter-labels-1mm.nii.gz";
         const bytes = readFileSync(JHU);
@@ -76,7 +75,7 @@ test("S1 the JHU atlas opens into its 48 structures, as the CLI extracts them (t
     });
 });
 
-test("S2 the phantom's .seg.nrrd names its structures; picking one makes it the model with its voxel size", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "S2 the phantom's .seg.nrrd names its structures; picking one makes it the model with its voxel size", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
         const list = await app.call("structures");
@@ -104,7 +103,7 @@ test("S2 the phantom's .seg.nrrd names its structures; picking one makes it the 
     });
 });
 
-test("S3 a broken label map is refused by name and the open structure stays", { timeout: TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "S3 a broken label map is refused by name and the open structure stays", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(PHANTOM_NIFTI), "case_phantom_shared.nii.gz");
         const whole = readFileSync(PHANTOM_NIFTI);
@@ -165,7 +164,7 @@ function ctSizedLabelMap() {
     return gzipSync(out, { level: 1 });
 }
 
-test("S4 a CT-sized label map (512 x 512 x 400) opens natively and in the page (times and peak memory printed)", { timeout: 600_000 }, async () => {
+testIn(WEBGPU_RUN, "S4 a CT-sized label map (512 x 512 x 400) opens natively and in the page (times and peak memory printed)", { timeout: 600_000 }, async () => {
     const bytes = ctSizedLabelMap();
     const file = join(E2E_OUT, `ct_sized_${MODE}.nii.gz`);
     writeFileSync(file, bytes);
@@ -202,7 +201,7 @@ test("S4 a CT-sized label map (512 x 512 x 400) opens natively and in the page (
     });
 });
 
-test("S5 a label map dropped on the page opens as its structures", { timeout: TIMEOUT }, async () => {
+testIn(WEBGPU_RUN, "S5 a label map dropped on the page opens as its structures", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.dropFile(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
         const deadline = Date.now() + 60_000;
