@@ -425,3 +425,23 @@ fn smooth_sweep_and_suggest_run_on_the_gpu_backend() {
         }
     }
 }
+
+/// A reader that goes away (`meshsmooth info brain.ply | head -0`) ends the tool quietly, with
+/// no panic message, as Unix tools end.
+#[test]
+fn a_closed_output_pipe_ends_quietly() {
+    use std::process::{Command, Stdio};
+    let scalp = data("real/fsaverage_head_scalp_mne.ply");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_meshsmooth"))
+        .args(["info", scalp.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the meshsmooth binary runs");
+    // Closed before the tool has read the mesh, so its first write finds no reader.
+    child.stdout = None;
+    let out = child.wait_with_output().expect("it ends");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "status {:?}: {stderr}", out.status);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

@@ -120,7 +120,7 @@ pub(super) fn run(
         } else {
             super::to_json(&results)?
         };
-        println!("{text}");
+        outln!("{text}");
     } else {
         let engine = match &gpu {
             Some(g) => format!(
@@ -129,15 +129,15 @@ pub(super) fn run(
             ),
             None => "cpu backend".to_string(),
         };
-        println!(
+        outln!(
             "{}: {} vertices, {engine}, {} threads, best of {repeat}",
             file.display(),
             mesh.vertex_count(),
             rayon::current_num_threads()
         );
-        println!("filter   iter   smooth ms   M vertex-it/s   measure ms   drift ms   measure / 10 Laplace it");
+        outln!("filter   iter   smooth ms   M vertex-it/s   measure ms   drift ms   measure / 10 Laplace it");
         for r in &results {
-            println!(
+            outln!(
                 "{:<8} {:>4} {:>11.2} {:>15.1} {:>12.2} {:>10.2} {:>25.2}",
                 r.filter,
                 r.iterations,
@@ -149,9 +149,9 @@ pub(super) fn run(
             );
         }
         if gpu.is_some() {
-            println!("filter   gpu measure ms   gpu drift ms");
+            outln!("filter   gpu measure ms   gpu drift ms");
             for r in &results {
-                println!(
+                outln!(
                     "{:<8} {:>15.2} {:>14.2}",
                     r.filter,
                     r.gpu_measure_seconds.unwrap_or(0.0) * 1e3,

@@ -27,11 +27,11 @@ pub fn run(path: &Path, repeat: usize, json: bool) -> Result<(), String> {
     let timing = measure(&bytes, &path.display().to_string(), repeat)?;
     if json {
         let text = serde_json::to_string(&timing).map_err(|e| e.to_string())?;
-        println!("{text}");
+        outln!("{text}");
     } else {
-        println!("{}", timing.file);
-        println!("  {} vertices, {} faces", timing.vertices, timing.faces);
-        println!(
+        outln!("{}", timing.file);
+        outln!("  {} vertices, {} faces", timing.vertices, timing.faces);
+        outln!(
             "  parse {:.2} ms, topology {:.2} ms, total {:.2} ms (best of {})",
             timing.parse_seconds * 1e3,
             timing.topology_seconds * 1e3,

@@ -170,11 +170,11 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         out["suggest_seconds"] = serde_json::json!(suggest_seconds);
         out["seconds"] = serde_json::json!(started.elapsed().as_secs_f64());
         out["bytes"] = serde_json::json!(bytes.len());
-        println!("{}", super::to_json(&out)?);
+        outln!("{}", super::to_json(&out)?);
     } else {
-        print!("{}", table(&case));
-        print!("{}", case::checks_text(&case, &before, &after, &changes));
-        println!(
+        out!("{}", table(&case));
+        out!("{}", case::checks_text(&case, &before, &after, &changes));
+        outln!(
             "{} structures, {evaluations} parameter sets, suggested and smoothed in {:.2} s; \
              {} written ({} bytes)",
             case.structures.len(),
@@ -232,15 +232,15 @@ fn info(file: &Path, json: bool) -> Result<(), String> {
     let scene = crate::io::load_gltf_scene(&bytes, &name).map_err(|e| format!("{name}: {e}"))?;
     let case = case::from_gltf_scene(scene, &name).map_err(|e| format!("{name}: {e}"))?;
     if json {
-        println!("{}", super::to_json(&case_json(&case))?);
+        outln!("{}", super::to_json(&case_json(&case))?);
     } else {
         if !case.title.is_empty() {
-            println!("{}", case.title);
+            outln!("{}", case.title);
         }
         if !case.description.is_empty() {
-            println!("{}", case.description);
+            outln!("{}", case.description);
         }
-        print!("{}", table(&case));
+        out!("{}", table(&case));
     }
     Ok(())
 }

@@ -84,10 +84,10 @@ pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
             "seconds": seconds,
             "peak_memory_bytes": peak_memory_bytes(),
         });
-        println!("{}", super::to_json(&out)?);
+        outln!("{}", super::to_json(&out)?);
     } else {
-        print!("{}", table_text(&structures));
-        println!("{} structures in {seconds:.3} s", structures.len());
+        out!("{}", table_text(&structures));
+        outln!("{} structures in {seconds:.3} s", structures.len());
     }
     Ok(())
 }

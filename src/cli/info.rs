@@ -10,9 +10,9 @@ pub(super) fn run(file: &Path, json: bool) -> Result<(), String> {
     let mesh = super::load_file(file)?;
     let report = MeshReport::new(&mesh, &Topology::build(&mesh));
     if json {
-        println!("{}", super::to_json(&report)?);
+        outln!("{}", super::to_json(&report)?);
     } else {
-        print!("{}", text(&report));
+        out!("{}", text(&report));
     }
     Ok(())
 }
@@ -72,21 +72,25 @@ fn label_map(file: &Path, json: bool) -> Result<(), String> {
             "layers": map.layers.len(),
             "structures": list,
         });
-        println!("{}", super::to_json(&out)?);
+        outln!("{}", super::to_json(&out)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "grid                   {} x {} x {}",
-        map.dims[0], map.dims[1], map.dims[2]
+        map.dims[0],
+        map.dims[1],
+        map.dims[2]
     );
-    println!(
+    outln!(
         "voxel size             {:.4} x {:.4} x {:.4} mm",
-        spacing[0], spacing[1], spacing[2]
+        spacing[0],
+        spacing[1],
+        spacing[2]
     );
-    println!("layers                 {}", map.layers.len());
-    println!("structures             {}", labels.len());
+    outln!("layers                 {}", map.layers.len());
+    outln!("structures             {}", labels.len());
     for l in &labels {
-        println!(
+        outln!(
             "{:>6}  {:<40} {:>10} voxels {:>12.1} mm3",
             l.label,
             l.name,

@@ -51,9 +51,9 @@ pub(super) fn run(
         ));
     }
     if json {
-        println!("{}", super::to_json(&m)?);
+        outln!("{}", super::to_json(&m)?);
     } else {
-        print!("{}", text(&m));
+        out!("{}", text(&m));
     }
     Ok(())
 }

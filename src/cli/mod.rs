@@ -1,6 +1,9 @@
 //! The native command-line tool: fixed pipelines (e.g. CFD preparation) on the same engine as
 //! the web app. Every error goes to stderr with a non-zero exit code.
 
+#[macro_use]
+mod stdout;
+
 mod backend;
 mod bench;
 mod bench_load;

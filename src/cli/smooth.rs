@@ -77,17 +77,17 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
                 "evaluations": s.evaluations,
             });
         }
-        println!("{}", super::to_json(&report)?);
+        outln!("{}", super::to_json(&report)?);
     } else {
         if let Some(s) = &suggestion {
-            println!(
+            outln!(
                 "suggested for tau {tau} by {} search ({} parameter sets): {}",
                 s.search.name(),
                 s.evaluations,
                 params.to_json()
             );
         }
-        println!(
+        outln!(
             "{} -> {} ({} {} iterations, {:.1} ms)",
             file.display(),
             output.display(),
@@ -95,7 +95,7 @@ pub(super) fn run(file: &Path, output: &Path, args: &FilterArgs, how: &How) -> R
             params.iterations,
             seconds * 1e3
         );
-        print!("{}", super::measure::text(&metrics));
+        out!("{}", super::measure::text(&metrics));
     }
     Ok(())
 }

@@ -64,9 +64,9 @@ pub(super) fn run(args: &SuggestArgs) -> Result<(), String> {
     let s = s?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
-        println!("{}", super::to_json(&s.to_json(seconds))?);
+        outln!("{}", super::to_json(&s.to_json(seconds))?);
     } else {
-        print!("{}", text(&s, seconds));
+        out!("{}", text(&s, seconds));
     }
     Ok(())
 }

@@ -80,11 +80,11 @@ pub(super) fn run(args: &SweepArgs) -> Result<(), String> {
         })?;
     }
     if args.json {
-        println!("{}", super::to_json(&graphs.to_json(seconds))?);
+        outln!("{}", super::to_json(&graphs.to_json(seconds))?);
     } else if args.csv {
-        print!("{}", csv(&graphs));
+        out!("{}", csv(&graphs));
     } else {
-        print!("{}", text(&graphs, seconds));
+        out!("{}", text(&graphs, seconds));
     }
     Ok(())
 }
