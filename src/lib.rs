@@ -8,6 +8,7 @@
 pub mod case;
 pub mod evaluate;
 pub mod export;
+#[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod io;
 pub mod mesh;
@@ -19,8 +20,8 @@ pub mod suggest;
 pub mod view;
 pub mod worker;
 
-#[cfg(not(target_arch = "wasm32"))]
+#[cfg(all(not(target_arch = "wasm32"), feature = "cli"))]
 pub mod cli;
 
-#[cfg(target_arch = "wasm32")]
+#[cfg(all(target_arch = "wasm32", feature = "cli"))]
 pub mod app;

@@ -32,4 +32,5 @@ pub use roughness::{roughness, roughness_ratio};
 pub use score::ScoreTerms;
 
 // What the GPU engine's measure pass shares with the CPU's.
+#[cfg(feature = "gpu")]
 pub(crate) use report::{metrics as metrics_from_sums, Sums};

@@ -121,6 +121,7 @@ impl Original {
 
     /// [`Self::fan_corners`] of every vertex, in vertex order (parallel to the topology's
     /// `vertex_triangles`): what the GPU engine uploads.
+    #[cfg(feature = "gpu")]
     pub(crate) fn all_fan_corners(&self) -> &[[u32; 2]] {
         &self.fan_corners
     }

@@ -296,6 +296,7 @@ pub(crate) struct Sums {
 
 impl Sums {
     /// Totals summed elsewhere (the GPU engine's measure pass).
+    #[cfg(feature = "gpu")]
     pub(crate) fn from_totals(
         volume6: f64,
         (curvature_sum, curvature_count): (f64, usize),

@@ -22,6 +22,7 @@ mod umbrella;
 
 pub use params::{shortest, Filter, ParamError, Params};
 // The GPU engine evaluates the same windowed-sinc series.
+#[cfg(feature = "gpu")]
 pub(crate) use sinc_coefficients::sinc_coefficients;
 
 use crate::mesh::{Mesh, Topology};
