@@ -27,6 +27,21 @@ const TIMEOUT = 20 * 60_000;
 
 const state = (app) => app.page.evaluate(() => window.meshsmooth.state());
 
+/** Starts logging the times of the page's animation frames. */
+const startFrameLog = (app) =>
+    app.page.evaluate(() => {
+        window.frameLog = [];
+        const look = (t) => {
+            window.frameLog.push(t);
+            requestAnimationFrame(look);
+        };
+        requestAnimationFrame(look);
+    });
+
+/** The longest interval between logged frames so far (ms). */
+const longestLoggedFrame = (app) =>
+    app.page.evaluate(() => Math.round(Math.max(0, ...window.frameLog.slice(1).map((t, i) => t - window.frameLog[i]))));
+
 /** Prints a figure line and keeps it in target/e2e/bench.json. */
 function emit(line) {
     console.log(JSON.stringify(line));
@@ -226,7 +241,9 @@ testIn(CPU_RUN, "B3 the HC grid suggestion on the 206k-vertex mesh with one and 
             await app.call("metrics");
             const engine = (await state(app)).cpu_engine;
             assert.deepEqual(engine, { workers, threaded: true }, "the page runs the CPU engine in its workers");
+            await startFrameLog(app);
             pages[workers] = await app.call("suggest", { tau: 0.5, search: "grid" });
+            pages[workers].longest_frame_ms = await longestLoggedFrame(app);
         }, { query: `?workers=${workers}` });
     }
     const want = await cli.cliJson("suggest", BRAIN, "--filter", "hc", "--tau", "0.5", "--search", "grid", "--json");
@@ -240,6 +257,8 @@ testIn(CPU_RUN, "B3 the HC grid suggestion on the 206k-vertex mesh with one and 
         pool_speedup: pages[1].seconds / pages[2].seconds,
         one_worker_vs_cli: pages[1].seconds / want.seconds,
         two_workers_vs_cli: pages[2].seconds / want.seconds,
+        longest_frame_ms_one_worker: pages[1].longest_frame_ms,
+        longest_frame_ms_two_workers: pages[2].longest_frame_ms,
     };
     emit(line);
 });
@@ -265,5 +284,75 @@ testIn(EVERY_RUN, "B4 picking under the brush on the 206k-vertex segmentation", 
         // The aim: a pick per mouse move leaves most of a 60 Hz frame (under 16 ms).
         emit({ bench: "brush-pick", mode: MODE, mesh: "seg_mni152_gm_plus_wm_p0.5_1mm.ply", triangles: 414236, picks: times.length, median_ms: median, max_ms: times.at(-1) });
         await app.screenshot("bench-brain-brush");
+    });
+});
+
+testIn(EVERY_RUN, "B5 from dropping the 206k-vertex brain to its first smoothed frame, and the longest frame meanwhile", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        const name = "seg_mni152_gm_plus_wm_p0.5_1mm.ply";
+        // Every animation frame from the drop on: its time, and whether the brain is the model
+        // and its result for the current parameters is there.
+        await app.page.evaluate((name) => {
+            window.benchFrames = [];
+            const look = (t) => {
+                const s = window.meshsmooth.state();
+                window.benchFrames.push({ t, opened: s.model === name, smoothed: s.model === name && !s.busy });
+                requestAnimationFrame(look);
+            };
+            requestAnimationFrame(look);
+        }, name);
+        const dropped = await app.page.evaluate(() => performance.now());
+        await app.dropFile(readFileSync(BRAIN), name);
+        await app.page.waitForFunction(() => window.benchFrames.filter((f) => f.smoothed).length >= 2, null, { timeout: 5 * 60_000, polling: 100 });
+        const frames = await app.page.evaluate(() => window.benchFrames);
+        const after = frames.filter((f) => f.t >= dropped);
+        const first = (key) => after.find((f) => f[key]).t;
+        const smoothedAt = first("smoothed");
+        const gaps = after.filter((f) => f.t <= smoothedAt).map((f, i, a) => (i ? f.t - a[i - 1].t : 0));
+        emit({
+            bench: "drop-to-first-smoothed-frame",
+            mode: MODE,
+            backend: await app.backend(),
+            mesh: name,
+            // Includes handing the file's bytes to the page (the test's DataTransfer).
+            seconds_to_opened: (first("opened") - dropped) / 1000,
+            seconds_to_first_smoothed_frame: (smoothedAt - dropped) / 1000,
+            frames: gaps.length,
+            longest_frame_ms: Math.round(Math.max(...gaps)),
+        });
+        await app.screenshot("bench-brain-dropped");
+    });
+});
+
+testIn(CPU_RUN, "B6 the quality graphs of the 206k-vertex brain with one and two workers, against the CLI's sweep on two threads", { timeout: 30 * 60_000 }, async () => {
+    const pages = {};
+    for (const workers of [1, 2]) {
+        await withApp(async (app) => {
+            await app.call("setFilter", "hc");
+            await app.loadMesh(readFileSync(BRAIN), "brain.ply");
+            await app.call("metrics");
+            assert.deepEqual((await state(app)).cpu_engine, { workers, threaded: true });
+            // The graphs of the opened mesh first; the timed ones are for a new alpha, from
+            // its change to the last sample.
+            await app.call("sweep");
+            pages[workers] = await app.page.evaluate(async () => {
+                const start = performance.now();
+                await window.meshsmooth.setParams({ alpha: 0.11 });
+                const sweep = await window.meshsmooth.sweep();
+                return { seconds: (performance.now() - start) / 1000, sweep };
+            });
+        }, { query: `?workers=${workers}` });
+    }
+    const want = await cli.cliJson("sweep", BRAIN, "--filter", "hc", "--alpha", "0.11", "--json");
+    for (const got of Object.values(pages)) {
+        assert.equal(got.sweep.current.alpha, 0.11);
+        assert.deepEqual(got.sweep.curves.map((c) => c.best), want.curves.map((c) => c.best), "the page's graphs have the CLI's minima");
+    }
+    emit({
+        bench: "page-quality-graphs", mesh: "seg_mni152 206k", filter: "hc",
+        page_one_worker_s: pages[1].seconds, page_two_workers_s: pages[2].seconds,
+        cli_two_threads_s: want.seconds,
+        pool_speedup: pages[1].seconds / pages[2].seconds,
+        two_workers_vs_cli: pages[2].seconds / want.seconds,
     });
 });
