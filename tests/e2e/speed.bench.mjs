@@ -42,6 +42,17 @@ const startFrameLog = (app) =>
 const longestLoggedFrame = (app) =>
     app.page.evaluate(() => Math.round(Math.max(0, ...window.frameLog.slice(1).map((t, i) => t - window.frameLog[i]))));
 
+/** Runs `body(app)` on a page with `workers` engine workers, the brain open with HC and measured. */
+function withBrainOnWorkers(workers, body) {
+    return withApp(async (app) => {
+        await app.call("setFilter", "hc");
+        await app.loadMesh(readFileSync(BRAIN), "brain.ply");
+        await app.call("metrics");
+        assert.deepEqual((await state(app)).cpu_engine, { workers, threaded: true }, "the page runs the CPU engine in its workers");
+        return body(app);
+    }, { query: `?workers=${workers}` });
+}
+
 /** Prints a figure line and keeps it in target/e2e/bench.json. */
 function emit(line) {
     console.log(JSON.stringify(line));
@@ -235,16 +246,11 @@ async function framesWhileGraphsCompute(query) {
 testIn(CPU_RUN, "B3 the HC grid suggestion on the 206k-vertex mesh with one and two workers, against the CLI on two threads", { timeout: 30 * 60_000 }, async () => {
     const pages = {};
     for (const workers of [1, 2]) {
-        await withApp(async (app) => {
-            await app.call("setFilter", "hc");
-            await app.loadMesh(readFileSync(BRAIN), "brain.ply");
-            await app.call("metrics");
-            const engine = (await state(app)).cpu_engine;
-            assert.deepEqual(engine, { workers, threaded: true }, "the page runs the CPU engine in its workers");
+        await withBrainOnWorkers(workers, async (app) => {
             await startFrameLog(app);
             pages[workers] = await app.call("suggest", { tau: 0.5, search: "grid" });
             pages[workers].longest_frame_ms = await longestLoggedFrame(app);
-        }, { query: `?workers=${workers}` });
+        });
     }
     const want = await cli.cliJson("suggest", BRAIN, "--filter", "hc", "--tau", "0.5", "--search", "grid", "--json");
     for (const got of Object.values(pages)) {
@@ -327,11 +333,7 @@ testIn(EVERY_RUN, "B5 from dropping the 206k-vertex brain to its first smoothed 
 testIn(CPU_RUN, "B6 the quality graphs of the 206k-vertex brain with one and two workers, against the CLI's sweep on two threads", { timeout: 30 * 60_000 }, async () => {
     const pages = {};
     for (const workers of [1, 2]) {
-        await withApp(async (app) => {
-            await app.call("setFilter", "hc");
-            await app.loadMesh(readFileSync(BRAIN), "brain.ply");
-            await app.call("metrics");
-            assert.deepEqual((await state(app)).cpu_engine, { workers, threaded: true });
+        await withBrainOnWorkers(workers, async (app) => {
             // The graphs of the opened mesh first; the timed ones are for a new alpha, from
             // its change to the last sample.
             await app.call("sweep");
@@ -341,7 +343,7 @@ testIn(CPU_RUN, "B6 the quality graphs of the 206k-vertex brain with one and two
                 const sweep = await window.meshsmooth.sweep();
                 return { seconds: (performance.now() - start) / 1000, sweep };
             });
-        }, { query: `?workers=${workers}` });
+        });
     }
     const want = await cli.cliJson("sweep", BRAIN, "--filter", "hc", "--alpha", "0.11", "--json");
     for (const got of Object.values(pages)) {
