@@ -1,5 +1,5 @@
-//! The GPU engine in a browser (`wasm-pack test --headless --chrome`, WebGPU from the flags in
-//! webdriver.json): the path the web app takes. A run with the drifting reference, then the
+//! The GPU engine in a browser (`cargo test --target wasm32-unknown-unknown`, WebGPU from the
+//! flags in webdriver.json): the path the web app takes. A run with the drifting reference, then the
 //! readback of positions and references and the measure pass's readback, both polled between
 //! turns of the event loop (nothing blocks), against the CPU engine in the same page. Every
 //! kernel must also pass the browser's own WGSL compiler (Tint), which is stricter than naga in

@@ -1,5 +1,5 @@
-//! The parsers and the topology compiled to wasm32 and run in a browser (`wasm-pack test
-//! --headless --chrome`): the same code path the web app takes after a file is opened.
+//! The parsers and the topology compiled to wasm32 and run in a browser (`cargo test --target
+//! wasm32-unknown-unknown`, headless Chromium as tests/run.sh sets it): the same code path the web app takes after a file is opened.
 //!
 //! Meshes come from `../shared/data` (see its README for the expected values); only the small
 //! ones are embedded, to keep the test module's size sane.
