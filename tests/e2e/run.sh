@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # End-to-end tests of the built web app in headless Chromium, in two runs:
-#   webgpu  WebGPU on SwiftShader (the app's GPU engine): every test;
+#   webgpu  WebGPU on SwiftShader (the app's GPU engine): every test but the CPU engine's own;
 #   cpu     no WebGPU: eframe falls back to WebGL2 and the app uses its CPU engine: the tests
 #           whose outcome the engine or the renderer changes (testIn in lib/suite.mjs).
 # Both runs always happen; the script fails if either failed.

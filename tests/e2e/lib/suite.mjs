@@ -12,9 +12,9 @@ import { DIST, outputDir } from "./paths.mjs";
 import { serveDirectory } from "./server.mjs";
 
 /**
- * The runs each test takes part in. The webgpu run takes every test; the cpu run repeats only
- * the tests whose outcome its engine (the CPU workers instead of the GPU) or its renderer (WebGL2
- * instead of WebGPU) can change.
+ * The runs each test takes part in. The webgpu run takes every test but those about the CPU
+ * engine alone (CPU_RUN); the cpu run takes only the tests whose outcome its engine (the CPU
+ * workers instead of the GPU) or its renderer (WebGL2 instead of WebGPU) can change.
  */
 export const EVERY_RUN = ["webgpu", "cpu"];
 export const WEBGPU_RUN = ["webgpu"];
