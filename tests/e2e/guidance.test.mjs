@@ -1,7 +1,7 @@
 // End-to-end tests of the guidance features: suggestions, quality graphs and the gallery (the
 // frame rate while they compute is a benchmark: speed.bench.mjs).
 import assert from "node:assert/strict";
-import { mkdtempSync, readFileSync } from "node:fs";
+import { mkdtempSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
