@@ -13,6 +13,7 @@ pub mod gpu;
 pub mod io;
 pub mod mesh;
 pub mod metrics;
+pub mod model;
 pub mod segmentation;
 pub mod session;
 pub mod smooth;

@@ -10,7 +10,7 @@ mod shapes;
 use meshsmooth::mesh::{Mesh, Topology};
 use meshsmooth::metrics::{
     exact_distances, exact_error, identity, measure, measure_vertices, point_triangle_distance2,
-    vertex_curvatures, DriftingReference, MeasureInParts, Original, OriginalInParts, TriangleBvh,
+    vertex_curvatures, DriftingReference, Original, TriangleBvh,
 };
 use meshsmooth::smooth::{self, Filter, NoObserver, Params};
 use std::f64::consts::PI;
@@ -194,63 +194,60 @@ fn nothing_moved_means_no_error_and_no_change() {
 }
 
 #[test]
-fn a_measure_pass_in_parts_equals_the_pass_in_one_call() {
+fn the_per_vertex_measures_add_up_to_the_report() {
     // The pial surface (10,242 vertices: six chunks) after 10 HC iterations.
     let (mesh, topology) = data::load(data::CLOSED_MESHES[0].0);
     assert!(mesh.vertex_count() > 5 * 2048);
     let o = Original::new(&mesh, &topology);
     let params = Params::defaults(Filter::Hc);
     let (positions, reference) = meshsmooth::metrics::smooth_drifting(&o, &params, None);
-    let whole = measure_vertices(&o, &positions, &reference, 0.3);
-    assert_eq!(whole.0, measure(&o, &positions, &reference, 0.3));
-    let n = mesh.vertex_count();
-    for part in [1, 2048, 5000, n] {
-        let mut pass = MeasureInParts::new(&o, &positions, &reference);
-        let mut calls = 0;
-        while !pass.advance(&o, &positions, &reference, part) {
-            calls += 1;
-            let (done, total) = pass.progress();
-            assert!(done < total && calls <= n, "part {part}: {done}/{total}");
-        }
-        let expected_calls = n.div_ceil(part.div_ceil(2048) * 2048);
-        assert_eq!(calls + 1, expected_calls, "part {part}");
-        assert_eq!(pass.finish(&o, 0.3), whole, "part {part}");
-    }
+    let (report, vertex) = measure_vertices(&o, &positions, &reference, 0.3);
+    assert_eq!(report, measure(&o, &positions, &reference, 0.3));
+    let errors = &vertex.local_error;
+    let mean = errors.iter().map(|&e| e as f64).sum::<f64>() / o.referenced_vertices() as f64;
+    assert!(
+        (mean - report.mean_error).abs() <= 1e-6 * report.mean_error,
+        "{mean}"
+    );
+    let max = errors.iter().fold(0.0f32, |m, &e| m.max(e)) as f64;
+    assert!(
+        (max - report.max_error).abs() <= 1e-6 * report.max_error,
+        "{max}"
+    );
+    let curvatures = &vertex.gaussian_curvature;
+    let interior = (0..mesh.vertex_count()).filter(|&i| !topology.is_boundary[i]);
+    let k = interior.map(|i| curvatures[i].abs() as f64).sum::<f64>() / mesh.vertex_count() as f64;
+    assert!(
+        (k - report.curvature).abs() <= 1e-4 * report.curvature,
+        "{k}"
+    );
 }
 
 #[test]
-fn the_original_measured_in_parts_equals_the_original_at_once() {
+fn an_original_sent_between_workers_measures_the_same() {
     for (name, _) in [data::CLOSED_MESHES[0], data::CLOSED_MESHES[6]] {
         let (mesh, topology) = data::load(name);
-        let at_once = Original::new(&mesh, &topology);
-        for part in [1, 3000, usize::MAX] {
-            let mut parts = OriginalInParts::new(mesh.clone(), topology.clone());
-            let mut fraction = parts.fraction();
-            assert_eq!(fraction, 0.0);
-            // Three precomputation steps (fan corners, stay radii, triangle areas), then the
-            // measure pass; the fraction grows within each.
-            let mut preparing = parts.preparing();
-            let mut calls = 0;
-            while !parts.advance(part) {
-                calls += 1;
-                if parts.preparing() != preparing {
-                    (preparing, fraction) = (parts.preparing(), 0.0);
-                }
-                assert!(
-                    parts.fraction() >= fraction && parts.fraction() < 1.0,
-                    "{name}"
-                );
-                fraction = parts.fraction();
-            }
-            assert!(
-                !preparing && calls >= 3,
-                "{name} part {part}: {calls} calls"
-            );
-            let o = parts.finish();
-            assert_eq!(o.volume(), at_once.volume(), "{name} part {part}");
-            assert_eq!(o.curvature(), at_once.curvature(), "{name} part {part}");
-            assert_eq!(o.referenced_vertices(), at_once.referenced_vertices());
-        }
+        let here = Original::new(&mesh, &topology);
+        let wire = postcard::to_allocvec(&here).unwrap();
+        let there: Original = postcard::from_bytes(&wire).unwrap();
+        assert_eq!(there.volume(), here.volume(), "{name}");
+        assert_eq!(there.curvature(), here.curvature(), "{name}");
+        assert_eq!(there.roughness(), here.roughness(), "{name}");
+        assert_eq!(there.referenced_vertices(), here.referenced_vertices());
+        assert_eq!(there.topology(), here.topology(), "{name}");
+        let params = Params::defaults(Filter::Hc);
+        let (positions, reference) = meshsmooth::metrics::smooth_drifting(&here, &params, None);
+        let smoothed_there = meshsmooth::metrics::smooth_drifting(&there, &params, None);
+        assert_eq!(
+            smoothed_there,
+            (positions.clone(), reference.clone()),
+            "{name}"
+        );
+        assert_eq!(
+            measure_vertices(&there, &positions, &reference, 0.5),
+            measure_vertices(&here, &positions, &reference, 0.5),
+            "{name}"
+        );
     }
 }
 

@@ -299,7 +299,7 @@ fn several_mask_files_are_one_structure_each_named_by_the_file() {
     }
 }
 
-/// The page's session opens a label map in stages (read, extract, then a mesh's), makes the
+/// The page's session opens a label map in a worker (read, extract, then a mesh's stages), makes the
 /// first structure the model with its voxel size, and opens another structure on request.
 #[test]
 fn a_session_opens_a_label_map_as_its_structures() {
@@ -307,19 +307,21 @@ fn a_session_opens_a_label_map_as_its_structures() {
     let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
     let mut session = Session::default();
     session.begin_open("case_phantom_shared.seg.nrrd", bytes);
-    let mut stages = Vec::new();
-    while let Some(p) = session.loading() {
-        if stages.last() != Some(&p.doing) {
-            stages.push(p.doing);
-        }
-        assert_eq!(p.total, 6);
-        if let Some(done) = session.step_loading(&|| 0.0, 0.0) {
-            done.expect("opens");
-        }
-    }
+    session.poll_opening().expect("done").expect("opens");
+    let stages: Vec<&str> = session
+        .open_stages()
+        .iter()
+        .map(|(d, _)| d.as_str())
+        .collect();
     assert_eq!(
-        &stages[..2],
-        ["reading the label map", "extracting the structures"]
+        stages,
+        [
+            "reading the label map",
+            "extracting the structures",
+            "building the topology",
+            "checking the mesh",
+            "measuring the original"
+        ]
     );
     let structures = session.structures().expect("a segmentation");
     assert_eq!(structures.list.len(), 4);
@@ -333,11 +335,7 @@ fn a_session_opens_a_label_map_as_its_structures() {
     assert!((vd - (0.78f64 * 0.78 * 2.0 + 2.5 * 2.5).sqrt()).abs() < 1e-6);
 
     session.begin_open_structure(2).expect("structure 2 exists");
-    while session.loading().is_some() {
-        if let Some(done) = session.step_loading(&|| 0.0, f64::MAX) {
-            done.expect("opens");
-        }
-    }
+    session.poll_opening().expect("done").expect("opens");
     let structures = session.structures().expect("still the segmentation");
     assert_eq!(structures.current, 2);
     assert_eq!(
@@ -353,11 +351,7 @@ fn a_session_opens_a_label_map_as_its_structures() {
     let mut broken = read("labelmaps/case_phantom_shared.nii.gz");
     broken.truncate(broken.len() / 2);
     session.begin_open("half.nii.gz", broken);
-    let mut outcome = None;
-    while session.loading().is_some() {
-        outcome = session.step_loading(&|| 0.0, f64::MAX).or(outcome);
-    }
-    let e = outcome.expect("finished").unwrap_err();
+    let e = session.poll_opening().expect("finished").unwrap_err();
     assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
     assert_eq!(
         session.model().expect("kept").name,

@@ -3,6 +3,9 @@
 // Requests are done one after another, in the order they came.
 let engine = null;
 
+// Replies sent before a request's answer (an opening's stages), as their bytes.
+const tell = (bytes) => self.postMessage(bytes.buffer, [bytes.buffer]);
+
 self.onmessage = (event) => {
     if (engine === null) {
         const { glue, wasm } = event.data;
@@ -16,7 +19,7 @@ self.onmessage = (event) => {
     const request = new Uint8Array(event.data);
     engine = engine.then((module) => {
         try {
-            const reply = module.worker_handle(request);
+            const reply = module.worker_handle(request, tell);
             if (reply !== undefined) {
                 self.postMessage(reply.buffer, [reply.buffer]);
             }

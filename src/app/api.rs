@@ -2,8 +2,8 @@
 //! the app has started, announced by a `meshsmooth-ready` event on `window`.
 //!
 //! - `loadMesh(bytes: Uint8Array, name): Promise<info>` (the CLI's `info --json` keys), once the
-//!   mesh is open: it opens a stage per frame (`state().loading`), the current model staying open
-//!   until then; a later `loadMesh` before it is open replaces it (its promise rejects)
+//!   mesh is open: a worker opens it (`state().loading` tells the stage), the current model
+//!   staying open until then; a later `loadMesh` before it is open replaces it (its promise rejects)
 //!   A label map (`.nii`, `.nii.gz`, `.nrrd`, `.seg.nrrd`) opens the same way: its structures
 //!   are extracted and the first one becomes the model
 //! - `structures()`: `{file, current, structures: [{label, name, color, voxels, voxel_size,
@@ -26,7 +26,7 @@
 //! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, loading,
 //!   open_stages, backend, timings, brush, view, layout, guidance}` (`loading`: `{name, stage, stages,
 //!   doing}` while a file opens, else null; `open_stages`: `[{doing, ms}]`, the latest opening's
-//!   stages and their times; `timings`: the last result's `smooth_ms` and `measure_ms`
+//!   stages and their times in the worker; `timings`: the last result's `smooth_ms` and `measure_ms`
 //!   of the CPU engine's own work, or `gpu_run_ms` from submitting a GPU run to having its
 //!   results back; `weights`: `{painted, locked, min, mean}` of the painted weights, or null;
 //!   `brush`: `{on, pick_ms}`, whether the weight brush is on and how long its latest pick took;
@@ -223,7 +223,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                 let bytes = bytes.to_vec();
                 let (d, c) = (d.clone(), c.clone());
                 let mut bytes = Some(bytes);
-                // Opened a stage per frame; the promise settles once it is open (or not).
+                // Opened in a worker; the promise settles once it is open (or not).
                 Promise::new(&mut |resolve: Function, reject: Function| {
                     let Some(bytes) = bytes.take() else { return };
                     let waiter = info_waiter(resolve, reject);

@@ -36,9 +36,6 @@ impl Backend {
     }
 }
 
-/// CPU work per frame (ms) before the frame is drawn; leaves room for drawing at 30+ fps.
-pub const FRAME_BUDGET_MS: f64 = 20.0;
-
 /// How long the last result took.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EngineTimings {
@@ -205,7 +202,7 @@ impl Document {
         }
     }
 
-    /// Starts opening a file's bytes, a stage per frame ([`Self::step_loading`]); the current
+    /// Starts opening a file's bytes in a worker ([`Self::step_loading`] takes it); the current
     /// model stays until it is open. `waiter`, when given, hears how it ended. A file still
     /// opening is dropped for this one, and its waiters hear so.
     pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>, waiter: Option<LoadWaiter>) {
@@ -224,9 +221,7 @@ impl Document {
         index: usize,
         waiter: Option<LoadWaiter>,
     ) -> Result<(), String> {
-        let replaced = self.session.loading().map(|l| l.name);
-        self.session.begin_open_structure(index)?;
-        if let Some(replaced) = replaced {
+        if let Some(replaced) = self.session.begin_open_structure(index)? {
             let why = format!("{replaced} was not opened: another structure was chosen first");
             for w in std::mem::take(&mut self.waiting_for_load) {
                 w(Err(why.clone()));
@@ -236,14 +231,14 @@ impl Document {
         Ok(())
     }
 
-    /// This frame's work on the file being opened, if one is: whether nothing is being opened,
-    /// it is still opening, or it opened (or failed) in this frame. Either of the last two takes
-    /// the frame: the engines take up a new model from the next frame on, before the view does.
+    /// Whether nothing is being opened, a worker is still opening it, or it opened (or failed)
+    /// in this frame. The last takes the frame: the engines take up a new model from the next
+    /// frame on, before the view does.
     pub fn step_loading(&mut self) -> Opening {
         if self.session.loading().is_none() {
             return Opening::Idle;
         }
-        let Some(outcome) = self.session.step_loading(&now_ms, FRAME_BUDGET_MS) else {
+        let Some(outcome) = self.session.poll_opening() else {
             return Opening::Working;
         };
         match &outcome {

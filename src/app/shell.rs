@@ -490,12 +490,12 @@ impl eframe::App for Shell {
         for action in shortcuts::pressed(&ctx) {
             self.apply(action);
         }
-        // A file still opening takes the frame (the model it replaces needs no more work), and
-        // so does the one that opens it; uploading it to the GPU takes the next.
+        // The frame a new model arrives in takes it up; uploading it to the GPU takes the next.
+        // While a worker opens a file, the open model is worked on as before.
         let opening = self.doc.borrow_mut().step_loading();
-        let loading = opening != Opening::Idle;
-        let uploading = !loading && self.compute();
-        if !loading && !uploading {
+        let arrived = opening == Opening::Done;
+        let uploading = !arrived && self.compute();
+        if !arrived && !uploading {
             let mut doc = self.doc.borrow_mut();
             let vertices = doc.session.model().map_or(0, |m| m.mesh().vertex_count());
             let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));

@@ -144,11 +144,21 @@ thread_local! {
     static ENGINE: RefCell<crate::worker::Worker> = RefCell::default();
 }
 
-/// Called by `web/worker.js` with each request's bytes: the reply's bytes, if any.
+/// Called by `web/worker.js` with each request's bytes: the reply's bytes, if any. `tell`
+/// posts the replies sent before it (an opening's stages), each as its bytes.
 #[wasm_bindgen]
-pub fn worker_handle(request: &[u8]) -> Option<Vec<u8>> {
+pub fn worker_handle(request: &[u8], tell: &js_sys::Function) -> Option<Vec<u8>> {
+    let mut post = |reply: Reply| {
+        let bytes = js_sys::Uint8Array::from(encode(&reply).as_slice());
+        if let Err(e) = tell.call1(&JsValue::NULL, &bytes) {
+            log::error!("{}", super::page::js_error_text(&e));
+        }
+    };
     let reply = match decode::<Request>(request) {
-        Ok(request) => ENGINE.with(|e| e.borrow_mut().handle(request, &crate::worker::clock_ms)),
+        Ok(request) => ENGINE.with(|e| {
+            e.borrow_mut()
+                .handle(request, &crate::worker::clock_ms, &mut post)
+        }),
         Err(why) => {
             log::error!("{why}");
             None

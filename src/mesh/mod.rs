@@ -3,20 +3,19 @@
 //! A mesh is two flat arrays (positions, triangles) so it can be uploaded to a GPU as-is;
 //! topology (`Topology`) and the validation report (`MeshReport`) are built on demand.
 
+pub(crate) mod flat_bytes;
 mod normals;
 mod padded_ring;
 mod report;
-mod report_parts;
+mod report_checks;
 mod topology;
-mod topology_parts;
+mod topology_build;
 
 pub use normals::vertex_normals;
 pub use padded_ring::{PaddedRing, PADDED_WIDTH};
 pub use report::MeshReport;
-pub use report_parts::ReportInParts;
 pub use topology::Topology;
-pub(crate) use topology_parts::by_blocks;
-pub use topology_parts::TopologyInParts;
+pub(crate) use topology_build::by_blocks;
 
 /// "No such index" in flat `u32` arrays.
 pub const NONE: u32 = u32::MAX;
@@ -25,7 +24,9 @@ pub const NONE: u32 = u32::MAX;
 /// counter-clockwise triangles (seen from outside).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mesh {
+    #[serde(with = "flat_bytes")]
     pub positions: Vec<[f32; 3]>,
+    #[serde(with = "flat_bytes")]
     pub triangles: Vec<[u32; 3]>,
 }
 

@@ -19,14 +19,17 @@ pub const PADDED_WIDTH: usize = 8;
 const BLOCK: usize = 4096;
 
 /// Per vertex, its smoothing ring padded to [`PADDED_WIDTH`] slots, and the ring's inverse size.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PaddedRing {
     /// The ring's neighbours, then the vertex count (the zero entry) in the unused slots; for a
     /// larger ring, the range of `large` that holds it in its first two slots.
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub rows: Vec<[u32; PADDED_WIDTH]>,
     /// `1 / ring size`; 0 for an isolated vertex (empty ring).
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub inverse_sizes: Vec<f32>,
     /// The rings larger than a row, whole, one after another in vertex order.
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub large: Vec<u32>,
     /// How far a ring reaches in vertex order: the largest `|j - i|` over every vertex `i` and
     /// neighbour `j` (0 without edges). Meshes from a volume come in slice order, so this is

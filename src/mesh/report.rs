@@ -2,12 +2,12 @@
 //!
 //! Odd meshes (open, several components, non-manifold, degenerate faces) are reported, never refused.
 
-use super::report_parts::ReportInParts;
+use super::report_checks;
 use super::{Mesh, Topology};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Counts and flags that describe a mesh. Serialises to the `meshsmooth info --json` keys.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MeshReport {
     pub vertices: usize,
     pub faces: usize,
@@ -36,12 +36,9 @@ pub struct MeshReport {
 }
 
 impl MeshReport {
-    /// The report of `mesh`; `topology` must be `Topology::build(mesh)`. The steps of
-    /// [`ReportInParts`] in one call.
+    /// The report of `mesh`; `topology` must be `Topology::build(mesh)`.
     pub fn new(mesh: &Mesh, topology: &Topology) -> Self {
-        let mut parts = ReportInParts::new(mesh);
-        while !parts.advance(mesh, topology, usize::MAX) {}
-        parts.finish(mesh, topology)
+        report_checks::check(mesh, topology)
     }
 
     /// Human-readable warnings for whatever is odd about the mesh (empty when nothing is).

@@ -4,23 +4,28 @@
 //! `offsets[i]..offsets[i + 1]` indexes vertex `i`'s entries (the paper's "lookup table").
 
 use super::padded_ring::PaddedRing;
-use super::topology_parts::TopologyInParts;
+use super::topology_build;
 use super::Mesh;
 use rayon::prelude::*;
 
 /// Connectivity of an indexed mesh.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Topology {
     /// CSR offsets into `neighbors`, one more than the vertex count.
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub neighbor_offsets: Vec<u32>,
     /// 1-ring `N(i)`: the vertices sharing an edge with `i`, each once, ascending.
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub neighbors: Vec<u32>,
     /// Parallel to `neighbors`: how many triangles use the edge `(i, neighbors[k])`.
     /// 1 = boundary edge, 2 = manifold interior edge, 3+ = non-manifold edge.
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub edge_triangle_counts: Vec<u32>,
     /// CSR offsets into `vertex_triangles`, one more than the vertex count.
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub triangle_offsets: Vec<u32>,
     /// Triangles incident to each vertex, ascending, each once.
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub vertex_triangles: Vec<u32>,
     /// True for vertices on a boundary edge (an edge used by exactly one triangle).
     pub is_boundary: Vec<bool>,
@@ -37,12 +42,9 @@ pub struct Topology {
 
 impl Topology {
     /// Builds the CSR arrays for `mesh`. Triangles with repeated indices contribute only their
-    /// distinct edges; indices must be in range (the parsers guarantee it). The steps of
-    /// [`TopologyInParts`] in one call.
+    /// distinct edges; indices must be in range (the parsers guarantee it).
     pub fn build(mesh: &Mesh) -> Self {
-        let mut parts = TopologyInParts::new(mesh);
-        while !parts.advance(mesh, usize::MAX) {}
-        parts.finish()
+        topology_build::build(mesh)
     }
 
     /// The topology from its 1-rings and incidence; derives the boundary flags and the

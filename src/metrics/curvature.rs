@@ -337,7 +337,8 @@ pub(crate) fn fan_corners(
 
 /// A triangle's corner by its place in the list of all corners, three per triangle: the
 /// incidence count fits in 32 bits (the topology's offsets), so these do too.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(transparent)]
 pub(crate) struct CornerCode(u32);
 
 impl CornerCode {

@@ -23,10 +23,10 @@ pub use curvature::{vertex_curvatures, VertexCurvature};
 pub use drift::{identity, smooth_drifting, DriftState, DriftingReference};
 pub(crate) use exact_distance::build_tree;
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
-pub use original::{Original, OriginalInParts};
+pub use original::Original;
 pub use report::{
-    exact_distances, exact_error, measure, measure_shape, measure_vertices, ErrorSummary,
-    MeasureInParts, Metrics, VertexMeasures,
+    exact_distances, exact_error, measure, measure_shape, measure_vertices, ErrorSummary, Metrics,
+    VertexMeasures,
 };
 pub use roughness::{roughness, roughness_ratio};
 pub use score::ScoreTerms;

@@ -3,26 +3,28 @@
 
 use super::curvature::{fan_corners, CornerCode};
 use super::prism_rows::PrismRows;
-use super::report::MeasureInParts;
 use crate::mesh::{Mesh, Topology};
 
 /// The original mesh with what the measures precompute from it: the triangle fans in the order
 /// the passes read them, the drift's shortcut radius, the volume V0 (closed meshes only), the
 /// curvature K0 and the roughness R0.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Original {
     mesh: Mesh,
     topology: Topology,
     /// Other two corners of each vertex->triangle incidence (parallel to `vertex_triangles`).
+    #[serde(with = "crate::mesh::flat_bytes")]
     fan_corners: Vec<[u32; 2]>,
     /// Each vertex->triangle incidence as the triangle's corner (parallel to
     /// `vertex_triangles`).
+    #[serde(with = "crate::mesh::flat_bytes")]
     corner_codes: Vec<CornerCode>,
     /// Each vertex's fan as one row of its rim, where it fits (the local error's fast path).
     prism_rows: PrismRows,
     /// Per vertex, the square of 0.49 times its shortest edge: a point that near the vertex is
     /// nearer to it than to any neighbour (each is at least 0.51 edge away), so the drift can
     /// skip the ring. The margin keeps the shortcut exact in f32.
+    #[serde(with = "crate::mesh::flat_bytes")]
     stay_radius2: Vec<f32>,
     volume: Option<f64>,
     curvature: f64,
@@ -35,12 +37,19 @@ pub struct Original {
 impl Original {
     /// Precomputes the original's measures. `topology` must be `Topology::build(mesh)`.
     pub fn new(mesh: &Mesh, topology: &Topology) -> Self {
-        let mut parts = OriginalInParts::new(mesh.clone(), topology.clone());
-        while !parts.advance(usize::MAX) {}
-        parts.finish()
+        let mut o = Self::bare(mesh.clone(), topology.clone());
+        (o.fan_corners, o.corner_codes) = fan_corners(&o.mesh.triangles, &o.topology);
+        o.prism_rows = PrismRows::new(o.mesh.vertex_count(), |r| o.fan_corners(r));
+        o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology);
+        o.roughness = super::roughness(&o, &o.mesh.positions);
+        // The volume and curvature need no reference: the local error of the original is 0.
+        let sums = super::report::measure_pass(&o, &o.mesh.positions, None);
+        o.volume = o.is_closed().then(|| sums.volume());
+        o.curvature = sums.curvature();
+        o
     }
 
-    /// The original with nothing precomputed yet (see [`OriginalInParts`]).
+    /// The original with nothing precomputed yet.
     fn bare(mesh: Mesh, topology: Topology) -> Self {
         assert_eq!(
             topology.vertex_count(),
@@ -158,87 +167,4 @@ fn stay_radius2(positions: &[[f32; 3]], topology: &Topology) -> Vec<f32> {
             }
         })
         .collect()
-}
-
-/// [`Original::new`] spread over calls, for a caller that must return between them (the
-/// browser's one thread opening a large mesh). Each [`Self::advance`] does one step: the fan
-/// corners, their rim rows, the drift's stay radii and the roughness R0, the triangle shapes, then the measure pass
-/// of the original ([`MeasureInParts`], every vertex its own reference) a run of vertices per
-/// call. The result is [`Original::new`]'s, bit for bit.
-pub struct OriginalInParts {
-    original: Original,
-    /// Precomputation steps done, of [`PREPARATION_STEPS`].
-    prepared: usize,
-    reference: Vec<u32>,
-    pass: Option<MeasureInParts>,
-}
-
-/// The fan corners, their rim rows, the stay radii with the roughness, and the triangle shapes.
-const PREPARATION_STEPS: usize = 4;
-
-impl OriginalInParts {
-    /// `topology` must be `Topology::build(&mesh)`. Nothing is computed yet.
-    pub fn new(mesh: Mesh, topology: Topology) -> Self {
-        Self {
-            original: Original::bare(mesh, topology),
-            prepared: 0,
-            reference: Vec::new(),
-            pass: None,
-        }
-    }
-
-    /// Does the next precomputation step, or measures up to `vertices` more vertices; returns
-    /// whether every vertex is measured.
-    pub fn advance(&mut self, vertices: usize) -> bool {
-        let o = &mut self.original;
-        match self.prepared {
-            0 => (o.fan_corners, o.corner_codes) = fan_corners(&o.mesh.triangles, &o.topology),
-            1 => o.prism_rows = PrismRows::new(o.mesh.vertex_count(), |r| o.fan_corners(r)),
-            2 => {
-                o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology);
-                o.roughness = super::roughness(o, &o.mesh.positions);
-            }
-            3 => {
-                self.reference = super::identity(o.mesh.vertex_count());
-                self.pass = Some(MeasureInParts::new(o, &o.mesh.positions, &self.reference));
-            }
-            _ => {
-                let pass = self
-                    .pass
-                    .as_mut()
-                    .expect("begun in the last preparation step");
-                return pass.advance(o, &o.mesh.positions, &self.reference, vertices);
-            }
-        }
-        self.prepared += 1;
-        false
-    }
-
-    /// Whether the precomputation is still under way (the measure pass not begun).
-    pub fn preparing(&self) -> bool {
-        self.prepared < PREPARATION_STEPS
-    }
-
-    /// The fraction done of the precomputation while [`Self::preparing`], else of the
-    /// vertices measured.
-    pub fn fraction(&self) -> f32 {
-        match &self.pass {
-            Some(pass) => {
-                let (done, total) = pass.progress();
-                done as f32 / total.max(1) as f32
-            }
-            None => self.prepared as f32 / PREPARATION_STEPS as f32,
-        }
-    }
-
-    /// The original with its measures, once [`Self::advance`] returned true.
-    pub fn finish(self) -> Original {
-        let Self {
-            mut original, pass, ..
-        } = self;
-        let sums = pass.expect("finish after advance returned true").sums();
-        original.volume = original.is_closed().then(|| sums.volume());
-        original.curvature = sums.curvature();
-        original
-    }
 }

@@ -20,8 +20,8 @@ const NO_ROW: u32 = u32::MAX;
 const BLOCK: usize = 4096;
 
 /// One row per vertex (see the module's notes).
-#[derive(Clone, Debug, Default)]
-pub(crate) struct PrismRows(Vec<[u32; ROW]>);
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub(crate) struct PrismRows(#[serde(with = "crate::mesh::flat_bytes")] Vec<[u32; ROW]>);
 
 impl PrismRows {
     /// Rows for `n` vertices whose fans `fan(r)` lists as the other two corners of each triangle

@@ -107,97 +107,27 @@ pub fn measure_vertices(
     reference: &[u32],
     tau: f64,
 ) -> (Metrics, VertexMeasures) {
-    let mut pass = MeasureInParts::new(original, positions, reference);
-    pass.advance(original, positions, reference, usize::MAX);
-    pass.finish(original, tau)
-}
-
-/// [`measure_vertices`] spread over calls, for a caller that must return between them (the
-/// browser's one thread, which has a frame to draw): the triangle areas when created, then
-/// [`Self::advance`] by runs of vertices. The result is the one-call pass's, bit for bit.
-#[derive(Clone, Debug)]
-pub struct MeasureInParts {
-    corners: Vec<CornerShape>,
-    volume6: f64,
-    /// One entry per chunk of vertices measured so far, added in chunk order at the end.
-    partial: Vec<Sums>,
-    vertex: VertexMeasures,
-}
-
-impl MeasureInParts {
-    /// The smallest part [`Self::advance`] measures (vertices): a part is whole chunks.
-    pub const SMALLEST_PART: usize = CHUNK;
-
-    /// Checks the arrays against the original and computes the triangle areas and the volume.
-    /// `positions` and `reference` must stay the same through [`Self::advance`].
-    pub fn new(original: &Original, positions: &[[f32; 3]], reference: &[u32]) -> Self {
-        let n = check_arrays(original, positions, Some(reference));
-        let (corners, volume6) = triangle_shapes(positions, &original.mesh().triangles);
-        Self {
-            corners,
-            volume6,
-            partial: Vec::with_capacity(n.div_ceil(CHUNK)),
-            vertex: VertexMeasures {
-                local_error: vec![0.0; n],
-                gaussian_curvature: vec![0.0; n],
-            },
-        }
-    }
-
-    /// Measures up to `vertices` more vertices (rounded up to whole chunks of [`CHUNK`]);
-    /// returns whether every vertex is measured.
-    pub fn advance(
-        &mut self,
-        original: &Original,
-        positions: &[[f32; 3]],
-        reference: &[u32],
-        vertices: usize,
-    ) -> bool {
-        let pass = Pass {
-            original,
-            positions,
-            reference: Some(reference),
-            corners: &self.corners,
-        };
-        let (done, total) = self.progress();
-        let end = total.min(done + vertices.div_ceil(CHUNK).max(1));
-        let error = &mut self.vertex.local_error[done * CHUNK..];
-        let curvature = &mut self.vertex.gaussian_curvature[done * CHUNK..];
-        let sums: Vec<Sums> = error
-            .par_chunks_mut(CHUNK)
-            .zip(curvature.par_chunks_mut(CHUNK))
-            .take(end - done)
-            .enumerate()
-            .map(|(c, (e, k))| pass.chunk((done + c) * CHUNK, Some((e, k))))
-            .collect();
-        self.partial.extend(sums);
-        self.partial.len() == total
-    }
-
-    /// Vertices measured so far.
-    pub fn measured(&self) -> usize {
-        (self.partial.len() * CHUNK).min(self.vertex.local_error.len())
-    }
-
-    /// `(chunks measured, chunks)`.
-    pub fn progress(&self) -> (usize, usize) {
-        (
-            self.partial.len(),
-            self.vertex.local_error.len().div_ceil(CHUNK),
-        )
-    }
-
-    /// The report and the per-vertex arrays, once [`Self::advance`] returned true.
-    pub fn finish(self, original: &Original, tau: f64) -> (Metrics, VertexMeasures) {
-        (metrics(original, &self.sums(), tau), self.vertex)
-    }
-
-    /// The pass's totals, once [`Self::advance`] returned true.
-    pub(crate) fn sums(&self) -> Sums {
-        let (done, total) = self.progress();
-        assert_eq!(done, total, "finish before every vertex is measured");
-        total_of(self.volume6, &self.partial)
-    }
+    let n = check_arrays(original, positions, Some(reference));
+    let (corners, volume6) = triangle_shapes(positions, &original.mesh().triangles);
+    let pass = Pass {
+        original,
+        positions,
+        reference: Some(reference),
+        corners: &corners,
+    };
+    let mut vertex = VertexMeasures {
+        local_error: vec![0.0; n],
+        gaussian_curvature: vec![0.0; n],
+    };
+    let partial: Vec<Sums> = vertex
+        .local_error
+        .par_chunks_mut(CHUNK)
+        .zip(vertex.gaussian_curvature.par_chunks_mut(CHUNK))
+        .enumerate()
+        .map(|(c, (e, k))| pass.chunk(c * CHUNK, Some((e, k))))
+        .collect();
+    let sums = total_of(volume6, &partial);
+    (metrics(original, &sums, tau), vertex)
 }
 
 /// Exact distance from each vertex of `positions` to the original mesh, summarised over the same
@@ -331,7 +261,7 @@ impl Sums {
 }
 
 /// Volume, curvature and local error in one pass over the vertices (`reference`: `None` leaves
-/// the local error out), without per-vertex arrays ([`MeasureInParts`] fills those).
+/// the local error out), without per-vertex arrays ([`measure_vertices`] fills those).
 pub(crate) fn measure_pass(
     original: &Original,
     positions: &[[f32; 3]],
@@ -375,7 +305,7 @@ fn check_arrays(original: &Original, positions: &[[f32; 3]], reference: Option<&
 }
 
 /// The volume plus the chunks' partial sums, added in chunk order (the same bit for bit
-/// whatever the thread count or the number of calls).
+/// whatever the thread count).
 fn total_of(volume6: f64, partial: &[Sums]) -> Sums {
     let mut total = Sums {
         volume6,

@@ -18,7 +18,7 @@ pub struct ExtractOptions {
 }
 
 /// One labelled structure: its surface in world millimetres (RAS) and what it is.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Structure {
     pub label: i64,
     /// The label map's layer (several only in a `.seg.nrrd` with overlapping segments).

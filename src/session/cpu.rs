@@ -97,7 +97,7 @@ impl Session {
                 self.error = Some(format!("The CPU engine failed: {why}"));
                 None
             }
-            Reply::Terms { .. } | Reply::Broken { .. } => None,
+            _ => None,
         }
     }
 

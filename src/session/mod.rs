@@ -9,89 +9,23 @@
 mod colors;
 mod cpu;
 mod guidance;
-mod loading;
+mod opening;
 mod weights;
 
+pub use crate::model::{Model, OpenFailure, Structures};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
-pub use loading::{LoadProgress, Loaded, Loading, OpenFailure};
+pub use opening::LoadProgress;
 pub use weights::WeightsSummary;
 
 use crate::export::{self, ExportFormat, ExportOptions};
-use crate::mesh::{vertex_normals, Mesh, MeshReport, Topology};
-use crate::metrics::{Metrics, Original, VertexMeasures};
-use crate::segmentation::Structure;
+use crate::mesh::{vertex_normals, Mesh};
+use crate::metrics::{Metrics, VertexMeasures};
 use crate::smooth::{Filter, Params};
 use crate::worker::{Pool, SmoothJob};
-use std::sync::Arc;
 
 /// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
 pub const DEFAULT_TAU: f64 = 0.5;
-
-/// A mesh the session opened, with what the measures precompute from it.
-#[derive(Clone, Debug)]
-pub struct Model {
-    pub name: String,
-    pub original: Original,
-    pub report: MeshReport,
-    pub warnings: Vec<String>,
-    /// Each edge once (`i < j`), for the wireframe overlay.
-    pub edges: Vec<[u32; 2]>,
-    /// Where the model is one structure of a segmentation: all of them, and which it is.
-    pub structures: Option<Structures>,
-}
-
-/// The structures extracted from a label map, and which one is the open model.
-#[derive(Clone, Debug)]
-pub struct Structures {
-    /// The label map's file name.
-    pub file: String,
-    pub list: Arc<Vec<Structure>>,
-    pub current: usize,
-}
-
-impl Structures {
-    pub fn current(&self) -> &Structure {
-        &self.list[self.current]
-    }
-
-    /// The list for `state()` and the page's API: what each structure is, without its mesh.
-    pub fn to_json(&self) -> serde_json::Value {
-        let list: Vec<_> = self
-            .list
-            .iter()
-            .map(|s| {
-                serde_json::json!({
-                    "label": s.label,
-                    "name": s.name,
-                    "color": s.color,
-                    "voxels": s.voxels,
-                    "voxel_size": s.voxel_size,
-                    "vertices": s.mesh.vertex_count(),
-                    "triangles": s.mesh.triangle_count(),
-                    "volume": s.mesh.signed_volume(),
-                })
-            })
-            .collect();
-        serde_json::json!({ "file": self.file, "current": self.current, "structures": list })
-    }
-}
-
-impl Model {
-    /// Parses `bytes` (the format chosen by `name`'s extension), builds topology, report and
-    /// the original's measures (every stage of [`Loading`] in one call).
-    pub fn load(name: &str, bytes: &[u8]) -> Result<Self, OpenFailure> {
-        Loading::new(name, bytes.to_vec()).finish()
-    }
-
-    pub fn mesh(&self) -> &Mesh {
-        self.original.mesh()
-    }
-
-    pub fn topology(&self) -> &Topology {
-        self.original.topology()
-    }
-}
 
 /// A smoothing run's result and its measures.
 #[derive(Clone, Debug)]
@@ -137,10 +71,10 @@ pub struct Session {
     /// Counts changes of `weights`.
     weights_version: u64,
     guidance: guidance::Guidance,
-    /// A file being opened, a stage per [`Self::step_loading`] call.
-    loading: Option<Loading>,
+    /// A file (or structure) the CPU engine's workers are opening.
+    opening: Option<opening::Opening>,
     /// How long each stage of the latest opening took (ms), in order.
-    open_stages: Vec<(&'static str, f64)>,
+    open_stages: Vec<(String, f64)>,
 }
 
 impl Default for Session {
@@ -160,7 +94,7 @@ impl Default for Session {
             weights: None,
             weights_version: 0,
             guidance: guidance::Guidance::default(),
-            loading: None,
+            opening: None,
             open_stages: Vec::new(),
         }
     }
@@ -228,88 +162,9 @@ impl Session {
         self.revision += 1;
     }
 
-    /// Opens a file's bytes. On failure the current model stays, the error is recorded (and
-    /// returned) as "Cannot open NAME: reason".
-    pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<&Model, String> {
-        match Model::load(name, bytes) {
-            Ok(model) => Ok(self.set_model(model)),
-            Err(e) => Err(self.fail(name, &e.to_string())),
-        }
-    }
-
-    /// Starts opening structure `index` of the open segmentation as the model, in stages as a
-    /// file opens. Errors when no segmentation is open or it has no such structure.
-    pub fn begin_open_structure(&mut self, index: usize) -> Result<(), String> {
-        let Some(structures) = self.model.as_ref().and_then(|m| m.structures.clone()) else {
-            return Err("no segmentation is open".to_string());
-        };
-        if index >= structures.list.len() {
-            return Err(format!(
-                "structure {index} does not exist: the segmentation has {}",
-                structures.list.len()
-            ));
-        }
-        self.loading = Some(Loading::structure(Structures {
-            current: index,
-            ..structures
-        }));
-        self.open_stages.clear();
-        Ok(())
-    }
-
     /// The open segmentation's structures, when the model is one of them.
     pub fn structures(&self) -> Option<&Structures> {
         self.model.as_ref().and_then(|m| m.structures.as_ref())
-    }
-
-    /// Starts opening a file's bytes in stages ([`Self::step_loading`] does the work); the
-    /// current model stays open meanwhile. Returns the name of an opening this one replaces.
-    pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>) -> Option<String> {
-        let replaced = self.loading.take().map(|l| l.name().to_string());
-        self.loading = Some(Loading::new(name, bytes));
-        self.open_stages.clear();
-        replaced
-    }
-
-    /// Works on the file being opened for about `budget_ms` (at least one stage). Once it is
-    /// done: `Ok` with the model open, or the error (as [`Self::open`] reports it) with the
-    /// previous model still open. `None` while stages remain, or when nothing is being opened.
-    pub fn step_loading(
-        &mut self,
-        clock: &dyn Fn() -> f64,
-        budget_ms: f64,
-    ) -> Option<Result<(), String>> {
-        let start = clock();
-        while let Some(loading) = self.loading.take() {
-            let name = loading.name().to_string();
-            let doing = loading.progress().doing;
-            let stage_start = clock();
-            let step = loading.step();
-            self.open_stages.push((doing, clock() - stage_start));
-            match step {
-                Loaded::Pending(next) => self.loading = Some(*next),
-                Loaded::Done(model) => {
-                    self.set_model(*model);
-                    return Some(Ok(()));
-                }
-                Loaded::Failed(e) => return Some(Err(self.fail(&name, &e.to_string()))),
-            }
-            if clock() - start >= budget_ms {
-                break;
-            }
-        }
-        None
-    }
-
-    /// How long each stage of the latest opening took (ms), in order: the longest is the
-    /// longest the page could not draw while a file opened.
-    pub fn open_stages(&self) -> &[(&'static str, f64)] {
-        &self.open_stages
-    }
-
-    /// How far the file being opened got, while one is.
-    pub fn loading(&self) -> Option<LoadProgress> {
-        self.loading.as_ref().map(Loading::progress)
     }
 
     /// Makes `model` the open model (the previous result is dropped).
@@ -472,7 +327,7 @@ impl Session {
             "loading": self.loading().map(|l| serde_json::json!({
                 "name": l.name, "stage": l.stage, "stages": l.total, "doing": l.doing,
             })),
-            "open_stages": self.open_stages.iter()
+            "open_stages": self.open_stages().iter()
                 .map(|(doing, ms)| serde_json::json!({"doing": doing, "ms": ms}))
                 .collect::<Vec<_>>(),
         })

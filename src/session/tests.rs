@@ -243,45 +243,43 @@ fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
     );
 }
 
+/// A session whose CPU engine answers only once `deliver` is set, as busy workers do.
+fn deferred_session() -> (Session, std::rc::Rc<std::cell::Cell<bool>>) {
+    let (carrier, deliver) = crate::worker::deferred::Deferred::new(1);
+    (
+        Session::with_cpu_engine(Pool::new(Box::new(carrier))),
+        deliver,
+    )
+}
+
 #[test]
-fn opening_in_stages_equals_opening_at_once_and_keeps_the_model_until_done() {
-    let mut s = Session::default();
+fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
+    let (mut s, deliver) = deferred_session();
     s.open("first.ply", SAMPLE).unwrap();
     let at_once = Model::load("second.ply", SAMPLE).unwrap();
     assert_eq!(s.begin_open("second.ply", SAMPLE.to_vec()), None);
-    // A budget of 0 ms: one step per call, the progress moving through every stage in order
-    // (the stages done in parts take several steps).
-    let mut stages = Vec::new();
-    let outcome = loop {
+    for _ in 0..3 {
         let p = s.loading().expect("opening");
-        assert_eq!((p.name.as_str(), p.total), ("second.ply", 5));
-        stages.push(p.stage);
-        assert_eq!(
-            s.model().unwrap().name,
-            "first.ply",
-            "the open model stays meanwhile"
-        );
+        assert_eq!((p.name.as_str(), p.stage), ("second.ply", 0));
         assert_eq!(s.state_json(false)["loading"]["doing"], p.doing);
-        if let Some(outcome) = s.step_loading(&|| 0.0, 0.0) {
-            break outcome;
-        }
-    };
-    assert_eq!(outcome, Ok(()));
-    let steps = stages.len();
-    stages.dedup();
-    assert_eq!(stages, [0, 1, 2, 3, 4]);
-    assert!(steps > 5, "{steps} steps");
-    let timed: Vec<&str> = s.open_stages().iter().map(|(doing, _)| *doing).collect();
-    let named: Vec<String> = (0..steps)
-        .map(|k| {
-            s.state_json(false)["open_stages"][k]["doing"]
-                .as_str()
-                .unwrap()
-                .to_string()
-        })
-        .collect();
-    assert_eq!(timed, named);
-    assert_eq!(timed.len(), steps);
+        assert_eq!(s.poll_opening(), None, "the worker is busy");
+        assert_eq!(s.model().unwrap().name, "first.ply", "the model stays");
+    }
+    deliver.set(true);
+    assert_eq!(s.poll_opening(), Some(Ok(())));
+    let timed: Vec<&str> = s.open_stages().iter().map(|(d, _)| d.as_str()).collect();
+    assert_eq!(
+        timed,
+        [
+            "reading the file",
+            "building the topology",
+            "checking the mesh",
+            "measuring the original"
+        ]
+    );
+    for (k, doing) in timed.iter().enumerate() {
+        assert_eq!(s.state_json(false)["open_stages"][k]["doing"], *doing);
+    }
     assert!(s.loading().is_none() && s.state_json(false)["loading"].is_null());
     let model = s.model().unwrap();
     assert_eq!(model.name, "second.ply");
@@ -289,28 +287,32 @@ fn opening_in_stages_equals_opening_at_once_and_keeps_the_model_until_done() {
     assert_eq!(model.edges, at_once.edges);
     assert_eq!(model.original.curvature(), at_once.original.curvature());
     assert_eq!(model.original.volume(), at_once.original.volume());
-    assert_eq!(s.step_loading(&|| 0.0, 0.0), None, "nothing left to open");
+    assert_eq!(s.poll_opening(), None, "nothing left to open");
+    // The workers hold the new model: the view's result comes from them.
+    assert!(s.smooth_cpu().is_some() && s.result().is_some());
 }
 
 #[test]
-fn a_bad_file_opened_in_stages_keeps_the_model_and_a_later_file_replaces_an_earlier() {
+fn a_bad_file_opened_in_a_worker_keeps_the_model_and_a_later_file_replaces_an_earlier() {
     let mut s = sample_session();
     let revision = s.revision();
     s.begin_open(
         "broken.ply",
         b"ply\nformat ascii 1.0\nelement vertex 99\n".to_vec(),
     );
-    let e = s.step_loading(&|| 0.0, f64::INFINITY).unwrap().unwrap_err();
+    let e = s.poll_opening().unwrap().unwrap_err();
     assert!(e.starts_with("Cannot open broken.ply: "), "{e}");
     assert_eq!(s.error(), Some(e.as_str()));
     assert_eq!(s.model().unwrap().name, "bent_tube_staircase.ply");
     assert_eq!(s.revision(), revision, "nothing changed");
 
+    let (mut s, deliver) = deferred_session();
     s.begin_open("first.ply", SAMPLE.to_vec());
-    assert_eq!(s.step_loading(&|| 0.0, 0.0), None);
+    assert_eq!(s.poll_opening(), None);
     let replaced = s.begin_open("second.ply", SAMPLE.to_vec());
     assert_eq!(replaced.as_deref(), Some("first.ply"));
-    assert_eq!(s.step_loading(&|| 0.0, f64::INFINITY), Some(Ok(())));
+    deliver.set(true);
+    assert_eq!(s.poll_opening(), Some(Ok(())));
     assert_eq!(s.model().unwrap().name, "second.ply");
     assert_eq!(s.error(), None);
 }

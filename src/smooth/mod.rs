@@ -124,7 +124,7 @@ pub fn smooth(
 /// Continues a run of Laplace, Taubin or HC: `current` is the result of `done` iterations of
 /// `params` from `mesh`'s positions; returns the result of `done + more` iterations (the
 /// observer sees iterations `done + 1 ..= done + more`), equal to [`smooth`] with that many
-/// iterations. Lets a caller without threads spread a run over several frames. `None` for
+/// iterations. Lets a search go on from a run it kept instead of starting over. `None` for
 /// windowed sinc, whose terms are not shorter filters' results (and for a `current` of the
 /// wrong length).
 #[allow(clippy::too_many_arguments)]

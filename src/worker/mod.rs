@@ -3,24 +3,43 @@
 //! workers (`app::workers`) carry the bytes, the native tests hand them to [`Worker::handle`]
 //! on their own thread ([`InThread`]). [`Pool`] keeps the queue on the asking side.
 
+#[cfg(test)]
+pub(crate) mod deferred;
 mod pool;
 
-pub use pool::{Carrier, InThread, Pool, SmoothJob};
+pub use pool::{Carrier, InThread, LoadJob, Pool, SmoothJob};
 
 use serde::{Deserialize, Serialize};
 
 use crate::evaluate::{Evaluator, Terms};
 use crate::mesh::{Mesh, Topology};
 use crate::metrics::{self, Metrics, Original, VertexMeasures};
+use crate::model::{self, Model};
 use crate::smooth::Params;
 use crate::suggest::MeshEvaluator;
+
+/// What a [`Request::Load`] opens.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub enum Input {
+    /// A file's bytes (the format from the name's extension).
+    File(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
+    /// A structure extracted earlier, by its mesh.
+    Structure(Mesh),
+}
 
 /// A message to a worker.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub enum Request {
-    /// Hold `mesh` as model `model` (its topology and the original's measures are built here),
-    /// dropping any other.
-    Open { model: u64, mesh: Mesh },
+    /// Open `input` as a model named `name` and send it back whole ([`Reply::Loaded`]), telling
+    /// each stage as it begins ([`Reply::Progress`]).
+    Load {
+        job: u64,
+        name: String,
+        input: Input,
+    },
+    /// Hold `mesh` as model `model` (its topology and the original's measures are built here,
+    /// unless this worker just opened that very mesh), dropping any other.
+    Hold { model: u64, mesh: Mesh },
     /// The per-vertex weights of `model` from now on (`None`: all 1), known as `version`.
     Weights {
         model: u64,
@@ -37,9 +56,22 @@ pub enum Request {
     },
 }
 
-/// A worker's answer to [`Request::Smooth`] or [`Request::Terms`].
+/// A worker's answer to [`Request::Load`], [`Request::Smooth`] or [`Request::Terms`].
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub enum Reply {
+    /// A stage of an opening begins: `stage` (0-based) of `stages`. Not the job's answer.
+    Progress {
+        job: u64,
+        stage: u32,
+        stages: u32,
+        doing: String,
+    },
+    Loaded {
+        job: u64,
+        model: Box<Model>,
+        /// Each stage with the milliseconds it took, in order.
+        stages: Vec<(String, f64)>,
+    },
     Smoothed {
         job: u64,
         positions: Vec<[f32; 3]>,
@@ -67,9 +99,11 @@ impl Reply {
     /// The job this answers (`None`: the worker's job under way, see [`Reply::Broken`]).
     pub fn job(&self) -> Option<u64> {
         match self {
-            Reply::Smoothed { job, .. } | Reply::Terms { job, .. } | Reply::Failed { job, .. } => {
-                Some(*job)
-            }
+            Reply::Progress { job, .. }
+            | Reply::Loaded { job, .. }
+            | Reply::Smoothed { job, .. }
+            | Reply::Terms { job, .. }
+            | Reply::Failed { job, .. } => Some(*job),
             Reply::Broken { .. } => None,
         }
     }
@@ -92,21 +126,33 @@ struct Held {
     weights: Option<Vec<f32>>,
 }
 
-/// A worker's state: the model it holds. Requests come one at a time and each is done whole.
+/// A worker's state: the model it holds, and the one it opened last until the page asks it
+/// to hold that. Requests come one at a time and each is done whole.
 #[derive(Default)]
 pub struct Worker {
     held: Option<Held>,
+    opened: Option<Original>,
 }
 
 impl Worker {
-    /// Does `request`; `clock` gives milliseconds. Open and Weights answer nothing.
-    pub fn handle(&mut self, request: Request, clock: &dyn Fn() -> f64) -> Option<Reply> {
+    /// Does `request`; `clock` gives milliseconds, `tell` takes the replies sent before the
+    /// answer ([`Reply::Progress`]). Hold and Weights answer nothing.
+    pub fn handle(
+        &mut self,
+        request: Request,
+        clock: &dyn Fn() -> f64,
+        tell: &mut dyn FnMut(Reply),
+    ) -> Option<Reply> {
         match request {
-            Request::Open { model, mesh } => {
-                let topology = Topology::build(&mesh);
+            Request::Load { job, name, input } => Some(self.load(job, &name, input, clock, tell)),
+            Request::Hold { model, mesh } => {
+                let original = match self.opened.take() {
+                    Some(o) if *o.mesh() == mesh => o,
+                    _ => Original::new(&mesh, &Topology::build(&mesh)),
+                };
                 self.held = Some(Held {
                     id: model,
-                    original: Original::new(&mesh, &topology),
+                    original,
                     weights: None,
                 });
                 None
@@ -119,6 +165,54 @@ impl Worker {
             }
             Request::Smooth { job, params, tau } => Some(self.smooth(job, &params, tau, clock)),
             Request::Terms { job, params, at } => Some(self.terms(job, &params, &at, clock)),
+        }
+    }
+
+    fn load(
+        &mut self,
+        job: u64,
+        name: &str,
+        input: Input,
+        clock: &dyn Fn() -> f64,
+        tell: &mut dyn FnMut(Reply),
+    ) -> Reply {
+        let mut stages: Vec<(String, f64)> = Vec::new();
+        let mut began = clock();
+        let mut on_stage = |stage: model::Stage| {
+            let now = clock();
+            if let Some(last) = stages.last_mut() {
+                last.1 = now - began;
+            }
+            began = now;
+            stages.push((stage.doing.to_string(), 0.0));
+            tell(Reply::Progress {
+                job,
+                stage: stage.index as u32,
+                stages: stage.total as u32,
+                doing: stage.doing.to_string(),
+            });
+        };
+        let opened = match input {
+            Input::File(bytes) => model::open_file(name, &bytes, &mut on_stage),
+            Input::Structure(mesh) => Ok(model::open_structure(name, mesh, &mut on_stage)),
+        };
+        let ended = clock();
+        if let Some(last) = stages.last_mut() {
+            last.1 = ended - began;
+        }
+        match opened {
+            Ok(model) => {
+                self.opened = Some(model.original.clone());
+                Reply::Loaded {
+                    job,
+                    model: Box::new(model),
+                    stages,
+                }
+            }
+            Err(e) => Reply::Failed {
+                job,
+                why: e.to_string(),
+            },
         }
     }
 

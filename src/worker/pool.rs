@@ -5,7 +5,7 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use super::{Reply, Request, Worker};
+use super::{Input, Reply, Request, Worker};
 use crate::evaluate::{failed_terms, ModelRef, Offload, Request as TermsRequest, Terms};
 use crate::smooth::Params;
 
@@ -47,9 +47,14 @@ impl Carrier for InThread {
         let Ok(request) = super::decode::<Request>(&super::encode(request)) else {
             return;
         };
-        if let Some(reply) = self.workers[worker].handle(request, &super::clock_ms) {
-            self.replies.push((worker, reply));
-        }
+        let mut told = Vec::new();
+        let reply = self.workers[worker].handle(request, &super::clock_ms, &mut |r| told.push(r));
+        let wired = told
+            .iter()
+            .chain(&reply)
+            .map(|r| super::decode(&super::encode(r)));
+        self.replies
+            .extend(wired.filter_map(Result::ok).map(|r| (worker, r)));
     }
 
     fn take_replies(&mut self) -> Vec<(usize, Reply)> {
@@ -65,6 +70,18 @@ impl Carrier for InThread {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SmoothJob(u64);
 
+/// An opening: a file or structure made a model in a worker.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoadJob(u64);
+
+/// How far an opening got: the stage under way (0-based) of `stages`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoadStage {
+    pub stage: u32,
+    pub stages: u32,
+    pub doing: String,
+}
+
 /// A terms request as a key: the model, its weights and the request's encoding.
 type TermsKey = (u64, u64, Vec<u8>);
 
@@ -78,12 +95,14 @@ struct QueuedSmooth {
 
 /// What a worker is doing.
 enum Flight {
+    Load,
     Smooth,
     Terms(TermsKey),
 }
 
-/// The engine workers seen from the page: a queue of smoothing jobs (first) and the guidance's
-/// terms requests (the one asked, then the ones it said come next), handed out to idle workers.
+/// The engine workers seen from the page: the opening asked last (first), a queue of smoothing
+/// jobs, and the guidance's terms requests (the one asked, then the ones it said come next),
+/// handed out to idle workers.
 pub struct Pool {
     carrier: Box<dyn Carrier>,
     /// The job each worker is doing.
@@ -91,6 +110,10 @@ pub struct Pool {
     /// The model and weights version every worker was sent.
     sent: Option<(u64, u64)>,
     next_job: u64,
+    /// An opening not handed out yet.
+    load: Option<(u64, Request)>,
+    loaded: HashMap<u64, Reply>,
+    load_stages: HashMap<u64, LoadStage>,
     smooths: VecDeque<QueuedSmooth>,
     /// The terms request asked last and those to come, in order.
     asked: Option<TermsKey>,
@@ -118,6 +141,9 @@ impl Pool {
             busy: vec![None; workers],
             sent: None,
             next_job: 0,
+            load: None,
+            loaded: HashMap::new(),
+            load_stages: HashMap::new(),
             smooths: VecDeque::new(),
             asked: None,
             upcoming: Vec::new(),
@@ -145,7 +171,44 @@ impl Pool {
 
     /// Whether any worker is doing something or anything waits to be handed out.
     pub fn busy(&self) -> bool {
-        self.busy.iter().any(Option::is_some) || !self.smooths.is_empty()
+        self.busy.iter().any(Option::is_some) || !self.smooths.is_empty() || self.load.is_some()
+    }
+
+    /// Queues opening `input` as a model named `name`, ahead of every other job. It supersedes
+    /// an opening still waiting or under way (whose answer is then dropped).
+    pub fn load(&mut self, name: &str, input: Input) -> LoadJob {
+        if let Some((old, _)) = self.load.take() {
+            self.load_stages.remove(&old);
+        }
+        let superseded: Vec<u64> = (self.in_flight.iter())
+            .filter(|(_, f)| matches!(f, Flight::Load))
+            .map(|(job, _)| *job)
+            .collect();
+        for job in superseded {
+            self.in_flight.remove(&job);
+            self.load_stages.remove(&job);
+        }
+        self.loaded.clear();
+        let job = self.new_job();
+        let name = name.to_string();
+        self.load = Some((job, Request::Load { job, name, input }));
+        self.pump();
+        LoadJob(job)
+    }
+
+    /// The answer to `job` once it is there ([`Reply::Loaded`] or [`Reply::Failed`]).
+    pub fn take_loaded(&mut self, job: LoadJob) -> Option<Reply> {
+        self.pump();
+        let reply = self.loaded.remove(&job.0);
+        if reply.is_some() {
+            self.load_stages.remove(&job.0);
+        }
+        reply
+    }
+
+    /// The stage `job` is at, once its worker began it.
+    pub fn load_stage(&self, job: LoadJob) -> Option<&LoadStage> {
+        self.load_stages.get(&job.0)
     }
 
     /// Queues smoothing `model` with `params` and measuring the result at `tau`. A
@@ -224,14 +287,14 @@ impl Pool {
             return;
         }
         if self.sent.map(|s| s.0) != Some(model.id) {
-            let open = Request::Open {
+            let hold = Request::Hold {
                 model: model.id,
                 mesh: model.original.mesh().clone(),
             };
-            self.broadcast(&open);
-            // Whatever waits is for another model.
+            self.broadcast(&hold);
+            // Whatever waits is for another model (an opening stays: it makes the next one).
             self.smooths.clear();
-            self.in_flight.clear();
+            self.in_flight.retain(|_, f| matches!(f, Flight::Load));
             self.smoothed.clear();
             self.terms.clear();
         }
@@ -271,6 +334,23 @@ impl Pool {
     }
 
     fn receive(&mut self, worker: usize, reply: Reply) {
+        if let Reply::Progress {
+            job,
+            stage,
+            stages,
+            doing,
+        } = reply
+        {
+            if self.in_flight.contains_key(&job) {
+                let stage = LoadStage {
+                    stage,
+                    stages,
+                    doing,
+                };
+                self.load_stages.insert(job, stage);
+            }
+            return;
+        }
         let doing = self.busy.get_mut(worker).and_then(Option::take);
         // A broken worker's job fails; the worker stays, and fails again if it cannot go on.
         let (job, reply) = match reply {
@@ -284,6 +364,9 @@ impl Pool {
             },
         };
         match self.in_flight.remove(&job) {
+            Some(Flight::Load) => {
+                self.loaded.insert(job, reply);
+            }
             Some(Flight::Smooth) => {
                 self.smoothed.insert(job, reply);
             }
@@ -300,9 +383,13 @@ impl Pool {
         }
     }
 
-    /// Gives `worker` the next job: a smoothing first, then the terms asked, then those to
-    /// come. Returns whether there was one.
+    /// Gives `worker` the next job: an opening first, then a smoothing, then the terms asked,
+    /// then those to come. Returns whether there was one.
     fn hand_out(&mut self, worker: usize) -> bool {
+        if let Some((job, request)) = self.load.take() {
+            self.start(worker, job, Flight::Load, &request);
+            return true;
+        }
         if let Some(s) = self.smooths.pop_front() {
             let request = Request::Smooth {
                 job: s.job,
@@ -317,7 +404,7 @@ impl Pool {
             .values()
             .filter_map(|f| match f {
                 Flight::Terms(k) => Some(k),
-                Flight::Smooth => None,
+                Flight::Load | Flight::Smooth => None,
             })
             .collect();
         let next = self

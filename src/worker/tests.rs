@@ -1,6 +1,8 @@
+use super::deferred::Deferred;
 use super::*;
 use crate::evaluate::{ModelRef, Offload};
 use crate::io;
+use crate::model::Model;
 use crate::smooth::Filter;
 
 const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
@@ -90,40 +92,10 @@ fn terms_spread_over_the_workers_equal_the_evaluators() {
 
 #[test]
 fn a_newer_view_job_supersedes_one_still_waiting() {
-    /// Holds every request until told to deliver, as busy workers do.
-    struct Held {
-        inner: InThread,
-        posted: Vec<(usize, Request)>,
-        deliver: std::rc::Rc<std::cell::Cell<bool>>,
-    }
-    impl Carrier for Held {
-        fn workers(&self) -> usize {
-            1
-        }
-        fn post(&mut self, worker: usize, request: &Request) {
-            self.posted.push((worker, request.clone()));
-        }
-        fn take_replies(&mut self) -> Vec<(usize, Reply)> {
-            if !self.deliver.get() {
-                return Vec::new();
-            }
-            for (w, r) in std::mem::take(&mut self.posted) {
-                self.inner.post(w, &r);
-            }
-            self.inner.take_replies()
-        }
-        fn threaded(&self) -> bool {
-            false
-        }
-    }
     let original = sample();
     let m = model(&original, None, 0);
-    let deliver = std::rc::Rc::new(std::cell::Cell::new(false));
-    let mut pool = Pool::new(Box::new(Held {
-        inner: InThread::new(1),
-        posted: Vec::new(),
-        deliver: deliver.clone(),
-    }));
+    let (carrier, deliver) = Deferred::new(1);
+    let mut pool = Pool::new(Box::new(carrier));
     // The first goes out at once; the second waits behind it and the third replaces it.
     let first = pool.smooth(&m, &params(Filter::Laplace, 2), 0.5, true);
     let second = pool.smooth(&m, &params(Filter::Laplace, 3), 0.5, true);
@@ -155,6 +127,7 @@ fn a_worker_without_a_model_says_so() {
             tau: 0.5,
         },
         &clock_ms,
+        &mut |_| {},
     );
     assert!(
         matches!(reply, Some(Reply::Failed { job: 3, .. })),
@@ -212,4 +185,61 @@ fn a_broken_worker_fails_its_job_instead_of_holding_it() {
         pool.take_smoothed(next),
         Some(Reply::Smoothed { .. })
     ));
+}
+
+#[test]
+fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
+    let (carrier, deliver) = Deferred::new(2);
+    let mut pool = Pool::new(Box::new(carrier));
+    let job = pool.load("tube.ply", Input::File(SAMPLE.to_vec()));
+    assert!(pool.take_loaded(job).is_none() && pool.load_stage(job).is_none());
+    deliver.set(true);
+    pool.pump();
+    let stage = pool.load_stage(job).expect("the worker told its stages");
+    assert_eq!((stage.stage, stage.stages), (3, 4));
+    assert_eq!(stage.doing, "measuring the original");
+    let Some(Reply::Loaded { model, stages, .. }) = pool.take_loaded(job) else {
+        panic!("no model came back");
+    };
+    let here = Model::load("tube.ply", SAMPLE).unwrap();
+    assert_eq!(model.name, "tube.ply");
+    assert_eq!((&model.report, &model.edges), (&here.report, &here.edges));
+    assert_eq!(model.mesh(), here.mesh());
+    assert_eq!(model.topology(), here.topology());
+    assert_eq!(
+        (model.original.curvature(), model.original.volume()),
+        (here.original.curvature(), here.original.volume())
+    );
+    let names: Vec<&str> = stages.iter().map(|(doing, _)| doing.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "reading the file",
+            "building the topology",
+            "checking the mesh",
+            "measuring the original"
+        ]
+    );
+    assert!(stages.iter().all(|(_, ms)| *ms >= 0.0));
+    assert!(!pool.busy());
+}
+
+#[test]
+fn a_newer_opening_supersedes_an_older_and_a_bad_file_fails_its_job() {
+    let (carrier, deliver) = Deferred::new(1);
+    let mut pool = Pool::new(Box::new(carrier));
+    let first = pool.load("first.ply", Input::File(SAMPLE.to_vec()));
+    let second = pool.load("second.ply", Input::File(b"ply\nrubbish".to_vec()));
+    deliver.set(true);
+    let mut answers = Vec::new();
+    for _ in 0..4 {
+        answers.extend(pool.take_loaded(first).map(|r| ("first", r)));
+        answers.extend(pool.take_loaded(second).map(|r| ("second", r)));
+    }
+    assert_eq!(answers.len(), 1, "{answers:?}");
+    let ("second", Reply::Failed { why, .. }) = &answers[0] else {
+        panic!("{answers:?}");
+    };
+    assert!(why.contains("PLY") || why.contains("ply"), "{why}");
+    assert!(!pool.busy());
 }

@@ -95,9 +95,7 @@ pub(super) fn step_gallery(job: &mut GalleryJob, engine: &mut Engine<'_, '_>) ->
             Err(why) => return gave_up(job, why),
         },
         Reply::Failed { why, .. } => return gave_up(job, why),
-        Reply::Terms { .. } | Reply::Broken { .. } => {
-            return gave_up(job, "a terms reply to a smoothing".into())
-        }
+        _ => return gave_up(job, "another reply to a smoothing".into()),
     };
     job.picks.push(GalleryPick {
         tau,

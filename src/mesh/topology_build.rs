@@ -1,8 +1,6 @@
-//! Building a [`Topology`] in steps, for a caller that must return between them (the browser's
-//! one thread opening a large mesh draws a frame between steps): the vertex->triangle incidence
-//! when created, the 1-rings a run of vertices per [`TopologyInParts::advance`], then the
-//! compaction and the boundary in [`TopologyInParts::finish`]. `Topology::build` runs the same
-//! steps in one call, so both give the same arrays.
+//! Building a [`Topology`]: the vertex->triangle incidence by counting sort, every vertex's
+//! 1-ring in parallel blocks (sorted, with each edge's triangle count), then the rings packed
+//! into CSR arrays.
 
 use std::ops::Range;
 
@@ -12,8 +10,15 @@ use rayon::prelude::*;
 /// Vertices per parallel work item when building the rings.
 const BLOCK: usize = 2048;
 
+/// The topology of `mesh`. Triangle indices must be in range (the parsers guarantee it).
+pub(super) fn build(mesh: &Mesh) -> Topology {
+    let mut rings = Rings::new(mesh);
+    rings.build(mesh);
+    rings.pack()
+}
+
 /// A topology under construction.
-pub struct TopologyInParts {
+struct Rings {
     triangle_offsets: Vec<u32>,
     vertex_triangles: Vec<u32>,
     /// Per vertex, two slots per incident triangle at twice its triangle offset: its distinct
@@ -25,10 +30,10 @@ pub struct TopologyInParts {
     unique: Vec<u32>,
 }
 
-impl TopologyInParts {
+impl Rings {
     /// The vertex->triangle incidence of `mesh`, by counting sort (ascending triangle order for
-    /// free). Triangle indices must be in range (the parsers guarantee it).
-    pub fn new(mesh: &Mesh) -> Self {
+    /// free).
+    fn new(mesh: &Mesh) -> Self {
         let n = mesh.positions.len();
         let tris = &mesh.triangles;
         debug_assert!(tris.iter().flatten().all(|&v| (v as usize) < n));
@@ -60,33 +65,19 @@ impl TopologyInParts {
             vertex_triangles,
             raw: vec![0; slots],
             counts: vec![0; slots],
-            unique: Vec::with_capacity(n),
+            unique: Vec::new(),
         }
     }
 
-    fn vertex_count(&self) -> usize {
-        self.triangle_offsets.len() - 1
-    }
-
-    /// Builds the rings of up to `vertices` more vertices (whole blocks of [`BLOCK`], at least
-    /// one); returns whether every ring is built. `mesh` must be the one given to [`Self::new`].
-    pub fn advance(&mut self, mesh: &Mesh, vertices: usize) -> bool {
-        let n = self.vertex_count();
-        assert_eq!(
-            mesh.vertex_count(),
-            n,
-            "the mesh the incidence was built for"
-        );
-        let start = self.unique.len();
-        let blocks = vertices.div_ceil(BLOCK).max(1);
-        let end = n.min(start.saturating_add(blocks.saturating_mul(BLOCK)));
+    /// Builds every vertex's ring. `mesh` must be the one given to [`Self::new`].
+    fn build(&mut self, mesh: &Mesh) {
+        let n = self.triangle_offsets.len() - 1;
         let offsets = &self.triangle_offsets;
-        let slots = 2 * offsets[start] as usize..2 * offsets[end] as usize;
-        let raw = by_blocks(&mut self.raw[slots.clone()], offsets, start..end, 2);
-        let counts = by_blocks(&mut self.counts[slots], offsets, start..end, 2);
+        let raw = by_blocks(&mut self.raw, offsets, 0..n, 2);
+        let counts = by_blocks(&mut self.counts, offsets, 0..n, 2);
         let tris = &mesh.triangles;
         let vertex_triangles = &self.vertex_triangles;
-        let unique: Vec<u32> = raw
+        self.unique = raw
             .into_par_iter()
             .zip(counts)
             .flat_map_iter(|((range, raw), (_, counts))| {
@@ -104,20 +95,12 @@ impl TopologyInParts {
                     .collect::<Vec<u32>>()
             })
             .collect();
-        self.unique.extend(unique);
-        self.unique.len() == n
     }
 
-    /// The share of the rings built, in [0, 1].
-    pub fn fraction(&self) -> f32 {
-        self.unique.len() as f32 / self.vertex_count().max(1) as f32
-    }
-
-    /// The topology, once [`Self::advance`] returned true: the rings packed into CSR arrays,
-    /// the boundary flags and the smoothing neighbourhood.
-    pub fn finish(self) -> Topology {
-        let n = self.vertex_count();
-        assert_eq!(self.unique.len(), n, "finish before every ring is built");
+    /// The topology: the rings packed into CSR arrays, the boundary flags and the smoothing
+    /// neighbourhood.
+    fn pack(self) -> Topology {
+        let n = self.triangle_offsets.len() - 1;
         let Self {
             triangle_offsets,
             vertex_triangles,
@@ -202,37 +185,4 @@ pub(crate) fn by_blocks<'a, T>(
         pieces.push((start..end, piece));
     }
     pieces
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::mesh::fixtures;
-
-    #[test]
-    fn any_steps_build_the_same_topology() {
-        let meshes = [
-            fixtures::tetrahedron(),
-            fixtures::grid(70, 90),
-            Mesh::new(
-                vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [5.0; 3]],
-                vec![[0, 1, 2], [0, 0, 1]],
-            ),
-            Mesh::default(),
-        ];
-        for mesh in meshes {
-            let whole = Topology::build(&mesh);
-            for part in [1, BLOCK, BLOCK + 1, 3 * BLOCK] {
-                let mut parts = TopologyInParts::new(&mesh);
-                let mut calls = 1;
-                while !parts.advance(&mesh, part) {
-                    calls += 1;
-                    assert!(parts.fraction() < 1.0);
-                }
-                let expected_calls = mesh.vertex_count().div_ceil(part.div_ceil(BLOCK) * BLOCK);
-                assert_eq!(calls, expected_calls.max(1), "part {part}");
-                assert_eq!(parts.finish(), whole, "part {part}");
-            }
-        }
-    }
 }
