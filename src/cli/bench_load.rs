@@ -1,11 +1,15 @@
 //! `meshsmooth bench-load FILE [--repeat N] [--json]`: how long reading a mesh takes, split into
-//! parsing (bytes to indexed mesh, welding included) and building the topology.
+//! parsing (bytes to indexed mesh, welding included) and building the topology; then what the
+//! page's opening costs: the whole model built in a worker, and its trip to the page (encoded
+//! there, decoded on the page's thread, which draws no frame meanwhile).
 //!
 //! The file is read into memory once so disk speed does not count; the best of `repeat` runs is
 //! reported, the usual way to take noise from other processes out of a wall-clock timing.
 
 use crate::io;
 use crate::mesh::Topology;
+use crate::model::Model;
+use crate::worker;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -20,6 +24,12 @@ pub struct LoadTiming {
     pub topology_seconds: f64,
     /// Best single run of parse + topology (not the sum of the two bests).
     pub total_seconds: f64,
+    /// The whole opening a worker does: parse, topology, checks, the original's measures.
+    pub open_seconds: f64,
+    /// The opened model in the workers' wire format.
+    pub wire_bytes: usize,
+    pub encode_seconds: f64,
+    pub decode_seconds: f64,
 }
 
 pub fn run(path: &Path, repeat: usize, json: bool) -> Result<(), String> {
@@ -38,6 +48,14 @@ pub fn run(path: &Path, repeat: usize, json: bool) -> Result<(), String> {
             timing.total_seconds * 1e3,
             repeat.max(1)
         );
+        outln!(
+            "  opened as the page's workers do {:.2} ms; to the page: {:.1} MB, encode {:.2} ms, \
+             decode {:.2} ms",
+            timing.open_seconds * 1e3,
+            timing.wire_bytes as f64 / 1e6,
+            timing.encode_seconds * 1e3,
+            timing.decode_seconds * 1e3
+        );
     }
     Ok(())
 }
@@ -51,6 +69,10 @@ pub fn measure(bytes: &[u8], name: &str, repeat: usize) -> Result<LoadTiming, St
         parse_seconds: f64::INFINITY,
         topology_seconds: f64::INFINITY,
         total_seconds: f64::INFINITY,
+        open_seconds: f64::INFINITY,
+        wire_bytes: 0,
+        encode_seconds: f64::INFINITY,
+        decode_seconds: f64::INFINITY,
     };
     for _ in 0..repeat.max(1) {
         let start = Instant::now();
@@ -67,6 +89,19 @@ pub fn measure(bytes: &[u8], name: &str, repeat: usize) -> Result<LoadTiming, St
         timing.total_seconds = timing.total_seconds.min(parse + topo);
         timing.vertices = mesh.vertex_count();
         timing.faces = mesh.triangle_count();
+
+        let start = Instant::now();
+        let model = Model::load(name, bytes).map_err(|e| e.to_string())?;
+        let opened = Instant::now();
+        let wire = worker::encode(&model);
+        let encoded = Instant::now();
+        let back: Model = worker::decode(&wire)?;
+        let decoded = Instant::now();
+        std::hint::black_box(&back);
+        timing.open_seconds = timing.open_seconds.min((opened - start).as_secs_f64());
+        timing.encode_seconds = timing.encode_seconds.min((encoded - opened).as_secs_f64());
+        timing.decode_seconds = timing.decode_seconds.min((decoded - encoded).as_secs_f64());
+        timing.wire_bytes = wire.len();
     }
     Ok(timing)
 }
@@ -91,6 +126,10 @@ mod tests {
             "parse_seconds",
             "topology_seconds",
             "total_seconds",
+            "open_seconds",
+            "wire_bytes",
+            "encode_seconds",
+            "decode_seconds",
         ] {
             assert!(json.get(key).is_some(), "{key}");
         }
