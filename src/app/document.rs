@@ -303,6 +303,12 @@ impl Document {
         }
     }
 
+    /// Whether all the work under way runs in the CPU engine's workers, whose replies wake
+    /// the page: then frames are needed only when one lands, not continuously.
+    pub fn working_elsewhere(&self) -> bool {
+        self.backend == Backend::Cpu && !self.guidance_on_gpu && self.session.cpu_engine_threaded()
+    }
+
     /// Whether anything is computing (the current result or background work), so the page
     /// keeps drawing frames.
     pub fn working(&self) -> bool {

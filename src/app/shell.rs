@@ -24,6 +24,10 @@ use eframe::egui;
 use eframe::egui_wgpu;
 use std::cell::RefCell;
 use std::rc::Rc;
+use std::time::Duration;
+
+/// How often the page redraws while only the workers work: the progress bars move on.
+const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
 
 pub struct Shell {
     doc: SharedDocument,
@@ -93,6 +97,13 @@ impl Shell {
         match workers::WebWorkers::start(workers::pool_size(), &cc.egui_ctx) {
             Ok(w) => {
                 log::info!("CPU engine: {} workers", w.workers());
+                let weak = Rc::downgrade(&doc);
+                w.on_reply(Box::new(move || {
+                    // Between frames the document is free; skipped should it not be.
+                    if let Some(Ok(mut doc)) = weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
+                        doc.session.pump_cpu_engine();
+                    }
+                }));
                 doc.borrow_mut()
                     .session
                     .set_cpu_engine(Pool::new(Box::new(w)));
@@ -517,7 +528,11 @@ impl eframe::App for Shell {
             let mut doc = self.doc.borrow_mut();
             doc.answer_waiting();
             self.repainting = doc.working();
-            if self.repainting {
+            if self.repainting && doc.working_elsewhere() {
+                // The replies wake the page; this only moves the progress on. Frames drawn
+                // for nothing would take a core from the workers.
+                ctx.request_repaint_after(PROGRESS_REPAINT);
+            } else if self.repainting {
                 ctx.request_repaint();
             }
         }

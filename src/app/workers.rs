@@ -14,10 +14,14 @@ use crate::worker::{decode, encode, Carrier, Reply, Request};
 
 type Inbox = Rc<RefCell<Vec<(usize, Reply)>>>;
 
+/// What runs as a reply lands, between frames.
+type OnReply = Rc<RefCell<Option<Box<dyn FnMut()>>>>;
+
 /// The workers, with the message handlers that must live as long as they do.
 pub struct WebWorkers {
     workers: Vec<web_sys::Worker>,
     inbox: Inbox,
+    on_reply: OnReply,
     _handlers: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
 }
 
@@ -36,10 +40,18 @@ impl WebWorkers {
         self.workers.len()
     }
 
+    /// Runs `hook` whenever a reply lands, between frames: the pool hands the worker its next
+    /// job there, instead of leaving it idle until the next frame (which can take long while a
+    /// large mesh is drawn).
+    pub fn on_reply(&self, hook: Box<dyn FnMut()>) {
+        *self.on_reply.borrow_mut() = Some(hook);
+    }
+
     /// Starts `count` workers on the page's own wasm, waking `ctx` when a reply comes.
     pub fn start(count: usize, ctx: &egui::Context) -> Result<Self, String> {
         let (glue, wasm) = own_module_urls()?;
         let inbox: Inbox = Rc::default();
+        let on_reply: OnReply = Rc::default();
         let mut workers = Vec::new();
         let mut handlers = Vec::new();
         for index in 0..count.max(1) {
@@ -49,7 +61,7 @@ impl WebWorkers {
             let worker = web_sys::Worker::new_with_options("worker.js", &options).map_err(|e| {
                 format!("cannot start a worker: {}", super::page::js_error_text(&e))
             })?;
-            let handler = reply_handler(index, inbox.clone(), ctx.clone());
+            let handler = reply_handler(index, inbox.clone(), on_reply.clone(), ctx.clone());
             worker.set_onmessage(Some(handler.as_ref().unchecked_ref()));
             let start = js_sys::Object::new();
             let set = |k: &str, v: &str| js_sys::Reflect::set(&start, &k.into(), &v.into());
@@ -63,6 +75,7 @@ impl WebWorkers {
         Ok(Self {
             workers,
             inbox,
+            on_reply,
             _handlers: handlers,
         })
     }
@@ -72,6 +85,7 @@ impl WebWorkers {
 fn reply_handler(
     index: usize,
     inbox: Inbox,
+    on_reply: OnReply,
     ctx: egui::Context,
 ) -> Closure<dyn FnMut(web_sys::MessageEvent)> {
     Closure::new(move |event: web_sys::MessageEvent| {
@@ -87,6 +101,11 @@ fn reply_handler(
             log::error!("engine worker {} failed: {why}", index + 1);
             let why = format!("engine worker {} failed: {why}", index + 1);
             inbox.borrow_mut().push((index, Reply::Broken { why }));
+        }
+        if let Ok(mut hook) = on_reply.try_borrow_mut() {
+            if let Some(hook) = hook.as_mut() {
+                hook();
+            }
         }
         ctx.request_repaint();
     })

@@ -21,6 +21,17 @@ impl Session {
         self.cpu_job = None;
     }
 
+    /// Whether the CPU engine's workers run beside this thread.
+    pub fn cpu_engine_threaded(&self) -> bool {
+        self.cpu.threaded()
+    }
+
+    /// Takes the CPU engine's replies and hands its idle workers their next jobs (the ones
+    /// already asked for: the view's result, the searches' parameter sets to come).
+    pub fn pump_cpu_engine(&mut self) {
+        self.cpu.pump();
+    }
+
     /// Smooths and measures the current revision on the CPU engine until its result is there
     /// (at once with workers on this thread); the time each half took comes back.
     pub fn smooth_cpu(&mut self) -> Option<Timings> {

@@ -164,6 +164,11 @@ impl Pool {
         self.busy.len()
     }
 
+    /// Whether the workers run beside the caller's thread (else each job blocks it).
+    pub fn threaded(&self) -> bool {
+        self.carrier.threaded()
+    }
+
     /// What `state()` says of the CPU engine: its workers and whether they are threads.
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({ "workers": self.workers(), "threaded": self.carrier.threaded() })
