@@ -66,6 +66,8 @@ struct SurfaceFragment {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) albedo: vec3<f32>,
+    // Opacity: the colour's alpha (a case's translucent structures), else 1.
+    @location(3) alpha: f32,
 }
 
 @vertex
@@ -76,8 +78,10 @@ fn vs_surface(v: SurfaceVertex) -> SurfaceFragment {
     out.normal = v.normal.xyz;
     if (view.flags & VERTEX_COLORS) != 0u {
         out.albedo = linear_from_srgb(v.color.rgb);
+        out.alpha = v.color.a;
     } else {
         out.albedo = view.base_color.rgb;
+        out.alpha = 1.0;
     }
     return out;
 }
@@ -104,7 +108,7 @@ fn fs_surface(f: SurfaceFragment, @builtin(front_facing) front: bool) -> @locati
     let half_vector = normalize(to_light + to_eye);
     let highlight = select(0.0, pow(max(dot(n, half_vector), 0.0), SHININESS), key > 0.0);
     let rgb = albedo * (AMBIENT + KEY * key + FILL * fill) + vec3<f32>(SPECULAR * highlight);
-    return encode(rgb, 1.0);
+    return encode(rgb, f.alpha);
 }
 
 // Wireframe lines lie exactly on the surface, so each is moved this fraction of its distance

@@ -358,3 +358,122 @@ fn a_session_opens_a_label_map_as_its_structures() {
         "case_phantom_shared.seg.nrrd: tumor"
     );
 }
+
+/// The page's session shows a segmentation's structures each its own way: colours, opacity,
+/// visibility and names as the author sets them, and each structure's smoothing kept while
+/// another is the model, and restored when it is the model again.
+#[test]
+fn a_session_keeps_each_structures_look_and_smoothing() {
+    use meshsmooth::session::{Session, StructureChange};
+    use meshsmooth::smooth::{Filter, Params};
+    let mut session = Session::default();
+    session.begin_open(
+        "case_phantom_shared.seg.nrrd",
+        read("labelmaps/case_phantom_shared.seg.nrrd"),
+    );
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(session.structure_looks().len(), 4);
+    assert!(session
+        .structure_looks()
+        .iter()
+        .all(|l| l.visible && l.color[3] == 1.0));
+    // Three others around the liver, as extracted.
+    let others: Vec<usize> = session.other_structures().iter().map(|o| o.index).collect();
+    assert_eq!(others, [1, 2, 3]);
+
+    let (index, change) = StructureChange::from_json(&serde_json::json!({
+        "index": 2, "name": " tumour ", "color": [0.0, 1.0, 0.0], "opacity": 0.4
+    }))
+    .unwrap();
+    let version = session.looks_version();
+    session.set_structure(index.unwrap(), change).unwrap();
+    assert!(session.looks_version() > version);
+    let tumour = &session.structure_looks()[2];
+    assert_eq!(
+        (tumour.name.as_str(), tumour.color),
+        ("tumour", [0.0, 1.0, 0.0, 0.4])
+    );
+    for bad in [
+        serde_json::json!({"opacity": 1.5}),
+        serde_json::json!({"color": [0, 2, 0]}),
+        serde_json::json!({"name": "  "}),
+        serde_json::json!({"group": "Vessels"}),
+        serde_json::json!({"visible": "yes"}),
+        serde_json::json!([1]),
+    ] {
+        let refused =
+            StructureChange::from_json(&bad).and_then(|(_, c)| session.set_structure(2, c));
+        assert!(refused.is_err(), "{bad}");
+    }
+    assert!(session
+        .set_structure(9, StructureChange::default())
+        .is_err());
+    assert_eq!(
+        session.structure_looks()[2].name,
+        "tumour",
+        "a refusal changes nothing"
+    );
+
+    // Solo shows one alone; again, every one.
+    session.solo_structure(3).unwrap();
+    let visible: Vec<bool> = session
+        .structure_looks()
+        .iter()
+        .map(|l| l.visible)
+        .collect();
+    assert_eq!(visible, [false, false, false, true]);
+    assert_eq!(session.other_structures().len(), 1);
+    session.solo_structure(3).unwrap();
+    assert!(session.structure_looks().iter().all(|l| l.visible));
+
+    // Smooth the liver, then work on the portal vein: the liver keeps its smoothing.
+    let liver_params = Params {
+        iterations: 7,
+        ..Params::defaults(Filter::Taubin)
+    };
+    session.set_params(liver_params).unwrap();
+    session.smooth_cpu();
+    let liver = session.result().expect("smoothed").clone();
+    session.begin_open_structure(1).unwrap();
+    session.poll_opening().expect("done").expect("opens");
+    let others = session.other_structures();
+    let kept_liver = others
+        .iter()
+        .find(|o| o.index == 0)
+        .expect("the liver is drawn");
+    assert_eq!(kept_liver.positions, &liver.positions[..]);
+    session
+        .set_params(Params::defaults(Filter::Laplace))
+        .unwrap();
+    session.smooth_cpu();
+    let json = session.structures_json().unwrap();
+    assert_eq!(json["current"], 1);
+    assert_eq!(json["structures"][2]["name"], "tumour");
+    assert_eq!(json["structures"][2]["opacity"], 0.4f32 as f64);
+    assert_eq!(
+        json["structures"][0]["metrics"],
+        serde_json::to_value(&liver.metrics).unwrap()
+    );
+    assert!(json["structures"][3]["metrics"].is_null(), "never smoothed");
+    assert_ne!(json["structures"][1]["metrics"], serde_json::Value::Null);
+
+    // Back to the liver: its parameters return, and with them the same result.
+    session.begin_open_structure(0).unwrap();
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(*session.params(), liver_params);
+    session.smooth_cpu();
+    assert_eq!(session.result().unwrap().positions, liver.positions);
+    assert_eq!(
+        session.structure_looks()[2].name,
+        "tumour",
+        "looks stay across switches"
+    );
+
+    // A new file starts over.
+    session.begin_open(
+        "case_phantom_shared.seg.nrrd",
+        read("labelmaps/case_phantom_shared.seg.nrrd"),
+    );
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(session.structure_looks()[2].name, "tumor");
+}

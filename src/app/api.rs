@@ -6,9 +6,13 @@
 //!   staying open until then; a later `loadMesh` before it is open replaces it (its promise rejects)
 //!   A label map (`.nii`, `.nii.gz`, `.nrrd`, `.seg.nrrd`) opens the same way: its structures
 //!   are extracted and the first one becomes the model
-//! - `structures()`: `{file, current, structures: [{label, name, color, voxels, voxel_size,
-//!   vertices, triangles, volume}]}` of the open segmentation, or null when the model is a mesh
-//! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`
+//! - `structures()`: `{file, current, structures: [{label, name, color, opacity, visible,
+//!   voxels, voxel_size, vertices, triangles, volume, metrics}]}` of the open segmentation, or
+//!   null when the model is a mesh (`metrics`: its last smoothing's measures, or null)
+//! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`;
+//!   the structure left keeps its smoothing, one coming back gets its own back
+//! - `setStructure({index, name, color, opacity, visible})`: changes how a structure (by
+//!   default the model's) is shown; throws on a bad value
 //! - `setFilter(name)`, `setParams(object)` (keys `lambda mu alpha beta passband iterations
 //!   max_displacement`); both throw with the engine's message on a bad name or value
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
@@ -240,8 +244,8 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
         "structures",
         Closure::<dyn FnMut() -> JsValue>::new(move || {
             let doc = d.borrow();
-            match doc.session.structures() {
-                Some(s) => to_js(&s.to_json()),
+            match doc.session.structures_json() {
+                Some(s) => to_js(&s),
                 None => JsValue::NULL,
             }
         }),
@@ -279,6 +283,16 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
         "setFilter",
         setter(doc, ctx, |session, name| {
             session.set_filter_name(&name.as_string().unwrap_or_default())
+        }),
+    )?;
+    define(
+        &api,
+        "setStructure",
+        setter(doc, ctx, |session, values| {
+            let (index, change) = crate::session::StructureChange::from_json(&from_js(&values)?)?;
+            let current = session.structures().map(|s| s.current);
+            let index = index.or(current).ok_or("no segmentation is open")?;
+            session.set_structure(index, change)
         }),
     )?;
     define(

@@ -33,7 +33,7 @@ mod report_view;
 mod shell;
 mod shortcuts;
 mod status;
-mod structure_picker;
+mod structure_list;
 pub mod viewer;
 mod workers;
 

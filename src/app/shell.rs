@@ -11,7 +11,7 @@ use super::file_input::FileInput;
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
 use super::shortcuts::{self, Action};
-use super::structure_picker;
+use super::structure_list::{StructureAction, StructureList};
 use super::viewer::{self, Viewer};
 use super::{
     api, download, legend, page, query, report_view, status, workers, SAMPLE_BYTES, SAMPLE_NAME,
@@ -52,6 +52,9 @@ pub struct Shell {
     view: Option<(Viewer, egui_wgpu::RenderState)>,
     /// What the view shows now, so it is re-uploaded only when that changes.
     shown: Shown,
+    /// The segmentation the view framed whole (its file and structure count).
+    framed_case: Option<(String, usize)>,
+    structures: StructureList,
     /// Whether the last frame asked for the next at once.
     repainting: bool,
 }
@@ -74,6 +77,8 @@ struct Shown {
     /// Field and result revision of the colours, `None` for plain shading.
     colors: Option<(ColorField, u64)>,
     legend: Option<Legend>,
+    /// The version of the structures' looks the other structures were uploaded for.
+    looks: Option<u64>,
 }
 
 impl Shell {
@@ -140,6 +145,8 @@ impl Shell {
             gpu_fallback: None,
             view,
             shown: Shown::default(),
+            framed_case: None,
+            structures: StructureList::default(),
             repainting: false,
         }
     }
@@ -158,7 +165,21 @@ impl Shell {
         let mesh = model.mesh();
         if self.shown.generation != doc.model_generation || self.shown.positions.is_none() {
             let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
+            let kept_view = viewer.view_state();
             viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
+            // A segmentation is framed whole once; another of its structures keeps the view.
+            let case = session.structures().map(|s| (s.file.clone(), s.list.len()));
+            match (&case, case == self.framed_case) {
+                (Some(_), true) => viewer.set_view_state(kept_view),
+                (Some(_), false) => {
+                    let list = &session.structures().expect("a segmentation").list;
+                    let all: Vec<&[[f32; 3]]> =
+                        list.iter().map(|s| s.mesh.positions.as_slice()).collect();
+                    viewer.frame_all(&all);
+                }
+                (None, _) => {}
+            }
+            self.framed_case = case;
             self.shown = Shown {
                 generation: doc.model_generation,
                 positions: Some(Positions::Original),
@@ -214,6 +235,22 @@ impl Shell {
             viewer.set_colors(rs, computed.as_ref().map(|(c, _)| c.as_slice()));
             self.shown.legend = computed.map(|(_, l)| l);
             self.shown.colors = colors;
+        }
+        if self.shown.looks != Some(session.looks_version()) {
+            let others = session.other_structures();
+            let surfaces: Vec<viewer::ContextSurface<'_>> = others
+                .iter()
+                .map(|o| viewer::ContextSurface {
+                    positions: o.positions,
+                    triangles: o.triangles,
+                    color: o.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
+                })
+                .collect();
+            viewer.set_context(rs, &surfaces);
+            let look = session.model_look();
+            let color = look.map(|l| [l.color[0], l.color[1], l.color[2]]);
+            viewer.set_model_look(color, look.is_none_or(|l| l.visible));
+            self.shown.looks = Some(session.looks_version());
         }
     }
 
@@ -376,8 +413,13 @@ impl Shell {
     fn smoothing_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
         let timings = doc.timings;
-        if let Some(index) = structure_picker::show(ui, &doc.session) {
-            if let Err(e) = doc.begin_open_structure(index, None) {
+        for action in self.structures.show(ui, &doc.session) {
+            let done = match action {
+                StructureAction::Select(i) => doc.begin_open_structure(i, None),
+                StructureAction::Change(i, change) => doc.session.set_structure(i, change),
+                StructureAction::Solo(i) => doc.session.solo_structure(i),
+            };
+            if let Err(e) = done {
                 log::warn!("{e}");
             }
         }

@@ -10,12 +10,14 @@ mod colors;
 mod cpu;
 mod guidance;
 mod opening;
+mod structures;
 mod weights;
 
 pub use crate::model::{Model, OpenFailure, Structures};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use opening::LoadProgress;
+pub use structures::{Kept, OtherStructure, StructureChange, StructureLook};
 pub use weights::WeightsSummary;
 
 use crate::export::{self, ExportFormat, ExportOptions};
@@ -75,6 +77,9 @@ pub struct Session {
     opening: Option<opening::Opening>,
     /// How long each stage of the latest opening took (ms), in order.
     open_stages: Vec<(String, f64)>,
+    /// How each structure of the open segmentation is shown, and what it keeps.
+    looks: Vec<structures::StructureLook>,
+    looks_version: u64,
 }
 
 impl Default for Session {
@@ -96,6 +101,8 @@ impl Default for Session {
             guidance: guidance::Guidance::default(),
             opening: None,
             open_stages: Vec::new(),
+            looks: Vec::new(),
+            looks_version: 0,
         }
     }
 }
@@ -323,7 +330,7 @@ impl Session {
             "busy": busy,
             "cpu_engine": self.cpu.to_json(),
             "weights": self.weights_summary(),
-            "structures": self.structures().map(Structures::to_json),
+            "structures": self.structures_json(),
             "loading": self.loading().map(|l| serde_json::json!({
                 "name": l.name, "stage": l.stage, "stages": l.total, "doing": l.doing,
             })),

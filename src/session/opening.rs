@@ -31,7 +31,11 @@ impl Session {
     /// error is recorded (and returned) as "Cannot open NAME: reason".
     pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<&Model, String> {
         match Model::load(name, bytes) {
-            Ok(model) => Ok(self.set_model(model)),
+            Ok(model) => {
+                self.set_model(model);
+                self.reset_looks();
+                Ok(self.model.as_ref().expect("just set"))
+            }
             Err(e) => Err(self.fail(name, &e.to_string())),
         }
     }
@@ -94,10 +98,19 @@ impl Session {
                 mut model, stages, ..
             } => {
                 self.open_stages = stages;
-                if structures.is_some() {
+                let switching = structures.is_some();
+                if switching {
+                    // Another structure of the open segmentation: the one leaving keeps its
+                    // smoothing, the one coming gets back what it kept.
+                    self.keep_model_structure();
                     model.structures = structures;
                 }
                 self.set_model(*model);
+                if switching {
+                    self.restore_model_structure();
+                } else {
+                    self.reset_looks();
+                }
                 Some(Ok(()))
             }
             Reply::Failed { why, .. } => Some(Err(self.fail(&name, &why))),

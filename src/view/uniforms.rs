@@ -79,6 +79,20 @@ impl ViewUniforms {
             _padding: [0; 3],
         }
     }
+
+    /// The same record with `srgb` (display colour, each in [0, 1]) as the colour of a mesh
+    /// without vertex colours: a case's structure in its own colour.
+    pub fn with_base_color(mut self, srgb: [f32; 3]) -> Self {
+        let [r, g, b] = srgb.map(|c| linear_from_srgb(c.clamp(0.0, 1.0)));
+        self.base_color = [r, g, b, 1.0];
+        self
+    }
+
+    /// The same record with `flags` set as well.
+    pub fn with_flags(mut self, flags: u32) -> Self {
+        self.flags |= flags;
+        self
+    }
 }
 
 /// Linear light from an sRGB-encoded value in 0..1 (the sRGB transfer function's inverse;
@@ -94,6 +108,15 @@ pub fn linear_from_srgb(c: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_structure_colour_becomes_the_base_colour_in_linear_light() {
+        let u = ViewUniforms::new(&OrbitCamera::default(), 1.0, 0).with_base_color([1.0, 0.5, 0.0]);
+        assert_eq!(u.base_color[0], 1.0);
+        assert!((u.base_color[1] - 0.214).abs() < 1e-3, "{:?}", u.base_color);
+        assert_eq!((u.base_color[2], u.base_color[3]), (0.0, 1.0));
+        assert_eq!(u.with_flags(VERTEX_COLORS).flags, VERTEX_COLORS);
+    }
 
     #[test]
     fn srgb_decoding_matches_known_values() {

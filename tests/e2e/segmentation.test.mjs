@@ -216,3 +216,72 @@ testIn(WEBGPU_RUN, "S5 a label map dropped on the page opens as its structures",
         await app.screenshot("S5-dropped-seg-nrrd");
     });
 });
+
+/**
+ * Strongly green pixels in the 3D view (`view`: its rectangle from state()), left of its colour
+ * legend: the tumour once it is coloured pure green (the list's swatch is outside the view).
+ */
+function greenPixels(image, view) {
+    let count = 0;
+    for (let y = Math.round(view.y); y < Math.round(view.y + view.height); y++) {
+        for (let x = Math.round(view.x); x < Math.round(view.x + 0.7 * view.width); x++) {
+            const i = (y * image.width + x) * 4;
+            const [r, g, b] = [image.rgba[i], image.rgba[i + 1], image.rgba[i + 2]];
+            if (g > 90 && g > r + 60 && g > b + 60) count++;
+        }
+    }
+    return count;
+}
+
+testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, solo and names; each keeps its own smoothing", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
+        const looks = (list) => list.structures.map((s) => [s.name, s.opacity, s.visible]);
+        let list = await app.call("structures");
+        assert.deepEqual(looks(list), [["liver", 1, true], ["portal_vein", 1, true], ["tumor", 1, true], ["right_kidney", 1, true]]);
+        await app.screenshot("S6-phantom-all-structures");
+        // Work on the kidney; the tumour, inside the liver, turns pure green.
+        await app.call("selectStructure", 3);
+        await app.call("setStructure", { index: 2, color: [0, 1, 0] });
+        await app.metrics();
+        const { view } = await app.state();
+        const hidden = greenPixels(await app.screenshot("S6-tumour-green-inside-the-liver"), view);
+        // The liver made translucent shows the tumour inside it.
+        await app.call("setStructure", { index: 0, opacity: 0.3 });
+        await app.metrics();
+        const seen = greenPixels(await app.screenshot("S6-liver-translucent-tumour-seen"), view);
+        assert.ok(seen > hidden + 200, `the tumour shows through the translucent liver: ${hidden} -> ${seen} green pixels`);
+        await app.call("setStructure", { index: 2, visible: false });
+        await app.metrics();
+        const gone = greenPixels(await app.screenshot("S6-tumour-hidden"), view);
+        assert.ok(gone < 50, `the hidden tumour is not drawn: ${gone} green pixels (${seen} shown)`);
+        await app.call("setStructure", { index: 1, name: "portal vein" });
+        const refused = await app.attempt("setStructure", { index: 0, opacity: 2 });
+        assert.equal(refused.ok, false);
+        assert.match(refused.message, /opacity/);
+        list = await app.call("structures");
+        assert.deepEqual(looks(list), [["liver", 0.30000001192092896, true], ["portal vein", 1, true], ["tumor", 1, false], ["right_kidney", 1, true]]);
+        assert.deepEqual(list.structures[2].color, [0, 1, 0]);
+
+        // The kidney smoothed; then the liver: the kidney keeps its smoothing and measures.
+        await app.setFilter("taubin");
+        await app.setParams({ iterations: 12 });
+        const kidney = await app.metrics();
+        await app.call("selectStructure", 0);
+        await app.setFilter("laplace");
+        await app.setParams({ iterations: 4 });
+        const liver = await app.metrics();
+        list = await app.call("structures");
+        assert.deepEqual(list.structures[3].metrics, kidney, "the kidney keeps its measures");
+        assert.deepEqual(list.structures[0].metrics, liver);
+        assert.equal(list.structures[1].metrics, null, "never smoothed");
+        assert.equal(list.structures[2].metrics, null, "never smoothed");
+        // Back to the kidney: its filter and parameters return, and its result with them.
+        await app.call("selectStructure", 3);
+        const state = await app.state();
+        assert.equal(state.filter, "taubin");
+        assert.equal(state.params.iterations, 12);
+        assert.deepEqual(await app.metrics(), kidney);
+        await app.screenshot("S6-kidney-again-liver-smoothed-translucent");
+    });
+});

@@ -10,6 +10,7 @@ use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu, CallbackResources, CallbackTrait};
 
 use super::buffers::MeshBuffers;
+use super::context::{far_to_near, ContextMesh};
 use super::pipelines::Pipelines;
 use super::target::Target;
 use crate::view::ViewUniforms;
@@ -20,6 +21,12 @@ pub struct ViewResources {
     pub uniforms: wgpu::Buffer,
     pub view_group: wgpu::BindGroup,
     pub mesh: MeshBuffers,
+    /// The case's other structures, and a count of their changes.
+    pub context: Vec<ContextMesh>,
+    pub context_generation: u64,
+    /// The per-frame record with vertex colours on, for the other structures.
+    context_uniforms: wgpu::Buffer,
+    context_group: wgpu::BindGroup,
     target: Option<Target>,
     /// What the target holds, to skip drawing the same frame again.
     drawn: Option<Frame>,
@@ -31,37 +38,49 @@ struct Frame {
     uniforms: ViewUniforms,
     wireframe: bool,
     mesh_generation: u64,
+    context_generation: u64,
+    show_model: bool,
     size: [u32; 2],
 }
 
 impl ViewResources {
     pub fn new(device: &wgpu::Device, pipelines: Pipelines) -> Self {
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("meshsmooth view uniforms"),
-            size: std::mem::size_of::<ViewUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("meshsmooth view"),
-            layout: &pipelines.view_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniforms.as_entire_binding(),
-            }],
-        });
+        let record = |label| {
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: std::mem::size_of::<ViewUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout: &pipelines.view_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                }],
+            });
+            (buffer, group)
+        };
+        let (uniforms, view_group) = record("meshsmooth view");
+        let (context_uniforms, context_group) = record("meshsmooth view, other structures");
         Self {
             pipelines,
             uniforms,
             view_group,
             mesh: MeshBuffers::default(),
+            context: Vec::new(),
+            context_generation: 0,
+            context_uniforms,
+            context_group,
             target: None,
             drawn: None,
         }
     }
 
-    /// Draws the mesh into the target (cleared to transparent) and resolves it.
-    fn draw(&self, encoder: &mut wgpu::CommandEncoder, target: &Target, wireframe: bool) {
+    /// Draws the model and the other structures into the target (cleared to transparent) and
+    /// resolves it.
+    fn draw(&self, encoder: &mut wgpu::CommandEncoder, target: &Target, frame: &Frame) {
         let (color, resolve_target) = match &target.multisampled {
             Some(multisampled) => (multisampled, Some(&target.resolved)),
             None => (&target.resolved, None),
@@ -94,29 +113,52 @@ impl ViewResources {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let mesh = &self.mesh;
-        let (Some(positions), Some(normals), Some(colors), Some(triangles)) = (
-            &mesh.positions,
-            &mesh.normals,
-            &mesh.colors,
-            &mesh.triangles,
-        ) else {
-            return;
-        };
         pass.set_bind_group(0, &self.view_group, &[]);
         pass.set_pipeline(&self.pipelines.surface);
-        pass.set_vertex_buffer(0, positions.slice(..));
-        pass.set_vertex_buffer(1, normals.slice(..));
-        pass.set_vertex_buffer(2, colors.slice(..));
-        pass.set_index_buffer(triangles.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..mesh.triangle_indices, 0, 0..1);
-
-        if let (true, Some(edges)) = (wireframe, &mesh.edges) {
+        if frame.show_model {
+            draw_surface(&mut pass, &self.mesh);
+        }
+        pass.set_bind_group(0, &self.context_group, &[]);
+        for context in self.context.iter().filter(|c| c.opaque) {
+            draw_surface(&mut pass, &context.buffers);
+        }
+        if let (true, true, Some(positions), Some(edges)) = (
+            frame.wireframe,
+            frame.show_model,
+            &self.mesh.positions,
+            &self.mesh.edges,
+        ) {
+            pass.set_bind_group(0, &self.view_group, &[]);
             pass.set_pipeline(&self.pipelines.wire);
+            pass.set_vertex_buffer(0, positions.slice(..));
             pass.set_index_buffer(edges.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..mesh.edge_indices, 0, 0..1);
+            pass.draw_indexed(0..self.mesh.edge_indices, 0, 0..1);
+        }
+        // Translucent structures last, far to near, over everything opaque.
+        pass.set_bind_group(0, &self.context_group, &[]);
+        pass.set_pipeline(&self.pipelines.translucent);
+        let eye = [0, 1, 2].map(|k| frame.uniforms.eye[k]);
+        for i in far_to_near(&self.context, eye) {
+            draw_surface(&mut pass, &self.context[i].buffers);
         }
     }
+}
+
+/// Draws `mesh`'s triangles with the pipeline and record set.
+fn draw_surface(pass: &mut wgpu::RenderPass<'_>, mesh: &MeshBuffers) {
+    let (Some(positions), Some(normals), Some(colors), Some(triangles)) = (
+        &mesh.positions,
+        &mesh.normals,
+        &mesh.colors,
+        &mesh.triangles,
+    ) else {
+        return;
+    };
+    pass.set_vertex_buffer(0, positions.slice(..));
+    pass.set_vertex_buffer(1, normals.slice(..));
+    pass.set_vertex_buffer(2, colors.slice(..));
+    pass.set_index_buffer(triangles.slice(..), wgpu::IndexFormat::Uint32);
+    pass.draw_indexed(0..mesh.triangle_indices, 0, 0..1);
 }
 
 /// One frame of the view.
@@ -125,6 +167,8 @@ pub struct ViewCallback {
     pub rect: egui::Rect,
     pub uniforms: ViewUniforms,
     pub wireframe: bool,
+    /// Whether the model itself is drawn (a case may hide it and show the others).
+    pub show_model: bool,
 }
 
 impl CallbackTrait for ViewCallback {
@@ -156,14 +200,18 @@ impl CallbackTrait for ViewCallback {
             uniforms: self.uniforms,
             wireframe: self.wireframe,
             mesh_generation: view.mesh.generation,
+            context_generation: view.context_generation,
+            show_model: self.show_model,
             size,
         };
         if view.drawn == Some(frame) {
             return Vec::new();
         }
         queue.write_buffer(&view.uniforms, 0, bytemuck::bytes_of(&self.uniforms));
+        let context = self.uniforms.with_flags(crate::view::VERTEX_COLORS);
+        queue.write_buffer(&view.context_uniforms, 0, bytemuck::bytes_of(&context));
         if let Some(target) = &view.target {
-            view.draw(encoder, target, self.wireframe);
+            view.draw(encoder, target, &frame);
         }
         view.drawn = Some(frame);
         Vec::new()

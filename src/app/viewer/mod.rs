@@ -6,14 +6,18 @@
 //! [`crate::view`].
 //!
 //! Modules: `pipelines` (surface, wireframe and composite pipelines), `target` (the view's
-//! multisampled render target), `buffers` (the model's vertex and index buffers), `callback`
-//! (the egui-wgpu callback and the resources it draws with), `controls` (input to camera moves).
+//! multisampled render target), `buffers` (the model's vertex and index buffers), `context`
+//! (a case's other structures around the model), `callback` (the egui-wgpu callback and the
+//! resources it draws with), `controls` (input to camera moves).
 
 mod buffers;
 mod callback;
+mod context;
 mod controls;
 mod pipelines;
 mod target;
+
+pub use context::ContextSurface;
 
 use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu};
@@ -51,6 +55,12 @@ pub struct Viewer {
     output_linear: bool,
     /// Why the model is not shown (too large for this GPU, mismatched arrays), if so.
     problem: Option<String>,
+    /// The model's colour where it is a case's structure (display sRGB), else the default.
+    model_color: Option<[f32; 3]>,
+    /// Whether the model is drawn (a case's structure can be hidden).
+    show_model: bool,
+    /// Other structures are drawn around the model.
+    has_context: bool,
 }
 
 impl Viewer {
@@ -84,6 +94,42 @@ impl Viewer {
             has_colors: false,
             output_linear: render_state.target_format.is_srgb(),
             problem: None,
+            model_color: None,
+            show_model: true,
+            has_context: false,
+        }
+    }
+
+    /// How the model is shown as a case's structure: its colour (`None`: the default) and
+    /// whether it is drawn at all.
+    pub fn set_model_look(&mut self, color: Option<[f32; 3]>, visible: bool) {
+        self.model_color = color;
+        self.show_model = visible;
+    }
+
+    /// The case's other structures, drawn around the model (replacing those set before).
+    pub fn set_context(&mut self, rs: &egui_wgpu::RenderState, surfaces: &[ContextSurface<'_>]) {
+        let result = with_resources(rs, |view| {
+            let meshes: Result<Vec<_>, String> = surfaces
+                .iter()
+                .map(|s| context::ContextMesh::new(&rs.device, &rs.queue, s))
+                .collect();
+            view.context = meshes?;
+            view.context_generation += 1;
+            Ok(())
+        });
+        match result {
+            Ok(()) => self.has_context = !surfaces.is_empty(),
+            Err(e) => self.fail(e),
+        }
+    }
+
+    /// Frames every point of `surfaces` (a whole case) and makes that the view's home.
+    pub fn frame_all(&mut self, surfaces: &[&[[f32; 3]]]) {
+        let points: Vec<[f32; 3]> = surfaces.iter().flat_map(|s| s.iter().copied()).collect();
+        if !points.is_empty() {
+            self.home = first_view(&points);
+            self.reset_view();
         }
     }
 
@@ -174,7 +220,7 @@ impl Viewer {
         ui.painter().rect_filled(rect, 0.0, BACKGROUND);
         if let Some(problem) = &self.problem {
             centered_note(ui, rect, problem, ui.visuals().error_fg_color);
-        } else if self.vertex_count == 0 {
+        } else if self.vertex_count == 0 && !self.has_context {
             centered_note(ui, rect, "Nothing to show", ui.visuals().weak_text_color());
         } else if rect.width() >= 1.0 && rect.height() >= 1.0 {
             let mut flags = 0;
@@ -184,15 +230,30 @@ impl Viewer {
             if self.output_linear {
                 flags |= OUTPUT_LINEAR;
             }
+            let mut uniforms = ViewUniforms::new(&self.camera, rect.width() / rect.height(), flags);
+            if let Some(color) = self.model_color {
+                uniforms = uniforms.with_base_color(color);
+            }
             let callback = ViewCallback {
                 rect,
-                uniforms: ViewUniforms::new(&self.camera, rect.width() / rect.height(), flags),
+                uniforms,
                 wireframe: self.wireframe,
+                show_model: self.show_model,
             };
             ui.painter()
                 .add(egui_wgpu::Callback::new_paint_callback(rect, callback));
         }
         response
+    }
+
+    /// The camera and the home view, to keep across a new model of the same scene.
+    pub fn view_state(&self) -> (OrbitCamera, OrbitCamera) {
+        (self.camera, self.home)
+    }
+
+    pub fn set_view_state(&mut self, (camera, home): (OrbitCamera, OrbitCamera)) {
+        self.camera = camera;
+        self.home = home;
     }
 
     /// The camera the view is drawn with (for picking).

@@ -32,6 +32,8 @@ pub struct Pipelines {
     pub composite_layout: wgpu::BindGroupLayout,
     /// Lit, two-sided triangles; writes depth.
     pub surface: wgpu::RenderPipeline,
+    /// The same, translucent: blended over what is drawn, tests depth, writes none.
+    pub translucent: wgpu::RenderPipeline,
     /// Edges as a line list over the same positions; tests depth, writes none.
     pub wire: wgpu::RenderPipeline,
     /// The resolved image into egui's pass.
@@ -163,34 +165,42 @@ impl Pipelines {
             per_vertex(VEC4_STRIDE, &NORMAL),
             per_vertex(COLOR_STRIDE, &COLOR),
         ];
-        let surface = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("meshsmooth surface"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_surface"),
-                compilation_options: Default::default(),
-                buffers: &surface_buffers,
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                // Two-sided: open meshes show their inside.
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: depth(true, wgpu::CompareFunction::Less),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_surface"),
-                compilation_options: Default::default(),
-                // Opaque.
-                targets: &target(None),
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let surface_pipeline = |label, write_depth, blend| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_surface"),
+                    compilation_options: Default::default(),
+                    buffers: &surface_buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    // Two-sided: open meshes show their inside.
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: depth(write_depth, wgpu::CompareFunction::Less),
+                multisample,
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_surface"),
+                    compilation_options: Default::default(),
+                    targets: &target(blend),
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let surface = surface_pipeline("meshsmooth surface", true, None);
+        // The shader writes premultiplied alpha.
+        let translucent = surface_pipeline(
+            "meshsmooth translucent surface",
+            false,
+            Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+        );
 
         let wire = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("meshsmooth wireframe"),
@@ -254,6 +264,7 @@ impl Pipelines {
             view_layout,
             composite_layout,
             surface,
+            translucent,
             wire,
             composite,
             samples,

@@ -1,0 +1,70 @@
+//! The other structures of a case, drawn around the one being smoothed: each in its own colour
+//! and opacity, uploaded once per change of the case (not per frame).
+
+use eframe::egui_wgpu::wgpu;
+
+use super::buffers::MeshBuffers;
+
+/// A structure to draw beside the model: its surface and display colour (sRGB, alpha the
+/// opacity).
+pub struct ContextSurface<'a> {
+    pub positions: &'a [[f32; 3]],
+    pub triangles: &'a [[u32; 3]],
+    pub color: [u8; 4],
+}
+
+/// One such structure on the GPU.
+pub struct ContextMesh {
+    pub buffers: MeshBuffers,
+    pub opaque: bool,
+    /// The middle of its bounding box: translucent structures are drawn far to near.
+    pub centre: [f32; 3],
+}
+
+impl ContextMesh {
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        surface: &ContextSurface<'_>,
+    ) -> Result<Self, String> {
+        let normals = crate::mesh::vertex_normals(surface.positions, surface.triangles);
+        let mut buffers = MeshBuffers::default();
+        buffers.set_mesh(
+            device,
+            queue,
+            surface.positions,
+            &normals,
+            surface.triangles,
+            &[],
+        )?;
+        buffers.set_colors(queue, &vec![surface.color; surface.positions.len()])?;
+        Ok(Self {
+            buffers,
+            opaque: surface.color[3] == 255,
+            centre: centre(surface.positions),
+        })
+    }
+}
+
+fn centre(positions: &[[f32; 3]]) -> [f32; 3] {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if positions.is_empty() {
+        return [0.0; 3];
+    }
+    [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]))
+}
+
+/// The order to draw translucent structures in: farthest from `eye` first.
+pub fn far_to_near(meshes: &[ContextMesh], eye: [f32; 3]) -> Vec<usize> {
+    let distance2 = |c: [f32; 3]| (0..3).map(|k| (c[k] - eye[k]).powi(2)).sum::<f32>();
+    let mut order: Vec<usize> = (0..meshes.len()).filter(|&i| !meshes[i].opaque).collect();
+    order.sort_by(|&a, &b| distance2(meshes[b].centre).total_cmp(&distance2(meshes[a].centre)));
+    order
+}
