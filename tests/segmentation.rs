@@ -469,6 +469,41 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         "looks stay across switches"
     );
 
+    // The case as arranged: the page's case glTF reads back with the same names, looks,
+    // parameters and smoothed surfaces (the portal vein's kept, the liver's current).
+    session.set_case_text(Some(" Abdomen "), Some("Liver with a tumour"));
+    let glb = session
+        .export_case(meshsmooth::export::Container::Glb)
+        .expect("the case exports");
+    let files = [meshsmooth::segmentation::NamedBytes {
+        name: "case.glb",
+        bytes: &glb,
+    }];
+    let back = meshsmooth::case::open(&files, None, &Default::default()).expect("reads back");
+    assert_eq!(
+        (back.title.as_str(), back.description.as_str()),
+        ("Abdomen", "Liver with a tumour")
+    );
+    let names: Vec<&str> = back.structures.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["liver", "portal_vein", "tumour", "right_kidney"]);
+    assert!((back.structures[2].color[3] - 0.4).abs() < 1e-6);
+    assert_eq!(back.structures[0].params, liver_params);
+    assert_eq!(back.structures[1].params.filter, Filter::Laplace);
+    assert!(
+        back.structures[1].smoothed.is_some(),
+        "the portal vein's kept smoothing"
+    );
+    assert!(back.structures[3].smoothed.is_none(), "never smoothed");
+    let got = &back.structures[0]
+        .smoothed
+        .as_ref()
+        .expect("smoothed")
+        .positions;
+    let far = (got.iter().zip(&liver.positions))
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0f32, f32::max);
+    assert!(far < 1e-4, "the liver moved {far} mm in the round trip");
+
     // A new file starts over.
     session.begin_open(
         "case_phantom_shared.seg.nrrd",

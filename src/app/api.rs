@@ -18,6 +18,9 @@
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
 //!   parameters' result is computed
 //! - `exportMesh(format): Promise<Uint8Array>` for `glb stl ply obj`
+//! - `exportCase(format): Promise<Uint8Array>`: the case glTF (`glb`, the default, or `gltf`)
+//!   of every structure as shown and smoothed (a mesh alone is a case of one), once the
+//!   current parameters' result is computed; `setCase({title, description})` names the case
 //! - `suggest({tau, search}): Promise<object>`: sets tau and searches (`grid`, the default, or
 //!   `local`) for the active filter; resolves with the CLI's `suggest --json` keys (the
 //!   suggestion is shown, not applied)
@@ -45,7 +48,7 @@
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
 
 use super::document::{LoadWaiter, SharedDocument};
-use crate::export::ExportFormat;
+use crate::export::{Container, ExportFormat};
 use eframe::egui;
 use js_sys::{Function, Promise, Uint8Array};
 use wasm_bindgen::closure::Closure;
@@ -409,6 +412,52 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                 let bytes = session.export(format, None)?;
                 Ok(Uint8Array::from(bytes.as_slice()).into())
             })
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "exportCase",
+        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
+            let name = format.as_string().unwrap_or_else(|| "glb".into());
+            let container = match name.as_str() {
+                "glb" => Container::Glb,
+                "gltf" => Container::Gltf,
+                _ => {
+                    return settled(Err(format!(
+                        "unknown case format '{name}': use glb or gltf"
+                    )))
+                }
+            };
+            when_current(&d, &c, move |session| {
+                let bytes = session.export_case(container)?;
+                Ok(Uint8Array::from(bytes.as_slice()).into())
+            })
+        }),
+    )?;
+    define(
+        &api,
+        "setCase",
+        setter(doc, ctx, |session, values| {
+            let values = from_js(&values)?;
+            let text = |key: &str| match values.get(key) {
+                None => Ok(None),
+                Some(v) => v
+                    .as_str()
+                    .map(Some)
+                    .ok_or_else(|| format!("setCase: {key} must be a string")),
+            };
+            if let Some(key) = values
+                .as_object()
+                .ok_or("setCase takes an object: {title, description}")?
+                .keys()
+                .find(|k| !["title", "description"].contains(&k.as_str()))
+            {
+                return Err(format!("setCase: unknown key {key} (title, description)"));
+            }
+            session.set_case_text(text("title")?, text("description")?);
+            Ok(())
         }),
     )?;
 

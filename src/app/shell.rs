@@ -418,6 +418,20 @@ impl Shell {
                 StructureAction::Select(i) => doc.begin_open_structure(i, None),
                 StructureAction::Change(i, change) => doc.session.set_structure(i, change),
                 StructureAction::Solo(i) => doc.session.solo_structure(i),
+                StructureAction::CaseText(title, description) => {
+                    doc.session.set_case_text(Some(&title), Some(&description));
+                    Ok(())
+                }
+                StructureAction::ExportCase => {
+                    let file = doc.session.structures().map(|s| s.file.clone());
+                    let stem = file
+                        .as_deref()
+                        .map_or("case", |f| f.split('.').next().unwrap_or(f));
+                    let name = format!("{stem}_case.glb");
+                    doc.session
+                        .export_case(crate::export::Container::Glb)
+                        .and_then(|bytes| download::save(&name, &bytes, "model/gltf-binary"))
+                }
             };
             if let Err(e) = done {
                 log::warn!("{e}");

@@ -11,12 +11,18 @@ pub enum StructureAction {
     Select(usize),
     Change(usize, StructureChange),
     Solo(usize),
+    /// The case's title and description as edited.
+    CaseText(String, String),
+    ExportCase,
 }
 
-/// The list's state between frames: the name being edited.
+/// The list's state between frames: the name being edited, the case's title and description.
 #[derive(Default)]
 pub struct StructureList {
     editing: Option<(usize, String)>,
+    /// The title and description being edited, and the session's when they were taken (the
+    /// API may change those: then the fields show the new ones).
+    case_text: ((String, String), (String, String)),
 }
 
 fn to_bytes(c: [f32; 4]) -> [u8; 4] {
@@ -97,7 +103,53 @@ impl StructureList {
                 }
             });
         }
+        self.case_fields(ui, session, &mut actions);
         ui.separator();
         actions
+    }
+
+    /// The case's title and description, and its export.
+    fn case_fields(
+        &mut self,
+        ui: &mut egui::Ui,
+        session: &Session,
+        actions: &mut Vec<StructureAction>,
+    ) {
+        let stored = (
+            session.case_title().to_string(),
+            session.case_description().to_string(),
+        );
+        if self.case_text.1 != stored {
+            self.case_text = (stored.clone(), stored);
+        }
+        let (title, description) = &mut self.case_text.0;
+        ui.horizontal(|ui| {
+            ui.label("Case");
+            let edit = ui.add(egui::TextEdit::singleline(title).hint_text("title"));
+            if edit.lost_focus() {
+                actions.push(StructureAction::CaseText(
+                    title.clone(),
+                    description.clone(),
+                ));
+            }
+        });
+        let edit = ui.add(
+            egui::TextEdit::multiline(description)
+                .hint_text("description")
+                .desired_rows(2),
+        );
+        if edit.lost_focus() {
+            actions.push(StructureAction::CaseText(
+                title.clone(),
+                description.clone(),
+            ));
+        }
+        if ui
+            .button("Export case (GLB)")
+            .on_hover_text("Every structure as shown, smoothed ones with their originals and records, in metres with Y up")
+            .clicked()
+        {
+            actions.push(StructureAction::ExportCase);
+        }
     }
 }

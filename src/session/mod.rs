@@ -6,6 +6,7 @@
 //! revision it was computed for, so a result that arrives late (from the GPU) for an older
 //! revision is refused and the measures shown always match the parameters shown.
 
+mod case;
 mod colors;
 mod cpu;
 mod guidance;
@@ -80,6 +81,8 @@ pub struct Session {
     /// How each structure of the open segmentation is shown, and what it keeps.
     looks: Vec<structures::StructureLook>,
     looks_version: u64,
+    /// The case's title and description.
+    case_text: (String, String),
 }
 
 impl Default for Session {
@@ -103,6 +106,7 @@ impl Default for Session {
             open_stages: Vec::new(),
             looks: Vec::new(),
             looks_version: 0,
+            case_text: Default::default(),
         }
     }
 }

@@ -3,7 +3,7 @@
 //! view shows every structure smoothed its own way and coming back to one restores it.
 
 use super::{Session, Structures};
-use crate::metrics::Metrics;
+use crate::case::Smoothed;
 use crate::segmentation::Structure;
 use crate::smooth::Params;
 
@@ -24,8 +24,8 @@ pub struct Kept {
     pub params: Params,
     pub tau: f64,
     pub weights: Option<Vec<f32>>,
-    /// The smoothed surface, when it had been smoothed.
-    pub smoothed: Option<(Vec<[f32; 3]>, Metrics)>,
+    /// The smoothed surface and its measures, when it had been smoothed.
+    pub smoothed: Option<Smoothed>,
 }
 
 /// What [`Session::set_structure`] changes; `None` leaves a field as it is.
@@ -141,7 +141,7 @@ impl Session {
                 let smoothed = look.kept.as_ref().and_then(|k| k.smoothed.as_ref());
                 OtherStructure {
                     index,
-                    positions: smoothed.map_or(&s.mesh.positions, |(p, _)| p),
+                    positions: smoothed.map_or(&s.mesh.positions, |k| &k.positions),
                     triangles: &s.mesh.triangles,
                     color: look.color,
                 }
@@ -167,9 +167,11 @@ impl Session {
             params: *self.params(),
             tau: self.tau,
             weights: self.weights.clone(),
-            smoothed: self
-                .result()
-                .map(|r| (r.positions.clone(), r.metrics.clone())),
+            smoothed: self.result().map(|r| Smoothed {
+                positions: r.positions.clone(),
+                metrics: r.metrics.clone(),
+                local_error: Some(r.vertex.local_error.clone()),
+            }),
         };
         if let Some(look) = self.looks.get_mut(current) {
             look.kept = Some(kept);
@@ -212,7 +214,7 @@ impl Session {
                 look.kept
                     .as_ref()
                     .and_then(|k| k.smoothed.as_ref())
-                    .map(|(_, m)| m)
+                    .map(|k| &k.metrics)
             };
             entry["metrics"] = serde_json::to_value(metrics).unwrap_or_default();
         }

@@ -10,6 +10,7 @@ import { join } from "node:path";
 import * as cli from "./lib/cli.mjs";
 import { metricDifferences } from "./lib/compare.mjs";
 import { E2E_OUT, meshPath } from "./lib/paths.mjs";
+import { gltfValidator } from "./lib/deps.mjs";
 import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
@@ -283,5 +284,28 @@ testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, s
         assert.equal(state.params.iterations, 12);
         assert.deepEqual(await app.metrics(), kidney);
         await app.screenshot("S6-kidney-again-liver-smoothed-translucent");
+
+        // The case as arranged, exported: valid glTF, and the CLI reads back every structure
+        // with its name, look, parameters and measures.
+        await app.call("setCase", { title: "Abdomen", description: "Liver, portal vein, tumour, kidney" });
+        const bytes = Buffer.from(await app.call("exportCase", "glb"));
+        const file = join(E2E_OUT, MODE, "S6-case.glb");
+        writeFileSync(file, bytes);
+        const report = await gltfValidator.validateBytes(new Uint8Array(bytes), { uri: "S6-case.glb", format: "glb" });
+        const issues = report.issues.messages.filter((m) => m.severity <= 1).map((m) => `${m.code} ${m.pointer ?? ""}: ${m.message}`);
+        assert.deepEqual(issues, [], "the page's case GLB has no validator errors or warnings");
+        const back = await cli.cliJson("case", "info", file, "--json");
+        assert.equal(back.title, "Abdomen");
+        assert.deepEqual(back.structures.map((s) => [s.name, s.visible, s.smoothed, s.filter]), [
+            ["liver", true, true, "laplace"],
+            ["portal vein", true, false, "hc"],
+            ["tumor", false, false, "hc"],
+            ["right_kidney", true, true, "taubin"],
+        ]);
+        assert.ok(Math.abs(back.structures[0].color[3] - 0.3) < 1e-6, "the liver's opacity");
+        assert.deepEqual(back.structures[2].color.slice(0, 3), [0, 1, 0]);
+        const { problems } = metricDifferences(back.structures[3].metrics, kidney, 1e-9);
+        assert.deepEqual(problems, [], `the kidney's record: ${problems.join("; ")}`);
+        assert.equal(back.structures[3].params.iterations, 12);
     });
 });
