@@ -512,3 +512,78 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     session.poll_opening().expect("done").expect("opens");
     assert_eq!(session.structure_looks()[2].name, "tumor");
 }
+
+/// "Suggest all" in the page's session: each structure gets what the CLI's pipeline suggests for
+/// it (its own filter and bound), the model's structure as its new parameters, the others kept
+/// with their smoothed surfaces; cancelling leaves the rest as they were.
+#[test]
+fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
+    use meshsmooth::case::{self, Case, SuggestAllOptions};
+    use meshsmooth::session::Session;
+    use meshsmooth::suggest::SearchMethod;
+    let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
+    let mut session = Session::default();
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes.clone());
+    session.poll_opening().expect("done").expect("opens");
+    assert!(session.start_suggest_all(1.5, SearchMethod::Local).is_err());
+    session.start_suggest_all(0.5, SearchMethod::Local).unwrap();
+    // Workers on this thread answer at once.
+    assert!(session.step_suggest_all());
+    assert!(!session.suggesting_all());
+    let outcome = session.suggest_all_json().unwrap();
+    assert_eq!(
+        (outcome["done"].as_u64(), outcome["total"].as_u64()),
+        (Some(4), Some(4))
+    );
+
+    let structures = session.structures().unwrap().list.clone();
+    let mut expected = Case::from_label_map(structures.to_vec(), None);
+    let options = SuggestAllOptions {
+        tau: 0.5,
+        filter: None,
+        method: SearchMethod::Local,
+        max_volume_change: Some(0.05),
+    };
+    // The model's structure starts from the session's parameters, the others from a case's.
+    expected.structures[0].params = *session.params();
+    let mut liver = expected.structures[0].clone();
+    let first = case::suggest_structure(&mut liver, &options, &mut |_| true)
+        .unwrap()
+        .unwrap();
+    case::suggest_all(&mut expected, &options, &|_| true).unwrap();
+    assert_eq!(
+        *session.params(),
+        first.params,
+        "the model takes its suggestion"
+    );
+    session.smooth_cpu();
+    assert_eq!(
+        session.result().unwrap().positions,
+        liver.smoothed.as_ref().unwrap().positions
+    );
+    for i in 1..4 {
+        let kept = session.structure_looks()[i].kept.as_ref().expect("kept");
+        let want = &expected.structures[i];
+        assert_eq!(kept.params, want.params, "structure {i}");
+        let smoothed = kept.smoothed.as_ref().unwrap();
+        assert_eq!(
+            smoothed.positions,
+            want.smoothed.as_ref().unwrap().positions
+        );
+        assert_eq!(smoothed.metrics, want.smoothed.as_ref().unwrap().metrics);
+        assert_eq!(outcome["structures"][i]["params"], want.params.to_json());
+    }
+    // Drawn as suggested.
+    let others = session.other_structures();
+    assert_eq!(
+        others[0].positions,
+        &expected.structures[1].smoothed.as_ref().unwrap().positions[..]
+    );
+
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes);
+    session.poll_opening().expect("done").expect("opens");
+    assert!(
+        session.suggest_all_json().is_none(),
+        "a new file starts over"
+    );
+}

@@ -18,6 +18,10 @@
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
 //!   parameters' result is computed
 //! - `exportMesh(format): Promise<Uint8Array>` for `glb stl ply obj`
+//! - `suggestAll({tau, search}): Promise<object>`: the suggestion for every structure, each
+//!   with its own filter and bound, one structure per engine worker, each then smoothed with
+//!   it; resolves with `{tau, search, structures: [{name, params, evaluations, metrics}],
+//!   done, total, cancelled}`
 //! - `exportCase(format): Promise<Uint8Array>`: the case glTF (`glb`, the default, or `gltf`)
 //!   of every structure as shown and smoothed (a mesh alone is a case of one), once the
 //!   current parameters' result is computed; `setCase({title, description})` names the case
@@ -136,14 +140,26 @@ fn start_suggest(
     doc: &SharedDocument,
     options: &JsValue,
 ) -> Result<(f64, crate::suggest::SearchMethod), String> {
+    let mut doc = doc.borrow_mut();
+    let session = &mut doc.session;
+    let (tau, method) = tau_and_search(session, options, "suggest")?;
+    session.set_tau(tau)?;
+    session.start_suggest(method);
+    Ok((tau, method))
+}
+
+/// `{tau, search}` of `suggest` and `suggestAll` (tau: the session's, search: grid by default).
+fn tau_and_search(
+    session: &crate::session::Session,
+    options: &JsValue,
+    what: &str,
+) -> Result<(f64, crate::suggest::SearchMethod), String> {
     use crate::suggest::SearchMethod;
     let options = if options.is_undefined() || options.is_null() {
         serde_json::json!({})
     } else {
         from_js(options)?
     };
-    let mut doc = doc.borrow_mut();
-    let session = &mut doc.session;
     if session.model().is_none() {
         return Err("no mesh is open: call loadMesh first".into());
     }
@@ -151,17 +167,15 @@ fn start_suggest(
         None | Some(serde_json::Value::Null) => session.tau(),
         Some(v) => v
             .as_f64()
-            .ok_or_else(|| format!("suggest: tau must be a number in [0, 1], got {v}"))?,
+            .ok_or_else(|| format!("{what}: tau must be a number in [0, 1], got {v}"))?,
     };
     let method = match options.get("search") {
         None | Some(serde_json::Value::Null) => SearchMethod::Grid,
         Some(v) => v
             .as_str()
             .and_then(SearchMethod::from_name)
-            .ok_or_else(|| format!("suggest: unknown search {v}: use grid or local"))?,
+            .ok_or_else(|| format!("{what}: unknown search {v}: use grid or local"))?,
     };
-    session.set_tau(tau)?;
-    session.start_suggest(method);
     Ok((tau, method))
 }
 
@@ -362,6 +376,33 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                     s.graphs_json()
                         .map(|v| to_js(&v))
                         .ok_or_else(|| "no quality graphs".to_string())
+                },
+            )
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "suggestAll",
+        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |options: JsValue| {
+            let started = {
+                let mut doc = d.borrow_mut();
+                tau_and_search(&doc.session, &options, "suggestAll")
+                    .and_then(|(tau, method)| doc.session.start_suggest_all(tau, method))
+            };
+            if let Err(e) = started {
+                return settled(Err(e));
+            }
+            c.request_repaint();
+            when_ready(
+                &d,
+                &c,
+                |s| !s.suggesting_all(),
+                |s| {
+                    s.suggest_all_json()
+                        .map(|v| to_js(&v))
+                        .ok_or_else(|| "no Suggest all".to_string())
                 },
             )
         }),

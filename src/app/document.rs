@@ -312,7 +312,10 @@ impl Document {
     /// Whether anything is computing (the current result or background work), so the page
     /// keeps drawing frames.
     pub fn working(&self) -> bool {
-        self.busy() || self.session.guidance_busy() || self.session.loading().is_some()
+        self.busy()
+            || self.session.guidance_busy()
+            || self.session.loading().is_some()
+            || self.session.suggesting_all()
     }
 
     /// The CPU engine's share of this frame: asks its workers for the current parameters'

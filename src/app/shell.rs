@@ -422,6 +422,15 @@ impl Shell {
                     doc.session.set_case_text(Some(&title), Some(&description));
                     Ok(())
                 }
+                StructureAction::SuggestAll => {
+                    let tau = doc.session.tau();
+                    let method = self.guide.method;
+                    doc.session.start_suggest_all(tau, method)
+                }
+                StructureAction::CancelSuggestAll => {
+                    doc.session.cancel_suggest_all();
+                    Ok(())
+                }
                 StructureAction::ExportCase => {
                     let file = doc.session.structures().map(|s| s.file.clone());
                     let stem = file
@@ -560,6 +569,7 @@ impl eframe::App for Shell {
         // The frame a new model arrives in takes it up; uploading it to the GPU takes the next.
         // While a worker opens a file, the open model is worked on as before.
         let opening = self.doc.borrow_mut().step_loading();
+        self.doc.borrow_mut().session.step_suggest_all();
         let arrived = opening == Opening::Done;
         let uploading = !arrived && self.compute();
         if !arrived && !uploading {

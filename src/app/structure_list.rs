@@ -14,6 +14,9 @@ pub enum StructureAction {
     /// The case's title and description as edited.
     CaseText(String, String),
     ExportCase,
+    /// "Suggest all" at the Suggest panel's tau, or cancel it.
+    SuggestAll,
+    CancelSuggestAll,
 }
 
 /// The list's state between frames: the name being edited, the case's title and description.
@@ -144,6 +147,24 @@ impl StructureList {
                 description.clone(),
             ));
         }
+        ui.horizontal(|ui| match session.suggest_all_progress() {
+            Some((done, total)) => {
+                let bar = egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                    .desired_width(160.0)
+                    .text(format!("Suggest all: {done} of {total}"));
+                ui.add(bar);
+                if ui.button("Cancel").clicked() {
+                    actions.push(StructureAction::CancelSuggestAll);
+                }
+            }
+            None => {
+                let tip = "The suggestion at the Suggest panel's τ for every structure, each with \
+                           its own filter and bound, then smoothed with it";
+                if ui.button("Suggest all").on_hover_text(tip).clicked() {
+                    actions.push(StructureAction::SuggestAll);
+                }
+            }
+        });
         if ui
             .button("Export case (GLB)")
             .on_hover_text("Every structure as shown, smoothed ones with their originals and records, in metres with Y up")

@@ -13,7 +13,9 @@ pub mod relations;
 
 pub use checks::{check, checks_json, checks_text};
 pub use open::{open, CaseOpenError};
-pub use pipeline::{smooth_structure, suggest_all, SuggestAllOptions, SuggestAllProgress};
+pub use pipeline::{
+    smooth_structure, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllProgress,
+};
 pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
 
 use crate::mesh::Mesh;

@@ -34,7 +34,7 @@ fn smooth_on(structure: &CaseStructure, original: &Original) -> Smoothed {
 }
 
 /// What "Suggest all" does.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SuggestAllOptions {
     pub tau: f64,
     /// Every structure's filter becomes this one first; `None` keeps each structure's own.
@@ -100,7 +100,7 @@ pub fn suggest_all(
             if let Some(filter) = options.filter {
                 s.set_filter(filter);
             }
-            let outcome = suggest_one(&mut s, options, &mut |_| {
+            let outcome = suggest_structure(&mut s, options, &mut |_| {
                 evaluations.fetch_add(1, Ordering::Relaxed);
                 tell(false)
             });
@@ -135,7 +135,7 @@ pub fn suggest_all(
 type Outcome = Result<Option<(Suggestion, CaseStructure)>, SuggestError>;
 
 /// One structure's suggestion, applied and smoothed; `None` when it has no vertices.
-fn suggest_one(
+pub fn suggest_structure(
     s: &mut CaseStructure,
     options: &SuggestAllOptions,
     on_progress: &mut dyn FnMut(crate::suggest::Progress) -> bool,

@@ -12,6 +12,7 @@ mod cpu;
 mod guidance;
 mod opening;
 mod structures;
+mod suggest_all;
 mod weights;
 
 pub use crate::model::{Model, OpenFailure, Structures};
@@ -83,6 +84,7 @@ pub struct Session {
     looks_version: u64,
     /// The case's title and description.
     case_text: (String, String),
+    suggest_all: suggest_all::SuggestAll,
 }
 
 impl Default for Session {
@@ -107,6 +109,7 @@ impl Default for Session {
             looks: Vec::new(),
             looks_version: 0,
             case_text: Default::default(),
+            suggest_all: Default::default(),
         }
     }
 }

@@ -151,6 +151,9 @@ impl Session {
 
     /// Looks for the structures of a segmentation just opened from its file.
     pub(super) fn reset_looks(&mut self) {
+        // A "Suggest all" of the structures before is of no use now.
+        self.cancel_suggest_all();
+        self.suggest_all = Default::default();
         self.looks = self
             .structures()
             .map(|s| s.list.iter().map(StructureLook::of).collect())

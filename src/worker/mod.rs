@@ -7,10 +7,11 @@
 pub(crate) mod deferred;
 mod pool;
 
-pub use pool::{Carrier, InThread, LoadJob, Pool, SmoothJob};
+pub use pool::{Carrier, InThread, LoadJob, Pool, SmoothJob, StructureJob};
 
 use serde::{Deserialize, Serialize};
 
+use crate::case::{self, CaseStructure, SuggestAllOptions};
 use crate::evaluate::{Evaluator, Terms};
 use crate::mesh::{Mesh, Topology};
 use crate::metrics::{self, Metrics, Original, VertexMeasures};
@@ -48,6 +49,15 @@ pub enum Request {
     },
     /// Smooth the model with `params` and measure the result at `tau`.
     Smooth { job: u64, params: Params, tau: f64 },
+    /// "Suggest all" for one structure: the suggestion at `tau` from `params` (its filter and
+    /// bound) on `mesh` with `weights`, then the structure smoothed with it and measured.
+    SuggestStructure {
+        job: u64,
+        mesh: Mesh,
+        params: Params,
+        weights: Option<Vec<f32>>,
+        options: SuggestAllOptions,
+    },
     /// The terms of `params` after each count of `at` ([`Evaluator::measure`]).
     Terms {
         job: u64,
@@ -88,6 +98,11 @@ pub enum Reply {
         terms: Vec<Terms>,
         ms: f64,
     },
+    /// A structure's suggestion and its surface smoothed with it (`None`: nothing to smooth).
+    Suggested {
+        job: u64,
+        suggested: Option<Box<StructureSuggestion>>,
+    },
     /// The job could not be done (no model, weights of another length).
     Failed { job: u64, why: String },
     /// The worker stopped in the middle of its job (a trap in its module): whatever it was
@@ -103,10 +118,23 @@ impl Reply {
             | Reply::Loaded { job, .. }
             | Reply::Smoothed { job, .. }
             | Reply::Terms { job, .. }
+            | Reply::Suggested { job, .. }
             | Reply::Failed { job, .. } => Some(*job),
             Reply::Broken { .. } => None,
         }
     }
+}
+
+/// What [`Request::SuggestStructure`] found.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StructureSuggestion {
+    pub params: Params,
+    /// Parameter sets measured.
+    pub evaluations: usize,
+    pub positions: Vec<[f32; 3]>,
+    /// [`Metrics`] as JSON, as in [`Reply::Smoothed`].
+    pub metrics: String,
+    pub local_error: Vec<f32>,
 }
 
 /// Encodes a message for the wire.
@@ -165,6 +193,13 @@ impl Worker {
             }
             Request::Smooth { job, params, tau } => Some(self.smooth(job, &params, tau, clock)),
             Request::Terms { job, params, at } => Some(self.terms(job, &params, &at, clock)),
+            Request::SuggestStructure {
+                job,
+                mesh,
+                params,
+                weights,
+                options,
+            } => Some(suggest_structure(job, mesh, params, weights, &options)),
         }
     }
 
@@ -253,6 +288,37 @@ impl Worker {
                 why: e.to_string(),
             },
         }
+    }
+}
+
+/// One structure's part of "Suggest all", as the CLI's `case build` does it.
+fn suggest_structure(
+    job: u64,
+    mesh: Mesh,
+    params: Params,
+    weights: Option<Vec<f32>>,
+    options: &SuggestAllOptions,
+) -> Reply {
+    let mut structure = CaseStructure::from_mesh("", mesh, [1.0; 3]);
+    structure.params = params;
+    structure.weights = weights;
+    match case::suggest_structure(&mut structure, options, &mut |_| true) {
+        Ok(suggestion) => {
+            let suggested = suggestion.zip(structure.smoothed).map(|(s, smoothed)| {
+                Box::new(StructureSuggestion {
+                    params: s.params,
+                    evaluations: s.evaluations,
+                    positions: smoothed.positions,
+                    metrics: serde_json::to_string(&smoothed.metrics).unwrap_or_default(),
+                    local_error: smoothed.local_error.unwrap_or_default(),
+                })
+            });
+            Reply::Suggested { job, suggested }
+        }
+        Err(e) => Reply::Failed {
+            job,
+            why: e.to_string(),
+        },
     }
 }
 

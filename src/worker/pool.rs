@@ -6,7 +6,9 @@
 use std::collections::{HashMap, VecDeque};
 
 use super::{Input, Reply, Request, Worker};
+use crate::case::SuggestAllOptions;
 use crate::evaluate::{failed_terms, ModelRef, Offload, Request as TermsRequest, Terms};
+use crate::mesh::Mesh;
 use crate::smooth::Params;
 
 /// Carries requests to workers and brings their replies back.
@@ -70,6 +72,10 @@ impl Carrier for InThread {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SmoothJob(u64);
 
+/// One structure's part of "Suggest all".
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StructureJob(u64);
+
 /// An opening: a file or structure made a model in a worker.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadJob(u64);
@@ -97,6 +103,7 @@ struct QueuedSmooth {
 enum Flight {
     Load,
     Smooth,
+    Structure,
     Terms(TermsKey),
 }
 
@@ -115,6 +122,9 @@ pub struct Pool {
     loaded: HashMap<u64, Reply>,
     load_stages: HashMap<u64, LoadStage>,
     smooths: VecDeque<QueuedSmooth>,
+    /// "Suggest all"'s structures not handed out yet, and their answers.
+    structure_jobs: VecDeque<(u64, Request)>,
+    suggested: HashMap<u64, Reply>,
     /// The terms request asked last and those to come, in order.
     asked: Option<TermsKey>,
     upcoming: Vec<TermsKey>,
@@ -145,6 +155,8 @@ impl Pool {
             loaded: HashMap::new(),
             load_stages: HashMap::new(),
             smooths: VecDeque::new(),
+            structure_jobs: VecDeque::new(),
+            suggested: HashMap::new(),
             asked: None,
             upcoming: Vec::new(),
             in_flight: HashMap::new(),
@@ -176,7 +188,47 @@ impl Pool {
 
     /// Whether any worker is doing something or anything waits to be handed out.
     pub fn busy(&self) -> bool {
-        self.busy.iter().any(Option::is_some) || !self.smooths.is_empty() || self.load.is_some()
+        self.busy.iter().any(Option::is_some)
+            || !self.smooths.is_empty()
+            || !self.structure_jobs.is_empty()
+            || self.load.is_some()
+    }
+
+    /// Queues one structure's part of "Suggest all" (after the view's smoothing, before the
+    /// guidance's terms): it needs no model held, so structures spread over the pool.
+    pub fn suggest_structure(
+        &mut self,
+        mesh: Mesh,
+        params: Params,
+        weights: Option<Vec<f32>>,
+        options: SuggestAllOptions,
+    ) -> StructureJob {
+        let job = self.new_job();
+        let request = Request::SuggestStructure {
+            job,
+            mesh,
+            params,
+            weights,
+            options,
+        };
+        self.structure_jobs.push_back((job, request));
+        self.pump();
+        StructureJob(job)
+    }
+
+    /// The answer to `job` once it is there ([`Reply::Suggested`] or [`Reply::Failed`]).
+    pub fn take_suggested(&mut self, job: StructureJob) -> Option<Reply> {
+        self.pump();
+        self.suggested.remove(&job.0)
+    }
+
+    /// Drops `jobs` still waiting and stops waiting for those under way (cancel).
+    pub fn forget_structures(&mut self, jobs: &[StructureJob]) {
+        for job in jobs {
+            self.structure_jobs.retain(|(j, _)| *j != job.0);
+            self.in_flight.remove(&job.0);
+            self.suggested.remove(&job.0);
+        }
     }
 
     /// Queues opening `input` as a model named `name`, ahead of every other job. It supersedes
@@ -299,7 +351,8 @@ impl Pool {
             self.broadcast(&hold);
             // Whatever waits is for another model (an opening stays: it makes the next one).
             self.smooths.clear();
-            self.in_flight.retain(|_, f| matches!(f, Flight::Load));
+            self.in_flight
+                .retain(|_, f| matches!(f, Flight::Load | Flight::Structure));
             self.smoothed.clear();
             self.terms.clear();
         }
@@ -375,6 +428,9 @@ impl Pool {
             Some(Flight::Smooth) => {
                 self.smoothed.insert(job, reply);
             }
+            Some(Flight::Structure) => {
+                self.suggested.insert(job, reply);
+            }
             Some(Flight::Terms(key)) => {
                 let answer = match reply {
                     Reply::Terms { terms, .. } => Ok(terms),
@@ -388,8 +444,8 @@ impl Pool {
         }
     }
 
-    /// Gives `worker` the next job: an opening first, then a smoothing, then the terms asked,
-    /// then those to come. Returns whether there was one.
+    /// Gives `worker` the next job: an opening first, then a smoothing, then a structure of
+    /// "Suggest all", then the terms asked, then those to come. Returns whether there was one.
     fn hand_out(&mut self, worker: usize) -> bool {
         if let Some((job, request)) = self.load.take() {
             self.start(worker, job, Flight::Load, &request);
@@ -404,12 +460,16 @@ impl Pool {
             self.start(worker, s.job, Flight::Smooth, &request);
             return true;
         }
+        if let Some((job, request)) = self.structure_jobs.pop_front() {
+            self.start(worker, job, Flight::Structure, &request);
+            return true;
+        }
         let in_flight: Vec<&TermsKey> = self
             .in_flight
             .values()
             .filter_map(|f| match f {
                 Flight::Terms(k) => Some(k),
-                Flight::Load | Flight::Smooth => None,
+                Flight::Load | Flight::Smooth | Flight::Structure => None,
             })
             .collect();
         let next = self

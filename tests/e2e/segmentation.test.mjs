@@ -309,3 +309,35 @@ testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, s
         assert.equal(back.structures[3].params.iterations, 12);
     });
 });
+
+testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build suggestion, one structure per worker", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
+        const start = Date.now();
+        const all = await app.call("suggestAll", { tau: 0.5, search: "local" });
+        const seconds = (Date.now() - start) / 1000;
+        assert.deepEqual([all.done, all.total, all.cancelled], [4, 4, false]);
+        const file = join(E2E_OUT, MODE, "S7-cli-case.glb");
+        const cliStart = Date.now();
+        await cli.cli("case", "build", PHANTOM_NRRD, "--search", "local", "-o", file);
+        const cliSeconds = (Date.now() - cliStart) / 1000;
+        const native = (await cli.cliJson("case", "info", file, "--json")).structures;
+        // The liver is the model and starts from the page's parameters (no bound); the others
+        // start as the CLI's structures do, with their bound at half a voxel diagonal.
+        for (const i of [1, 2, 3]) {
+            assert.deepEqual(all.structures[i].params, native[i].params, `${native[i].name}'s suggestion`);
+            const { problems } = metricDifferences(all.structures[i].metrics, native[i].metrics, 1e-9);
+            assert.deepEqual(problems, [], `${native[i].name}'s measures: ${problems.join("; ")}`);
+        }
+        const state = await app.state();
+        assert.deepEqual(state.params, all.structures[0].params, "the model takes its suggestion");
+        // Its result follows its new parameters.
+        await app.metrics();
+        const list = await app.call("structures");
+        assert.ok(list.structures.every((s) => s.metrics !== null), "every structure smoothed");
+        const line = { bench: "page-suggest-all", mode: MODE, file: "case_phantom_shared.seg.nrrd", structures: 4, search: "local", page_s: seconds, cli_s: cliSeconds, workers: state.cpu_engine.workers };
+        console.log(JSON.stringify(line));
+        appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
+        await app.screenshot("S7-phantom-suggested-all");
+    });
+});

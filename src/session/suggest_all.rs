@@ -1,0 +1,197 @@
+//! "Suggest all" in the page: every structure of the open segmentation gets the suggestion at
+//! one target smoothness with its own filter and bound, then is smoothed with it, one
+//! structure per engine worker (the CLI's `case build` does the same on its threads). Progress
+//! and cancel; the structure that is the model takes its suggestion as new parameters.
+
+use super::{Kept, Session};
+use crate::case::{CaseStructure, Smoothed, SuggestAllOptions};
+use crate::suggest::SearchMethod;
+use crate::worker::{metrics_of, Reply, StructureJob};
+
+/// A "Suggest all" under way, or its outcome.
+#[derive(Clone, Debug, Default)]
+pub struct SuggestAll {
+    options: Option<SuggestAllOptions>,
+    /// Each structure's job still to answer.
+    waiting: Vec<(usize, StructureJob)>,
+    total: usize,
+    /// Per structure, what it got: `{name, params, evaluations, metrics}` or `{name, error}`.
+    outcome: Vec<serde_json::Value>,
+    cancelled: bool,
+}
+
+impl Session {
+    /// Starts "Suggest all" at `tau` with `method` for every structure of the open segmentation
+    /// (a mesh alone is one structure). Replaces one under way.
+    pub fn start_suggest_all(&mut self, tau: f64, method: SearchMethod) -> Result<(), String> {
+        if !(0.0..=1.0).contains(&tau) {
+            return Err(format!("tau = {tau} is out of range: [0, 1]"));
+        }
+        self.cancel_suggest_all();
+        let model = self.model.as_ref().ok_or("no mesh is open")?;
+        let options = SuggestAllOptions {
+            tau,
+            filter: None,
+            method,
+            // As `case build` does by default: thin structures lose volume faster than the
+            // score weighs it.
+            max_volume_change: Some(0.05),
+        };
+        let mut work = Vec::new();
+        match &model.structures {
+            None => work.push((
+                0,
+                model.mesh().clone(),
+                *self.params(),
+                self.weights.clone(),
+            )),
+            Some(s) => {
+                for (i, structure) in s.list.iter().enumerate() {
+                    let kept = self.looks.get(i).and_then(|l| l.kept.as_ref());
+                    let (params, weights) = match kept {
+                        _ if i == s.current => (*self.params(), self.weights.clone()),
+                        Some(k) => (k.params, k.weights.clone()),
+                        // Its filter and bound as a case structure starts with them.
+                        None => (
+                            CaseStructure::from_label_map(structure.clone(), None).params,
+                            None,
+                        ),
+                    };
+                    work.push((i, structure.mesh.clone(), params, weights));
+                }
+            }
+        }
+        // The largest first, so no worker is left with one big structure at the end.
+        work.sort_by_key(|w| std::cmp::Reverse(w.1.vertex_count()));
+        let total = work.len();
+        let waiting = work
+            .into_iter()
+            .map(|(i, mesh, params, weights)| {
+                (
+                    i,
+                    self.cpu.suggest_structure(mesh, params, weights, options),
+                )
+            })
+            .collect();
+        self.suggest_all = SuggestAll {
+            options: Some(options),
+            waiting,
+            total,
+            outcome: vec![serde_json::Value::Null; total],
+            cancelled: false,
+        };
+        Ok(())
+    }
+
+    /// Whether "Suggest all" is under way.
+    pub fn suggesting_all(&self) -> bool {
+        !self.suggest_all.waiting.is_empty()
+    }
+
+    /// Structures done and in all, while "Suggest all" is under way.
+    pub fn suggest_all_progress(&self) -> Option<(usize, usize)> {
+        let s = &self.suggest_all;
+        self.suggesting_all()
+            .then(|| (s.total - s.waiting.len(), s.total))
+    }
+
+    /// Stops "Suggest all": structures already done keep what they got.
+    pub fn cancel_suggest_all(&mut self) {
+        let jobs: Vec<StructureJob> = self.suggest_all.waiting.drain(..).map(|w| w.1).collect();
+        if !jobs.is_empty() {
+            self.cpu.forget_structures(&jobs);
+            self.suggest_all.cancelled = true;
+        }
+    }
+
+    /// Takes the structures' answers that came; returns whether any did.
+    pub fn step_suggest_all(&mut self) -> bool {
+        let Some(options) = self.suggest_all.options else {
+            return false;
+        };
+        let mut came = Vec::new();
+        let mut waiting = std::mem::take(&mut self.suggest_all.waiting);
+        waiting.retain(|&(i, job)| match self.cpu.take_suggested(job) {
+            Some(reply) => {
+                came.push((i, reply));
+                false
+            }
+            None => true,
+        });
+        self.suggest_all.waiting = waiting;
+        let any = !came.is_empty();
+        for (i, reply) in came {
+            let outcome = self.take_structure_suggestion(i, reply, options.tau);
+            if let Some(slot) = self.suggest_all.outcome.get_mut(i) {
+                *slot = outcome;
+            }
+        }
+        any
+    }
+
+    /// Applies structure `i`'s answer: the model's structure takes the parameters (its result
+    /// follows), another keeps them with its smoothed surface.
+    fn take_structure_suggestion(&mut self, i: usize, reply: Reply, tau: f64) -> serde_json::Value {
+        let name = match self.looks.get(i) {
+            Some(look) => look.name.clone(),
+            None => self
+                .model
+                .as_ref()
+                .map_or(String::new(), |m| m.name.clone()),
+        };
+        let suggested = match reply {
+            Reply::Suggested {
+                suggested: Some(s), ..
+            } => s,
+            Reply::Suggested {
+                suggested: None, ..
+            } => return serde_json::json!({"name": name, "error": "nothing to smooth"}),
+            Reply::Failed { why, .. } => return serde_json::json!({"name": name, "error": why}),
+            _ => return serde_json::json!({"name": name, "error": "another reply"}),
+        };
+        let metrics = match metrics_of(&suggested.metrics) {
+            Ok(m) => m,
+            Err(why) => return serde_json::json!({"name": name, "error": why}),
+        };
+        let summary = serde_json::json!({
+            "name": name,
+            "params": suggested.params.to_json(),
+            "evaluations": suggested.evaluations,
+            "metrics": metrics,
+        });
+        let current = self.structures().map_or(Some(0), |s| Some(s.current));
+        if current == Some(i) {
+            // The engines smooth it again for the view, to the same surface.
+            let _ = self.set_params(suggested.params);
+            let _ = self.set_tau(tau);
+        } else if let Some(look) = self.looks.get_mut(i) {
+            let weights = look.kept.as_ref().and_then(|k| k.weights.clone());
+            look.kept = Some(Kept {
+                params: suggested.params,
+                tau,
+                weights,
+                smoothed: Some(Smoothed {
+                    positions: suggested.positions,
+                    metrics,
+                    local_error: Some(suggested.local_error),
+                }),
+            });
+            self.looks_version += 1;
+        }
+        summary
+    }
+
+    /// The last "Suggest all": `{tau, search, structures: [...], cancelled, done, total}`.
+    pub fn suggest_all_json(&self) -> Option<serde_json::Value> {
+        let s = &self.suggest_all;
+        let options = s.options?;
+        Some(serde_json::json!({
+            "tau": options.tau,
+            "search": options.method,
+            "structures": s.outcome,
+            "done": s.total - s.waiting.len(),
+            "total": s.total,
+            "cancelled": s.cancelled,
+        }))
+    }
+}
