@@ -17,7 +17,7 @@ use super::{
     api, download, legend, page, query, report_view, status, workers, SAMPLE_BYTES, SAMPLE_NAME,
 };
 use crate::export::ExportFormat;
-use crate::session::{ColorField, Legend};
+use crate::session::ColorField;
 use crate::smooth::Filter;
 use crate::worker::Pool;
 use eframe::egui;
@@ -28,6 +28,10 @@ use std::time::Duration;
 
 /// How often the page redraws while only the workers work: the progress bars move on.
 const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
+
+mod view_sync;
+
+use view_sync::{Positions, Shown};
 
 pub struct Shell {
     doc: SharedDocument,
@@ -57,28 +61,6 @@ pub struct Shell {
     structures: StructureList,
     /// Whether the last frame asked for the next at once.
     repainting: bool,
-}
-
-/// Where the view's positions come from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Positions {
-    Original,
-    /// The CPU engine's result for this revision.
-    Cpu(u64),
-    /// The GPU engine's buffers after the run for this revision.
-    Gpu(u64),
-}
-
-/// The state of the view's buffers.
-#[derive(Default)]
-struct Shown {
-    generation: u64,
-    positions: Option<Positions>,
-    /// Field and result revision of the colours, `None` for plain shading.
-    colors: Option<(ColorField, u64)>,
-    legend: Option<Legend>,
-    /// The version of the structures' looks the other structures were uploaded for.
-    looks: Option<u64>,
 }
 
 impl Shell {
@@ -148,109 +130,6 @@ impl Shell {
             framed_case: None,
             structures: StructureList::default(),
             repainting: false,
-        }
-    }
-
-    /// Brings the view's buffers up to date with the document: a new model, new positions
-    /// (the original, the CPU result or the GPU buffers), new colours.
-    fn sync_view(&mut self) {
-        let Some((viewer, rs)) = &mut self.view else {
-            return;
-        };
-        let doc = self.doc.borrow();
-        let session = &doc.session;
-        let Some(model) = session.model() else {
-            return;
-        };
-        let mesh = model.mesh();
-        if self.shown.generation != doc.model_generation || self.shown.positions.is_none() {
-            let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
-            let kept_view = viewer.view_state();
-            viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
-            // A segmentation is framed whole once; another of its structures keeps the view.
-            let case = session.structures().map(|s| (s.file.clone(), s.list.len()));
-            match (&case, case == self.framed_case) {
-                (Some(_), true) => viewer.set_view_state(kept_view),
-                (Some(_), false) => {
-                    let list = &session.structures().expect("a segmentation").list;
-                    let all: Vec<&[[f32; 3]]> =
-                        list.iter().map(|s| s.mesh.positions.as_slice()).collect();
-                    viewer.frame_all(&all);
-                }
-                (None, _) => {}
-            }
-            self.framed_case = case;
-            self.shown = Shown {
-                generation: doc.model_generation,
-                positions: Some(Positions::Original),
-                ..Shown::default()
-            };
-        }
-        let result = session.last_result();
-        let wanted = if self.show_original {
-            Positions::Original
-        } else if let Some(gpu) = &self.gpu {
-            gpu.submitted().map_or(Positions::Original, Positions::Gpu)
-        } else {
-            result.map_or(Positions::Original, |r| Positions::Cpu(r.revision))
-        };
-        if self.shown.positions != Some(wanted) {
-            let shown = match wanted {
-                Positions::Original => {
-                    let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
-                    viewer.set_positions(rs, &mesh.positions, &normals);
-                    true
-                }
-                Positions::Cpu(_) => {
-                    if let Some(r) = result {
-                        let normals = crate::mesh::vertex_normals(&r.positions, &mesh.triangles);
-                        viewer.set_positions(rs, &r.positions, &normals);
-                    }
-                    true
-                }
-                // While a run is under way in the engine's buffers they hold none of its
-                // results: copy once it is done.
-                Positions::Gpu(_) => match self.gpu.as_ref().and_then(|g| g.buffers()) {
-                    Some((positions, normals)) => {
-                        viewer.copy_positions_from(rs, positions, normals);
-                        true
-                    }
-                    None => false,
-                },
-            };
-            if shown {
-                self.shown.positions = Some(wanted);
-            }
-        }
-        // The brush shows what it paints; the weights' colours follow their own changes.
-        let colors = if self.brush.active {
-            Some((ColorField::Weights, session.weights_version()))
-        } else {
-            self.coloring
-                .filter(|_| !self.show_original)
-                .zip(result.map(|r| r.revision))
-        };
-        if self.shown.colors != colors {
-            let computed = colors.and_then(|(field, _)| session.colors(field));
-            viewer.set_colors(rs, computed.as_ref().map(|(c, _)| c.as_slice()));
-            self.shown.legend = computed.map(|(_, l)| l);
-            self.shown.colors = colors;
-        }
-        if self.shown.looks != Some(session.looks_version()) {
-            let others = session.other_structures();
-            let surfaces: Vec<viewer::ContextSurface<'_>> = others
-                .iter()
-                .map(|o| viewer::ContextSurface {
-                    positions: o.positions,
-                    triangles: o.triangles,
-                    color: o.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
-                })
-                .collect();
-            viewer.set_context(rs, &surfaces);
-            let look = session.model_look();
-            let color = look.map(|l| [l.color[0], l.color[1], l.color[2]]);
-            viewer.set_model_look(color, look.is_none_or(|l| l.visible));
-            self.shown.looks = Some(session.looks_version());
         }
     }
 
