@@ -1,8 +1,8 @@
 //! The open model as a case: a title and description, and the case glTF of every structure of
 //! its segmentation as the author arranged and smoothed it (a mesh alone is a case of one).
 
-use super::Session;
-use crate::case::{Case, CaseStructure, Smoothed};
+use super::{Kept, Session};
+use crate::case::{Case, CaseStructure};
 use crate::export::{self, CaseGltfOptions, Container};
 use crate::segmentation::default_color;
 
@@ -30,16 +30,13 @@ impl Session {
     /// current result, the others' kept ones). `None` without a model.
     pub fn to_case(&self) -> Option<Case> {
         let model = self.model.as_ref()?;
-        let current = |s: &mut CaseStructure| {
-            s.params = *self.params();
-            s.tau = self.tau;
-            s.weights = self.weights.clone();
-            s.smoothed = self.result().map(|r| Smoothed {
-                positions: r.positions.clone(),
-                metrics: r.metrics.clone(),
-                local_error: Some(r.vertex.local_error.clone()),
-            });
+        let take = |s: &mut CaseStructure, kept: Kept| {
+            s.params = kept.params;
+            s.tau = kept.tau;
+            s.weights = kept.weights;
+            s.smoothed = kept.smoothed;
         };
+        let current = |s: &mut CaseStructure| take(s, self.model_smoothing());
         let structures = match &model.structures {
             None => {
                 let mut s =
@@ -57,10 +54,7 @@ impl Session {
                     if i == list.current {
                         current(&mut s);
                     } else if let Some(kept) = &look.kept {
-                        s.params = kept.params;
-                        s.tau = kept.tau;
-                        s.weights = kept.weights.clone();
-                        s.smoothed = kept.smoothed.clone();
+                        take(&mut s, kept.clone());
                     }
                     s
                 })

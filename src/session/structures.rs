@@ -161,12 +161,9 @@ impl Session {
         self.looks_version += 1;
     }
 
-    /// Keeps the model's smoothing in its structure's look, before another structure opens.
-    pub(super) fn keep_model_structure(&mut self) {
-        let Some(current) = self.structures().map(|s| s.current) else {
-            return;
-        };
-        let kept = Kept {
+    /// The model's smoothing as a structure keeps it: what a case structure takes too.
+    pub(super) fn model_smoothing(&self) -> Kept {
+        Kept {
             params: *self.params(),
             tau: self.tau,
             weights: self.weights.clone(),
@@ -175,7 +172,15 @@ impl Session {
                 metrics: r.metrics.clone(),
                 local_error: Some(r.vertex.local_error.clone()),
             }),
+        }
+    }
+
+    /// Keeps the model's smoothing in its structure's look, before another structure opens.
+    pub(super) fn keep_model_structure(&mut self) {
+        let Some(current) = self.structures().map(|s| s.current) else {
+            return;
         };
+        let kept = self.model_smoothing();
         if let Some(look) = self.looks.get_mut(current) {
             look.kept = Some(kept);
             self.looks_version += 1;

@@ -47,18 +47,9 @@ impl ContextMesh {
 }
 
 fn centre(positions: &[[f32; 3]]) -> [f32; 3] {
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for p in positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if positions.is_empty() {
-        return [0.0; 3];
-    }
-    [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]))
+    crate::mesh::bounding_box(positions).map_or([0.0; 3], |(lo, hi)| {
+        [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]))
+    })
 }
 
 /// The order to draw translucent structures in: farthest from `eye` first.
