@@ -2,17 +2,25 @@
 //! the app has started, announced by a `meshsmooth-ready` event on `window`.
 //!
 //! - `loadMesh(bytes: Uint8Array, name): Promise<info>` (the CLI's `info --json` keys), once the
-//!   mesh is open: a worker opens it (`state().loading` tells the stage), the current model
-//!   staying open until then; a later `loadMesh` before it is open replaces it (its promise rejects)
-//!   A label map (`.nii`, `.nii.gz`, `.nrrd`, `.seg.nrrd`) opens the same way: its structures
-//!   are extracted and the first one becomes the model
-//! - `structures()`: `{file, current, structures: [{label, name, color, opacity, visible,
-//!   voxels, voxel_size, vertices, triangles, volume, metrics}]}` of the open segmentation, or
-//!   null when the model is a mesh (`metrics`: its last smoothing's measures, or null)
+//!   file is open: a worker opens it (`state().loading` tells the stage), the current model
+//!   staying open until then; a later `loadMesh` before it is open replaces it (its promise
+//!   rejects). Every file opens as a case: a label map (`.nii`, `.nii.gz`, `.nrrd`,
+//!   `.seg.nrrd`) with its structures extracted, a case glTF with its structures, a surface as
+//!   a case of one; the first structure becomes the model
+//! - `loadCase(bytes, name): Promise<structures>`: `loadMesh` resolving with `structures()`,
+//!   for a case glTF written here (reopened as it was: names, colours, groups, parameters,
+//!   smoothed surfaces) or any file above
+//! - `addFile(bytes, name): Promise<structures>`: adds the file's structures to the open case
+//!   (after a file still opening); the model stays
+//! - `structures()`: `{file, current, title, description, structures: [{label, name, color,
+//!   opacity, visible, group, source, voxels, voxel_size, vertices, triangles, volume,
+//!   metrics}]}` of the open case, or null with nothing open (`metrics`: its last smoothing's
+//!   measures, or null; `label`, `voxels`, `voxel_size`: null where it came from no label map)
 //! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`;
 //!   the structure left keeps its smoothing, one coming back gets its own back
-//! - `setStructure({index, name, color, opacity, visible})`: changes how a structure (by
-//!   default the model's) is shown; throws on a bad value
+//! - `setStructure({index, name, color, opacity, visible, group})`: changes how a structure
+//!   (by default the model's) is shown and grouped (`group` null or "" ungroups); throws on a
+//!   bad value; `soloStructure(index)` shows that structure alone (again: all of them)
 //! - `setFilter(name)`, `setParams(object)` (keys `lambda mu alpha beta passband iterations
 //!   max_displacement`); both throw with the engine's message on a bad name or value
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
@@ -179,25 +187,92 @@ fn tau_and_search(
     Ok((tau, method))
 }
 
-/// A function of one argument that edits the session, throwing the engine's message when it
-/// refuses, and redraws the page when it accepts.
-/// Settles a promise once a file (or structure) is open: with the model's `info --json` keys,
-/// or with why it did not open.
-fn info_waiter(resolve: Function, reject: Function) -> LoadWaiter {
+/// Settles a promise once a file (or structure) is open: with `answer` of the session (the
+/// model's `info --json` keys, the structures), or with why it did not open.
+fn load_waiter(
+    resolve: Function,
+    reject: Function,
+    answer: fn(&crate::session::Session) -> Option<serde_json::Value>,
+) -> LoadWaiter {
     Box::new(move |outcome: Result<&crate::session::Session, String>| {
-        let info = outcome.and_then(|session| {
-            session
-                .info_json()
+        let value = outcome.and_then(|session| {
+            answer(session)
                 .map(|v| to_js(&v))
-                .ok_or_else(|| "no report".to_string())
+                .ok_or_else(|| "nothing is open".to_string())
         });
-        let _ = match info {
+        let _ = match value {
             Ok(v) => resolve.call1(&JsValue::NULL, &v),
             Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
         };
     })
 }
 
+fn info_waiter(resolve: Function, reject: Function) -> LoadWaiter {
+    load_waiter(resolve, reject, crate::session::Session::info_json)
+}
+
+/// How a file handed to the API opens.
+#[derive(Clone, Copy)]
+enum FileCall {
+    /// `loadMesh`: opens it, resolving with the model's info.
+    Mesh,
+    /// `loadCase`: opens it, resolving with the structures.
+    Case,
+    /// `addFile`: adds its structures to the open case, resolving with the structures.
+    Add,
+}
+
+impl FileCall {
+    fn name(self) -> &'static str {
+        match self {
+            FileCall::Mesh => "loadMesh",
+            FileCall::Case => "loadCase",
+            FileCall::Add => "addFile",
+        }
+    }
+}
+
+/// `loadMesh`, `loadCase` or `addFile` of `(bytes: Uint8Array, name)`: opened in a worker, the
+/// promise settles once it is open (or not).
+fn file_call(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+    call: FileCall,
+) -> Closure<dyn FnMut(JsValue, JsValue) -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move |bytes: JsValue, name: JsValue| {
+        let Some(bytes) = bytes.dyn_ref::<Uint8Array>() else {
+            let why = format!("{}(bytes, name): bytes must be a Uint8Array", call.name());
+            return settled(Err(why));
+        };
+        let Some(name) = name.as_string().filter(|n| !n.is_empty()) else {
+            let why = format!("{}(bytes, name): name must name the file", call.name());
+            return settled(Err(why));
+        };
+        let mut bytes = Some(bytes.to_vec());
+        let (d, c) = (d.clone(), c.clone());
+        Promise::new(&mut |resolve: Function, reject: Function| {
+            let Some(bytes) = bytes.take() else { return };
+            let structures = crate::session::Session::structures_json;
+            let mut doc = d.borrow_mut();
+            match call {
+                FileCall::Mesh => doc.begin_open(&name, bytes, Some(info_waiter(resolve, reject))),
+                FileCall::Case => {
+                    let waiter = load_waiter(resolve, reject, structures);
+                    doc.begin_open(&name, bytes, Some(waiter))
+                }
+                FileCall::Add => {
+                    let waiter = load_waiter(resolve, reject, structures);
+                    doc.begin_add(&name, bytes, Some(waiter))
+                }
+            }
+            c.request_repaint();
+        })
+    })
+}
+
+/// A function of one argument that edits the session, throwing the engine's message when it
+/// refuses, and redraws the page when it accepts.
 fn setter(
     doc: &SharedDocument,
     ctx: &egui::Context,
@@ -229,31 +304,9 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     let window = web_sys::window().ok_or("no window")?;
     let api = js_sys::Object::new();
 
-    let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
-        "loadMesh",
-        Closure::<dyn FnMut(JsValue, JsValue) -> Promise>::new(
-            move |bytes: JsValue, name: JsValue| {
-                let Some(bytes) = bytes.dyn_ref::<Uint8Array>() else {
-                    return settled(Err(
-                        "loadMesh(bytes, name): bytes must be a Uint8Array".into()
-                    ));
-                };
-                let name = name.as_string().unwrap_or_else(|| "mesh.ply".into());
-                let bytes = bytes.to_vec();
-                let (d, c) = (d.clone(), c.clone());
-                let mut bytes = Some(bytes);
-                // Opened in a worker; the promise settles once it is open (or not).
-                Promise::new(&mut |resolve: Function, reject: Function| {
-                    let Some(bytes) = bytes.take() else { return };
-                    let waiter = info_waiter(resolve, reject);
-                    d.borrow_mut().begin_open(&name, bytes, Some(waiter));
-                    c.request_repaint();
-                })
-            },
-        ),
-    )?;
+    for call in [FileCall::Mesh, FileCall::Case, FileCall::Add] {
+        define(&api, call.name(), file_call(doc, ctx, call))?;
+    }
 
     let d = doc.clone();
     define(
@@ -307,9 +360,18 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
         "setStructure",
         setter(doc, ctx, |session, values| {
             let (index, change) = crate::session::StructureChange::from_json(&from_js(&values)?)?;
-            let current = session.structures().map(|s| s.current);
-            let index = index.or(current).ok_or("no segmentation is open")?;
+            let index = (index.or(session.current_structure())).ok_or("nothing is open")?;
             session.set_structure(index, change)
+        }),
+    )?;
+    define(
+        &api,
+        "soloStructure",
+        setter(doc, ctx, |session, index| {
+            let index = (index.as_f64())
+                .filter(|i| *i >= 0.0 && i.fract() == 0.0)
+                .ok_or("soloStructure(index): index must be a whole number >= 0")?;
+            session.solo_structure(index as usize)
         }),
     )?;
     define(

@@ -165,6 +165,8 @@ pub struct Document {
     pub guidance_on_gpu: bool,
     /// Calls waiting for the file being opened.
     waiting_for_load: Vec<LoadWaiter>,
+    /// The first failure among the files opened since the waiters last heard.
+    load_failure: Option<String>,
 }
 
 /// The handle the shell and the API hold.
@@ -184,6 +186,7 @@ impl Document {
             show_gallery: false,
             guidance_on_gpu: false,
             waiting_for_load: Vec::new(),
+            load_failure: None,
         }
     }
 
@@ -231,22 +234,39 @@ impl Document {
         Ok(())
     }
 
+    /// Starts adding a file's structures to the open case (after the file opening now, if
+    /// one is). `waiter`, when given, hears once everything asked to open is open.
+    pub fn begin_add(&mut self, name: &str, bytes: Vec<u8>, waiter: Option<LoadWaiter>) {
+        self.session.begin_add(name, bytes);
+        self.waiting_for_load.extend(waiter);
+    }
+
     /// Whether nothing is being opened, a worker is still opening it, or it opened (or failed)
     /// in this frame. The last takes the frame: the engines take up a new model from the next
-    /// frame on, before the view does.
+    /// frame on, before the view does. The waiters hear once nothing more is to open, of the
+    /// first failure if there was one.
     pub fn step_loading(&mut self) -> Opening {
         if self.session.loading().is_none() {
             return Opening::Idle;
         }
+        let model_before = self.session.model_id();
         let Some(outcome) = self.session.poll_opening() else {
             return Opening::Working;
         };
         match &outcome {
-            Ok(()) => self.opened(),
+            // A file added to the case leaves the model as it was.
+            Ok(()) if self.session.model_id() != model_before => self.opened(),
+            Ok(()) => {}
             Err(message) => log::warn!("{message}"),
         }
-        for w in std::mem::take(&mut self.waiting_for_load) {
-            w(outcome.clone().map(|()| &self.session));
+        if let Err(message) = outcome {
+            self.load_failure.get_or_insert(message);
+        }
+        if self.session.loading().is_none() {
+            let outcome = self.load_failure.take();
+            for w in std::mem::take(&mut self.waiting_for_load) {
+                w(outcome.clone().map_or(Ok(&self.session), Err));
+            }
         }
         Opening::Done
     }

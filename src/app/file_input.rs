@@ -19,7 +19,21 @@ const ACCEPT: &str = ".stl,.obj,.ply,.glb,.gltf,.nii,.gz,.nrrd";
 pub struct ArrivedFile {
     pub name: String,
     pub bytes: Result<Vec<u8>, String>,
+    /// Whether its structures join the open case (the Add button, or a file after the first
+    /// of several chosen or dropped together) instead of opening as a new one.
+    pub add: bool,
 }
+
+/// A file to read: its name and the read, which starts when awaited.
+type PendingRead = (
+    String,
+    Box<
+        dyn FnOnce(
+            OnProgress,
+        )
+            -> std::pin::Pin<Box<dyn std::future::Future<Output = Result<Vec<u8>, String>>>>,
+    >,
+);
 
 /// A file being read: bytes so far, and the total when known.
 #[derive(Clone, Debug, PartialEq)]
@@ -59,6 +73,8 @@ struct Inbox {
     /// The reads in flight, by number.
     reading: Rc<RefCell<Vec<(u64, Reading)>>>,
     next: Rc<Cell<u64>>,
+    /// Whether the picker was opened to add files to the open case.
+    adding: Rc<Cell<bool>>,
 }
 
 impl Inbox {
@@ -87,6 +103,26 @@ impl Inbox {
         self.reading.borrow_mut().retain(|(i, _)| *i != id);
         self.arrived.borrow_mut().push(file);
         ctx.request_repaint();
+    }
+
+    /// Reads `files` one after another and delivers each in turn, so they arrive in order:
+    /// the first opens (unless `add`), the others join its case.
+    fn read_in_order(&self, files: Vec<PendingRead>, add: bool, ctx: &egui::Context) {
+        let reads: Vec<_> = files
+            .into_iter()
+            .enumerate()
+            .map(|(i, (name, read))| {
+                let (id, progress) = self.begin(&name, ctx);
+                (id, name, add || i > 0, read(progress))
+            })
+            .collect();
+        let (inbox, ctx) = (self.clone(), ctx.clone());
+        wasm_bindgen_futures::spawn_local(async move {
+            for (id, name, add, read) in reads {
+                let bytes = read.await;
+                inbox.deliver(id, ArrivedFile { name, bytes, add }, &ctx);
+            }
+        });
     }
 }
 
@@ -121,37 +157,44 @@ impl FileInput {
         }
     }
 
-    /// Opens the browser's file dialog; the chosen file arrives later through [`Self::take_arrived`].
-    pub fn open_picker(&self) -> Result<(), String> {
+    /// Opens the browser's file dialog; the chosen files arrive later through
+    /// [`Self::take_arrived`], to open as a case or (`add`) to join the open one.
+    pub fn open_picker(&self, add: bool) -> Result<(), String> {
         let input = self.picker.as_ref().map_err(String::clone)?;
+        self.inbox.adding.set(add);
         // Clearing the value lets the same file be chosen twice in a row.
         input.set_value("");
         input.click();
         Ok(())
     }
 
-    /// Starts reading the files dropped on the page this frame. One mesh is open at a time,
-    /// so only the first file of a multi-file drop is read.
+    /// Starts reading the files dropped on the page this frame: the first opens, the others
+    /// join its case.
     pub fn collect_dropped(&self, ctx: &egui::Context) {
         let dropped = ctx.input(|i| i.raw.dropped_files.clone());
-        let Some(file) = dropped.into_iter().next() else {
-            return;
-        };
-        let name = file
-            .path()
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| file.path().to_string_lossy().into_owned());
-        let inbox = self.inbox.clone();
-        let ctx = ctx.clone();
-        let (id, progress) = inbox.begin(&name, &ctx);
-        wasm_bindgen_futures::spawn_local(async move {
-            let bytes = match file.web_file() {
-                Some(web_file) => read_bytes::read_file(web_file, progress).await,
-                None => file.bytes_async().await,
-            };
-            inbox.deliver(id, ArrivedFile { name, bytes }, &ctx);
-        });
+        let files: Vec<PendingRead> = dropped
+            .into_iter()
+            .map(|file| {
+                let name = file
+                    .path()
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| file.path().to_string_lossy().into_owned());
+                let read: Box<dyn FnOnce(OnProgress) -> _> = Box::new(move |progress| {
+                    Box::pin(async move {
+                        match file.web_file() {
+                            Some(web_file) => read_bytes::read_file(web_file, progress).await,
+                            None => file.bytes_async().await,
+                        }
+                    })
+                        as std::pin::Pin<Box<dyn std::future::Future<Output = _>>>
+                });
+                (name, read)
+            })
+            .collect();
+        if !files.is_empty() {
+            self.inbox.read_in_order(files, false, ctx);
+        }
     }
 
     /// Starts fetching `url` (same origin, see `query`) into the inbox as `name`.
@@ -161,7 +204,8 @@ impl FileInput {
         let (id, progress) = inbox.begin(&name, &ctx);
         wasm_bindgen_futures::spawn_local(async move {
             let bytes = read_bytes::fetch(&url, progress).await;
-            inbox.deliver(id, ArrivedFile { name, bytes }, &ctx);
+            let add = false;
+            inbox.deliver(id, ArrivedFile { name, bytes, add }, &ctx);
         });
     }
 
@@ -195,6 +239,7 @@ fn create_picker(
         .map_err(|_| "created element is not an <input>")?;
     input.set_type("file");
     input.set_accept(ACCEPT);
+    input.set_multiple(true);
     input.set_hidden(true);
     input.set_id("meshsmooth_file_input");
     let body = document.body().ok_or("the page has no <body>")?;
@@ -206,17 +251,23 @@ fn create_picker(
         let inbox = inbox.clone();
         let ctx = ctx.clone();
         Closure::<dyn FnMut()>::new(move || {
-            let Some(file) = input.files().and_then(|list| list.get(0)) else {
+            let Some(list) = input.files() else {
                 return;
             };
-            let inbox = inbox.clone();
-            let ctx = ctx.clone();
-            let name = file.name();
-            let (id, progress) = inbox.begin(&name, &ctx);
-            wasm_bindgen_futures::spawn_local(async move {
-                let bytes = read_bytes::read_file(&file, progress).await;
-                inbox.deliver(id, ArrivedFile { name, bytes }, &ctx);
-            });
+            let files: Vec<PendingRead> = (0..list.length())
+                .filter_map(|i| list.get(i))
+                .map(|file| {
+                    let name = file.name();
+                    let read: Box<dyn FnOnce(OnProgress) -> _> = Box::new(move |progress| {
+                        Box::pin(async move { read_bytes::read_file(&file, progress).await })
+                            as std::pin::Pin<Box<dyn std::future::Future<Output = _>>>
+                    });
+                    (name, read)
+                })
+                .collect();
+            if !files.is_empty() {
+                inbox.read_in_order(files, inbox.adding.get(), &ctx);
+            }
         })
     };
     input.set_onchange(Some(on_change.as_ref().unchecked_ref()));

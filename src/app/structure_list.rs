@@ -1,9 +1,11 @@
-//! The Structure list: every structure of an open segmentation with its colour, opacity and
-//! visibility (the eye shows or hides it, S shows it alone); the one selected is the model the
-//! smoothing, the graphs, the brush and the suggestions act on, and it can be renamed.
+//! The Structure list: every structure of the open case, by group, with its colour, opacity and
+//! visibility (the box shows or hides it, S shows it alone); the one selected is the model the
+//! smoothing, the graphs, the brush and the suggestions act on, and it can be renamed and
+//! grouped. Files added join the case.
 
 use eframe::egui;
 
+use crate::case::CaseStructure;
 use crate::session::{Session, StructureChange};
 
 /// What the author did in the list this frame.
@@ -13,19 +15,31 @@ pub enum StructureAction {
     Solo(usize),
     /// The case's title and description as edited.
     CaseText(String, String),
+    /// Choose files whose structures join the case.
+    AddFiles,
     ExportCase,
     /// "Suggest all" at the Suggest panel's tau, or cancel it.
     SuggestAll,
     CancelSuggestAll,
 }
 
-/// The list's state between frames: the name being edited, the case's title and description.
+/// The list's state between frames: the name and group being edited, the case's title and
+/// description.
 #[derive(Default)]
 pub struct StructureList {
-    editing: Option<(usize, String)>,
+    editing: Option<Editing>,
     /// The title and description being edited, and the session's when they were taken (the
     /// API may change those: then the fields show the new ones).
     case_text: ((String, String), (String, String)),
+}
+
+/// The model's name and group as edited, and what the session had when they were taken: a
+/// new model, or a change made elsewhere (the API), shows the session's again.
+struct Editing {
+    /// The session's model and the structure it is.
+    key: (u64, usize),
+    taken: (String, String),
+    text: (String, String),
 }
 
 fn to_bytes(c: [f32; 4]) -> [u8; 4] {
@@ -33,73 +47,76 @@ fn to_bytes(c: [f32; 4]) -> [u8; 4] {
 }
 
 impl StructureList {
-    /// Shows the list when the model is a structure of a segmentation.
+    /// Shows the open case's structures, ungrouped ones first, then each group's.
     pub fn show(&mut self, ui: &mut egui::Ui, session: &Session) -> Vec<StructureAction> {
         let mut actions = Vec::new();
-        let (Some(structures), looks) = (session.structures(), session.structure_looks()) else {
+        let Some(current) = session.current_structure() else {
             return actions;
         };
-        ui.heading("Structures");
+        let list = session.case_structures();
+        ui.horizontal(|ui| {
+            ui.heading("Structures");
+            let tip = "Open more files (meshes, a label map, a case glTF) into this case";
+            if ui.button("Add files…").on_hover_text(tip).clicked() {
+                actions.push(StructureAction::AddFiles);
+            }
+        });
+        let mut groups: Vec<Option<&str>> = vec![None];
+        groups.extend(list.iter().filter_map(|s| s.group.as_deref().map(Some)));
+        groups.dedup();
+        let mut seen = Vec::new();
+        groups.retain(|g| {
+            !seen.contains(g) && {
+                seen.push(*g);
+                true
+            }
+        });
         egui::ScrollArea::vertical()
             .max_height(220.0)
             .id_salt("structure list")
             .show(ui, |ui| {
-                for (i, (s, look)) in structures.list.iter().zip(looks).enumerate() {
-                    ui.horizontal(|ui| {
-                        let mut visible = look.visible;
-                        if ui
-                            .checkbox(&mut visible, "")
-                            .on_hover_text("Show or hide")
-                            .changed()
-                        {
-                            let change = StructureChange {
-                                visible: Some(visible),
-                                ..Default::default()
-                            };
-                            actions.push(StructureAction::Change(i, change));
+                for group in groups {
+                    if let Some(name) = group {
+                        ui.label(egui::RichText::new(name).strong());
+                    }
+                    for (i, s) in list.iter().enumerate() {
+                        if s.group.as_deref() == group {
+                            row(ui, i, s, i == current, &mut actions);
                         }
-                        let mut rgba = to_bytes(look.color);
-                        let button = ui.color_edit_button_srgba_unmultiplied(&mut rgba);
-                        if button.changed() {
-                            let c = rgba.map(|v| f32::from(v) / 255.0);
-                            let change = StructureChange {
-                                color: Some([c[0], c[1], c[2]]),
-                                opacity: Some(c[3]),
-                                ..Default::default()
-                            };
-                            actions.push(StructureAction::Change(i, change));
-                        }
-                        if ui.small_button("S").on_hover_text("Show alone").clicked() {
-                            actions.push(StructureAction::Solo(i));
-                        }
-                        let selected = i == structures.current;
-                        let label =
-                            ui.selectable_label(selected, &look.name)
-                                .on_hover_text(format!(
-                                    "label {}, {} voxels, {} vertices, {} triangles",
-                                    s.label,
-                                    s.voxels,
-                                    s.mesh.vertex_count(),
-                                    s.mesh.triangle_count()
-                                ));
-                        if label.clicked() && !selected {
-                            actions.push(StructureAction::Select(i));
-                        }
-                    });
+                    }
                 }
             });
-        let current = structures.current;
-        if let Some(look) = looks.get(current) {
-            let name = match &mut self.editing {
-                Some((i, name)) if *i == current => name,
-                editing => &mut editing.insert((current, look.name.clone())).1,
+        if let Some(s) = list.get(current) {
+            let key = (session.model_id(), current);
+            let stored = (s.name.clone(), s.group.clone().unwrap_or_default());
+            let editing = match &mut self.editing {
+                Some(e) if e.key == key && e.taken == stored => e,
+                editing => editing.insert(Editing {
+                    key,
+                    taken: stored.clone(),
+                    text: stored,
+                }),
             };
+            let (name, group) = &mut editing.text;
             ui.horizontal(|ui| {
                 ui.label("Name");
-                let edit = ui.text_edit_singleline(name);
-                if edit.lost_focus() && name.trim() != look.name {
+                let edit = ui.add(egui::TextEdit::singleline(name).desired_width(110.0));
+                if edit.lost_focus() && name.trim() != s.name {
                     let change = StructureChange {
                         name: Some(name.clone()),
+                        ..Default::default()
+                    };
+                    actions.push(StructureAction::Change(current, change));
+                }
+                ui.label("Group");
+                let edit = ui.add(
+                    egui::TextEdit::singleline(group)
+                        .hint_text("none")
+                        .desired_width(80.0),
+                );
+                if edit.lost_focus() && Some(group.trim()) != s.group.as_deref() {
+                    let change = StructureChange {
+                        group: Some(Some(group.clone())),
                         ..Default::default()
                     };
                     actions.push(StructureAction::Change(current, change));
@@ -173,4 +190,56 @@ impl StructureList {
             actions.push(StructureAction::ExportCase);
         }
     }
+}
+
+/// One structure's row: visibility, colour with opacity, show alone, and its name to select.
+fn row(
+    ui: &mut egui::Ui,
+    i: usize,
+    s: &CaseStructure,
+    selected: bool,
+    actions: &mut Vec<StructureAction>,
+) {
+    ui.horizontal(|ui| {
+        let mut visible = s.visible;
+        if ui
+            .checkbox(&mut visible, "")
+            .on_hover_text("Show or hide")
+            .changed()
+        {
+            let change = StructureChange {
+                visible: Some(visible),
+                ..Default::default()
+            };
+            actions.push(StructureAction::Change(i, change));
+        }
+        let mut rgba = to_bytes(s.color);
+        if ui.color_edit_button_srgba_unmultiplied(&mut rgba).changed() {
+            let c = rgba.map(|v| f32::from(v) / 255.0);
+            let change = StructureChange {
+                color: Some([c[0], c[1], c[2]]),
+                opacity: Some(c[3]),
+                ..Default::default()
+            };
+            actions.push(StructureAction::Change(i, change));
+        }
+        if ui.small_button("S").on_hover_text("Show alone").clicked() {
+            actions.push(StructureAction::Solo(i));
+        }
+        let mut about = format!(
+            "{} vertices, {} triangles",
+            s.original.vertex_count(),
+            s.original.triangle_count()
+        );
+        if let (Some(label), Some(voxels)) = (s.label, s.voxels) {
+            about = format!("label {label}, {voxels} voxels, {about}");
+        }
+        if let Some(source) = &s.source {
+            about = format!("{about}\nfrom {source}");
+        }
+        let label = ui.selectable_label(selected, &s.name).on_hover_text(about);
+        if label.clicked() && !selected {
+            actions.push(StructureAction::Select(i));
+        }
+    });
 }

@@ -12,11 +12,13 @@ mod record;
 pub mod relations;
 
 pub use checks::{check, checks_json, checks_text};
-pub use open::{open, CaseOpenError};
+pub use open::{file_name, open, surface_structure, CaseOpenError};
 pub use pipeline::{
     smooth_structure, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllProgress,
 };
 pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
+
+use serde::{Deserialize, Serialize};
 
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
@@ -26,8 +28,8 @@ use crate::smooth::{Filter, Params};
 /// The filter structures start with: Laplace+HC keeps volume best on staircase surfaces.
 pub const DEFAULT_FILTER: Filter = Filter::Hc;
 
-/// A case: what one glTF holds.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// A case: what one glTF holds. It travels between the page and its engine workers too.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Case {
     pub title: String,
     pub description: String,
@@ -35,7 +37,7 @@ pub struct Case {
 }
 
 /// One structure of a case.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CaseStructure {
     pub name: String,
     /// Display (sRGB) colour and opacity, each in [0, 1].
@@ -49,6 +51,8 @@ pub struct CaseStructure {
     pub label: Option<i64>,
     /// Voxel size along i, j, k (mm), when it came from a label map.
     pub voxel_size: Option<[f64; 3]>,
+    /// Its voxels in the label map (after dropping specks), when it came from one.
+    pub voxels: Option<usize>,
     /// The surface as opened (the staircase of a label map), in world millimetres.
     pub original: Mesh,
     /// The structure's own filter and parameters, bound included.
@@ -62,9 +66,11 @@ pub struct CaseStructure {
 }
 
 /// A structure's smoothed surface and its measures against the original.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Smoothed {
+    #[serde(with = "crate::mesh::flat_bytes")]
     pub positions: Vec<[f32; 3]>,
+    #[serde(with = "crate::metrics::as_json_text")]
     pub metrics: Metrics,
     /// Per-vertex local error (mm), when measured here (a reopened case may lack it).
     pub local_error: Option<Vec<f32>>,
@@ -81,6 +87,7 @@ impl CaseStructure {
             source: None,
             label: None,
             voxel_size: None,
+            voxels: None,
             original: mesh,
             params: Params::defaults(DEFAULT_FILTER),
             tau: 0.5,
@@ -97,6 +104,7 @@ impl CaseStructure {
         s.source = source.map(str::to_string);
         s.label = Some(structure.label);
         s.voxel_size = Some(structure.voxel_size);
+        s.voxels = Some(structure.voxels);
         s.params.max_displacement = s.default_bound();
         s
     }

@@ -4,6 +4,7 @@
 
 use super::{from_gltf_scene, Case, CaseRecordError, CaseStructure};
 use crate::io::{self, Format, LoadError};
+use crate::mesh::Mesh;
 use crate::segmentation::{self, default_color, NamedBytes, OpenOptions};
 
 /// Why files could not be opened as a case; each names the file at fault.
@@ -78,10 +79,8 @@ pub fn open(
             Some(Format::Stl | Format::Obj | Format::Ply) => {
                 let mesh = io::load(f.bytes, f.name).map_err(load)?;
                 let ordinal = case.structures.len();
-                let name = mesh_name(f.name);
-                let mut s = CaseStructure::from_mesh(&name, mesh, default_color(ordinal));
-                s.source = Some(file_name(f.name).to_string());
-                case.structures.push(s);
+                case.structures
+                    .push(surface_structure(f.name, mesh, ordinal));
             }
             _ => {
                 return Err(CaseOpenError::Unknown {
@@ -93,8 +92,16 @@ pub fn open(
     Ok(case)
 }
 
-/// A path's last component.
-fn file_name(path: &str) -> &str {
+/// The structure a surface file (STL, OBJ, PLY) makes: named by its file, coloured by its
+/// place in the case.
+pub fn surface_structure(path: &str, mesh: Mesh, ordinal: usize) -> CaseStructure {
+    let mut s = CaseStructure::from_mesh(&mesh_name(path), mesh, default_color(ordinal));
+    s.source = Some(file_name(path).to_string());
+    s
+}
+
+/// A path's last component: all of a path a case keeps.
+pub fn file_name(path: &str) -> &str {
     path.rsplit(['/', '\\']).next().unwrap_or(path)
 }
 

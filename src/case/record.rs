@@ -35,6 +35,7 @@ pub fn structure_record(s: &CaseStructure) -> Value {
         "visible": s.visible,
         "color": s.color,
         "voxel_size_mm": s.voxel_size,
+        "voxels": s.voxels,
         "voxel_diagonal_mm": diagonal,
         "filter": s.params.filter,
         "params": s.params.to_json(),
@@ -162,6 +163,10 @@ fn structure(
         .or(s.source);
     s.label = record.get("label").and_then(Value::as_i64);
     s.voxel_size = floats::<3>(record.get("voxel_size_mm"));
+    s.voxels = record
+        .get("voxels")
+        .and_then(Value::as_u64)
+        .and_then(|v| usize::try_from(v).ok());
     if let Some(tau) = record.get("tau").and_then(Value::as_f64) {
         s.tau = tau;
     }

@@ -6,6 +6,7 @@
 //! The file is read into memory once so disk speed does not count; the best of `repeat` runs is
 //! reported, the usual way to take noise from other processes out of a wall-clock timing.
 
+use crate::case::Case;
 use crate::io;
 use crate::mesh::Topology;
 use crate::model::Model;
@@ -93,9 +94,9 @@ pub fn measure(bytes: &[u8], name: &str, repeat: usize) -> Result<LoadTiming, St
         let start = Instant::now();
         let model = Model::load(name, bytes).map_err(|e| e.to_string())?;
         let opened = Instant::now();
-        let wire = worker::encode(&model);
+        let wire = worker::encode(&(&model.model, &model.case));
         let encoded = Instant::now();
-        let back: Model = worker::decode(&wire)?;
+        let back: (Model, Case) = worker::decode(&wire)?;
         let decoded = Instant::now();
         std::hint::black_box(&back);
         timing.open_seconds = timing.open_seconds.min((opened - start).as_secs_f64());

@@ -25,8 +25,8 @@ pub(crate) use exact_distance::build_tree;
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
 pub use original::Original;
 pub use report::{
-    exact_distances, exact_error, measure, measure_shape, measure_vertices, ErrorSummary, Metrics,
-    VertexMeasures,
+    as_json_text, exact_distances, exact_error, measure, measure_shape, measure_vertices,
+    ErrorSummary, Metrics, VertexMeasures,
 };
 pub use roughness::{roughness, roughness_ratio};
 pub use score::ScoreTerms;

@@ -372,3 +372,21 @@ impl Pass<'_> {
         s
     }
 }
+
+/// Serde for [`Metrics`] as its JSON text, for binary formats (postcard): its optional
+/// exact-error fields are left out when absent, which a binary format cannot express. Use with
+/// `#[serde(with = "crate::metrics::as_json_text")]`.
+pub mod as_json_text {
+    use super::Metrics;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(metrics: &Metrics, serializer: S) -> Result<S::Ok, S::Error> {
+        let text = serde_json::to_string(metrics).map_err(serde::ser::Error::custom)?;
+        serializer.serialize_str(&text)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Metrics, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        serde_json::from_str(&text).map_err(serde::de::Error::custom)
+    }
+}

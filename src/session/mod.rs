@@ -15,13 +15,14 @@ mod structures;
 mod suggest_all;
 mod weights;
 
-pub use crate::model::{Model, OpenFailure, Structures};
+pub use crate::model::{Model, OpenFailure};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use opening::LoadProgress;
-pub use structures::{Kept, OtherStructure, StructureChange, StructureLook};
+pub use structures::{OtherStructure, StructureChange};
 pub use weights::WeightsSummary;
 
+use crate::case::Case;
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh};
 use crate::metrics::{Metrics, VertexMeasures};
@@ -79,11 +80,16 @@ pub struct Session {
     opening: Option<opening::Opening>,
     /// How long each stage of the latest opening took (ms), in order.
     open_stages: Vec<(String, f64)>,
-    /// How each structure of the open segmentation is shown, and what it keeps.
-    looks: Vec<structures::StructureLook>,
-    looks_version: u64,
-    /// The case's title and description.
-    case_text: (String, String),
+    /// The open case: every structure opened, as the author arranges them; the model is
+    /// structure `current`'s surface (empty with nothing open).
+    case: Case,
+    /// The file the case was opened from.
+    case_file: String,
+    current: usize,
+    /// Counts changes of the case's structures, for the view.
+    case_version: u64,
+    /// Files to add to the case once the one opening now is open.
+    additions: std::collections::VecDeque<(String, Vec<u8>)>,
     suggest_all: suggest_all::SuggestAll,
 }
 
@@ -106,9 +112,11 @@ impl Default for Session {
             guidance: guidance::Guidance::default(),
             opening: None,
             open_stages: Vec::new(),
-            looks: Vec::new(),
-            looks_version: 0,
-            case_text: Default::default(),
+            case: Case::default(),
+            case_file: String::new(),
+            current: 0,
+            case_version: 0,
+            additions: Default::default(),
             suggest_all: Default::default(),
         }
     }
@@ -124,6 +132,11 @@ fn slot(filter: Filter) -> usize {
 impl Session {
     pub fn model(&self) -> Option<&Model> {
         self.model.as_ref()
+    }
+
+    /// Counts the models opened: it changes when another model (file or structure) opens.
+    pub fn model_id(&self) -> u64 {
+        self.model_id
     }
 
     pub fn error(&self) -> Option<&str> {
@@ -176,18 +189,8 @@ impl Session {
         self.revision += 1;
     }
 
-    /// The open segmentation's structures, when the model is one of them.
-    pub fn structures(&self) -> Option<&Structures> {
-        self.model.as_ref().and_then(|m| m.structures.as_ref())
-    }
-
     /// Makes `model` the open model (the previous result is dropped).
-    pub fn set_model(&mut self, model: Model) -> &Model {
-        if let Some(structures) = &model.structures {
-            // A structure from a label map knows its voxels: the legend reads in voxel
-            // diagonals and the bound defaults to half of one without the user typing it.
-            self.voxel_size = Some(structures.current().voxel_size);
-        }
+    fn set_model(&mut self, model: Model) -> &Model {
         self.error = None;
         self.result = None;
         self.changed();

@@ -1,9 +1,12 @@
-//! Opening files and structures: handed to the CPU engine's workers (which parse, build the
-//! topology, check the mesh and measure the original, then send the model whole), while the
-//! open model stays until the new one is there. Without threads the same request is done on
-//! the calling thread as it is made.
+//! Opening files and structures: handed to the CPU engine's workers (which read the file as a
+//! case, build the model's topology, check the mesh and measure the original, then send them
+//! whole), while the open model stays until the new one is there. Without threads the same
+//! request is done on the calling thread as it is made.
 
-use super::{Model, Session, Structures};
+use super::{Model, Session};
+use crate::case::Case;
+use crate::io::{self, Format};
+use crate::model::Opened;
 use crate::worker::{Input, LoadJob, Reply};
 
 /// How far an opening got: the stage under way (0-based) of [`LoadProgress::total`].
@@ -18,12 +21,22 @@ pub struct LoadProgress {
     pub fraction: f32,
 }
 
+/// What an opening makes of what comes back.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Purpose {
+    /// A file becomes the open case, its first structure the model.
+    File,
+    /// Structure `index` of the open case becomes the model.
+    Structure(usize),
+    /// A file's structures join the open case.
+    Addition,
+}
+
 /// An opening asked of the workers.
 pub(super) struct Opening {
     name: String,
     job: LoadJob,
-    /// A structure's list, attached to the model that comes back.
-    structures: Option<Structures>,
+    purpose: Purpose,
 }
 
 impl Session {
@@ -31,9 +44,8 @@ impl Session {
     /// error is recorded (and returned) as "Cannot open NAME: reason".
     pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<&Model, String> {
         match Model::load(name, bytes) {
-            Ok(model) => {
-                self.set_model(model);
-                self.reset_looks();
+            Ok(Opened { case, model }) => {
+                self.take_file(name, case, model);
                 Ok(self.model.as_ref().expect("just set"))
             }
             Err(e) => Err(self.fail(name, &e.to_string())),
@@ -43,78 +55,115 @@ impl Session {
     /// Starts opening a file's bytes in a worker ([`Self::poll_opening`] takes the model); the
     /// current model stays open meanwhile. Returns the name of an opening this one replaces.
     pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>) -> Option<String> {
-        self.begin(name.to_string(), Input::File(bytes), None)
+        // Files to add were meant for the case open or opening now, not this one.
+        self.additions.clear();
+        self.begin(name.to_string(), Input::File(bytes), Purpose::File)
     }
 
-    /// Starts opening structure `index` of the open segmentation as the model, as a file opens.
-    /// Errors when no segmentation is open or it has no such structure.
+    /// Starts adding a file's structures (a label map's, a case glTF's, a surface) to the open
+    /// case; the model stays. While another file opens, this one waits for it (several files
+    /// dropped together open as one case). With nothing open, opens the file instead.
+    pub fn begin_add(&mut self, name: &str, bytes: Vec<u8>) {
+        if self.opening.is_some() || !self.additions.is_empty() {
+            self.additions.push_back((name.to_string(), bytes));
+        } else if self.model.is_none() {
+            self.begin_open(name, bytes);
+        } else {
+            self.begin(name.to_string(), Input::Addition(bytes), Purpose::Addition);
+        }
+    }
+
+    /// Starts the next file waiting to be added, once nothing is being opened.
+    fn next_addition(&mut self) {
+        if self.opening.is_none() {
+            if let Some((name, bytes)) = self.additions.pop_front() {
+                self.begin_add(&name, bytes);
+            }
+        }
+    }
+
+    /// Starts opening structure `index` of the open case as the model, as a file opens.
+    /// Errors when no case is open or it has no such structure.
     pub fn begin_open_structure(&mut self, index: usize) -> Result<Option<String>, String> {
-        let Some(structures) = self.structures().cloned() else {
-            return Err("no segmentation is open".to_string());
-        };
-        let Some(structure) = structures.list.get(index) else {
+        if self.model.is_none() {
+            return Err("nothing is open".to_string());
+        }
+        let count = self.case.structures.len();
+        let Some(structure) = self.case.structures.get(index) else {
             return Err(format!(
-                "structure {index} does not exist: the segmentation has {}",
-                structures.list.len()
+                "structure {index} does not exist: the case has {count}"
             ));
         };
-        let name = format!("{}: {}", structures.file, structure.name);
-        let input = Input::Structure(structure.mesh.clone());
-        let structures = Structures {
-            current: index,
-            ..structures
-        };
-        Ok(self.begin(name, input, Some(structures)))
+        let name = format!("{}: {}", self.case_file, structure.name);
+        let input = Input::Structure(structure.original.clone());
+        Ok(self.begin(name, input, Purpose::Structure(index)))
     }
 
-    fn begin(
-        &mut self,
-        name: String,
-        input: Input,
-        structures: Option<Structures>,
-    ) -> Option<String> {
+    fn begin(&mut self, name: String, input: Input, purpose: Purpose) -> Option<String> {
         let replaced = self.opening.take().map(|o| o.name);
         self.open_stages.clear();
         let job = self.cpu.load(&name, input);
-        self.opening = Some(Opening {
-            name,
-            job,
-            structures,
-        });
+        self.opening = Some(Opening { name, job, purpose });
         replaced
     }
 
-    /// Takes the model being opened once it is there: `Ok` with it open, or the error (as
-    /// [`Self::open`] reports it) with the previous model still open. `None` while the worker
-    /// is at it, or when nothing is being opened.
+    /// Takes what is being opened once it is there: `Ok` with it open (or added), or the
+    /// error (as [`Self::open`] reports it) with the previous model still open. `None` while
+    /// the worker is at it, or when nothing is being opened.
     pub fn poll_opening(&mut self) -> Option<Result<(), String>> {
         let opening = self.opening.as_ref()?;
         let reply = self.cpu.take_loaded(opening.job)?;
-        let Opening {
-            name, structures, ..
-        } = self.opening.take()?;
-        match reply {
+        let Opening { name, purpose, .. } = self.opening.take()?;
+        let outcome = self.take_opened(&name, purpose, reply);
+        if outcome.is_err() && purpose == Purpose::File {
+            // Files to add to a case that did not open.
+            self.additions.clear();
+        }
+        self.next_addition();
+        Some(outcome)
+    }
+
+    fn take_opened(&mut self, name: &str, purpose: Purpose, reply: Reply) -> Result<(), String> {
+        let (model, case, stages) = match reply {
             Reply::Loaded {
-                mut model, stages, ..
-            } => {
-                self.open_stages = stages;
-                let switching = structures.is_some();
-                if switching {
-                    // Another structure of the open segmentation: the one leaving keeps its
-                    // smoothing, the one coming gets back what it kept.
-                    self.keep_model_structure();
-                    model.structures = structures;
-                }
+                model,
+                case,
+                stages,
+                ..
+            } => (model, case, stages),
+            Reply::Failed { why, .. } => return Err(self.fail(name, &why)),
+            _ => return Err(self.fail(name, "a worker answered something else")),
+        };
+        self.open_stages = stages;
+        match (purpose, model, case) {
+            (Purpose::File, Some(model), Some(case)) => self.take_file(name, *case, *model),
+            (Purpose::Structure(index), Some(model), _) => {
+                // The structure leaving keeps its smoothing, the one coming gets back what it
+                // kept.
+                self.keep_model_structure();
                 self.set_model(*model);
-                if switching {
-                    self.restore_model_structure();
-                } else {
-                    self.reset_looks();
-                }
-                Some(Ok(()))
+                self.current = index;
+                self.restore_model_structure();
             }
-            Reply::Failed { why, .. } => Some(Err(self.fail(&name, &why))),
-            _ => Some(Err(self.fail(&name, "a worker answered something else"))),
+            (Purpose::Addition, _, Some(case)) => {
+                self.error = None;
+                self.add_to_case(*case);
+            }
+            _ => return Err(self.fail(name, "a worker answered something else")),
+        }
+        Ok(())
+    }
+
+    /// Makes a file's case the open one and `model` (its first structure) the model. A label
+    /// map's or a case glTF's structure brings its own filter and parameters (a label map's
+    /// with the bound at half its voxel diagonal); a surface takes the session's.
+    fn take_file(&mut self, name: &str, case: Case, model: Model) {
+        self.adopt_case(case, name);
+        self.set_model(model);
+        let own_params = io::is_label_map(name)
+            || matches!(Format::from_name(name), Some(Format::Glb | Format::Gltf));
+        if own_params {
+            self.restore_model_structure();
         }
     }
 

@@ -1,32 +1,14 @@
-//! The structures of an open segmentation as the author arranges them: each one's name, colour,
-//! opacity and visibility, and its smoothing kept while another structure is the model, so the
+//! The open case's structures as the author arranges them: each one's name, colour, opacity,
+//! visibility and group, and its smoothing kept while another structure is the model, so the
 //! view shows every structure smoothed its own way and coming back to one restores it.
+//!
+//! The session's case holds them; the model is structure `current`'s surface, and while it
+//! is, that structure's parameters and result are the session's own (its entry catches up
+//! when another structure is selected, and in [`Session::to_case`]).
 
-use super::{Session, Structures};
-use crate::case::Smoothed;
-use crate::segmentation::Structure;
-use crate::smooth::Params;
-
-/// How a structure is shown, and what it was smoothed with.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StructureLook {
-    pub name: String,
-    /// Display (sRGB) colour and opacity, each in [0, 1].
-    pub color: [f32; 4],
-    pub visible: bool,
-    /// Its smoothing, kept when another structure became the model.
-    pub kept: Option<Kept>,
-}
-
-/// A structure's smoothing while it is not the model.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Kept {
-    pub params: Params,
-    pub tau: f64,
-    pub weights: Option<Vec<f32>>,
-    /// The smoothed surface and its measures, when it had been smoothed.
-    pub smoothed: Option<Smoothed>,
-}
+use super::Session;
+use crate::case::{Case, CaseStructure, Smoothed};
+use crate::segmentation::default_color;
 
 /// What [`Session::set_structure`] changes; `None` leaves a field as it is.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -36,6 +18,8 @@ pub struct StructureChange {
     pub color: Option<[f32; 3]>,
     pub opacity: Option<f32>,
     pub visible: Option<bool>,
+    /// `Some(None)` takes the structure out of its group.
+    pub group: Option<Option<String>>,
 }
 
 /// A structure drawn around the model.
@@ -47,197 +31,224 @@ pub struct OtherStructure<'a> {
     pub color: [f32; 4],
 }
 
-impl StructureLook {
-    fn of(structure: &Structure) -> Self {
-        let [r, g, b] = structure.color;
-        Self {
-            name: structure.name.clone(),
-            color: [r, g, b, 1.0],
-            visible: true,
-            kept: None,
-        }
-    }
-}
-
 impl Session {
-    /// How each structure of the open segmentation is shown (empty without one).
-    pub fn structure_looks(&self) -> &[StructureLook] {
-        &self.looks
+    /// The open case's structures (empty with nothing open); the model's entry holds what it
+    /// had when it became the model.
+    pub fn case_structures(&self) -> &[CaseStructure] {
+        &self.case.structures
     }
 
-    /// Counts the changes of how the structures look or what they keep, for the view.
-    pub fn looks_version(&self) -> u64 {
-        self.looks_version
+    /// Which structure the model is, while one is open.
+    pub fn current_structure(&self) -> Option<usize> {
+        self.model.as_ref().map(|_| self.current)
     }
 
-    /// The look of the structure that is the model, when it is one.
-    pub fn model_look(&self) -> Option<&StructureLook> {
-        self.looks.get(self.structures()?.current)
+    /// The name of the file the case was opened from.
+    pub fn case_file(&self) -> &str {
+        &self.case_file
     }
 
-    /// Changes structure `index`'s name, colour, opacity or visibility; all or nothing.
+    /// Counts the changes of the structures (their looks, what they keep, how many), for the
+    /// view.
+    pub fn case_version(&self) -> u64 {
+        self.case_version
+    }
+
+    /// The structure that is the model.
+    pub fn model_structure(&self) -> Option<&CaseStructure> {
+        self.case.structures.get(self.current_structure()?)
+    }
+
+    /// Changes structure `index`'s name, colour, opacity, visibility or group; all or nothing.
     pub fn set_structure(&mut self, index: usize, change: StructureChange) -> Result<(), String> {
-        let count = self.looks.len();
-        let look = self
-            .looks
-            .get(index)
+        let count = self.case.structures.len();
+        let s = self
+            .case
+            .structures
+            .get_mut(index)
             .ok_or_else(|| format!("structure {index} does not exist: there are {count}"))?;
-        let mut look = look.clone();
-        if let Some(name) = change.name {
-            let name = name.trim();
-            if name.is_empty() {
+        let (mut name, mut color, mut visible, mut group) =
+            (s.name.clone(), s.color, s.visible, s.group.clone());
+        if let Some(new) = change.name {
+            let new = new.trim();
+            if new.is_empty() {
                 return Err("a structure's name cannot be empty".to_string());
             }
-            look.name = name.to_string();
+            name = new.to_string();
         }
-        if let Some(color) = change.color {
-            if !color.iter().all(|c| (0.0..=1.0).contains(c)) {
-                return Err(format!("colour {color:?}: each channel must be in [0, 1]"));
+        if let Some(c) = change.color {
+            if !c.iter().all(|c| (0.0..=1.0).contains(c)) {
+                return Err(format!("colour {c:?}: each channel must be in [0, 1]"));
             }
-            look.color[..3].copy_from_slice(&color);
+            color[..3].copy_from_slice(&c);
         }
         if let Some(opacity) = change.opacity {
             if !(0.0..=1.0).contains(&opacity) {
                 return Err(format!("opacity {opacity}: must be in [0, 1]"));
             }
-            look.color[3] = opacity;
+            color[3] = opacity;
         }
-        if let Some(visible) = change.visible {
-            look.visible = visible;
+        if let Some(v) = change.visible {
+            visible = v;
         }
-        if self.looks[index] != look {
-            self.looks[index] = look;
-            self.looks_version += 1;
+        if let Some(g) = change.group {
+            group = g.map(|g| g.trim().to_string()).filter(|g| !g.is_empty());
+        }
+        if (&s.name, s.color, s.visible, &s.group) != (&name, color, visible, &group) {
+            (s.name, s.color, s.visible, s.group) = (name, color, visible, group);
+            self.case_version += 1;
         }
         Ok(())
     }
 
     /// Shows structure `index` alone (or, when it already is alone, every structure again).
     pub fn solo_structure(&mut self, index: usize) -> Result<(), String> {
-        if index >= self.looks.len() {
+        let list = &mut self.case.structures;
+        if index >= list.len() {
             return Err(format!("structure {index} does not exist"));
         }
-        let alone = self
-            .looks
+        let alone = list
             .iter()
             .enumerate()
-            .all(|(i, l)| l.visible == (i == index));
-        for (i, look) in self.looks.iter_mut().enumerate() {
-            look.visible = alone || i == index;
+            .all(|(i, s)| s.visible == (i == index));
+        for (i, s) in list.iter_mut().enumerate() {
+            s.visible = alone || i == index;
         }
-        self.looks_version += 1;
+        self.case_version += 1;
         Ok(())
     }
 
     /// The visible structures other than the model, as they were last smoothed (else as
-    /// extracted).
+    /// opened).
     pub fn other_structures(&self) -> Vec<OtherStructure<'_>> {
-        let Some(structures) = self.structures() else {
-            return Vec::new();
-        };
-        (structures.list.iter().zip(&self.looks).enumerate())
-            .filter(|(i, (_, look))| *i != structures.current && look.visible)
-            .map(|(index, (s, look))| {
-                let smoothed = look.kept.as_ref().and_then(|k| k.smoothed.as_ref());
-                OtherStructure {
-                    index,
-                    positions: smoothed.map_or(&s.mesh.positions, |k| &k.positions),
-                    triangles: &s.mesh.triangles,
-                    color: look.color,
-                }
+        let current = self.current_structure();
+        (self.case.structures.iter().enumerate())
+            .filter(|(i, s)| Some(*i) != current && s.visible)
+            .map(|(index, s)| OtherStructure {
+                index,
+                positions: s.positions(),
+                triangles: &s.original.triangles,
+                color: s.color,
             })
             .collect()
     }
 
-    /// Looks for the structures of a segmentation just opened from its file.
-    pub(super) fn reset_looks(&mut self) {
+    /// Makes `case` (opened from `file`) the open case, its first structure to be the model.
+    pub(super) fn adopt_case(&mut self, case: Case, file: &str) {
         // A "Suggest all" of the structures before is of no use now.
         self.cancel_suggest_all();
         self.suggest_all = Default::default();
-        self.looks = self
-            .structures()
-            .map(|s| s.list.iter().map(StructureLook::of).collect())
-            .unwrap_or_default();
-        self.looks_version += 1;
+        self.case = case;
+        self.case_file = file.to_string();
+        self.current = 0;
+        self.case_version += 1;
     }
 
-    /// The model's smoothing as a structure keeps it: what a case structure takes too.
-    pub(super) fn model_smoothing(&self) -> Kept {
-        Kept {
-            params: *self.params(),
-            tau: self.tau,
-            weights: self.weights.clone(),
-            smoothed: self.result().map(|r| Smoothed {
-                positions: r.positions.clone(),
-                metrics: r.metrics.clone(),
-                local_error: Some(r.vertex.local_error.clone()),
-            }),
+    /// Adds the structures of `other` (another file) to the open case. Surfaces, which carry
+    /// no colour of their own, get the palette's colour of their place in the case.
+    pub(super) fn add_to_case(&mut self, other: Case) {
+        let start = self.case.structures.len();
+        let mut other = other;
+        for (i, s) in other.structures.iter_mut().enumerate() {
+            if s.label.is_none() && s.smoothed.is_none() && s.voxel_size.is_none() {
+                let [r, g, b] = default_color(start + i);
+                s.color = [r, g, b, s.color[3]];
+            }
+        }
+        self.case.add(other);
+        self.case_version += 1;
+    }
+
+    /// The model's smoothing, to write into a structure as it keeps it.
+    pub(super) fn model_smoothing(&self) -> impl FnOnce(&mut CaseStructure) + 'static {
+        let (params, tau, weights) = (*self.params(), self.tau, self.weights.clone());
+        let smoothed = self.result().map(|r| Smoothed {
+            positions: r.positions.clone(),
+            metrics: r.metrics.clone(),
+            local_error: Some(r.vertex.local_error.clone()),
+        });
+        move |s: &mut CaseStructure| {
+            (s.params, s.tau, s.weights, s.smoothed) = (params, tau, weights, smoothed);
         }
     }
 
-    /// Keeps the model's smoothing in its structure's look, before another structure opens.
+    /// Keeps the model's smoothing in its structure, before another structure opens.
     pub(super) fn keep_model_structure(&mut self) {
-        let Some(current) = self.structures().map(|s| s.current) else {
+        let Some(current) = self.current_structure() else {
             return;
         };
-        let kept = self.model_smoothing();
-        if let Some(look) = self.looks.get_mut(current) {
-            look.kept = Some(kept);
-            self.looks_version += 1;
-        }
+        let store = self.model_smoothing();
+        store(&mut self.case.structures[current]);
+        self.case_version += 1;
     }
 
-    /// Restores what the structure that just became the model kept, if anything.
+    /// Takes up what the structure that is the model keeps: its filter and parameters (a
+    /// label map's with the bound at half its voxel diagonal), tau, weights and voxel size.
     pub(super) fn restore_model_structure(&mut self) {
-        let Some(current) = self.structures().map(|s| s.current) else {
+        let Some(s) = self.model_structure() else {
             return;
         };
-        let Some(kept) = self.looks.get_mut(current).and_then(|l| l.kept.take()) else {
-            return;
-        };
-        self.looks_version += 1;
-        // Values it was smoothed with were valid then; a refusal leaves the defaults.
-        let _ = self.set_params(kept.params);
-        let _ = self.set_tau(kept.tau);
-        if kept.weights.is_some() {
-            self.weights = kept.weights;
+        let (params, tau, weights, voxel_size) = (s.params, s.tau, s.weights.clone(), s.voxel_size);
+        // Values it was smoothed with (or read back with) were checked then; a refusal keeps
+        // the session's.
+        let _ = self.set_params(params);
+        let _ = self.set_tau(tau);
+        if weights.is_some() {
+            self.weights = weights;
             self.weights_version += 1;
         }
+        if voxel_size.is_some() {
+            self.voxel_size = voxel_size;
+        }
     }
 
-    /// The structures of the open segmentation for `state()` and the page's API: what each is,
-    /// how it is shown and, where it was smoothed, its measures.
+    /// The open case's structures for `state()` and the page's API: what each is, how it is
+    /// shown and, where it was smoothed, its measures.
     pub fn structures_json(&self) -> Option<serde_json::Value> {
-        let structures: &Structures = self.structures()?;
-        let mut json = structures.to_json();
-        let list = json["structures"].as_array_mut()?;
-        for (i, (entry, look)) in list.iter_mut().zip(&self.looks).enumerate() {
-            entry["name"] = look.name.clone().into();
-            entry["color"] = serde_json::json!([look.color[0], look.color[1], look.color[2]]);
-            entry["opacity"] = look.color[3].into();
-            entry["visible"] = look.visible.into();
-            let metrics = if i == structures.current {
-                self.result().map(|r| &r.metrics)
-            } else {
-                look.kept
-                    .as_ref()
-                    .and_then(|k| k.smoothed.as_ref())
-                    .map(|k| &k.metrics)
-            };
-            entry["metrics"] = serde_json::to_value(metrics).unwrap_or_default();
-        }
-        Some(json)
+        let current = self.current_structure()?;
+        let list: Vec<_> = (self.case.structures.iter().enumerate())
+            .map(|(i, s)| {
+                let metrics = if i == current {
+                    self.result().map(|r| &r.metrics)
+                } else {
+                    s.smoothed.as_ref().map(|k| &k.metrics)
+                };
+                serde_json::json!({
+                    "label": s.label,
+                    "name": s.name,
+                    "color": [s.color[0], s.color[1], s.color[2]],
+                    "opacity": s.color[3],
+                    "visible": s.visible,
+                    "group": s.group,
+                    "source": s.source,
+                    "voxels": s.voxels,
+                    "voxel_size": s.voxel_size,
+                    "vertices": s.original.vertex_count(),
+                    "triangles": s.original.triangle_count(),
+                    "volume": s.original.signed_volume(),
+                    "metrics": metrics,
+                })
+            })
+            .collect();
+        Some(serde_json::json!({
+            "file": self.case_file,
+            "current": current,
+            "title": self.case.title,
+            "description": self.case.description,
+            "structures": list,
+        }))
     }
 }
 
 impl StructureChange {
-    /// `{index, name, color: [r, g, b], opacity, visible}` as the page's `setStructure` takes
-    /// it (every key optional; `index` defaults to the model's structure). Unknown keys and
-    /// values of the wrong kind are refused, naming the key.
+    /// `{index, name, color: [r, g, b], opacity, visible, group}` as the page's
+    /// `setStructure` takes it (every key optional; `index` defaults to the model's structure;
+    /// `group` null or "" ungroups). Unknown keys and values of the wrong kind are refused,
+    /// naming the key.
     pub fn from_json(value: &serde_json::Value) -> Result<(Option<usize>, Self), String> {
         let object = value
             .as_object()
-            .ok_or("setStructure takes an object: {index, name, color, opacity, visible}")?;
+            .ok_or("setStructure takes an object: {index, name, color, opacity, visible, group}")?;
         let mut change = Self::default();
         let mut index = None;
         for (key, v) in object {
@@ -262,9 +273,16 @@ impl StructureChange {
                 "visible" => {
                     change.visible = Some(v.as_bool().ok_or_else(|| wrong("true or false"))?)
                 }
+                "group" => {
+                    let group = match v {
+                        serde_json::Value::Null => None,
+                        v => Some(v.as_str().ok_or_else(|| wrong("a string or null"))?.into()),
+                    };
+                    change.group = Some(group);
+                }
                 other => {
                     return Err(format!(
-                        "setStructure: unknown key {other} (index, name, color, opacity, visible)"
+                        "setStructure: unknown key {other} (index, name, color, opacity, visible, group)"
                     ))
                 }
             }

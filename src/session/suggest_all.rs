@@ -1,10 +1,10 @@
-//! "Suggest all" in the page: every structure of the open segmentation gets the suggestion at
+//! "Suggest all" in the page: every structure of the open case gets the suggestion at
 //! one target smoothness with its own filter and bound, then is smoothed with it, one
 //! structure per engine worker (the CLI's `case build` does the same on its threads). Progress
 //! and cancel; the structure that is the model takes its suggestion as new parameters.
 
-use super::{Kept, Session};
-use crate::case::{CaseStructure, Smoothed, SuggestAllOptions};
+use super::Session;
+use crate::case::{Smoothed, SuggestAllOptions};
 use crate::suggest::SearchMethod;
 use crate::worker::{metrics_of, Reply, StructureJob};
 
@@ -21,8 +21,8 @@ pub struct SuggestAll {
 }
 
 impl Session {
-    /// Starts "Suggest all" at `tau` with `method` for every structure of the open segmentation
-    /// (a mesh alone is one structure). Replaces one under way.
+    /// Starts "Suggest all" at `tau` with `method` for every structure of the open case, each
+    /// from its own filter and parameters (bound included). Replaces one under way.
     pub fn start_suggest_all(&mut self, tau: f64, method: SearchMethod) -> Result<(), String> {
         if !(0.0..=1.0).contains(&tau) {
             return Err(format!("tau = {tau} is out of range: [0, 1]"));
@@ -37,30 +37,19 @@ impl Session {
             // score weighs it.
             max_volume_change: Some(0.05),
         };
-        let mut work = Vec::new();
-        match &model.structures {
-            None => work.push((
-                0,
-                model.mesh().clone(),
-                *self.params(),
-                self.weights.clone(),
-            )),
-            Some(s) => {
-                for (i, structure) in s.list.iter().enumerate() {
-                    let kept = self.looks.get(i).and_then(|l| l.kept.as_ref());
-                    let (params, weights) = match kept {
-                        _ if i == s.current => (*self.params(), self.weights.clone()),
-                        Some(k) => (k.params, k.weights.clone()),
-                        // Its filter and bound as a case structure starts with them.
-                        None => (
-                            CaseStructure::from_label_map(structure.clone(), None).params,
-                            None,
-                        ),
-                    };
-                    work.push((i, structure.mesh.clone(), params, weights));
-                }
-            }
-        }
+        let current = self.current;
+        let work: Vec<_> = (self.case.structures.iter().enumerate())
+            .map(|(i, s)| match i == current {
+                true => (
+                    i,
+                    model.mesh().clone(),
+                    *self.params(),
+                    self.weights.clone(),
+                ),
+                false => (i, s.original.clone(), s.params, s.weights.clone()),
+            })
+            .collect();
+        let mut work = work;
         // The largest first, so no worker is left with one big structure at the end.
         work.sort_by_key(|w| std::cmp::Reverse(w.1.vertex_count()));
         let total = work.len();
@@ -132,13 +121,11 @@ impl Session {
     /// Applies structure `i`'s answer: the model's structure takes the parameters (its result
     /// follows), another keeps them with its smoothed surface.
     fn take_structure_suggestion(&mut self, i: usize, reply: Reply, tau: f64) -> serde_json::Value {
-        let name = match self.looks.get(i) {
-            Some(look) => look.name.clone(),
-            None => self
-                .model
-                .as_ref()
-                .map_or(String::new(), |m| m.name.clone()),
-        };
+        let name = self
+            .case
+            .structures
+            .get(i)
+            .map_or(String::new(), |s| s.name.clone());
         let suggested = match reply {
             Reply::Suggested {
                 suggested: Some(s), ..
@@ -159,24 +146,19 @@ impl Session {
             "evaluations": suggested.evaluations,
             "metrics": metrics,
         });
-        let current = self.structures().map_or(Some(0), |s| Some(s.current));
-        if current == Some(i) {
+        if self.current_structure() == Some(i) {
             // The engines smooth it again for the view, to the same surface.
             let _ = self.set_params(suggested.params);
             let _ = self.set_tau(tau);
-        } else if let Some(look) = self.looks.get_mut(i) {
-            let weights = look.kept.as_ref().and_then(|k| k.weights.clone());
-            look.kept = Some(Kept {
-                params: suggested.params,
-                tau,
-                weights,
-                smoothed: Some(Smoothed {
-                    positions: suggested.positions,
-                    metrics,
-                    local_error: Some(suggested.local_error),
-                }),
+        } else if let Some(s) = self.case.structures.get_mut(i) {
+            s.params = suggested.params;
+            s.tau = tau;
+            s.smoothed = Some(Smoothed {
+                positions: suggested.positions,
+                metrics,
+                local_error: Some(suggested.local_error),
             });
-            self.looks_version += 1;
+            self.case_version += 1;
         }
         summary
     }

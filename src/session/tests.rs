@@ -256,7 +256,7 @@ fn deferred_session() -> (Session, std::rc::Rc<std::cell::Cell<bool>>) {
 fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
     let (mut s, deliver) = deferred_session();
     s.open("first.ply", SAMPLE).unwrap();
-    let at_once = Model::load("second.ply", SAMPLE).unwrap();
+    let at_once = Model::load("second.ply", SAMPLE).unwrap().model;
     assert_eq!(s.begin_open("second.ply", SAMPLE.to_vec()), None);
     for _ in 0..3 {
         let p = s.loading().expect("opening");

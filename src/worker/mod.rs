@@ -11,7 +11,7 @@ pub use pool::{Carrier, InThread, LoadJob, Pool, SmoothJob, StructureJob};
 
 use serde::{Deserialize, Serialize};
 
-use crate::case::{self, CaseStructure, SuggestAllOptions};
+use crate::case::{self, Case, CaseStructure, SuggestAllOptions};
 use crate::evaluate::{Evaluator, Terms};
 use crate::mesh::{Mesh, Topology};
 use crate::metrics::{self, Metrics, Original, VertexMeasures};
@@ -22,9 +22,12 @@ use crate::suggest::MeshEvaluator;
 /// What a [`Request::Load`] opens.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub enum Input {
-    /// A file's bytes (the format from the name's extension).
+    /// A file's bytes (the format from the name's extension): its case, and its first
+    /// structure as the model.
     File(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
-    /// A structure extracted earlier, by its mesh.
+    /// A file's bytes read as a case only, to add its structures to the open one.
+    Addition(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
+    /// A structure of the open case, by its mesh: the model only.
     Structure(Mesh),
 }
 
@@ -78,7 +81,10 @@ pub enum Reply {
     },
     Loaded {
         job: u64,
-        model: Box<Model>,
+        /// The model (none for an [`Input::Addition`]).
+        model: Option<Box<Model>>,
+        /// The case the file makes (none for an [`Input::Structure`]).
+        case: Option<Box<Case>>,
         /// Each stage with the milliseconds it took, in order.
         stages: Vec<(String, f64)>,
     },
@@ -228,19 +234,29 @@ impl Worker {
             });
         };
         let opened = match input {
-            Input::File(bytes) => model::open_file(name, &bytes, &mut on_stage),
-            Input::Structure(mesh) => Ok(model::open_structure(name, mesh, &mut on_stage)),
+            Input::File(bytes) => {
+                model::open_file(name, &bytes, &mut on_stage).map(|o| (Some(o.model), Some(o.case)))
+            }
+            Input::Addition(bytes) => {
+                model::open_case(name, &bytes, &mut on_stage).map(|case| (None, Some(case)))
+            }
+            Input::Structure(mesh) => {
+                Ok((Some(model::open_structure(name, mesh, &mut on_stage)), None))
+            }
         };
         let ended = clock();
         if let Some(last) = stages.last_mut() {
             last.1 = ended - began;
         }
         match opened {
-            Ok(model) => {
-                self.opened = Some(model.original.clone());
+            Ok((model, case)) => {
+                if let Some(model) = &model {
+                    self.opened = Some(model.original.clone());
+                }
                 Reply::Loaded {
                     job,
-                    model: Box::new(model),
+                    model: model.map(Box::new),
+                    case: case.map(Box::new),
                     stages,
                 }
             }

@@ -198,10 +198,19 @@ fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
     let stage = pool.load_stage(job).expect("the worker told its stages");
     assert_eq!((stage.stage, stage.stages), (3, 4));
     assert_eq!(stage.doing, "measuring the original");
-    let Some(Reply::Loaded { model, stages, .. }) = pool.take_loaded(job) else {
-        panic!("no model came back");
+    let Some(Reply::Loaded {
+        model: Some(model),
+        case: Some(case),
+        stages,
+        ..
+    }) = pool.take_loaded(job)
+    else {
+        panic!("no model and case came back");
     };
     let here = Model::load("tube.ply", SAMPLE).unwrap();
+    assert_eq!(*case, here.case, "the file's case of one");
+    assert_eq!(case.structures[0].name, "tube");
+    let here = here.model;
     assert_eq!(model.name, "tube.ply");
     assert_eq!((&model.report, &model.edges), (&here.report, &here.edges));
     assert_eq!(model.mesh(), here.mesh());
@@ -222,6 +231,31 @@ fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
     );
     assert!(stages.iter().all(|(_, ms)| *ms >= 0.0));
     assert!(!pool.busy());
+}
+
+#[test]
+fn a_file_to_add_comes_back_as_its_case_alone_after_its_reading_stage() {
+    let mut pool = Pool::in_thread(1);
+    let job = pool.load("tube.ply", Input::Addition(SAMPLE.to_vec()));
+    let Some(Reply::Loaded {
+        model,
+        case,
+        stages,
+        ..
+    }) = pool.take_loaded(job)
+    else {
+        panic!("nothing came back");
+    };
+    assert!(
+        model.is_none(),
+        "no model is built for a file added to a case"
+    );
+    assert_eq!(
+        *case.expect("a case"),
+        Model::load("tube.ply", SAMPLE).unwrap().case
+    );
+    let names: Vec<&str> = stages.iter().map(|(doing, _)| doing.as_str()).collect();
+    assert_eq!(names, ["reading the file"]);
 }
 
 #[test]

@@ -14,6 +14,7 @@ import { basename, join } from "node:path";
 import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
+import { readGlb } from "./lib/glb.mjs";
 import { meshPath, outputDir } from "./lib/paths.mjs";
 import { assertNotBlank, colourHistogram, decodePng } from "./lib/png.mjs";
 import { WEBGPU_RUN, testIn } from "./lib/suite.mjs";
@@ -87,19 +88,6 @@ async function expectedStructures(c) {
         const entry = table.get(s.label) ?? {};
         return { label: s.label, name: entry.name ?? s.name, color: entry.color ?? s.color, opacity: 1 };
     });
-}
-
-/** The JSON and binary chunks of a GLB. */
-function readGlb(bytes) {
-    assert.equal(bytes.toString("latin1", 0, 4), "glTF", "GLB magic");
-    assert.equal(bytes.readUInt32LE(4), 2, "GLB version");
-    assert.equal(bytes.readUInt32LE(8), bytes.length, "GLB length");
-    const jsonLength = bytes.readUInt32LE(12);
-    assert.equal(bytes.toString("latin1", 16, 20), "JSON");
-    const json = JSON.parse(bytes.toString("utf8", 20, 20 + jsonLength));
-    const at = 20 + jsonLength;
-    const bin = at < bytes.length ? bytes.subarray(at + 8, at + 8 + bytes.readUInt32LE(at)) : Buffer.alloc(0);
-    return { json, bin };
 }
 
 /**

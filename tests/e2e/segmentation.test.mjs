@@ -11,6 +11,7 @@ import * as cli from "./lib/cli.mjs";
 import { metricDifferences } from "./lib/compare.mjs";
 import { E2E_OUT, meshPath } from "./lib/paths.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
+import { meshNodes } from "./lib/glb.mjs";
 import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
@@ -88,9 +89,12 @@ testIn(EVERY_RUN, "S2 the phantom's .seg.nrrd names its structures; picking one 
         const state = await app.state();
         assert.equal(state.model, "case_phantom_shared.seg.nrrd: tumor");
         assert.equal(state.structures.current, 2);
+        // It smooths by default within Gibson's bound: half its voxel diagonal.
+        const diagonal = Math.hypot(...list.structures[2].voxel_size);
+        assert.ok(Math.abs(state.params.max_displacement - diagonal / 2) < 1e-6, `bound ${state.params.max_displacement} mm, voxel diagonal ${diagonal} mm`);
         // The structure is the model: smoothed, it measures as the CLI measures the same
-        // surface (the PLY that extract wrote) smoothed the same way.
-        const params = { lambda: 0.5, mu: -0.53, iterations: 10 };
+        // surface (the PLY that extract wrote) smoothed the same way, bound included.
+        const params = { lambda: 0.5, mu: -0.53, iterations: 10, max_displacement: state.params.max_displacement };
         await app.setFilter("taubin");
         await app.setParams(params);
         const metrics = await app.metrics();
@@ -207,7 +211,7 @@ testIn(WEBGPU_RUN, "S5 a label map dropped on the page opens as its structures",
         await app.dropFile(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
         const deadline = Date.now() + 60_000;
         let state = await app.state();
-        while (!(state.structures && state.loading === null) && Date.now() < deadline) {
+        while (!(state.structures?.file === "case_phantom_shared.seg.nrrd" && state.loading === null) && Date.now() < deadline) {
             await new Promise((resolve) => setTimeout(resolve, 200));
             state = await app.state();
         }
@@ -256,13 +260,24 @@ testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, s
         await app.metrics();
         const gone = greenPixels(await app.screenshot("S6-tumour-hidden"), view);
         assert.ok(gone < 50, `the hidden tumour is not drawn: ${gone} green pixels (${seen} shown)`);
-        await app.call("setStructure", { index: 1, name: "portal vein" });
+        await app.call("setStructure", { index: 1, name: "portal vein", group: "Vessels" });
         const refused = await app.attempt("setStructure", { index: 0, opacity: 2 });
         assert.equal(refused.ok, false);
         assert.match(refused.message, /opacity/);
         list = await app.call("structures");
         assert.deepEqual(looks(list), [["liver", 0.30000001192092896, true], ["portal vein", 1, true], ["tumor", 1, false], ["right_kidney", 1, true]]);
         assert.deepEqual(list.structures[2].color, [0, 1, 0]);
+        assert.deepEqual(list.structures.map((s) => s.group), [null, "Vessels", null, null]);
+        // Solo: the portal vein alone (the model, the kidney, not drawn); again, all of them.
+        await app.call("soloStructure", 1);
+        list = await app.call("structures");
+        assert.deepEqual(list.structures.map((s) => s.visible), [false, true, false, false]);
+        await app.metrics();
+        await app.screenshot("S6-portal-vein-alone");
+        await app.call("soloStructure", 1);
+        list = await app.call("structures");
+        assert.deepEqual(list.structures.map((s) => s.visible), [true, true, true, true]);
+        await app.call("setStructure", { index: 2, visible: false });
 
         // The kidney smoothed; then the liver: the kidney keeps its smoothing and measures.
         await app.setFilter("taubin");
@@ -296,6 +311,7 @@ testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, s
         assert.deepEqual(issues, [], "the page's case GLB has no validator errors or warnings");
         const back = await cli.cliJson("case", "info", file, "--json");
         assert.equal(back.title, "Abdomen");
+        assert.deepEqual(back.structures.map((s) => s.group), [null, "Vessels", null, null]);
         assert.deepEqual(back.structures.map((s) => [s.name, s.visible, s.smoothed, s.filter]), [
             ["liver", true, true, "laplace"],
             ["portal vein", true, false, "hc"],
@@ -322,9 +338,9 @@ testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build sug
         await cli.cli("case", "build", PHANTOM_NRRD, "--search", "local", "-o", file);
         const cliSeconds = (Date.now() - cliStart) / 1000;
         const native = (await cli.cliJson("case", "info", file, "--json")).structures;
-        // The liver is the model and starts from the page's parameters (no bound); the others
-        // start as the CLI's structures do, with their bound at half a voxel diagonal.
-        for (const i of [1, 2, 3]) {
+        // Every structure, the model's too, starts as the CLI's do: its filter, with the bound
+        // at half its voxel diagonal.
+        for (const i of [0, 1, 2, 3]) {
             assert.deepEqual(all.structures[i].params, native[i].params, `${native[i].name}'s suggestion`);
             const { problems } = metricDifferences(all.structures[i].metrics, native[i].metrics, 1e-9);
             assert.deepEqual(problems, [], `${native[i].name}'s measures: ${problems.join("; ")}`);
@@ -339,5 +355,102 @@ testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build sug
         console.log(JSON.stringify(line));
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
         await app.screenshot("S7-phantom-suggested-all");
+    });
+});
+
+/** The largest difference between two lists of numbers (Infinity when their lengths differ). */
+function farthest(a, b) {
+    if (a.length !== b.length) return Infinity;
+    return a.reduce((worst, x, i) => Math.max(worst, Math.abs(x - b[i])), 0);
+}
+
+testIn(EVERY_RUN, "S8 a case GLB exported by the page reopens as the same case and exports the same again (1e-6 mm)", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
+        await app.call("setCase", { title: "Abdomen", description: "Round trip" });
+        await app.call("setStructure", { index: 1, group: "Vessels" });
+        await app.call("setStructure", { index: 0, opacity: 0.4 });
+        await app.metrics();
+        await app.call("selectStructure", 3);
+        await app.setFilter("taubin");
+        await app.setParams({ iterations: 9 });
+        await app.metrics();
+        const first = Buffer.from(await app.call("exportCase", "glb"));
+        writeFileSync(join(E2E_OUT, MODE, "S8-first.glb"), first);
+
+        const reopened = await app.loadMesh(first, "S8-first.glb", "loadCase");
+        assert.equal(reopened.file, "S8-first.glb");
+        assert.equal(reopened.current, 0);
+        assert.deepEqual([reopened.title, reopened.description], ["Abdomen", "Round trip"]);
+        assert.deepEqual(reopened.structures.map((s) => [s.name, s.group, s.opacity]), [
+            ["liver", null, 0.4000000059604645],
+            ["portal_vein", "Vessels", 1],
+            ["tumor", null, 1],
+            ["right_kidney", null, 1],
+        ]);
+        const state = await app.state();
+        assert.equal(state.model, "S8-first.glb: liver");
+        assert.equal(state.filter, "hc", "the liver's own filter and parameters come back");
+        assert.ok(state.params.max_displacement > 0, "with its bound");
+        await app.metrics();
+        await app.screenshot("S8-reopened-case");
+        const second = Buffer.from(await app.call("exportCase", "glb"));
+        writeFileSync(join(E2E_OUT, MODE, "S8-second.glb"), second);
+
+        // The same records (names, looks, groups, filters, parameters) and the same surfaces.
+        const [a, b] = await Promise.all(
+            ["S8-first.glb", "S8-second.glb"].map((f) => cli.cliJson("case", "info", join(E2E_OUT, MODE, f), "--json")),
+        );
+        const record = (s) => [s.name, s.color, s.visible, s.group, s.source, s.filter, s.params, s.tau, s.smoothed];
+        assert.deepEqual(b.structures.map(record), a.structures.map(record));
+        assert.deepEqual([b.title, b.description], [a.title, a.description]);
+        const [x, y] = [meshNodes(first), meshNodes(second)];
+        assert.deepEqual(y.map((n) => n.name), x.map((n) => n.name));
+        x.forEach((n, i) => {
+            const moved = farthest(n.positions, y[i].positions);
+            assert.ok(moved <= 1e-6, `${n.name}: surfaces differ by ${moved} mm`);
+            assert.equal(n.targets.length, y[i].targets.length, `${n.name}: its original as a morph target`);
+            n.targets.forEach((t, k) => assert.ok(farthest(t, y[i].targets[k]) <= 1e-6, `${n.name}: original differs`));
+        });
+        assert.equal(x[3].targets.length, 1, "the kidney was smoothed: its staircase is the morph target");
+    });
+});
+
+testIn(EVERY_RUN, "S9 files added to the case, and several dropped together, join it as structures", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
+        const before = await app.state();
+        const sphere = readFileSync(meshPath("synthetic/synthetic_sphere_r20.stl"));
+        const list = await app.loadMesh(sphere, "synthetic_sphere_r20.stl", "addFile");
+        assert.deepEqual(list.structures.map((s) => s.name), ["liver", "portal_vein", "tumor", "right_kidney", "synthetic sphere r20"]);
+        assert.equal(list.structures[4].source, "synthetic_sphere_r20.stl");
+        assert.equal(list.structures[4].label, null);
+        const state = await app.state();
+        assert.equal(state.model, before.model, "the model stays");
+        assert.deepEqual(state.params, before.params);
+        const refused = await app.attemptLoad(Buffer.from("solid nothing"), "broken.stl", "addFile");
+        assert.equal(refused.ok, false);
+        assert.match(refused.message, /broken\.stl/);
+        assert.equal((await app.call("structures")).structures.length, 5, "the case stays as it was");
+        await app.metrics();
+        await app.screenshot("S9-phantom-and-added-sphere");
+
+        // Dropped together: the first opens as the case, the others join it in order.
+        const ellipsoid = readFileSync(meshPath("synthetic/synthetic_ellipsoid_30_20_12.ply"));
+        await app.dropFiles([
+            { bytes: sphere, name: "synthetic_sphere_r20.stl" },
+            { bytes: ellipsoid, name: "synthetic_ellipsoid_30_20_12.ply" },
+        ]);
+        const deadline = Date.now() + 60_000;
+        let dropped = await app.state();
+        while (!(dropped.structures?.structures.length === 2 && dropped.loading === null) && Date.now() < deadline) {
+            await new Promise((resolve) => setTimeout(resolve, 200));
+            dropped = await app.state();
+        }
+        assert.equal(dropped.model, "synthetic_sphere_r20.stl");
+        assert.deepEqual(dropped.structures.structures.map((s) => s.name), ["synthetic sphere r20", "synthetic ellipsoid 30 20 12"]);
+        assert.notDeepEqual(dropped.structures.structures[0].color, dropped.structures.structures[1].color);
+        await app.metrics();
+        await app.screenshot("S9-two-meshes-dropped-as-one-case");
     });
 });

@@ -157,6 +157,7 @@ impl Shell {
         for file in self.files.take_arrived() {
             let mut doc = self.doc.borrow_mut();
             match file.bytes {
+                Ok(bytes) if file.add => doc.begin_add(&file.name, bytes, None),
                 Ok(bytes) => doc.begin_open(&file.name, bytes, None),
                 Err(reason) => {
                     doc.session.fail(&file.name, &reason);
@@ -165,8 +166,9 @@ impl Shell {
         }
     }
 
-    fn open_picker(&mut self) {
-        if let Err(e) = self.files.open_picker() {
+    /// The file dialog, to open files as a case or (`add`) to add them to the open one.
+    fn open_picker(&mut self, add: bool) {
+        if let Err(e) = self.files.open_picker(add) {
             self.doc.borrow_mut().session.fail("a file", &e);
         }
     }
@@ -193,7 +195,7 @@ impl Shell {
 
     fn apply(&mut self, action: Action) {
         match action {
-            Action::Open => self.open_picker(),
+            Action::Open => self.open_picker(false),
             Action::ToggleWireframe => {
                 if let Some((viewer, _)) = &mut self.view {
                     viewer.wireframe = !viewer.wireframe;
@@ -244,7 +246,7 @@ impl Shell {
             ui.heading("meshsmooth");
             ui.separator();
             if ui.button("Open…").on_hover_text("O").clicked() {
-                self.open_picker();
+                self.open_picker(false);
             }
             ui.menu_button("Export", |ui| {
                 for (label, format) in [
@@ -284,7 +286,7 @@ impl Shell {
                 self.help_open = !self.help_open;
             }
             ui.label(
-                "Drop a mesh (STL, OBJ, PLY, glTF) or a label map (NIfTI, NRRD) on the page to open it.",
+                "Drop meshes (STL, OBJ, PLY, glTF), a label map (NIfTI, NRRD) or a case glTF on the page to open them as a case.",
             );
         });
     }
@@ -292,8 +294,13 @@ impl Shell {
     fn smoothing_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
         let timings = doc.timings;
+        let mut add_files = false;
         for action in self.structures.show(ui, &doc.session) {
             let done = match action {
+                StructureAction::AddFiles => {
+                    add_files = true;
+                    Ok(())
+                }
                 StructureAction::Select(i) => doc.begin_open_structure(i, None),
                 StructureAction::Change(i, change) => doc.session.set_structure(i, change),
                 StructureAction::Solo(i) => doc.session.solo_structure(i),
@@ -311,11 +318,9 @@ impl Shell {
                     Ok(())
                 }
                 StructureAction::ExportCase => {
-                    let file = doc.session.structures().map(|s| s.file.clone());
-                    let stem = file
-                        .as_deref()
-                        .map_or("case", |f| f.split('.').next().unwrap_or(f));
-                    let name = format!("{stem}_case.glb");
+                    let file = doc.session.case_file();
+                    let stem = file.split('.').next().filter(|s| !s.is_empty());
+                    let name = format!("{}_case.glb", stem.unwrap_or("case"));
                     doc.session
                         .export_case(crate::export::Container::Glb)
                         .and_then(|bytes| download::save(&name, &bytes, "model/gltf-binary"))
@@ -339,6 +344,10 @@ impl Shell {
         ui.separator();
         ui.heading("Colours");
         controls::coloring(ui, &mut self.coloring, &mut doc.session);
+        drop(doc);
+        if add_files {
+            self.open_picker(true);
+        }
     }
 
     fn status_bar(&self, ui: &mut egui::Ui) {

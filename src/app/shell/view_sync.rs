@@ -47,13 +47,14 @@ impl Shell {
             let kept_view = viewer.view_state();
             viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
             // A segmentation is framed whole once; another of its structures keeps the view.
-            let case = session.structures().map(|s| (s.file.clone(), s.list.len()));
+            let structures = session.case_structures();
+            let case =
+                (structures.len() > 1).then(|| (session.case_file().to_string(), structures.len()));
             match (&case, case == self.framed_case) {
                 (Some(_), true) => viewer.set_view_state(kept_view),
                 (Some(_), false) => {
-                    let list = &session.structures().expect("a segmentation").list;
                     let all: Vec<&[[f32; 3]]> =
-                        list.iter().map(|s| s.mesh.positions.as_slice()).collect();
+                        (structures.iter()).map(|s| s.positions()).collect();
                     viewer.frame_all(&all);
                 }
                 (None, _) => {}
@@ -115,7 +116,7 @@ impl Shell {
             self.shown.legend = computed.map(|(_, l)| l);
             self.shown.colors = colors;
         }
-        if self.shown.looks != Some(session.looks_version()) {
+        if self.shown.looks != Some(session.case_version()) {
             let others = session.other_structures();
             let surfaces: Vec<viewer::ContextSurface<'_>> = others
                 .iter()
@@ -126,10 +127,10 @@ impl Shell {
                 })
                 .collect();
             viewer.set_context(rs, &surfaces);
-            let look = session.model_look();
+            let look = session.model_structure();
             let color = look.map(|l| [l.color[0], l.color[1], l.color[2]]);
             viewer.set_model_look(color, look.is_none_or(|l| l.visible));
-            self.shown.looks = Some(session.looks_version());
+            self.shown.looks = Some(session.case_version());
         }
     }
 }

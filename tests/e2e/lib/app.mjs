@@ -233,31 +233,34 @@ export class AppPage {
     }
 
     /** `loadMesh(bytes, name)` with the bytes of a Node Buffer; resolves with the info object. */
-    async loadMesh(bytes, name) {
-        const result = await this.attemptLoad(bytes, name);
+    async loadMesh(bytes, name, method = "loadMesh") {
+        const result = await this.attemptLoad(bytes, name, method);
         if (!result.ok) {
-            throw new Error(`loadMesh(${name}) rejected: ${result.message}`);
+            throw new Error(`${method}(${name}) rejected: ${result.message}`);
         }
         return result.value;
     }
 
-    /** `loadMesh` without throwing: `{ok, value}` or `{ok: false, isError, message}`. */
-    async attemptLoad(bytes, name) {
+    /**
+     * `loadMesh` (or `method`: `loadCase`, `addFile`, which take the same arguments) without
+     * throwing: `{ok, value}` or `{ok: false, isError, message}`.
+     */
+    async attemptLoad(bytes, name, method = "loadMesh") {
         await this.api();
         return this.page.evaluate(
-            async ([base64, name]) => {
+            async ([base64, name, method]) => {
                 const text = atob(base64);
                 const bytes = new Uint8Array(text.length);
                 for (let i = 0; i < text.length; i++) {
                     bytes[i] = text.charCodeAt(i);
                 }
                 try {
-                    return { ok: true, value: await window.meshsmooth.loadMesh(bytes, name) };
+                    return { ok: true, value: await window.meshsmooth[method](bytes, name) };
                 } catch (e) {
                     return { ok: false, isError: e instanceof Error, message: e instanceof Error ? e.message : String(e) };
                 }
             },
-            [Buffer.from(bytes).toString("base64"), name],
+            [Buffer.from(bytes).toString("base64"), name, method],
         );
     }
 
@@ -286,19 +289,24 @@ export class AppPage {
      * carrying a DataTransfer built in the page with one File.
      */
     async dropFile(bytes, name) {
-        const dataTransfer = await this.page.evaluateHandle(
-            ([base64, name]) => {
+        await this.dropFiles([{ bytes, name }]);
+    }
+
+    /** Drops several files at once (`[{bytes, name}]`), in one DataTransfer, in that order. */
+    async dropFiles(files) {
+        const encoded = files.map(({ bytes, name }) => [Buffer.from(bytes).toString("base64"), name]);
+        const dataTransfer = await this.page.evaluateHandle((files) => {
+            const transfer = new DataTransfer();
+            for (const [base64, name] of files) {
                 const text = atob(base64);
                 const data = new Uint8Array(text.length);
                 for (let i = 0; i < text.length; i++) {
                     data[i] = text.charCodeAt(i);
                 }
-                const transfer = new DataTransfer();
                 transfer.items.add(new File([data], name, { type: "application/octet-stream" }));
-                return transfer;
-            },
-            [Buffer.from(bytes).toString("base64"), name],
-        );
+            }
+            return transfer;
+        }, encoded);
         for (const type of ["dragenter", "dragover", "drop"]) {
             await this.page.dispatchEvent("#meshsmooth_canvas", type, { dataTransfer });
         }

@@ -1,0 +1,491 @@
+//! The page's session as a case: a label map's structures (each shown and smoothed its own
+//! way, with Gibson's bound by default), files added to the case, "Suggest all", and the case
+//! glTF it writes reopened as the same case.
+
+#[path = "common/label_maps.rs"]
+mod label_maps;
+
+use label_maps::read;
+use meshsmooth::export::Container;
+use meshsmooth::session::Session;
+
+/// Opens `name` in `session` (its workers run on this thread) and checks it opened.
+fn open(session: &mut Session, name: &str, bytes: Vec<u8>) {
+    session.begin_open(name, bytes);
+    session.poll_opening().expect("done").expect("opens");
+}
+
+/// The page's session opens a label map in a worker (read, extract, then a mesh's stages), makes the
+/// first structure the model with its voxel size, and opens another structure on request.
+#[test]
+fn a_session_opens_a_label_map_as_its_structures() {
+    use meshsmooth::session::Session;
+    let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
+    let mut session = Session::default();
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes);
+    session.poll_opening().expect("done").expect("opens");
+    let stages: Vec<&str> = session
+        .open_stages()
+        .iter()
+        .map(|(d, _)| d.as_str())
+        .collect();
+    assert_eq!(
+        stages,
+        [
+            "reading the label map",
+            "extracting the structures",
+            "building the topology",
+            "checking the mesh",
+            "measuring the original"
+        ]
+    );
+    let structures = session.case_structures();
+    assert_eq!(structures.len(), 4);
+    assert_eq!(session.current_structure(), Some(0));
+    let model = session.model().expect("a model");
+    assert_eq!(model.name, "case_phantom_shared.seg.nrrd: liver");
+    assert_eq!(model.mesh(), &structures[0].original);
+    let vd = session
+        .voxel_diagonal()
+        .expect("the voxel size comes with the structure");
+    assert!((vd - (0.78f64 * 0.78 * 2.0 + 2.5 * 2.5).sqrt()).abs() < 1e-6);
+    // Gibson's bound by default: half the voxel diagonal, with the case's filter.
+    let params = session.params();
+    assert_eq!(params.filter, meshsmooth::case::DEFAULT_FILTER);
+    assert_eq!(params.max_displacement, Some((0.5 * vd) as f32));
+
+    session.begin_open_structure(2).expect("structure 2 exists");
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(session.current_structure(), Some(2));
+    assert_eq!(
+        session.model().expect("a model").name,
+        "case_phantom_shared.seg.nrrd: tumor"
+    );
+    assert!(session
+        .begin_open_structure(4)
+        .unwrap_err()
+        .contains("4 does not exist"));
+
+    // A broken label map keeps the open model and says what is wrong with which file.
+    let mut broken = read("labelmaps/case_phantom_shared.nii.gz");
+    broken.truncate(broken.len() / 2);
+    session.begin_open("half.nii.gz", broken);
+    let e = session.poll_opening().expect("finished").unwrap_err();
+    assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
+    assert_eq!(
+        session.model().expect("kept").name,
+        "case_phantom_shared.seg.nrrd: tumor"
+    );
+}
+
+/// The page's session shows a segmentation's structures each its own way: colours, opacity,
+/// visibility and names as the author sets them, and each structure's smoothing kept while
+/// another is the model, and restored when it is the model again.
+#[test]
+fn a_session_keeps_each_structures_look_and_smoothing() {
+    use meshsmooth::session::{Session, StructureChange};
+    use meshsmooth::smooth::{Filter, Params};
+    let mut session = Session::default();
+    session.begin_open(
+        "case_phantom_shared.seg.nrrd",
+        read("labelmaps/case_phantom_shared.seg.nrrd"),
+    );
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(session.case_structures().len(), 4);
+    assert!(session
+        .case_structures()
+        .iter()
+        .all(|l| l.visible && l.color[3] == 1.0));
+    // Three others around the liver, as extracted.
+    let others: Vec<usize> = session.other_structures().iter().map(|o| o.index).collect();
+    assert_eq!(others, [1, 2, 3]);
+
+    let (index, change) = StructureChange::from_json(&serde_json::json!({
+        "index": 2, "name": " tumour ", "color": [0.0, 1.0, 0.0], "opacity": 0.4
+    }))
+    .unwrap();
+    let version = session.case_version();
+    session.set_structure(index.unwrap(), change).unwrap();
+    assert!(session.case_version() > version);
+    let tumour = &session.case_structures()[2];
+    assert_eq!(
+        (tumour.name.as_str(), tumour.color),
+        ("tumour", [0.0, 1.0, 0.0, 0.4])
+    );
+    for bad in [
+        serde_json::json!({"opacity": 1.5}),
+        serde_json::json!({"color": [0, 2, 0]}),
+        serde_json::json!({"name": "  "}),
+        serde_json::json!({"group": 3}),
+        serde_json::json!({"visible": "yes"}),
+        serde_json::json!([1]),
+    ] {
+        let refused =
+            StructureChange::from_json(&bad).and_then(|(_, c)| session.set_structure(2, c));
+        assert!(refused.is_err(), "{bad}");
+    }
+    assert!(session
+        .set_structure(9, StructureChange::default())
+        .is_err());
+    assert_eq!(
+        session.case_structures()[2].name,
+        "tumour",
+        "a refusal changes nothing"
+    );
+    // Groups: set, trimmed, and taken away by null.
+    let group = |v| {
+        StructureChange::from_json(&serde_json::json!({ "group": v }))
+            .unwrap()
+            .1
+    };
+    session
+        .set_structure(1, group(serde_json::json!(" Vessels ")))
+        .unwrap();
+    assert_eq!(
+        session.case_structures()[1].group.as_deref(),
+        Some("Vessels")
+    );
+    assert_eq!(
+        session.structures_json().unwrap()["structures"][1]["group"],
+        "Vessels"
+    );
+    session
+        .set_structure(1, group(serde_json::Value::Null))
+        .unwrap();
+    assert_eq!(session.case_structures()[1].group, None);
+    session
+        .set_structure(1, group(serde_json::json!("Vessels")))
+        .unwrap();
+
+    // Solo shows one alone; again, every one.
+    session.solo_structure(3).unwrap();
+    let visible: Vec<bool> = session
+        .case_structures()
+        .iter()
+        .map(|l| l.visible)
+        .collect();
+    assert_eq!(visible, [false, false, false, true]);
+    assert_eq!(session.other_structures().len(), 1);
+    session.solo_structure(3).unwrap();
+    assert!(session.case_structures().iter().all(|l| l.visible));
+
+    // Smooth the liver, then work on the portal vein: the liver keeps its smoothing.
+    let liver_params = Params {
+        iterations: 7,
+        ..Params::defaults(Filter::Taubin)
+    };
+    session.set_params(liver_params).unwrap();
+    session.smooth_cpu();
+    let liver = session.result().expect("smoothed").clone();
+    session.begin_open_structure(1).unwrap();
+    session.poll_opening().expect("done").expect("opens");
+    let others = session.other_structures();
+    let kept_liver = others
+        .iter()
+        .find(|o| o.index == 0)
+        .expect("the liver is drawn");
+    assert_eq!(kept_liver.positions, &liver.positions[..]);
+    session
+        .set_params(Params::defaults(Filter::Laplace))
+        .unwrap();
+    session.smooth_cpu();
+    let json = session.structures_json().unwrap();
+    assert_eq!(json["current"], 1);
+    assert_eq!(json["structures"][2]["name"], "tumour");
+    assert_eq!(json["structures"][2]["opacity"], 0.4f32 as f64);
+    assert_eq!(
+        json["structures"][0]["metrics"],
+        serde_json::to_value(&liver.metrics).unwrap()
+    );
+    assert!(json["structures"][3]["metrics"].is_null(), "never smoothed");
+    assert_ne!(json["structures"][1]["metrics"], serde_json::Value::Null);
+
+    // Back to the liver: its parameters return, and with them the same result.
+    session.begin_open_structure(0).unwrap();
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(*session.params(), liver_params);
+    session.smooth_cpu();
+    assert_eq!(session.result().unwrap().positions, liver.positions);
+    assert_eq!(
+        session.case_structures()[2].name,
+        "tumour",
+        "looks stay across switches"
+    );
+
+    // The case as arranged: the page's case glTF reads back with the same names, looks,
+    // parameters and smoothed surfaces (the portal vein's kept, the liver's current).
+    session.set_case_text(Some(" Abdomen "), Some("Liver with a tumour"));
+    let glb = session
+        .export_case(meshsmooth::export::Container::Glb)
+        .expect("the case exports");
+    let files = [meshsmooth::segmentation::NamedBytes {
+        name: "case.glb",
+        bytes: &glb,
+    }];
+    let back = meshsmooth::case::open(&files, None, &Default::default()).expect("reads back");
+    assert_eq!(
+        (back.title.as_str(), back.description.as_str()),
+        ("Abdomen", "Liver with a tumour")
+    );
+    let names: Vec<&str> = back.structures.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["liver", "portal_vein", "tumour", "right_kidney"]);
+    assert!((back.structures[2].color[3] - 0.4).abs() < 1e-6);
+    assert_eq!(back.structures[0].params, liver_params);
+    assert_eq!(back.structures[1].params.filter, Filter::Laplace);
+    assert!(
+        back.structures[1].smoothed.is_some(),
+        "the portal vein's kept smoothing"
+    );
+    assert!(back.structures[3].smoothed.is_none(), "never smoothed");
+    assert_eq!(back.structures[1].group.as_deref(), Some("Vessels"));
+    let got = &back.structures[0]
+        .smoothed
+        .as_ref()
+        .expect("smoothed")
+        .positions;
+    let far = (got.iter().zip(&liver.positions))
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0f32, f32::max);
+    assert!(far < 1e-4, "the liver moved {far} mm in the round trip");
+
+    // A new file starts over.
+    session.begin_open(
+        "case_phantom_shared.seg.nrrd",
+        read("labelmaps/case_phantom_shared.seg.nrrd"),
+    );
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(session.case_structures()[2].name, "tumor");
+}
+
+/// "Suggest all" in the page's session: each structure gets what the CLI's pipeline suggests for
+/// it (its own filter and bound), the model's structure as its new parameters, the others kept
+/// with their smoothed surfaces; cancelling leaves the rest as they were.
+#[test]
+fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
+    use meshsmooth::case::{self, Case, SuggestAllOptions};
+    use meshsmooth::session::Session;
+    use meshsmooth::suggest::SearchMethod;
+    let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
+    let mut session = Session::default();
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes.clone());
+    session.poll_opening().expect("done").expect("opens");
+    // Each structure starts from its own filter and bound, the model's as the session has it.
+    let mut expected = Case {
+        structures: session.case_structures().to_vec(),
+        ..Case::default()
+    };
+    assert_eq!(expected.structures[0].params, *session.params());
+    assert!(session.start_suggest_all(1.5, SearchMethod::Local).is_err());
+    session.start_suggest_all(0.5, SearchMethod::Local).unwrap();
+    // Workers on this thread answer at once.
+    assert!(session.step_suggest_all());
+    assert!(!session.suggesting_all());
+    let outcome = session.suggest_all_json().unwrap();
+    assert_eq!(
+        (outcome["done"].as_u64(), outcome["total"].as_u64()),
+        (Some(4), Some(4))
+    );
+
+    let options = SuggestAllOptions {
+        tau: 0.5,
+        filter: None,
+        method: SearchMethod::Local,
+        max_volume_change: Some(0.05),
+    };
+    let mut liver = expected.structures[0].clone();
+    let first = case::suggest_structure(&mut liver, &options, &mut |_| true)
+        .unwrap()
+        .unwrap();
+    case::suggest_all(&mut expected, &options, &|_| true).unwrap();
+    assert_eq!(
+        *session.params(),
+        first.params,
+        "the model takes its suggestion"
+    );
+    session.smooth_cpu();
+    assert_eq!(
+        session.result().unwrap().positions,
+        liver.smoothed.as_ref().unwrap().positions
+    );
+    for i in 1..4 {
+        let kept = &session.case_structures()[i];
+        let want = &expected.structures[i];
+        assert_eq!(kept.params, want.params, "structure {i}");
+        let smoothed = kept.smoothed.as_ref().unwrap();
+        assert_eq!(
+            smoothed.positions,
+            want.smoothed.as_ref().unwrap().positions
+        );
+        assert_eq!(smoothed.metrics, want.smoothed.as_ref().unwrap().metrics);
+        assert_eq!(outcome["structures"][i]["params"], want.params.to_json());
+    }
+    // Drawn as suggested.
+    let others = session.other_structures();
+    assert_eq!(
+        others[0].positions,
+        &expected.structures[1].smoothed.as_ref().unwrap().positions[..]
+    );
+
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes);
+    session.poll_opening().expect("done").expect("opens");
+    assert!(
+        session.suggest_all_json().is_none(),
+        "a new file starts over"
+    );
+}
+
+/// The largest difference of two position lists, in mm.
+fn farthest(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
+    assert_eq!(a.len(), b.len());
+    (a.iter().zip(b))
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0f32, f32::max)
+}
+
+/// #30's round trip in the page's session: export the case, open the file, export again; the
+/// same structures, looks, groups, parameters and positions (1e-6 mm), and the structure that
+/// becomes the model takes up its own parameters.
+#[test]
+fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
+    use meshsmooth::session::StructureChange;
+    use meshsmooth::smooth::{Filter, Params};
+    let mut session = Session::default();
+    let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
+    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    session.set_case_text(Some("Abdomen"), Some("Liver, tumour, vessels"));
+    let vessels = StructureChange {
+        group: Some(Some("Vessels".into())),
+        ..Default::default()
+    };
+    session.set_structure(1, vessels).unwrap();
+    let glassy = StructureChange {
+        opacity: Some(0.3),
+        ..Default::default()
+    };
+    session.set_structure(0, glassy).unwrap();
+    session.smooth_cpu();
+    let liver_params = *session.params();
+    session.begin_open_structure(3).unwrap();
+    session.poll_opening().expect("done").expect("opens");
+    let kidney_params = Params {
+        iterations: 9,
+        ..Params::defaults(Filter::Taubin)
+    };
+    session.set_params(kidney_params).unwrap();
+    session.smooth_cpu();
+    let first = session.export_case(Container::Glb).unwrap();
+
+    let mut again = Session::default();
+    open(&mut again, "abdomen_case.glb", first.clone());
+    assert_eq!(again.current_structure(), Some(0));
+    assert_eq!(again.model().unwrap().name, "abdomen_case.glb: liver");
+    assert_eq!(*again.params(), liver_params, "the liver's own parameters");
+    assert!(again.voxel_diagonal().is_some(), "its voxel size too");
+    assert_eq!(
+        (again.case_title(), again.case_description()),
+        ("Abdomen", "Liver, tumour, vessels")
+    );
+    assert_eq!(again.case_structures()[3].params, kidney_params);
+    again.smooth_cpu();
+    let second = again.export_case(Container::Glb).unwrap();
+
+    let read_case = |bytes: &[u8]| {
+        let files = [meshsmooth::segmentation::NamedBytes {
+            name: "case.glb",
+            bytes,
+        }];
+        meshsmooth::case::open(&files, None, &Default::default()).expect("reads back")
+    };
+    let (a, b) = (read_case(&first), read_case(&second));
+    assert_eq!((&a.title, &a.description), (&b.title, &b.description));
+    assert_eq!(a.structures.len(), 4);
+    assert_eq!(b.structures.len(), 4);
+    for (x, y) in a.structures.iter().zip(&b.structures) {
+        assert_eq!(
+            (&x.name, x.color, x.visible, &x.group, &x.source, x.label),
+            (&y.name, y.color, y.visible, &y.group, &y.source, y.label)
+        );
+        assert_eq!(
+            (x.params, x.tau, x.voxel_size, x.voxels),
+            (y.params, y.tau, y.voxel_size, y.voxels)
+        );
+        assert_eq!(x.smoothed.is_some(), y.smoothed.is_some(), "{}", x.name);
+        assert!(
+            farthest(&x.original.positions, &y.original.positions) <= 1e-6,
+            "{}",
+            x.name
+        );
+        assert!(
+            farthest(x.positions(), y.positions()) <= 1e-6,
+            "{}: smoothed",
+            x.name
+        );
+    }
+    assert!(a.structures[0].smoothed.is_some() && a.structures[3].smoothed.is_some());
+    assert_eq!(a.structures[1].group.as_deref(), Some("Vessels"));
+}
+
+/// Files added to an open case join it as structures (a surface coloured by its place, a label
+/// map's with its bound) while the model stays; files added while one opens wait for it, and
+/// are dropped when it fails to open.
+#[test]
+fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
+    let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
+    let sphere = read("synthetic/synthetic_sphere_r20.stl");
+    let mut session = Session::default();
+    open(
+        &mut session,
+        "case_phantom_shared.seg.nrrd",
+        phantom.clone(),
+    );
+    let model = session.model_id();
+    session.begin_add("synthetic_sphere_r20.stl", sphere.clone());
+    session.poll_opening().expect("done").expect("added");
+    assert_eq!(session.model_id(), model, "the model stays");
+    let list = session.case_structures();
+    assert_eq!(list.len(), 5);
+    let added = &list[4];
+    assert_eq!(added.name, "synthetic sphere r20");
+    assert_eq!(added.source.as_deref(), Some("synthetic_sphere_r20.stl"));
+    let [r, g, b] = meshsmooth::segmentation::default_color(4);
+    assert_eq!(added.color, [r, g, b, 1.0]);
+    assert_eq!(
+        added.params.max_displacement, None,
+        "a surface knows no voxels"
+    );
+
+    session.begin_add(
+        "sphere_r20_mask.nii.gz",
+        read("synthetic/sphere_r20_mask.nii.gz"),
+    );
+    session.poll_opening().expect("done").expect("added");
+    let mask = &session.case_structures()[5];
+    assert!(mask.voxel_size.is_some() && mask.label.is_some());
+    assert_eq!(mask.params.max_displacement, mask.default_bound());
+    let bound = mask.default_bound();
+    // It smooths as the model with its own bound.
+    session.begin_open_structure(5).unwrap();
+    session.poll_opening().expect("done").expect("opens");
+    assert_eq!(session.params().max_displacement, bound);
+    assert_eq!(session.to_case().unwrap().structures.len(), 6);
+
+    // Dropped together: the second waits for the first, then joins its case.
+    session.begin_open("case_phantom_shared.seg.nrrd", phantom);
+    session.begin_add("synthetic_sphere_r20.stl", sphere.clone());
+    session.poll_opening().expect("done").expect("opens");
+    assert!(session.loading().is_some(), "the addition follows");
+    assert_eq!(session.case_structures().len(), 4);
+    session.poll_opening().expect("done").expect("added");
+    assert_eq!(session.case_structures().len(), 5);
+    assert!(session.loading().is_none());
+
+    // A file that fails to open takes the files meant for its case with it.
+    let mut broken = read("labelmaps/case_phantom_shared.nii.gz");
+    broken.truncate(broken.len() / 2);
+    session.begin_open("half.nii.gz", broken);
+    session.begin_add("synthetic_sphere_r20.stl", sphere);
+    let e = session.poll_opening().expect("finished").unwrap_err();
+    assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
+    assert!(session.loading().is_none(), "nothing left to add");
+    assert_eq!(session.case_structures().len(), 5, "the case stays");
+}
