@@ -66,7 +66,8 @@ struct SurfaceFragment {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) albedo: vec3<f32>,
-    // Opacity: the colour's alpha (a case's translucent structures), else 1.
+    // Opacity: the record's (a case's translucent model) times the vertex colour's (a case's
+    // other structures).
     @location(3) alpha: f32,
 }
 
@@ -78,10 +79,10 @@ fn vs_surface(v: SurfaceVertex) -> SurfaceFragment {
     out.normal = v.normal.xyz;
     if (view.flags & VERTEX_COLORS) != 0u {
         out.albedo = linear_from_srgb(v.color.rgb);
-        out.alpha = v.color.a;
+        out.alpha = v.color.a * view.base_color.a;
     } else {
         out.albedo = view.base_color.rgb;
-        out.alpha = 1.0;
+        out.alpha = view.base_color.a;
     }
     return out;
 }

@@ -88,6 +88,13 @@ impl ViewUniforms {
         self
     }
 
+    /// The same record drawn with `opacity` (the base colour's alpha, which also scales the
+    /// vertex colours' own).
+    pub fn with_opacity(mut self, opacity: f32) -> Self {
+        self.base_color[3] = opacity.clamp(0.0, 1.0);
+        self
+    }
+
     /// The same record with `flags` set as well.
     pub fn with_flags(mut self, flags: u32) -> Self {
         self.flags |= flags;

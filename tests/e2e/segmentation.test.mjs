@@ -287,6 +287,13 @@ testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, s
         await app.setFilter("laplace");
         await app.setParams({ iterations: 4 });
         const liver = await app.metrics();
+        // The liver is the model now, drawn at its own opacity: the tumour shows through it.
+        const behindModel = greenPixels(await app.screenshot("S6-liver-model-tumour-hidden"), view);
+        await app.call("setStructure", { index: 2, visible: true });
+        await app.metrics();
+        const throughModel = greenPixels(await app.screenshot("S6-liver-model-translucent-tumour-seen"), view);
+        assert.ok(throughModel > behindModel + 200, `the tumour shows through the translucent model: ${behindModel} -> ${throughModel} green pixels`);
+        await app.call("setStructure", { index: 2, visible: false });
         list = await app.call("structures");
         assert.deepEqual(list.structures[3].metrics, kidney, "the kidney keeps its measures");
         assert.deepEqual(list.structures[0].metrics, liver);

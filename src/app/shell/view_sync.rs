@@ -128,8 +128,7 @@ impl Shell {
                 .collect();
             viewer.set_context(rs, &surfaces);
             let look = session.model_structure();
-            let color = look.map(|l| [l.color[0], l.color[1], l.color[2]]);
-            viewer.set_model_look(color, look.is_none_or(|l| l.visible));
+            viewer.set_model_look(look.map(|l| l.color), look.is_none_or(|l| l.visible));
             self.shown.looks = Some(session.case_version());
         }
     }

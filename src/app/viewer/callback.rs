@@ -113,9 +113,11 @@ impl ViewResources {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        // A translucent model is drawn with the translucent structures, first.
+        let model_translucent = frame.uniforms.base_color[3] < 1.0;
         pass.set_bind_group(0, &self.view_group, &[]);
         pass.set_pipeline(&self.pipelines.surface);
-        if frame.show_model {
+        if frame.show_model && !model_translucent {
             draw_surface(&mut pass, &self.mesh);
         }
         pass.set_bind_group(0, &self.context_group, &[]);
@@ -135,8 +137,12 @@ impl ViewResources {
             pass.draw_indexed(0..self.mesh.edge_indices, 0, 0..1);
         }
         // Translucent structures last, far to near, over everything opaque.
-        pass.set_bind_group(0, &self.context_group, &[]);
         pass.set_pipeline(&self.pipelines.translucent);
+        if frame.show_model && model_translucent {
+            pass.set_bind_group(0, &self.view_group, &[]);
+            draw_surface(&mut pass, &self.mesh);
+        }
+        pass.set_bind_group(0, &self.context_group, &[]);
         let eye = [0, 1, 2].map(|k| frame.uniforms.eye[k]);
         for i in far_to_near(&self.context, eye) {
             draw_surface(&mut pass, &self.context[i].buffers);
@@ -208,7 +214,7 @@ impl CallbackTrait for ViewCallback {
             return Vec::new();
         }
         queue.write_buffer(&view.uniforms, 0, bytemuck::bytes_of(&self.uniforms));
-        let context = self.uniforms.with_flags(crate::view::VERTEX_COLORS);
+        let context = (self.uniforms.with_flags(crate::view::VERTEX_COLORS)).with_opacity(1.0);
         queue.write_buffer(&view.context_uniforms, 0, bytemuck::bytes_of(&context));
         if let Some(target) = &view.target {
             view.draw(encoder, target, &frame);

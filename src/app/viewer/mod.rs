@@ -56,7 +56,7 @@ pub struct Viewer {
     /// Why the model is not shown (too large for this GPU, mismatched arrays), if so.
     problem: Option<String>,
     /// The model's colour where it is a case's structure (display sRGB), else the default.
-    model_color: Option<[f32; 3]>,
+    model_color: Option<[f32; 4]>,
     /// Whether the model is drawn (a case's structure can be hidden).
     show_model: bool,
     /// Other structures are drawn around the model.
@@ -100,9 +100,9 @@ impl Viewer {
         }
     }
 
-    /// How the model is shown as a case's structure: its colour (`None`: the default) and
-    /// whether it is drawn at all.
-    pub fn set_model_look(&mut self, color: Option<[f32; 3]>, visible: bool) {
+    /// How the model is shown as a case's structure: its colour and opacity (`None`: the
+    /// default, opaque) and whether it is drawn at all.
+    pub fn set_model_look(&mut self, color: Option<[f32; 4]>, visible: bool) {
         self.model_color = color;
         self.show_model = visible;
     }
@@ -231,8 +231,8 @@ impl Viewer {
                 flags |= OUTPUT_LINEAR;
             }
             let mut uniforms = ViewUniforms::new(&self.camera, rect.width() / rect.height(), flags);
-            if let Some(color) = self.model_color {
-                uniforms = uniforms.with_base_color(color);
+            if let Some([r, g, b, a]) = self.model_color {
+                uniforms = uniforms.with_base_color([r, g, b]).with_opacity(a);
             }
             let callback = ViewCallback {
                 rect,
