@@ -401,3 +401,29 @@ testIn(CPU_RUN, "B6 the quality graphs of the 206k-vertex brain with one and two
         two_workers_vs_cli: pages[2].seconds / want.seconds,
     });
 });
+
+testIn(CPU_RUN, "B7 Suggest all on the JHU atlas (48 structures) in the page's CPU engine, against the CLI's case build", { timeout: 30 * 60_000 }, async () => {
+    const atlas = meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz");
+    const search = "local";
+    const page = await withApp(async (app) => {
+        await app.loadMesh(readFileSync(atlas), "JHU-WhiteMatter-labels-1mm.nii.gz");
+        await app.call("metrics");
+        const start = Date.now();
+        const all = await app.call("suggestAll", { tau: 0.5, search });
+        const seconds = (Date.now() - start) / 1000;
+        assert.deepEqual([all.done, all.total, all.cancelled], [48, 48, false]);
+        return { seconds, all, workers: (await state(app)).cpu_engine.workers };
+    });
+    const out = join(tmp, "jhu-case.glb");
+    const native = await cli.cliJson("case", "build", atlas, "--search", search, "-o", out, "--json");
+    const cliStructures = (await cli.cliJson("case", "info", out, "--json")).structures;
+    const same = page.all.structures.filter((s, i) => JSON.stringify(s.params) === JSON.stringify(cliStructures[i].params)).length;
+    emit({
+        bench: "page-suggest-all", file: "JHU-WhiteMatter-labels-1mm.nii.gz", structures: 48, search, tau: 0.5,
+        page_s: page.seconds, page_workers: page.workers,
+        cli_suggest_s: native.suggest_seconds, cli_case_build_s: native.seconds,
+        page_vs_cli_suggest: page.seconds / native.suggest_seconds,
+        same_params_as_cli: same,
+    });
+    assert.equal(same, 48, "every structure's suggestion is the CLI's");
+});
