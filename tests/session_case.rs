@@ -489,3 +489,69 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     assert!(session.loading().is_none(), "nothing left to add");
     assert_eq!(session.case_structures().len(), 5, "the case stays");
 }
+
+/// The page's checks between structures report what the CLI's `case build` reports for the
+/// case as it stands: the tumour lies inside the liver, until the liver is shrunk around it.
+#[test]
+fn the_session_checks_its_structures_as_they_stand() {
+    use meshsmooth::smooth::{Filter, Params};
+    let mut session = Session::default();
+    let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
+    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    session.smooth_cpu();
+    session.start_checks().unwrap();
+    assert!(
+        session.step_checks(),
+        "a worker on this thread answers at once"
+    );
+    assert!(!session.checking());
+    let report = session.checks_json().unwrap();
+    assert!(
+        report["text"]
+            .as_str()
+            .unwrap()
+            .contains("tumor lies inside liver"),
+        "{report}"
+    );
+    assert_eq!(report["left_inside"], serde_json::json!([]));
+    assert_eq!(report["current"], true);
+    assert!(session.flagged_structures().is_empty());
+    // The same as the CLI's pipeline says of the same case.
+    let case = session.to_case().unwrap();
+    let before = meshsmooth::case::check(&case, false);
+    let after = meshsmooth::case::check(&case, true);
+    let changes = meshsmooth::case::relations::changes(&before, &after);
+    let cli = meshsmooth::case::checks_json(&case, &after, &changes);
+    assert_eq!(report["pairs"], cli["pairs"]);
+
+    // A liver shrunk by heavy Laplace smoothing no longer holds the tumour.
+    let shrink = Params {
+        lambda: 0.9,
+        iterations: 50,
+        max_displacement: None,
+        ..Params::defaults(Filter::Laplace)
+    };
+    session.set_params(shrink).unwrap();
+    assert_eq!(session.checks_json().unwrap()["current"], false);
+    session.smooth_cpu();
+    session.start_checks().unwrap();
+    session.step_checks();
+    let report = session.checks_json().unwrap();
+    assert_eq!(
+        report["left_inside"],
+        serde_json::json!([["tumor", "liver"]]),
+        "{}",
+        report["text"]
+    );
+    assert!(report["text"]
+        .as_str()
+        .unwrap()
+        .contains("warning: tumor no longer lies inside liver"));
+    // The shrunk liver now also crosses the portal vein, and the tumour.
+    let crossings = &report["new_crossings"];
+    assert_eq!(
+        crossings,
+        &serde_json::json!([["liver", "portal_vein"], ["liver", "tumor"]])
+    );
+    assert_eq!(session.flagged_structures(), [0, 1, 2]);
+}

@@ -30,6 +30,9 @@
 //!   with its own filter and bound, one structure per engine worker, each then smoothed with
 //!   it; resolves with `{tau, search, structures: [{name, params, evaluations, metrics}],
 //!   done, total, cancelled}`
+//! - `checkStructures(): Promise<object>`: the checks between the structures as they stand,
+//!   the CLI's `case build --json` `checks` (`pairs`, `left_inside`, `new_crossings`) with
+//!   `text` (the report's lines), `flagged` (the structures of its warnings, by index) and `ms`
 //! - `exportCase(format): Promise<Uint8Array>`: the case glTF (`glb`, the default, or `gltf`)
 //!   of every structure as shown and smoothed (a mesh alone is a case of one), once the
 //!   current parameters' result is computed; `setCase({title, description})` names the case
@@ -465,6 +468,28 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                     s.suggest_all_json()
                         .map(|v| to_js(&v))
                         .ok_or_else(|| "no Suggest all".to_string())
+                },
+            )
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    define(
+        &api,
+        "checkStructures",
+        Closure::<dyn FnMut() -> Promise>::new(move || {
+            if let Err(e) = d.borrow_mut().session.start_checks() {
+                return settled(Err(e));
+            }
+            c.request_repaint();
+            when_ready(
+                &d,
+                &c,
+                |s| !s.checking(),
+                |s| {
+                    s.checks_json()
+                        .map(|v| to_js(&v))
+                        .ok_or_else(|| "no checks".to_string())
                 },
             )
         }),

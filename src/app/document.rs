@@ -336,6 +336,7 @@ impl Document {
             || self.session.guidance_busy()
             || self.session.loading().is_some()
             || self.session.suggesting_all()
+            || self.session.checking()
     }
 
     /// The CPU engine's share of this frame: asks its workers for the current parameters'

@@ -17,6 +17,8 @@ pub enum StructureAction {
     CaseText(String, String),
     /// Choose files whose structures join the case.
     AddFiles,
+    /// Check the structures against each other (what lies inside what, what crosses).
+    Check,
     ExportCase,
     /// "Suggest all" at the Suggest panel's tau, or cancel it.
     SuggestAll,
@@ -71,6 +73,7 @@ impl StructureList {
                 true
             }
         });
+        let flagged = session.flagged_structures();
         egui::ScrollArea::vertical()
             .max_height(220.0)
             .id_salt("structure list")
@@ -81,7 +84,8 @@ impl StructureList {
                     }
                     for (i, s) in list.iter().enumerate() {
                         if s.group.as_deref() == group {
-                            row(ui, i, s, i == current, &mut actions);
+                            let flag = flagged.contains(&i);
+                            row(ui, i, s, (i == current, flag), &mut actions);
                         }
                     }
                 }
@@ -182,22 +186,59 @@ impl StructureList {
                 }
             }
         });
-        if ui
-            .button("Export case (GLB)")
-            .on_hover_text("Every structure as shown, smoothed ones with their originals and records, in metres with Y up")
-            .clicked()
-        {
-            actions.push(StructureAction::ExportCase);
-        }
+        ui.horizontal(|ui| {
+            if ui
+                .button("Export case (GLB)")
+                .on_hover_text("Every structure as shown, smoothed ones with their originals and records, in metres with Y up")
+                .clicked()
+            {
+                actions.push(StructureAction::ExportCase);
+            }
+            if session.checking() {
+                ui.spinner();
+                ui.label("checking…");
+            } else if ui
+                .button("Check structures")
+                .on_hover_text("Does each structure that lay inside another still lie inside it, and do surfaces that did not cross now cross?")
+                .clicked()
+            {
+                actions.push(StructureAction::Check);
+            }
+        });
+        checks_report(ui, session);
     }
 }
 
-/// One structure's row: visibility, colour with opacity, show alone, and its name to select.
+/// The last checks' lines, warnings in the warning colour.
+fn checks_report(ui: &mut egui::Ui, session: &Session) {
+    let Some(report) = session.checks_json() else {
+        return;
+    };
+    if let Some(error) = report["error"].as_str() {
+        ui.colored_label(
+            ui.visuals().error_fg_color,
+            format!("Checks failed: {error}"),
+        );
+        return;
+    }
+    for line in report["text"].as_str().unwrap_or_default().lines() {
+        match line.strip_prefix("warning: ") {
+            Some(warning) => ui.colored_label(ui.visuals().warn_fg_color, format!("⚠ {warning}")),
+            None => ui.small(line),
+        };
+    }
+    if report["current"] == false {
+        ui.small("(the case changed since: check again)");
+    }
+}
+
+/// One structure's row: visibility, colour with opacity, show alone, its name to select, and
+/// a warning sign when the last checks flagged it.
 fn row(
     ui: &mut egui::Ui,
     i: usize,
     s: &CaseStructure,
-    selected: bool,
+    (selected, flagged): (bool, bool),
     actions: &mut Vec<StructureAction>,
 ) {
     ui.horizontal(|ui| {
@@ -240,6 +281,10 @@ fn row(
         let label = ui.selectable_label(selected, &s.name).on_hover_text(about);
         if label.clicked() && !selected {
             actions.push(StructureAction::Select(i));
+        }
+        if flagged {
+            ui.colored_label(ui.visuals().warn_fg_color, "⚠")
+                .on_hover_text("The last checks warn of this structure: see below the list");
         }
     });
 }

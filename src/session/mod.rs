@@ -7,6 +7,7 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod case;
+mod checks;
 mod colors;
 mod cpu;
 mod guidance;
@@ -91,6 +92,7 @@ pub struct Session {
     /// Files to add to the case once the one opening now is open.
     additions: std::collections::VecDeque<(String, Vec<u8>)>,
     suggest_all: suggest_all::SuggestAll,
+    checks: checks::Checks,
 }
 
 impl Default for Session {
@@ -118,6 +120,7 @@ impl Default for Session {
             case_version: 0,
             additions: Default::default(),
             suggest_all: Default::default(),
+            checks: Default::default(),
         }
     }
 }

@@ -138,6 +138,7 @@ impl Session {
         // A "Suggest all" of the structures before is of no use now.
         self.cancel_suggest_all();
         self.suggest_all = Default::default();
+        self.checks = Default::default();
         self.case = case;
         self.case_file = file.to_string();
         self.current = 0;

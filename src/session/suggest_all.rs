@@ -100,7 +100,7 @@ impl Session {
         };
         let mut came = Vec::new();
         let mut waiting = std::mem::take(&mut self.suggest_all.waiting);
-        waiting.retain(|&(i, job)| match self.cpu.take_suggested(job) {
+        waiting.retain(|&(i, job)| match self.cpu.take_structure_reply(job) {
             Some(reply) => {
                 came.push((i, reply));
                 false

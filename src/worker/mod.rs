@@ -61,6 +61,8 @@ pub enum Request {
         weights: Option<Vec<f32>>,
         options: SuggestAllOptions,
     },
+    /// The checks between `case`'s structures: as opened, and as shown ([`Reply::Checked`]).
+    CheckCase { job: u64, case: Box<Case> },
     /// The terms of `params` after each count of `at` ([`Evaluator::measure`]).
     Terms {
         job: u64,
@@ -109,6 +111,10 @@ pub enum Reply {
         job: u64,
         suggested: Option<Box<StructureSuggestion>>,
     },
+    /// The checks between a case's structures: [`case::checks_json`] with the lines of
+    /// [`case::checks_text`] under `text` and the structures of its warnings (by index) under
+    /// `flagged`, as JSON text.
+    Checked { job: u64, report: String },
     /// The job could not be done (no model, weights of another length).
     Failed { job: u64, why: String },
     /// The worker stopped in the middle of its job (a trap in its module): whatever it was
@@ -125,6 +131,7 @@ impl Reply {
             | Reply::Smoothed { job, .. }
             | Reply::Terms { job, .. }
             | Reply::Suggested { job, .. }
+            | Reply::Checked { job, .. }
             | Reply::Failed { job, .. } => Some(*job),
             Reply::Broken { .. } => None,
         }
@@ -206,6 +213,7 @@ impl Worker {
                 weights,
                 options,
             } => Some(suggest_structure(job, mesh, params, weights, &options)),
+            Request::CheckCase { job, case } => Some(check_case(job, &case, clock)),
         }
     }
 
@@ -335,6 +343,28 @@ fn suggest_structure(
             job,
             why: e.to_string(),
         },
+    }
+}
+
+/// The checks between a case's structures, as the CLI's `case build` reports them.
+fn check_case(job: u64, case: &Case, clock: &dyn Fn() -> f64) -> Reply {
+    let start = clock();
+    let before = case::check(case, false);
+    let after = case::check(case, true);
+    let changes = case::relations::changes(&before, &after);
+    let mut report = case::checks_json(case, &after, &changes);
+    report["text"] = case::checks_text(case, &before, &after, &changes).into();
+    let mut flagged: Vec<usize> = (changes.left_inside.iter())
+        .chain(&changes.new_crossings)
+        .flat_map(|&(a, b)| [a, b])
+        .collect();
+    flagged.sort_unstable();
+    flagged.dedup();
+    report["flagged"] = flagged.into();
+    report["ms"] = (clock() - start).into();
+    Reply::Checked {
+        job,
+        report: report.to_string(),
     }
 }
 

@@ -6,7 +6,7 @@
 use std::collections::{HashMap, VecDeque};
 
 use super::{Input, Reply, Request, Worker};
-use crate::case::SuggestAllOptions;
+use crate::case::{Case, SuggestAllOptions};
 use crate::evaluate::{failed_terms, ModelRef, Offload, Request as TermsRequest, Terms};
 use crate::mesh::Mesh;
 use crate::smooth::Params;
@@ -72,7 +72,8 @@ impl Carrier for InThread {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SmoothJob(u64);
 
-/// One structure's part of "Suggest all".
+/// A job on a case's structures that needs no model held: one structure's part of "Suggest
+/// all", or the checks between the structures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StructureJob(u64);
 
@@ -216,8 +217,22 @@ impl Pool {
         StructureJob(job)
     }
 
-    /// The answer to `job` once it is there ([`Reply::Suggested`] or [`Reply::Failed`]).
-    pub fn take_suggested(&mut self, job: StructureJob) -> Option<Reply> {
+    /// Queues the checks between `case`'s structures, as opened and as shown (with the
+    /// structures' jobs).
+    pub fn check_case(&mut self, case: Case) -> StructureJob {
+        let job = self.new_job();
+        let request = Request::CheckCase {
+            job,
+            case: Box::new(case),
+        };
+        self.structure_jobs.push_back((job, request));
+        self.pump();
+        StructureJob(job)
+    }
+
+    /// The answer to `job` once it is there ([`Reply::Suggested`], [`Reply::Checked`] or
+    /// [`Reply::Failed`]).
+    pub fn take_structure_reply(&mut self, job: StructureJob) -> Option<Reply> {
         self.pump();
         self.suggested.remove(&job.0)
     }

@@ -333,7 +333,7 @@ testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, s
     });
 });
 
-testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build suggestion, one structure per worker", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build suggestion, one structure per worker; the checks agree", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
         const start = Date.now();
@@ -342,7 +342,7 @@ testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build sug
         assert.deepEqual([all.done, all.total, all.cancelled], [4, 4, false]);
         const file = join(E2E_OUT, MODE, "S7-cli-case.glb");
         const cliStart = Date.now();
-        await cli.cli("case", "build", PHANTOM_NRRD, "--search", "local", "-o", file);
+        const built = await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "-o", file, "--json");
         const cliSeconds = (Date.now() - cliStart) / 1000;
         const native = (await cli.cliJson("case", "info", file, "--json")).structures;
         // Every structure, the model's too, starts as the CLI's do: its filter, with the bound
@@ -358,10 +358,32 @@ testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build sug
         await app.metrics();
         const list = await app.call("structures");
         assert.ok(list.structures.every((s) => s.metrics !== null), "every structure smoothed");
+        // The checks between the structures say what the CLI's say of its case.
+        const checks = await app.call("checkStructures");
+        assert.equal(checks.current, true);
+        assert.deepEqual([checks.left_inside, checks.new_crossings, checks.flagged], [[], [], []]);
+        assert.match(checks.text, /tumor lies inside liver/);
+        const flags = (p) => [p.a, p.b, p.a_inside_b, p.b_inside_a, p.crosses];
+        assert.deepEqual(checks.pairs.map(flags), built.checks.pairs.map(flags));
+        const within = { cpu: 1e-9, webgpu: 1e-3 }[MODE];
+        checks.pairs.forEach((p, i) => {
+            for (const key of ["a_outside_b_mm", "b_outside_a_mm", "overlap_depth_mm"]) {
+                const [x, y] = [p[key], built.checks.pairs[i][key]];
+                assert.ok(x === y || Math.abs(x - y) <= within, `${p.a}/${p.b} ${key}: ${x} vs the CLI's ${y}`);
+            }
+        });
+        await app.screenshot("S7-phantom-suggested-all");
+        // The liver shrunk by heavy smoothing: the checks warn, and the list flags both.
+        await app.setFilter("laplace");
+        await app.setParams({ lambda: 0.9, iterations: 50, max_displacement: null });
+        await app.metrics();
+        const warned = await app.call("checkStructures");
+        assert.deepEqual(warned.left_inside, [["tumor", "liver"]]);
+        assert.ok(warned.flagged.includes(0) && warned.flagged.includes(2), `flagged ${warned.flagged}`);
+        await app.screenshot("S7-liver-shrunk-checks-warn");
         const line = { bench: "page-suggest-all", mode: MODE, file: "case_phantom_shared.seg.nrrd", structures: 4, search: "local", page_s: seconds, cli_s: cliSeconds, workers: state.cpu_engine.workers };
         console.log(JSON.stringify(line));
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
-        await app.screenshot("S7-phantom-suggested-all");
     });
 });
 

@@ -313,6 +313,7 @@ impl Shell {
                     let method = self.guide.method;
                     doc.session.start_suggest_all(tau, method)
                 }
+                StructureAction::Check => doc.session.start_checks(),
                 StructureAction::CancelSuggestAll => {
                     doc.session.cancel_suggest_all();
                     Ok(())
@@ -457,7 +458,11 @@ impl eframe::App for Shell {
         // The frame a new model arrives in takes it up; uploading it to the GPU takes the next.
         // While a worker opens a file, the open model is worked on as before.
         let opening = self.doc.borrow_mut().step_loading();
-        self.doc.borrow_mut().session.step_suggest_all();
+        {
+            let session = &mut self.doc.borrow_mut().session;
+            session.step_suggest_all();
+            session.step_checks();
+        }
         let arrived = opening == Opening::Done;
         let uploading = !arrived && self.compute();
         if !arrived && !uploading {
