@@ -402,28 +402,33 @@ testIn(CPU_RUN, "B6 the quality graphs of the 206k-vertex brain with one and two
     });
 });
 
-testIn(CPU_RUN, "B7 Suggest all on the JHU atlas (48 structures) in the page's CPU engine, against the CLI's case build", { timeout: 30 * 60_000 }, async () => {
+testIn(CPU_RUN, "B7 Suggest all on the JHU atlas (48 structures) in the page's CPU engine with one and two workers, against the CLI's case build", { timeout: 30 * 60_000 }, async () => {
     const atlas = meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz");
     const search = "local";
-    const page = await withApp(async (app) => {
-        await app.loadMesh(readFileSync(atlas), "JHU-WhiteMatter-labels-1mm.nii.gz");
-        await app.call("metrics");
-        const start = Date.now();
-        const all = await app.call("suggestAll", { tau: 0.5, search });
-        const seconds = (Date.now() - start) / 1000;
-        assert.deepEqual([all.done, all.total, all.cancelled], [48, 48, false]);
-        return { seconds, all, workers: (await state(app)).cpu_engine.workers };
-    });
+    const pages = {};
+    for (const workers of [1, 2]) {
+        pages[workers] = await withApp(async (app) => {
+            await app.loadMesh(readFileSync(atlas), "JHU-WhiteMatter-labels-1mm.nii.gz");
+            await app.call("metrics");
+            assert.equal((await state(app)).cpu_engine.workers, workers);
+            const start = Date.now();
+            const all = await app.call("suggestAll", { tau: 0.5, search });
+            const seconds = (Date.now() - start) / 1000;
+            assert.deepEqual([all.done, all.total, all.cancelled], [48, 48, false]);
+            return { seconds, all };
+        }, { query: `?workers=${workers}` });
+    }
     const out = join(tmp, "jhu-case.glb");
     const native = await cli.cliJson("case", "build", atlas, "--search", search, "-o", out, "--json");
     const cliStructures = (await cli.cliJson("case", "info", out, "--json")).structures;
-    const same = page.all.structures.filter((s, i) => JSON.stringify(s.params) === JSON.stringify(cliStructures[i].params)).length;
+    const same = (page) => page.all.structures.filter((s, i) => JSON.stringify(s.params) === JSON.stringify(cliStructures[i].params)).length;
     emit({
         bench: "page-suggest-all", file: "JHU-WhiteMatter-labels-1mm.nii.gz", structures: 48, search, tau: 0.5,
-        page_s: page.seconds, page_workers: page.workers,
-        cli_suggest_s: native.suggest_seconds, cli_case_build_s: native.seconds,
-        page_vs_cli_suggest: page.seconds / native.suggest_seconds,
-        same_params_as_cli: same,
+        page_one_worker_s: pages[1].seconds, page_two_workers_s: pages[2].seconds,
+        cli_suggest_two_threads_s: native.suggest_seconds, cli_case_build_s: native.seconds,
+        one_worker_vs_cli: pages[1].seconds / native.suggest_seconds,
+        two_workers_vs_cli: pages[2].seconds / native.suggest_seconds,
+        same_params_as_cli: [same(pages[1]), same(pages[2])],
     });
-    assert.equal(same, 48, "every structure's suggestion is the CLI's");
+    assert.deepEqual([same(pages[1]), same(pages[2])], [48, 48], "every structure's suggestion is the CLI's");
 });
