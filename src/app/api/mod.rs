@@ -62,9 +62,12 @@
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
 
-use super::document::{LoadWaiter, SharedDocument};
+mod files;
+
+use super::document::SharedDocument;
 use crate::export::{Container, ExportFormat};
 use eframe::egui;
+use files::{file_call, info_waiter, FileCall};
 use js_sys::{Function, Promise, Uint8Array};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::{JsCast, JsValue};
@@ -188,90 +191,6 @@ fn tau_and_search(
             .ok_or_else(|| format!("{what}: unknown search {v}: use grid or local"))?,
     };
     Ok((tau, method))
-}
-
-/// Settles a promise once a file (or structure) is open: with `answer` of the session (the
-/// model's `info --json` keys, the structures), or with why it did not open.
-fn load_waiter(
-    resolve: Function,
-    reject: Function,
-    answer: fn(&crate::session::Session) -> Option<serde_json::Value>,
-) -> LoadWaiter {
-    Box::new(move |outcome: Result<&crate::session::Session, String>| {
-        let value = outcome.and_then(|session| {
-            answer(session)
-                .map(|v| to_js(&v))
-                .ok_or_else(|| "nothing is open".to_string())
-        });
-        let _ = match value {
-            Ok(v) => resolve.call1(&JsValue::NULL, &v),
-            Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
-        };
-    })
-}
-
-fn info_waiter(resolve: Function, reject: Function) -> LoadWaiter {
-    load_waiter(resolve, reject, crate::session::Session::info_json)
-}
-
-/// How a file handed to the API opens.
-#[derive(Clone, Copy)]
-enum FileCall {
-    /// `loadMesh`: opens it, resolving with the model's info.
-    Mesh,
-    /// `loadCase`: opens it, resolving with the structures.
-    Case,
-    /// `addFile`: adds its structures to the open case, resolving with the structures.
-    Add,
-}
-
-impl FileCall {
-    fn name(self) -> &'static str {
-        match self {
-            FileCall::Mesh => "loadMesh",
-            FileCall::Case => "loadCase",
-            FileCall::Add => "addFile",
-        }
-    }
-}
-
-/// `loadMesh`, `loadCase` or `addFile` of `(bytes: Uint8Array, name)`: opened in a worker, the
-/// promise settles once it is open (or not).
-fn file_call(
-    doc: &SharedDocument,
-    ctx: &egui::Context,
-    call: FileCall,
-) -> Closure<dyn FnMut(JsValue, JsValue) -> Promise> {
-    let (d, c) = (doc.clone(), ctx.clone());
-    Closure::new(move |bytes: JsValue, name: JsValue| {
-        let Some(bytes) = bytes.dyn_ref::<Uint8Array>() else {
-            let why = format!("{}(bytes, name): bytes must be a Uint8Array", call.name());
-            return settled(Err(why));
-        };
-        let Some(name) = name.as_string().filter(|n| !n.is_empty()) else {
-            let why = format!("{}(bytes, name): name must name the file", call.name());
-            return settled(Err(why));
-        };
-        let mut bytes = Some(bytes.to_vec());
-        let (d, c) = (d.clone(), c.clone());
-        Promise::new(&mut |resolve: Function, reject: Function| {
-            let Some(bytes) = bytes.take() else { return };
-            let structures = crate::session::Session::structures_json;
-            let mut doc = d.borrow_mut();
-            match call {
-                FileCall::Mesh => doc.begin_open(&name, bytes, Some(info_waiter(resolve, reject))),
-                FileCall::Case => {
-                    let waiter = load_waiter(resolve, reject, structures);
-                    doc.begin_open(&name, bytes, Some(waiter))
-                }
-                FileCall::Add => {
-                    let waiter = load_waiter(resolve, reject, structures);
-                    doc.begin_add(&name, bytes, Some(waiter))
-                }
-            }
-            c.request_repaint();
-        })
-    })
 }
 
 /// A function of one argument that edits the session, throwing the engine's message when it
