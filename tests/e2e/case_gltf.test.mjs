@@ -1,7 +1,8 @@
-// End-to-end check of the case GLB `meshsmooth case build` writes for a label map, as other tools see it: the
-// Khronos glTF-Validator passes it with no error or warning, and three.js's GLTFLoader in
-// headless Chromium finds every structure by name, in its colour, in metres with +Y superior.
-// The app is not involved, so only the webgpu run takes these checks (in WebGL2: see BROWSER_MODE).
+// End-to-end check of the case GLBs `meshsmooth case build` and the authoring page write, as other
+// tools see them: the Khronos glTF-Validator passes each with no error or warning, and three.js's
+// GLTFLoader in headless Chromium finds every structure by name, in its colour and opacity, in
+// metres with +Y superior. Only the webgpu run takes these checks (three renders in WebGL2: see
+// BROWSER_MODE); the page's case is made by the page in that run.
 //
 //   node --test tests/e2e/case_gltf.test.mjs   (tests/e2e/run.sh runs it)
 //
@@ -17,7 +18,7 @@ import { gltfValidator } from "./lib/deps.mjs";
 import { readGlb } from "./lib/glb.mjs";
 import { meshPath, outputDir } from "./lib/paths.mjs";
 import { assertNotBlank, colourHistogram, decodePng } from "./lib/png.mjs";
-import { WEBGPU_RUN, testIn } from "./lib/suite.mjs";
+import { WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 import { openThreePage, serveThreePage, threeVersion } from "./lib/three.mjs";
 
 const MODE = modeFromEnv();
@@ -51,7 +52,37 @@ const CASES = [
         colors: meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.txt"),
         structures: 48,
     },
+    {
+        key: "page",
+        what: "the authoring page's (renamed, recoloured, grouped, translucent)",
+        input: meshPath("labelmaps/case_phantom_shared.seg.nrrd"),
+        fromPage: true,
+        structures: 4,
+    },
 ];
+
+const { withApp } = appSuite({ beforeAll: () => cli.requireCli() });
+
+/**
+ * The page's case GLB of the phantom as an author arranges it: every structure suggested and
+ * smoothed, the liver translucent, the portal vein renamed, recoloured and grouped. Returns
+ * the bytes and the structures as the page lists them (the names, colours and opacity the GLB
+ * must carry).
+ */
+function writePageCaseGlb(input, output) {
+    return withApp(async (app) => {
+        await app.loadMesh(readFileSync(input), basename(input));
+        await app.call("suggestAll", { tau: 0.5, search: "local" });
+        await app.call("setStructure", { index: 0, opacity: 0.4 });
+        await app.call("setStructure", { index: 1, name: "portal vein", color: [0.2, 0.3, 0.9], group: "Vessels" });
+        await app.call("setCase", { title: "Abdominal phantom", description: "Exported by the page" });
+        await app.metrics();
+        const bytes = Buffer.from(await app.call("exportCase", "glb"));
+        writeFileSync(output, bytes);
+        const listed = (await app.call("structures")).structures;
+        return listed.map((s) => ({ label: s.label, name: s.name, color: s.color, opacity: s.opacity }));
+    });
+}
 
 // --- what the GLB must hold ---
 
@@ -82,6 +113,7 @@ function readColourTable(path) {
  * Opaque: info gives no opacity.
  */
 async function expectedStructures(c) {
+    if (c.fromPage) return (await caseGlb(c)).listed;
     const info = await cli.info(c.input);
     const table = c.colors ? readColourTable(c.colors) : new Map();
     return info.structures.map((s) => {
@@ -148,9 +180,10 @@ const written = new Map();
 function caseGlb(c) {
     if (!written.has(c.key)) {
         const file = join(OUT, `case-${c.key}.glb`);
+        const writing = c.fromPage ? writePageCaseGlb(c.input, file) : writeCaseGlb(c.input, file, { colors: c.colors });
         written.set(
             c.key,
-            writeCaseGlb(c.input, file, { colors: c.colors }).then(() => ({ file, bytes: readFileSync(file) })),
+            writing.then((listed) => ({ file, bytes: readFileSync(file), listed })),
         );
     }
     return written.get(c.key);
