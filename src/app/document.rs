@@ -347,6 +347,17 @@ impl Document {
         }
     }
 
+    /// Between frames (an API call, a worker's reply): with the CPU engine in workers, sends
+    /// the current parameters' smoothing or takes its result now, and answers the calls
+    /// waiting for it, rather than a frame of a large mesh later.
+    pub fn step_cpu_engine(&mut self) {
+        self.session.pump_cpu_engine();
+        if self.backend == Backend::Cpu && self.session.cpu_engine_threaded() {
+            self.compute_on_cpu();
+            self.answer_waiting();
+        }
+    }
+
     /// The background work's share of this frame (graphs, suggestions, the gallery): hands
     /// its runs to the CPU engine's workers, or to the GPU engine's evaluator when one is lent.
     /// With the CPU engine it waits until the current parameters' result is there: what the

@@ -25,13 +25,15 @@ pub struct WebWorkers {
     _handlers: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
 }
 
-/// How many workers to start: one per core, leaving a core to the page, at least one; the
-/// page's `?workers=N` overrides it (benchmarks compare pool sizes).
+/// How many workers do the background's work (guidance, "Suggest all"): one per core, leaving
+/// one to the page and one to the view worker, at least one; the page's `?workers=N` overrides
+/// it (benchmarks compare pool sizes). The view worker comes on top: it runs only while the
+/// author waits for a result, so on two cores the page still has one most of the time.
 pub fn pool_size() -> usize {
     let asked = super::query::param("workers").and_then(|n| n.parse::<usize>().ok());
     let cores = web_sys::window().map_or(1.0, |w| w.navigator().hardware_concurrency());
     asked
-        .unwrap_or((cores as usize).saturating_sub(1))
+        .unwrap_or((cores as usize).saturating_sub(2))
         .clamp(1, 16)
 }
 

@@ -1,6 +1,6 @@
 //! A carrier for tests that holds every request until told to deliver, as busy workers do.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
 use super::{Carrier, InThread, Reply, Request};
@@ -9,18 +9,30 @@ pub(crate) struct Deferred {
     inner: InThread,
     posted: Vec<(usize, Request)>,
     deliver: Rc<Cell<bool>>,
+    log: Log,
 }
+
+/// Which worker was sent which request, in order.
+pub(crate) type Log = Rc<RefCell<Vec<(usize, Request)>>>;
 
 impl Deferred {
     /// `workers` workers on this thread, and the switch that lets their requests through.
     pub(crate) fn new(workers: usize) -> (Self, Rc<Cell<bool>>) {
+        let (carrier, deliver, _) = Self::logged(workers);
+        (carrier, deliver)
+    }
+
+    /// [`Self::new`], with the log of every request posted.
+    pub(crate) fn logged(workers: usize) -> (Self, Rc<Cell<bool>>, Log) {
         let deliver = Rc::new(Cell::new(false));
+        let log = Log::default();
         let carrier = Self {
             inner: InThread::new(workers),
             posted: Vec::new(),
             deliver: deliver.clone(),
+            log: log.clone(),
         };
-        (carrier, deliver)
+        (carrier, deliver, log)
     }
 }
 
@@ -30,6 +42,7 @@ impl Carrier for Deferred {
     }
 
     fn post(&mut self, worker: usize, request: &Request) {
+        self.log.borrow_mut().push((worker, request.clone()));
         self.posted.push((worker, request.clone()));
     }
 

@@ -135,6 +135,9 @@ pub struct Pool {
     /// Whether the last terms request was not answered yet.
     waiting: bool,
     failure: Option<String>,
+    /// The worker kept for the view's smoothing and openings, so a change of parameters never
+    /// waits behind a guidance task or a structure of "Suggest all".
+    view_worker: Option<usize>,
 }
 
 /// One worker on this thread.
@@ -165,7 +168,18 @@ impl Pool {
             terms: HashMap::new(),
             waiting: false,
             failure: None,
+            view_worker: None,
         }
+    }
+
+    /// A pool whose last worker is kept for the view (its smoothing, openings): the others do
+    /// the background's work (the guidance's terms, "Suggest all", checks) and, when idle, the
+    /// view's too. Needs two workers at least, else it is [`Self::new`].
+    pub fn with_view_worker(carrier: Box<dyn Carrier>) -> Self {
+        let mut pool = Self::new(carrier);
+        let workers = pool.busy.len();
+        pool.view_worker = (workers >= 2).then_some(workers - 1);
+        pool
     }
 
     /// A pool of `workers` on this thread.
@@ -173,8 +187,9 @@ impl Pool {
         Self::new(Box::new(InThread::new(workers)))
     }
 
+    /// The workers that do the background's work (all of them, but a view worker).
     pub fn workers(&self) -> usize {
-        self.busy.len()
+        self.busy.len() - usize::from(self.view_worker.is_some())
     }
 
     /// Whether the workers run beside the caller's thread (else each job blocks it).
@@ -184,7 +199,11 @@ impl Pool {
 
     /// What `state()` says of the CPU engine: its workers and whether they are threads.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({ "workers": self.workers(), "threaded": self.carrier.threaded() })
+        serde_json::json!({
+            "workers": self.workers(),
+            "view_worker": self.view_worker.is_some(),
+            "threaded": self.carrier.threaded(),
+        })
     }
 
     /// Whether any worker is doing something or anything waits to be handed out.
@@ -397,10 +416,13 @@ impl Pool {
             for (worker, reply) in self.carrier.take_replies() {
                 self.receive(worker, reply);
             }
-            let Some(worker) = self.busy.iter().position(Option::is_none) else {
-                return;
-            };
-            if !self.hand_out(worker) {
+            let mut idle: Vec<usize> = (0..self.busy.len())
+                .filter(|&w| self.busy[w].is_none())
+                .collect();
+            // The view's jobs go to the view worker first, leaving the others to the rest.
+            idle.sort_by_key(|&w| Some(w) != self.view_worker);
+            // One job per pass: a worker on this thread answers at once, and frees itself.
+            if !idle.into_iter().any(|worker| self.hand_out(worker)) {
                 return;
             }
         }
@@ -459,8 +481,9 @@ impl Pool {
         }
     }
 
-    /// Gives `worker` the next job: an opening first, then a smoothing, then a structure of
-    /// "Suggest all", then the terms asked, then those to come. Returns whether there was one.
+    /// Gives `worker` the next job: an opening first, then a smoothing, then (but to the view
+    /// worker) a structure of "Suggest all" or checks, then the terms asked, then those to
+    /// come. Returns whether there was one.
     fn hand_out(&mut self, worker: usize) -> bool {
         if let Some((job, request)) = self.load.take() {
             self.start(worker, job, Flight::Load, &request);
@@ -474,6 +497,9 @@ impl Pool {
             };
             self.start(worker, s.job, Flight::Smooth, &request);
             return true;
+        }
+        if self.view_worker == Some(worker) {
+            return false;
         }
         if let Some((job, request)) = self.structure_jobs.pop_front() {
             self.start(worker, job, Flight::Structure, &request);

@@ -117,6 +117,80 @@ fn a_newer_view_job_supersedes_one_still_waiting() {
     assert!(pool.take_smoothed(second).is_none());
 }
 
+/// #28's latency: with a worker kept for the view, a change of parameters is smoothed at once
+/// while the guidance's terms and "Suggest all" keep the other workers busy, and the view
+/// worker never takes their work.
+#[test]
+fn the_view_worker_smooths_at_once_while_the_others_are_busy() {
+    let original = sample();
+    let m = model(&original, None, 0);
+    let (carrier, deliver, log) = Deferred::logged(2);
+    let mut pool = Pool::with_view_worker(Box::new(carrier));
+    assert_eq!(pool.workers(), 1, "one worker for the background");
+    assert_eq!(pool.to_json()["view_worker"], true);
+    let requests: Vec<(Params, Vec<u32>)> = (1..4)
+        .map(|i| (params(Filter::Taubin, 0), vec![i * 5]))
+        .collect();
+    pool.prefetch(&m, &requests);
+    let structure = pool.suggest_structure(
+        original.mesh().clone(),
+        params(Filter::Hc, 10),
+        None,
+        crate::case::SuggestAllOptions {
+            tau: 0.5,
+            filter: None,
+            method: crate::suggest::SearchMethod::Local,
+            max_volume_change: None,
+        },
+    );
+    let view = pool.smooth(&m, &params(Filter::Hc, 20), 0.5, true);
+    let jobs = |worker: usize| -> Vec<String> {
+        (log.borrow().iter())
+            .filter(|(w, r)| {
+                *w == worker && !matches!(r, Request::Hold { .. } | Request::Weights { .. })
+            })
+            .map(|(_, r)| {
+                format!("{r:?}")
+                    .split([' ', '{'])
+                    .next()
+                    .unwrap_or_default()
+                    .to_string()
+            })
+            .collect()
+    };
+    assert_eq!(
+        jobs(1),
+        ["Smooth"],
+        "the view's job went out at once, to its worker"
+    );
+    assert_eq!(
+        jobs(0),
+        ["Terms"],
+        "the background's worker is busy with the guidance"
+    );
+    deliver.set(true);
+    let mut smoothed = None;
+    let mut suggested = None;
+    for _ in 0..40 {
+        pool.pump();
+        smoothed = smoothed.or_else(|| pool.take_smoothed(view));
+        suggested = suggested.or_else(|| pool.take_structure_reply(structure));
+        let _ = pool.measure(&m, &requests[2].0, &requests[2].1);
+    }
+    assert!(matches!(smoothed, Some(Reply::Smoothed { .. })));
+    assert!(matches!(suggested, Some(Reply::Suggested { .. })));
+    assert_eq!(
+        jobs(1),
+        ["Smooth"],
+        "nothing but the view's work on the view's worker"
+    );
+    assert!(
+        jobs(0).contains(&"SuggestStructure".to_string()),
+        "{:?}",
+        jobs(0)
+    );
+}
+
 #[test]
 fn a_worker_without_a_model_says_so() {
     let mut worker = Worker::default();

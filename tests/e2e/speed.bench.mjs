@@ -48,7 +48,7 @@ function withBrainOnWorkers(workers, body) {
         await app.call("setFilter", "hc");
         await app.loadMesh(readFileSync(BRAIN), "brain.ply");
         await app.call("metrics");
-        assert.deepEqual((await state(app)).cpu_engine, { workers, threaded: true }, "the page runs the CPU engine in its workers");
+        assert.deepEqual((await state(app)).cpu_engine, { workers, view_worker: true, threaded: true }, "the page runs the CPU engine in its workers, one more kept for the view");
         return body(app);
     }, { query: `?workers=${workers}` });
 }
@@ -59,7 +59,7 @@ function emit(line) {
     appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
 }
 
-testIn(EVERY_RUN, "B1 HC, 20 iterations: setParams to metrics() against the engine's own time and the native CLI", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "B1 HC, 20 iterations: setParams to metrics() against the engine's own time (median of 3) and the native CLI", { timeout: TIMEOUT }, async () => {
     const native = await cli.cliJson("bench", BRAIN, "--filter", "hc", "--iterations", "20", "--repeat", "3", "--json");
     emit({
         bench: "native",
@@ -94,9 +94,23 @@ testIn(EVERY_RUN, "B1 HC, 20 iterations: setParams to metrics() against the engi
             const engineMs = timings && timings.smooth_ms !== undefined ? timings.smooth_ms + timings.measure_ms : null;
             return { seconds, engineMs };
         };
+        /** Three timings (from 10 iterations to 20 each time), and the one of median ratio. */
+        const median = async () => {
+            const runs = [];
+            for (let i = 0; i < 3; i++) {
+                if (i > 0) {
+                    await app.setParams({ iterations: 10 });
+                    await app.metrics();
+                }
+                const run = await timed();
+                runs.push({ ...run, ratio: run.engineMs ? (run.seconds * 1e3) / run.engineMs : Infinity });
+            }
+            const sorted = [...runs].sort((a, b) => a.ratio - b.ratio);
+            return { ...sorted[1], ratios: runs.map((r) => r.ratio) };
+        };
         // While the suggestion and the graphs made on opening still run (as a user meets it),
         // then with the background idle (Escape cancels the suggestion, G closes the graphs).
-        const { seconds, engineMs } = await timed();
+        const { seconds, engineMs, ratios } = await median();
         const { view } = await state(app);
         await app.page.mouse.click(view.x + view.width / 2, view.y + view.height / 2);
         await app.page.keyboard.press("Escape");
@@ -104,7 +118,7 @@ testIn(EVERY_RUN, "B1 HC, 20 iterations: setParams to metrics() against the engi
         await app.page.waitForFunction(() => window.meshsmooth.state().guidance.activities.length === 0, null, { timeout: 60_000 });
         await app.setParams({ iterations: 10 });
         await app.metrics();
-        const idle = await timed();
+        const idle = await median();
         emit({
             bench: "browser",
             mode: MODE,
@@ -116,9 +130,11 @@ testIn(EVERY_RUN, "B1 HC, 20 iterations: setParams to metrics() against the engi
             seconds_set_params_and_metrics: seconds,
             engine_ms: engineMs,
             latency_vs_engine: engineMs ? (seconds * 1e3) / engineMs : null,
+            latency_vs_engine_runs: ratios,
             idle_seconds_set_params_and_metrics: idle.seconds,
             idle_engine_ms: idle.engineMs,
             idle_latency_vs_engine: idle.engineMs ? (idle.seconds * 1e3) / idle.engineMs : null,
+            idle_latency_vs_engine_runs: idle.ratios,
         });
         if (MODE === "cpu") {
             // The wasm CPU engine against the native one on one thread, each its best of 3:

@@ -202,8 +202,14 @@ fn setter(
 ) -> Closure<dyn FnMut(JsValue) -> Result<(), JsValue>> {
     let (doc, ctx) = (doc.clone(), ctx.clone());
     Closure::new(move |value: JsValue| {
-        edit(&mut doc.borrow_mut().session, value).map_err(|e| error(&e))?;
-        ctx.request_repaint();
+        let mut doc = doc.borrow_mut();
+        edit(&mut doc.session, value).map_err(|e| error(&e))?;
+        doc.step_cpu_engine();
+        // With the work in the CPU engine's workers, their reply wakes the page: a frame now
+        // would only draw the old surface while the new one is computed.
+        if !doc.working_elsewhere() || !doc.busy() {
+            ctx.request_repaint();
+        }
         Ok(())
     })
 }

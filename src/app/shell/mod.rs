@@ -81,19 +81,23 @@ impl Shell {
         let doc = Rc::new(RefCell::new(Document::new(backend)));
         // The CPU engine runs in workers; without them (a page that cannot start any) it runs
         // here, blocking frames, rather than not at all.
-        match workers::WebWorkers::start(workers::pool_size(), &cc.egui_ctx) {
+        // The background's workers, and one more kept for the view.
+        match workers::WebWorkers::start(workers::pool_size() + 1, &cc.egui_ctx) {
             Ok(w) => {
-                log::info!("CPU engine: {} workers", w.workers());
+                log::info!(
+                    "CPU engine: {} workers, one of them the view's",
+                    w.workers()
+                );
                 let weak = Rc::downgrade(&doc);
                 w.on_reply(Box::new(move || {
                     // Between frames the document is free; skipped should it not be.
                     if let Some(Ok(mut doc)) = weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
-                        doc.session.pump_cpu_engine();
+                        doc.step_cpu_engine();
                     }
                 }));
                 doc.borrow_mut()
                     .session
-                    .set_cpu_engine(Pool::new(Box::new(w)));
+                    .set_cpu_engine(Pool::with_view_worker(Box::new(w)));
             }
             Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
         }
