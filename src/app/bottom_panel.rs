@@ -38,7 +38,8 @@ impl BottomPanel {
 
     /// The panel's contents; `layout` gets where its graphs or gallery cards were drawn.
     pub fn show(&mut self, ui: &mut egui::Ui, session: &mut Session, layout: &mut PanelLayout) {
-        *layout = PanelLayout::default();
+        layout.graphs.clear();
+        layout.gallery.clear();
         ui.horizontal(|ui| {
             let mut gallery = self.gallery_tab;
             ui.selectable_value(

@@ -106,6 +106,19 @@ pub struct PanelLayout {
     pub graphs: Vec<GraphColumn>,
     /// The gallery cards' visible rectangles, in gallery order.
     pub gallery: Vec<PageRect>,
+    /// The Structures list's rows as drawn, and its Name field.
+    pub structures: Vec<StructureRow>,
+    pub structure_name: Option<PageRect>,
+}
+
+/// One row of the Structures list: its visibility box, show-alone button and name (which
+/// selects it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StructureRow {
+    pub index: usize,
+    pub visible: PageRect,
+    pub solo: PageRect,
+    pub name: PageRect,
 }
 
 /// One parameter's column of graphs.
@@ -130,6 +143,13 @@ impl PanelLayout {
                 }).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
             "gallery": self.gallery.iter().map(|r| r.to_json()).collect::<Vec<_>>(),
+            "structures": self.structures.iter().map(|r| serde_json::json!({
+                "index": r.index,
+                "visible": r.visible.to_json(),
+                "solo": r.solo.to_json(),
+                "name": r.name.to_json(),
+            })).collect::<Vec<_>>(),
+            "structure_name": self.structure_name.map(PageRect::to_json),
         })
     }
 }

@@ -5,6 +5,7 @@
 
 use eframe::egui;
 
+use super::document::{PanelLayout, StructureRow};
 use crate::case::CaseStructure;
 use crate::session::{Session, StructureChange};
 
@@ -49,8 +50,16 @@ fn to_bytes(c: [f32; 4]) -> [u8; 4] {
 }
 
 impl StructureList {
-    /// Shows the open case's structures, ungrouped ones first, then each group's.
-    pub fn show(&mut self, ui: &mut egui::Ui, session: &Session) -> Vec<StructureAction> {
+    /// Shows the open case's structures, ungrouped ones first, then each group's; `layout`
+    /// gets where the rows and the Name field were drawn.
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        session: &Session,
+        layout: &mut PanelLayout,
+    ) -> Vec<StructureAction> {
+        layout.structures.clear();
+        layout.structure_name = None;
         let mut actions = Vec::new();
         let Some(current) = session.current_structure() else {
             return actions;
@@ -85,7 +94,8 @@ impl StructureList {
                     for (i, s) in list.iter().enumerate() {
                         if s.group.as_deref() == group {
                             let flag = flagged.contains(&i);
-                            row(ui, i, s, (i == current, flag), &mut actions);
+                            let drawn = row(ui, i, s, (i == current, flag), &mut actions);
+                            layout.structures.push(drawn);
                         }
                     }
                 }
@@ -105,6 +115,7 @@ impl StructureList {
             ui.horizontal(|ui| {
                 ui.label("Name");
                 let edit = ui.add(egui::TextEdit::singleline(name).desired_width(110.0));
+                layout.structure_name = Some(edit.rect.into());
                 if edit.lost_focus() && name.trim() != s.name {
                     let change = StructureChange {
                         name: Some(name.clone()),
@@ -240,14 +251,11 @@ fn row(
     s: &CaseStructure,
     (selected, flagged): (bool, bool),
     actions: &mut Vec<StructureAction>,
-) {
+) -> StructureRow {
     ui.horizontal(|ui| {
         let mut visible = s.visible;
-        if ui
-            .checkbox(&mut visible, "")
-            .on_hover_text("Show or hide")
-            .changed()
-        {
+        let visibility = ui.checkbox(&mut visible, "").on_hover_text("Show or hide");
+        if visibility.changed() {
             let change = StructureChange {
                 visible: Some(visible),
                 ..Default::default()
@@ -264,7 +272,8 @@ fn row(
             };
             actions.push(StructureAction::Change(i, change));
         }
-        if ui.small_button("S").on_hover_text("Show alone").clicked() {
+        let solo = ui.small_button("S").on_hover_text("Show alone");
+        if solo.clicked() {
             actions.push(StructureAction::Solo(i));
         }
         let mut about = format!(
@@ -286,5 +295,12 @@ fn row(
             ui.colored_label(ui.visuals().warn_fg_color, "⚠")
                 .on_hover_text("The last checks warn of this structure: see below the list");
         }
-    });
+        StructureRow {
+            index: i,
+            visible: visibility.rect.into(),
+            solo: solo.rect.into(),
+            name: label.rect.into(),
+        }
+    })
+    .inner
 }

@@ -54,8 +54,10 @@
 //!   `brush`: `{on, pick_ms}`, whether the weight brush is on and how long its latest pick took;
 //!   `view`: `{x, y, width, height}`, the 3D view's rectangle in CSS pixels; `layout`:
 //!   `{graphs: [{param, strips: [{x, y, width, height, x0, x1}]}], gallery: [{x, y, width,
-//!   height}]}`, where the graphs' plot areas (with the parameter values at their left and
-//!   right edges) and the gallery's visible cards were drawn; `guidance`:
+//!   height}], structures: [{index, visible, solo, name}], structure_name}`, where the graphs'
+//!   plot areas (with the parameter values at their left and right edges), the gallery's
+//!   visible cards, the Structures list's rows (their show box, S button and name) and its
+//!   Name field were drawn; `guidance`:
 //!   background work under way, whether the graphs are current, the suggestion and the gallery)
 //! - `clearWeights()`: every vertex free again (undoes the weight brush)
 //!
@@ -145,6 +147,26 @@ fn when_ready(
             }),
         );
         ctx.request_repaint();
+    })
+}
+
+/// Work started in the background (`started`), and a promise settled once `ready` holds with
+/// the session's `report`, or at once with why it did not start.
+fn started_work(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+    started: Result<(), String>,
+    ready: super::document::Ready,
+    report: fn(&crate::session::Session) -> Option<serde_json::Value>,
+) -> Promise {
+    if let Err(e) = started {
+        return settled(Err(e));
+    }
+    ctx.request_repaint();
+    when_ready(doc, ctx, ready, move |s| {
+        report(s)
+            .map(|v| to_js(&v))
+            .ok_or_else(|| "no report".to_string())
     })
 }
 
@@ -381,19 +403,12 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
                 tau_and_search(&doc.session, &options, "suggestAll")
                     .and_then(|(tau, method)| doc.session.start_suggest_all(tau, method))
             };
-            if let Err(e) = started {
-                return settled(Err(e));
-            }
-            c.request_repaint();
-            when_ready(
+            started_work(
                 &d,
                 &c,
+                started,
                 |s| !s.suggesting_all(),
-                |s| {
-                    s.suggest_all_json()
-                        .map(|v| to_js(&v))
-                        .ok_or_else(|| "no Suggest all".to_string())
-                },
+                |s| s.suggest_all_json(),
             )
         }),
     )?;
@@ -403,20 +418,8 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
         &api,
         "checkStructures",
         Closure::<dyn FnMut() -> Promise>::new(move || {
-            if let Err(e) = d.borrow_mut().session.start_checks() {
-                return settled(Err(e));
-            }
-            c.request_repaint();
-            when_ready(
-                &d,
-                &c,
-                |s| !s.checking(),
-                |s| {
-                    s.checks_json()
-                        .map(|v| to_js(&v))
-                        .ok_or_else(|| "no checks".to_string())
-                },
-            )
+            let started = d.borrow_mut().session.start_checks();
+            started_work(&d, &c, started, |s| !s.checking(), |s| s.checks_json())
         }),
     )?;
 

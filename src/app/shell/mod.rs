@@ -296,10 +296,11 @@ impl Shell {
     }
 
     fn smoothing_panel(&mut self, ui: &mut egui::Ui) {
-        let mut doc = self.doc.borrow_mut();
+        let mut guard = self.doc.borrow_mut();
+        let doc = &mut *guard;
         let timings = doc.timings;
         let mut add_files = false;
-        for action in self.structures.show(ui, &doc.session) {
+        for action in self.structures.show(ui, &doc.session, &mut doc.panel) {
             let done = match action {
                 StructureAction::AddFiles => {
                     add_files = true;
@@ -349,7 +350,7 @@ impl Shell {
         ui.separator();
         ui.heading("Colours");
         controls::coloring(ui, &mut self.coloring, &mut doc.session);
-        drop(doc);
+        drop(guard);
         if add_files {
             self.open_picker(true);
         }
