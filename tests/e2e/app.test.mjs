@@ -161,8 +161,9 @@ testIn(WEBGPU_RUN, "3 Open… opens the file chooser, and the chosen torus is lo
         const chooserOpened = app.page.waitForEvent("filechooser", { timeout: 30_000 });
         chooserOpened.catch(() => {}); // awaited below; a rejection before then is not unhandled
         // The button is drawn in the canvas: find it in a screenshot of the top bar (the first
-        // flat-filled box from the left: the title and the hint are text, not boxes).
-        const topBarBoxes = (image) => flatBoxes(image, { y0: 0, y1: 48 });
+        // flat-filled box from the left: the title and the hint are text, not boxes). The bar
+        // ends above y = 25; below it, the Structures list's "Add files…" opens the chooser too.
+        const topBarBoxes = (image) => flatBoxes(image, { y0: 0, y1: 25 });
         const image = await app.screenshotWhen("03-before-open", (i) => topBarBoxes(i).length > 0, "a button in the top bar");
         const button = topBarBoxes(image)[0];
         await app.page.mouse.click(button.x + button.width / 2, button.y + button.height / 2);
