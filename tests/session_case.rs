@@ -7,7 +7,7 @@ mod label_maps;
 
 use label_maps::read;
 use meshsmooth::export::Container;
-use meshsmooth::session::Session;
+use meshsmooth::session::{Session, StructureChange};
 
 /// Opens `name` in `session` (its workers run on this thread) and checks it opened.
 fn open(session: &mut Session, name: &str, bytes: Vec<u8>) {
@@ -83,7 +83,6 @@ fn a_session_opens_a_label_map_as_its_structures() {
 /// another is the model, and restored when it is the model again.
 #[test]
 fn a_session_keeps_each_structures_look_and_smoothing() {
-    use meshsmooth::session::{Session, StructureChange};
     use meshsmooth::smooth::{Filter, Params};
     let mut session = Session::default();
     session.begin_open(
@@ -554,4 +553,37 @@ fn the_session_checks_its_structures_as_they_stand() {
         &serde_json::json!([["liver", "portal_vein"], ["liver", "tumor"]])
     );
     assert_eq!(session.flagged_structures(), [0, 1, 2]);
+
+    // The view marks where: the tumour's vertices out of the liver, the liver's in the vein and
+    // the tumour, the vein's and the tumour's in the liver; nothing of the kidney.
+    let marked = report["marked_vertices"].as_array().unwrap();
+    let counts: Vec<u64> = marked.iter().map(|n| n.as_u64().unwrap()).collect();
+    assert!(counts[..3].iter().all(|&n| n > 0), "{counts:?}");
+    assert_eq!(counts[3], 0, "{counts:?}");
+    let key = session.marks_key().expect("marks to show");
+    let patches = session.marked_surfaces();
+    assert_eq!(patches.len(), 3);
+    let liver = &session.case_structures()[0];
+    assert!(patches[0].triangle_count() < liver.original.triangle_count() / 2);
+    // Hiding or recolouring a structure leaves the surfaces as checked; a hidden one's marks
+    // are not drawn.
+    let hide = StructureChange {
+        visible: Some(false),
+        color: Some([0.2, 0.3, 0.4]),
+        ..Default::default()
+    };
+    session.set_structure(1, hide).unwrap();
+    assert_eq!(session.checks_json().unwrap()["current"], true);
+    assert_eq!(session.marks_key(), Some(key));
+    assert_eq!(session.marked_surfaces().len(), 2);
+    // Smoothing anew does not: the marks go.
+    session.set_params(Params::defaults(Filter::Hc)).unwrap();
+    session.smooth_cpu();
+    assert_eq!(session.checks_json().unwrap()["current"], false);
+    assert_eq!(session.marks_key(), None);
+    assert!(session.marked_surfaces().is_empty());
+    // Back to the checked parameters, the same surface again: the marks are current again.
+    session.set_params(shrink).unwrap();
+    session.smooth_cpu();
+    assert_eq!(session.marks_key(), Some(key));
 }

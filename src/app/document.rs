@@ -410,6 +410,7 @@ impl Document {
         state["brush"] = serde_json::json!({"on": v.brush_on, "pick_ms": v.pick_ms});
         state["view"] = v.rect.to_json();
         state["layout"] = self.panel.to_json();
+        state["checks"] = self.session.checks_json().unwrap_or_default();
         // WebAssembly memory only grows: its size is the page's peak.
         state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state

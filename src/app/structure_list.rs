@@ -7,6 +7,7 @@ use eframe::egui;
 
 use super::document::{PanelLayout, StructureRow};
 use crate::case::CaseStructure;
+use crate::metrics::Metrics;
 use crate::session::{Session, StructureChange};
 
 /// What the author did in the list this frame.
@@ -94,7 +95,9 @@ impl StructureList {
                     for (i, s) in list.iter().enumerate() {
                         if s.group.as_deref() == group {
                             let flag = flagged.contains(&i);
-                            let drawn = row(ui, i, s, (i == current, flag), &mut actions);
+                            let measures = measures(s, session, i);
+                            let state = (i == current, flag);
+                            let drawn = row(ui, (i, s, &measures), state, &mut actions);
                             layout.structures.push(drawn);
                         }
                     }
@@ -137,6 +140,9 @@ impl StructureList {
                     actions.push(StructureAction::Change(current, change));
                 }
             });
+            let [how, what] = measures(s, session, current);
+            ui.small(how);
+            ui.small(what);
         }
         self.case_fields(ui, session, &mut actions);
         ui.separator();
@@ -240,15 +246,45 @@ fn checks_report(ui: &mut egui::Ui, session: &Session) {
     }
     if report["current"] == false {
         ui.small("(the case changed since: check again)");
+    } else if session.marks_key().is_some() {
+        ui.small("Where: marked in magenta in the view, seen through what lies in front.");
     }
 }
 
-/// One structure's row: visibility, colour with opacity, show alone, its name to select, and
-/// a warning sign when the last checks flagged it.
+/// A structure's smoothing and its measures as shown, a line each: the filter and parameters;
+/// the volume change and the local error, mean and maximum (mm, and in voxel diagonals where
+/// the voxel size is known).
+fn measures(s: &CaseStructure, session: &Session, i: usize) -> [String; 2] {
+    let params = session.structure_params(i).unwrap_or(s.params);
+    let how = format!("{}: {}", params.filter.name(), params.describe());
+    let what = match session.structure_metrics(i) {
+        Some(m) => measured(m, s.voxel_diagonal()),
+        None if i == session.current_structure().unwrap_or(usize::MAX) => "smoothing…".into(),
+        None => "not smoothed".into(),
+    };
+    [how, what]
+}
+
+fn measured(m: &Metrics, diagonal: Option<f64>) -> String {
+    let volume = m.volume_change.map_or("volume –".into(), |v| {
+        format!("volume {:+.2}%", 100.0 * v)
+    });
+    let error = |mm: f64| match diagonal {
+        Some(d) if d > 0.0 => format!("{mm:.3} mm ({:.2} vd)", mm / d),
+        _ => format!("{mm:.3} mm"),
+    };
+    format!(
+        "{volume}, error mean {}, max {}",
+        error(m.mean_error),
+        error(m.max_error)
+    )
+}
+
+/// One structure's row: visibility, colour with opacity, show alone, its name to select (its
+/// measures on hover), its volume change, and a warning sign when the last checks flagged it.
 fn row(
     ui: &mut egui::Ui,
-    i: usize,
-    s: &CaseStructure,
+    (i, s, [how, what]): (usize, &CaseStructure, &[String; 2]),
     (selected, flagged): (bool, bool),
     actions: &mut Vec<StructureAction>,
 ) -> StructureRow {
@@ -287,9 +323,17 @@ fn row(
         if let Some(source) = &s.source {
             about = format!("{about}\nfrom {source}");
         }
+        let about = format!("{about}\n{how}\n{what}");
         let label = ui.selectable_label(selected, &s.name).on_hover_text(about);
         if label.clicked() && !selected {
             actions.push(StructureAction::Select(i));
+        }
+        if let Some(change) = what
+            .strip_prefix("volume ")
+            .and_then(|w| w.split(',').next())
+        {
+            ui.weak(change)
+                .on_hover_text("Volume change against the segmentation");
         }
         if flagged {
             ui.colored_label(ui.visuals().warn_fg_color, "⚠")

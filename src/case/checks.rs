@@ -3,16 +3,36 @@
 
 use serde_json::{json, Value};
 
-use super::relations::{relations, PairRelation, RelationChanges};
+use super::relations::{marks, relations, PairRelation, RelationChanges};
 use super::Case;
+use crate::mesh::Mesh;
 
 /// The relations of every pair of structures that come near each other: of the originals, or
 /// of the surfaces as shown. Each structure tolerates half its voxel diagonal (the
 /// segmentation cannot place its boundary closer than that), a surface mesh none.
 pub fn check(case: &Case, shown: bool) -> Vec<PairRelation> {
-    let meshes: Vec<_> = case
-        .structures
-        .iter()
+    let meshes = surfaces(case, shown);
+    let refs: Vec<_> = meshes.iter().collect();
+    relations(&refs, &tolerances(case))
+}
+
+/// The vertices of each structure's surface as shown that make the warnings of `changed`
+/// (found by [`check`] as opened, `before`, and as shown), so a view can mark where.
+pub fn check_marks(
+    case: &Case,
+    before: &[PairRelation],
+    changed: &RelationChanges,
+) -> Vec<Vec<u32>> {
+    if changed.left_inside.is_empty() && changed.new_crossings.is_empty() {
+        return vec![Vec::new(); case.structures.len()];
+    }
+    let meshes = surfaces(case, true);
+    let refs: Vec<_> = meshes.iter().collect();
+    marks(&refs, &tolerances(case), before, changed)
+}
+
+fn surfaces(case: &Case, shown: bool) -> Vec<Mesh> {
+    (case.structures.iter())
         .map(|s| {
             if shown {
                 s.surface()
@@ -20,14 +40,13 @@ pub fn check(case: &Case, shown: bool) -> Vec<PairRelation> {
                 s.original.clone()
             }
         })
-        .collect();
-    let refs: Vec<_> = meshes.iter().collect();
-    let tolerance: Vec<f64> = case
-        .structures
-        .iter()
+        .collect()
+}
+
+fn tolerances(case: &Case) -> Vec<f64> {
+    (case.structures.iter())
         .map(|s| s.voxel_diagonal().map_or(0.0, |d| 0.5 * d))
-        .collect();
-    relations(&refs, &tolerance)
+        .collect()
 }
 
 fn pair_names(case: &Case, pairs: &[(usize, usize)]) -> Vec<[String; 2]> {

@@ -11,7 +11,7 @@ mod pipeline;
 mod record;
 pub mod relations;
 
-pub use checks::{check, checks_json, checks_text};
+pub use checks::{check, check_marks, checks_json, checks_text};
 pub use open::{file_name, open, surface_structure, CaseOpenError};
 pub use pipeline::{
     smooth_structure, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllProgress,

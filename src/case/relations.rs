@@ -155,6 +155,93 @@ pub fn changes(before: &[PairRelation], after: &[PairRelation]) -> RelationChang
     out
 }
 
+/// The vertices behind each warning of `changed` (from [`changes`] of `before` and the
+/// relations of `meshes` now), per structure, so a view can show where: of a structure that
+/// left another, those farther outside it than the pair allows; of a pair that now crosses,
+/// those of each deeper in the other's material than the pair's crossing tolerance.
+/// `tolerance` is as given to [`relations`].
+///
+/// # Panics
+/// When `tolerance` and `meshes` differ in length.
+pub fn marks(
+    meshes: &[&Mesh],
+    tolerance: &[f64],
+    before: &[PairRelation],
+    changed: &RelationChanges,
+) -> Vec<Vec<u32>> {
+    assert_eq!(meshes.len(), tolerance.len(), "one tolerance per structure");
+    let tol = |a: usize, b: usize| Tolerance {
+        crossing: tolerance[a].max(tolerance[b]).max(0.0),
+        enclosure: tolerance[a].max(0.0) + tolerance[b].max(0.0),
+    };
+    // (structure marked, the other, what marks a vertex)
+    let mut asks: Vec<(usize, usize, Mark)> = Vec::new();
+    for &(inner, outer) in &changed.left_inside {
+        let t = tol(inner, outer);
+        let was = before
+            .iter()
+            .find(|r| (r.a, r.b) == (inner, outer) || (r.b, r.a) == (inner, outer))
+            .map_or(0.0, |r| {
+                if r.a == inner {
+                    r.a_outside_b
+                } else {
+                    r.b_outside_a
+                }
+            });
+        asks.push((inner, outer, Mark::OutsideBeyond(was + t.crossing)));
+    }
+    for &(a, b) in &changed.new_crossings {
+        let depth = tol(a, b).crossing;
+        asks.push((a, b, Mark::DeeperThan(depth)));
+        asks.push((b, a, Mark::DeeperThan(depth)));
+    }
+    let mut solids: HashMap<usize, Solid> = HashMap::new();
+    for &(_, other, _) in &asks {
+        if let (None, Some(bounds)) = (solids.get(&other), Box3::of(&meshes[other].positions)) {
+            solids.insert(other, Solid::new(meshes[other], bounds));
+        }
+    }
+    let mut out = vec![Vec::new(); meshes.len()];
+    for (marked, other, mark) in &asks {
+        let (Some(solid), Some(bounds)) = (solids.get(other), Box3::of(&meshes[*marked].positions))
+        else {
+            continue;
+        };
+        let t = tol(*marked, *other);
+        let mut against = Against::new(bounds, solid, t.enclosure + t.crossing);
+        // Every distance measured, so only the vertices that went too far are marked.
+        against.may_enclose = true;
+        let found: Vec<u32> = (meshes[*marked].positions.par_iter().enumerate())
+            .filter(|(_, &p)| mark.holds(against.at(to_f64(p))))
+            .map(|(i, _)| i as u32)
+            .collect();
+        out[*marked].extend(found);
+    }
+    for list in &mut out {
+        list.sort_unstable();
+        list.dedup();
+    }
+    out
+}
+
+/// What marks a vertex against another structure.
+#[derive(Clone, Copy)]
+enum Mark {
+    /// Lying farther outside it than this (mm).
+    OutsideBeyond(f64),
+    /// Lying deeper in its material than this (mm).
+    DeeperThan(f64),
+}
+
+impl Mark {
+    fn holds(self, r: Reach) -> bool {
+        match self {
+            Mark::OutsideBeyond(d) => r.outside > d,
+            Mark::DeeperThan(d) => r.depth > d,
+        }
+    }
+}
+
 /// A pair's tolerances (mm).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Tolerance {
@@ -233,49 +320,11 @@ struct Reach {
 /// How the surface with vertices `positions` (bounded by `bounds`) lies against `other`;
 /// distances outside it are measured up to `cap`.
 fn reach(positions: &[[f32; 3]], bounds: Box3, other: &Solid, cap: f64) -> Reach {
-    // Only a surface within the other's grown box can come within the cap; below that, only
-    // vertices in its box need rays, and distances only when they decide something.
-    let reachable = other.bounds.grown(cap);
-    let may_enclose = reachable.holds_box(&bounds);
-    let outside = |p: [f64; 3]| {
-        if !may_enclose {
-            return f64::INFINITY;
-        }
-        match other.distance.closest_within(p, cap.next_up()) {
-            Some(c) => c.distance,
-            None => f64::INFINITY,
-        }
-    };
+    let against = Against::new(bounds, other, cap);
     positions
         .par_iter()
         .with_min_len(128)
-        .map(|&p| {
-            let p = to_f64(p);
-            if !other.bounds.holds(p) {
-                return Reach {
-                    outside: if reachable.holds(p) {
-                        outside(p)
-                    } else {
-                        f64::INFINITY
-                    },
-                    depth: 0.0,
-                };
-            }
-            match other.rays.locate(p) {
-                Location::OnSurface => Reach {
-                    outside: 0.0,
-                    depth: 0.0,
-                },
-                Location::Within { shells } if shells % 2 == 1 => Reach {
-                    outside: 0.0,
-                    depth: other.distance.distance(p).unwrap_or(0.0),
-                },
-                Location::Within { shells } => Reach {
-                    outside: if shells > 0 { 0.0 } else { outside(p) },
-                    depth: 0.0,
-                },
-            }
-        })
+        .map(|&p| against.at(to_f64(p)))
         .reduce(
             || Reach {
                 outside: 0.0,
@@ -286,4 +335,65 @@ fn reach(positions: &[[f32; 3]], bounds: Box3, other: &Solid, cap: f64) -> Reach
                 depth: x.depth.max(y.depth),
             },
         )
+}
+
+/// Asks how the points of one surface lie against another structure.
+struct Against<'a> {
+    other: &'a Solid,
+    cap: f64,
+    /// The other's box grown by the cap: points beyond it are farther out than the cap.
+    reachable: Box3,
+    /// The surface lies within `reachable`: below that, some point is beyond the cap anyway.
+    may_enclose: bool,
+}
+
+impl<'a> Against<'a> {
+    fn new(bounds: Box3, other: &'a Solid, cap: f64) -> Self {
+        let reachable = other.bounds.grown(cap);
+        Self {
+            other,
+            cap,
+            reachable,
+            may_enclose: reachable.holds_box(&bounds),
+        }
+    }
+
+    /// Distances are computed only where they decide something: rays only for points in the
+    /// other's box, distances outside only where the surface may still be enclosed.
+    fn at(&self, p: [f64; 3]) -> Reach {
+        let other = self.other;
+        let outside = |p: [f64; 3]| {
+            if !self.may_enclose {
+                return f64::INFINITY;
+            }
+            match other.distance.closest_within(p, self.cap.next_up()) {
+                Some(c) => c.distance,
+                None => f64::INFINITY,
+            }
+        };
+        if !other.bounds.holds(p) {
+            return Reach {
+                outside: if self.reachable.holds(p) {
+                    outside(p)
+                } else {
+                    f64::INFINITY
+                },
+                depth: 0.0,
+            };
+        }
+        match other.rays.locate(p) {
+            Location::OnSurface => Reach {
+                outside: 0.0,
+                depth: 0.0,
+            },
+            Location::Within { shells } if shells % 2 == 1 => Reach {
+                outside: 0.0,
+                depth: other.distance.distance(p).unwrap_or(0.0),
+            },
+            Location::Within { shells } => Reach {
+                outside: if shells > 0 { 0.0 } else { outside(p) },
+                depth: 0.0,
+            },
+        }
+    }
 }

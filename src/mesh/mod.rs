@@ -64,6 +64,33 @@ impl Mesh {
     pub fn signed_volume(&self) -> f64 {
         signed_volume(&self.positions, &self.triangles)
     }
+
+    /// The part of the surface around `vertices`: every triangle with one of them as a
+    /// corner, over only the vertices those use. Indices out of range are ignored.
+    pub fn patch(&self, vertices: &[u32]) -> Mesh {
+        let mut marked = vec![false; self.positions.len()];
+        for &v in vertices {
+            if let Some(m) = marked.get_mut(v as usize) {
+                *m = true;
+            }
+        }
+        let touched = |t: &&[u32; 3]| t.iter().any(|&v| marked[v as usize]);
+        let mut new_index = vec![u32::MAX; self.positions.len()];
+        let mut positions = Vec::new();
+        let triangles = (self.triangles.iter().filter(touched))
+            .map(|t| {
+                t.map(|v| {
+                    let slot = &mut new_index[v as usize];
+                    if *slot == u32::MAX {
+                        *slot = positions.len() as u32;
+                        positions.push(self.positions[v as usize]);
+                    }
+                    *slot
+                })
+            })
+            .collect();
+        Mesh::new(positions, triangles)
+    }
 }
 
 /// Axis-aligned bounding box of a point set.
@@ -224,5 +251,35 @@ mod tests {
         assert_eq!(m.bounding_box(), Some(([0.0; 3], [1.0; 3])));
         assert!((m.bounding_box_diagonal() - 3f64.sqrt()).abs() < 1e-12);
         assert_eq!(Mesh::default().bounding_box(), None);
+    }
+
+    #[test]
+    fn a_patch_holds_the_triangles_around_its_vertices() {
+        let m = tetrahedron();
+        // Vertex 0 is a corner of three of the four triangles; those use all four vertices.
+        let around_0 = m.patch(&[0]);
+        let at_0 = m.triangles.iter().filter(|t| t.contains(&0)).count();
+        assert_eq!(around_0.triangle_count(), at_0);
+        assert_eq!(around_0.vertex_count(), 4);
+        assert!(
+            (around_0.signed_volume() - m.signed_volume()).abs() > 1e-3,
+            "one face left out"
+        );
+        // The same corners in the same places, reindexed.
+        for (t, old) in around_0
+            .triangles
+            .iter()
+            .zip(m.triangles.iter().filter(|t| t.contains(&0)))
+        {
+            for k in 0..3 {
+                assert_eq!(
+                    around_0.positions[t[k] as usize],
+                    m.positions[old[k] as usize]
+                );
+            }
+        }
+        assert_eq!(m.patch(&[]), Mesh::default());
+        assert_eq!(m.patch(&[99]), Mesh::default());
+        assert_eq!(m.patch(&[0, 1, 2, 3]).signed_volume(), m.signed_volume());
     }
 }

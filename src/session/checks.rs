@@ -1,7 +1,10 @@
 //! The checks between the open case's structures, as the author asks for them after smoothing:
 //! which structure that lay inside another has left it, and which surfaces that did not cross
 //! now do. A worker checks the case as it stands (the CLI's `case build` reports the same);
-//! the report says whether the case changed since.
+//! the report says whether the case changed since, and the view marks where the warnings are
+//! while the surfaces are as checked.
+
+use std::cell::Cell;
 
 use super::Session;
 use crate::worker::{Reply, StructureJob};
@@ -10,20 +13,37 @@ use crate::worker::{Reply, StructureJob};
 #[derive(Default)]
 pub(super) struct Checks {
     job: Option<StructureJob>,
-    /// The parameters' revision and the structures' version the checks were asked for.
-    asked: (u64, u64),
+    /// Each structure's surface as checked (positions; the triangles never change).
+    checked: Vec<Vec<[f32; 3]>>,
+    /// Whether the structures still show those surfaces, as last found, and for which
+    /// parameters' revision, structures' version and model result it was found: selecting,
+    /// hiding or recolouring a structure leaves them, smoothing one anew does not.
+    same: Cell<Option<(SessionState, bool)>>,
     report: Option<serde_json::Value>,
+    /// Per structure, the vertices of its surface as checked that make a warning.
+    marks: Vec<Vec<u32>>,
+    /// Counts the reports taken, so a view knows its marks are stale.
+    reports: u64,
 }
+
+/// `(revision, case version, whether the model's result is in)`.
+type SessionState = (u64, u64, bool);
 
 impl Session {
     /// Starts checking the case as it stands (replacing checks under way).
     pub fn start_checks(&mut self) -> Result<(), String> {
         let case = self.to_case().ok_or("nothing is open")?;
+        let checked = (case.structures.iter())
+            .map(|s| s.positions().to_vec())
+            .collect();
         let job = self.cpu.check_case(case);
         self.checks = Checks {
             job: Some(job),
-            asked: (self.revision, self.case_version),
+            checked,
+            same: Cell::new(None),
             report: None,
+            marks: Vec::new(),
+            reports: self.checks.reports,
         };
         Ok(())
     }
@@ -42,9 +62,13 @@ impl Session {
             return false;
         };
         self.checks.job = None;
+        self.checks.reports += 1;
         let report = match reply {
-            Reply::Checked { report, .. } => serde_json::from_str(&report)
-                .unwrap_or_else(|e| serde_json::json!({"error": e.to_string()})),
+            Reply::Checked { report, marks, .. } => {
+                self.checks.marks = marks;
+                serde_json::from_str(&report)
+                    .unwrap_or_else(|e| serde_json::json!({"error": e.to_string()}))
+            }
             Reply::Failed { why, .. } => serde_json::json!({ "error": why }),
             _ => serde_json::json!({ "error": "a worker answered something else" }),
         };
@@ -56,8 +80,58 @@ impl Session {
     /// (`current`: the case is as it was checked), or `{error}`.
     pub fn checks_json(&self) -> Option<serde_json::Value> {
         let mut report = self.checks.report.clone()?;
-        report["current"] = (self.checks.asked == (self.revision, self.case_version)).into();
+        report["current"] = self.checks_current().into();
         Some(report)
+    }
+
+    /// Whether every structure shows the surface the last checks found (as [`Session::to_case`]
+    /// gives it: the model's current result, or its original while that is computed).
+    fn checks_current(&self) -> bool {
+        if self.checks.report.is_none() {
+            return false;
+        }
+        let state = (self.revision, self.case_version, self.result().is_some());
+        if let Some((when, same)) = self.checks.same.get() {
+            if when == state {
+                return same;
+            }
+        }
+        let current = self.current_structure();
+        let list = &self.case.structures;
+        let same = list.len() == self.checks.checked.len()
+            && (list.iter().zip(&self.checks.checked).enumerate()).all(|(i, (s, checked))| {
+                let shown = match self.result() {
+                    Some(r) if Some(i) == current => &r.positions,
+                    _ if Some(i) == current => &s.original.positions,
+                    _ => s.positions(),
+                };
+                shown == checked
+            });
+        self.checks.same.set(Some((state, same)));
+        same
+    }
+
+    /// Which marks [`Session::marked_surfaces`] gives: changes when a report comes or the case
+    /// changes since; `None` when there are none to show.
+    pub fn marks_key(&self) -> Option<u64> {
+        let any = self.checks.marks.iter().any(|m| !m.is_empty());
+        (any && self.checks_current()).then_some(self.checks.reports)
+    }
+
+    /// Where the last checks' warnings are: per structure with marks, the patch of its surface
+    /// around the vertices that left another or reach too deep into one. Nothing once the case
+    /// changed since (the marks would point at surfaces no longer shown).
+    pub fn marked_surfaces(&self) -> Vec<crate::mesh::Mesh> {
+        if self.marks_key().is_none() {
+            return Vec::new();
+        }
+        let Some(case) = self.to_case() else {
+            return Vec::new();
+        };
+        (case.structures.iter().zip(&self.checks.marks))
+            .filter(|(s, marks)| s.visible && !marks.is_empty())
+            .map(|(s, marks)| s.surface().patch(marks))
+            .collect()
     }
 
     /// The structures of a warning of the last checks (one that left another, or crosses

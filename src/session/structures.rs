@@ -8,7 +8,9 @@
 
 use super::Session;
 use crate::case::{Case, CaseStructure, Smoothed};
+use crate::metrics::Metrics;
 use crate::segmentation::default_color;
+use crate::smooth::Params;
 
 /// What [`Session::set_structure`] changes; `None` leaves a field as it is.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -203,17 +205,33 @@ impl Session {
         }
     }
 
+    /// Structure `index`'s measures as shown: the model's current result's, another's kept
+    /// ones; `None` where it is not smoothed (or the model's result is still to come).
+    pub fn structure_metrics(&self, index: usize) -> Option<&Metrics> {
+        if Some(index) == self.current_structure() {
+            self.result().map(|r| &r.metrics)
+        } else {
+            let s = self.case.structures.get(index)?;
+            s.smoothed.as_ref().map(|k| &k.metrics)
+        }
+    }
+
+    /// Structure `index`'s filter and parameters: the session's for the model.
+    pub fn structure_params(&self, index: usize) -> Option<Params> {
+        if Some(index) == self.current_structure() {
+            Some(*self.params())
+        } else {
+            self.case.structures.get(index).map(|s| s.params)
+        }
+    }
+
     /// The open case's structures for `state()` and the page's API: what each is, how it is
     /// shown and, where it was smoothed, its measures.
     pub fn structures_json(&self) -> Option<serde_json::Value> {
         let current = self.current_structure()?;
         let list: Vec<_> = (self.case.structures.iter().enumerate())
             .map(|(i, s)| {
-                let metrics = if i == current {
-                    self.result().map(|r| &r.metrics)
-                } else {
-                    s.smoothed.as_ref().map(|k| &k.metrics)
-                };
+                let metrics = self.structure_metrics(i);
                 serde_json::json!({
                     "label": s.label,
                     "name": s.name,

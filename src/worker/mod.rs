@@ -113,8 +113,13 @@ pub enum Reply {
     },
     /// The checks between a case's structures: [`case::checks_json`] with the lines of
     /// [`case::checks_text`] under `text` and the structures of its warnings (by index) under
-    /// `flagged`, as JSON text.
-    Checked { job: u64, report: String },
+    /// `flagged`, as JSON text; and per structure the vertices of its surface as shown that
+    /// make a warning ([`case::check_marks`]).
+    Checked {
+        job: u64,
+        report: String,
+        marks: Vec<Vec<u32>>,
+    },
     /// The job could not be done (no model, weights of another length).
     Failed { job: u64, why: String },
     /// The worker stopped in the middle of its job (a trap in its module): whatever it was
@@ -361,10 +366,13 @@ fn check_case(job: u64, case: &Case, clock: &dyn Fn() -> f64) -> Reply {
     flagged.sort_unstable();
     flagged.dedup();
     report["flagged"] = flagged.into();
+    let marks = case::check_marks(case, &before, &changes);
+    report["marked_vertices"] = marks.iter().map(Vec::len).collect::<Vec<_>>().into();
     report["ms"] = (clock() - start).into();
     Reply::Checked {
         job,
         report: report.to_string(),
+        marks,
     }
 }
 

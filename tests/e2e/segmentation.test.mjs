@@ -227,16 +227,23 @@ testIn(WEBGPU_RUN, "S5 a label map dropped on the page opens as its structures",
  * legend: the tumour once it is coloured pure green (the list's swatch is outside the view).
  */
 function greenPixels(image, view) {
+    return viewPixels(image, view, (r, g, b) => g > 90 && g > r + 60 && g > b + 60);
+}
+
+/** Pixels of the 3D view left of its legend whose colour `(r, g, b)` passes `test`. */
+function viewPixels(image, view, test) {
     let count = 0;
     for (let y = Math.round(view.y); y < Math.round(view.y + view.height); y++) {
         for (let x = Math.round(view.x); x < Math.round(view.x + 0.7 * view.width); x++) {
             const i = (y * image.width + x) * 4;
-            const [r, g, b] = [image.rgba[i], image.rgba[i + 1], image.rgba[i + 2]];
-            if (g > 90 && g > r + 60 && g > b + 60) count++;
+            if (test(image.rgba[i], image.rgba[i + 1], image.rgba[i + 2])) count++;
         }
     }
     return count;
 }
+
+/** The checks' marks: magenta, unlike any structure of the phantom. */
+const magenta = (r, g, b) => r > 120 && b > 110 && g + 70 < Math.min(r, b);
 
 testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, solo and names; each keeps its own smoothing", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
@@ -372,7 +379,9 @@ testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build sug
                 assert.ok(x === y || Math.abs(x - y) <= within, `${p.a}/${p.b} ${key}: ${x} vs the CLI's ${y}`);
             }
         });
-        await app.screenshot("S7-phantom-suggested-all");
+        const view = (await app.state()).view;
+        const unmarked = viewPixels(await app.screenshot("S7-phantom-suggested-all"), view, magenta);
+        assert.ok(unmarked < 50, `no warning, no marks: ${unmarked} magenta pixels`);
         // The liver shrunk by heavy smoothing: the checks warn, and the list flags both.
         await app.setFilter("laplace");
         await app.setParams({ lambda: 0.9, iterations: 50, max_displacement: null });
@@ -380,7 +389,19 @@ testIn(EVERY_RUN, "S7 Suggest all gives every structure the CLI's case build sug
         const warned = await app.call("checkStructures");
         assert.deepEqual(warned.left_inside, [["tumor", "liver"]]);
         assert.ok(warned.flagged.includes(0) && warned.flagged.includes(2), `flagged ${warned.flagged}`);
-        await app.screenshot("S7-liver-shrunk-checks-warn");
+        // The view marks where, over everything.
+        assert.ok(warned.marked_vertices[2] > 0, `the tumour's vertices out of the liver: ${warned.marked_vertices}`);
+        const marked = (image) => viewPixels(image, view, magenta) > unmarked + 300;
+        await app.screenshotWhen("S7-liver-shrunk-checks-warn", marked, "the checks' marks");
+        // Hiding the kidney leaves the surfaces as checked, and the marks; smoothing anew does not.
+        await app.call("setStructure", { index: 3, visible: false });
+        assert.equal((await app.state()).checks.current, true);
+        await app.screenshotWhen("S7-marks-kidney-hidden", marked, "the marks with the kidney hidden");
+        await app.setParams({ iterations: 5 });
+        await app.metrics();
+        assert.equal((await app.state()).checks.current, false);
+        const gone = (image) => viewPixels(image, view, magenta) < unmarked + 50;
+        await app.screenshotWhen("S7-liver-changed-marks-gone", gone, "the marks gone");
         const line = { bench: "page-suggest-all", mode: MODE, file: "case_phantom_shared.seg.nrrd", structures: 4, search: "local", page_s: seconds, cli_s: cliSeconds, workers: state.cpu_engine.workers };
         console.log(JSON.stringify(line));
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");

@@ -32,7 +32,8 @@
 //!   done, total, cancelled}`
 //! - `checkStructures(): Promise<object>`: the checks between the structures as they stand,
 //!   the CLI's `case build --json` `checks` (`pairs`, `left_inside`, `new_crossings`) with
-//!   `text` (the report's lines), `flagged` (the structures of its warnings, by index) and `ms`
+//!   `text` (the report's lines), `flagged` (the structures of its warnings, by index),
+//!   `marked_vertices` (per structure, how many of its vertices the view marks) and `ms`
 //! - `exportCase(format): Promise<Uint8Array>`: the case glTF (`glb`, the default, or `gltf`)
 //!   of every structure as shown and smoothed (a mesh alone is a case of one), once the
 //!   current parameters' result is computed; `setCase({title, description})` names the case
@@ -46,7 +47,7 @@
 //!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
 //! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, loading,
-//!   open_stages, backend, timings, brush, view, layout, guidance}` (`loading`: `{name, stage, stages,
+//!   open_stages, backend, timings, brush, view, layout, checks, guidance}` (`loading`: `{name, stage, stages,
 //!   doing}` while a file opens, else null; `open_stages`: `[{doing, ms}]`, the latest opening's
 //!   stages and their times in the worker; `timings`: the last result's `smooth_ms` and `measure_ms`
 //!   of the CPU engine's own work, or `gpu_run_ms` from submitting a GPU run to having its
@@ -57,7 +58,9 @@
 //!   height}], structures: [{index, visible, solo, name}], structure_name}`, where the graphs'
 //!   plot areas (with the parameter values at their left and right edges), the gallery's
 //!   visible cards, the Structures list's rows (their show box, S button and name) and its
-//!   Name field were drawn; `guidance`:
+//!   Name field were drawn; `checks`: the last checks' report with `current` (every
+//!   structure shows the surface checked: hiding or selecting one keeps it, smoothing one
+//!   anew does not), or null; `guidance`:
 //!   background work under way, whether the graphs are current, the suggestion and the gallery)
 //! - `clearWeights()`: every vertex free again (undoes the weight brush)
 //!

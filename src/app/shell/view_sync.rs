@@ -27,6 +27,8 @@ pub(super) struct Shown {
     pub(super) legend: Option<Legend>,
     /// The version of the structures' looks the other structures were uploaded for.
     pub(super) looks: Option<u64>,
+    /// The checks' marks and the looks' version they were uploaded for.
+    pub(super) marks: (Option<u64>, u64),
 }
 
 impl Shell {
@@ -130,6 +132,19 @@ impl Shell {
             let look = session.model_structure();
             viewer.set_model_look(look.map(|l| l.color), look.is_none_or(|l| l.visible));
             self.shown.looks = Some(session.case_version());
+        }
+        let marks = (session.marks_key(), session.case_version());
+        if self.shown.marks != marks {
+            let patches = session.marked_surfaces();
+            let surfaces: Vec<viewer::ContextSurface<'_>> = (patches.iter())
+                .map(|p| viewer::ContextSurface {
+                    positions: &p.positions,
+                    triangles: &p.triangles,
+                    color: viewer::MARK_COLOR,
+                })
+                .collect();
+            viewer.set_marks(rs, &surfaces);
+            self.shown.marks = marks;
         }
     }
 }

@@ -24,6 +24,10 @@ pub struct ViewResources {
     /// The case's other structures, and a count of their changes.
     pub context: Vec<ContextMesh>,
     pub context_generation: u64,
+    /// Where the last checks' warnings lie (patches of structures), drawn over everything,
+    /// and a count of their changes.
+    pub marks: Vec<ContextMesh>,
+    pub marks_generation: u64,
     /// The per-frame record with vertex colours on, for the other structures.
     context_uniforms: wgpu::Buffer,
     context_group: wgpu::BindGroup,
@@ -39,6 +43,7 @@ struct Frame {
     wireframe: bool,
     mesh_generation: u64,
     context_generation: u64,
+    marks_generation: u64,
     show_model: bool,
     size: [u32; 2],
 }
@@ -71,6 +76,8 @@ impl ViewResources {
             mesh: MeshBuffers::default(),
             context: Vec::new(),
             context_generation: 0,
+            marks: Vec::new(),
+            marks_generation: 0,
             context_uniforms,
             context_group,
             target: None,
@@ -78,7 +85,7 @@ impl ViewResources {
         }
     }
 
-    /// Draws the model and the other structures into the target (cleared to transparent) and
+    /// Draws the model, the other structures and the marks into the target (cleared to transparent) and
     /// resolves it.
     fn draw(&self, encoder: &mut wgpu::CommandEncoder, target: &Target, frame: &Frame) {
         let (color, resolve_target) = match &target.multisampled {
@@ -147,6 +154,10 @@ impl ViewResources {
         for i in far_to_near(&self.context, eye) {
             draw_surface(&mut pass, &self.context[i].buffers);
         }
+        pass.set_pipeline(&self.pipelines.over);
+        for marks in &self.marks {
+            draw_surface(&mut pass, &marks.buffers);
+        }
     }
 }
 
@@ -207,6 +218,7 @@ impl CallbackTrait for ViewCallback {
             wireframe: self.wireframe,
             mesh_generation: view.mesh.generation,
             context_generation: view.context_generation,
+            marks_generation: view.marks_generation,
             show_model: self.show_model,
             size,
         };

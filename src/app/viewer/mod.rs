@@ -37,6 +37,10 @@ pub const BACKGROUND: egui::Color32 = {
     egui::Color32::from_rgb(r, g, b)
 };
 
+/// Where the checks warn (sRGB, with opacity): magenta, which anatomy's colour tables leave
+/// to no tissue, seen through whatever lies in front.
+pub const MARK_COLOR: [u8; 4] = [255, 0, 220, 200];
+
 /// The 3D view of one model. Its GPU resources live in egui-wgpu's callback resources, so one
 /// `Viewer` per app.
 pub struct Viewer {
@@ -121,6 +125,23 @@ impl Viewer {
         match result {
             Ok(()) => self.has_context = !surfaces.is_empty(),
             Err(e) => self.fail(e),
+        }
+    }
+
+    /// Marks drawn over everything (replacing those set before): where the last checks'
+    /// warnings lie.
+    pub fn set_marks(&mut self, rs: &egui_wgpu::RenderState, surfaces: &[ContextSurface<'_>]) {
+        let result = with_resources(rs, |view| {
+            let meshes: Result<Vec<_>, String> = surfaces
+                .iter()
+                .map(|s| context::ContextMesh::new(&rs.device, &rs.queue, s))
+                .collect();
+            view.marks = meshes?;
+            view.marks_generation += 1;
+            Ok(())
+        });
+        if let Err(e) = result {
+            self.fail(e);
         }
     }
 

@@ -34,6 +34,9 @@ pub struct Pipelines {
     pub surface: wgpu::RenderPipeline,
     /// The same, translucent: blended over what is drawn, tests depth, writes none.
     pub translucent: wgpu::RenderPipeline,
+    /// The same, blended over everything whatever lies in front: marks that must show
+    /// where they lie hidden (inside another structure).
+    pub over: wgpu::RenderPipeline,
     /// Edges as a line list over the same positions; tests depth, writes none.
     pub wire: wgpu::RenderPipeline,
     /// The resolved image into egui's pass.
@@ -165,7 +168,7 @@ impl Pipelines {
             per_vertex(VEC4_STRIDE, &NORMAL),
             per_vertex(COLOR_STRIDE, &COLOR),
         ];
-        let surface_pipeline = |label, write_depth, blend| {
+        let surface_pipeline = |label, write_depth, compare, blend| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(&layout),
@@ -182,7 +185,7 @@ impl Pipelines {
                     cull_mode: None,
                     ..Default::default()
                 },
-                depth_stencil: depth(write_depth, wgpu::CompareFunction::Less),
+                depth_stencil: depth(write_depth, compare),
                 multisample,
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
@@ -194,12 +197,16 @@ impl Pipelines {
                 cache: None,
             })
         };
-        let surface = surface_pipeline("meshsmooth surface", true, None);
+        let less = wgpu::CompareFunction::Less;
+        let surface = surface_pipeline("meshsmooth surface", true, less, None);
         // The shader writes premultiplied alpha.
-        let translucent = surface_pipeline(
-            "meshsmooth translucent surface",
+        let blend = Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
+        let translucent = surface_pipeline("meshsmooth translucent surface", false, less, blend);
+        let over = surface_pipeline(
+            "meshsmooth surface over all",
             false,
-            Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+            wgpu::CompareFunction::Always,
+            blend,
         );
 
         let wire = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -265,6 +272,7 @@ impl Pipelines {
             composite_layout,
             surface,
             translucent,
+            over,
             wire,
             composite,
             samples,

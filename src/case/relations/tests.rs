@@ -394,3 +394,44 @@ fn changes_report_left_insides_and_new_crossings_only() {
     let c = changes(&[touching(2.0)], &[touching(2.6)]);
     assert_eq!(c.left_inside, vec![(0, 1)]);
 }
+
+#[test]
+fn marks_are_the_vertices_that_left_or_reach_too_deep() {
+    // A tumour in an organ's cavity, one corner pulled out through the wall.
+    let organ = with_cavity(cube([0.0; 3], [10.0; 3]), cube([2.0; 3], [8.0; 3]));
+    let tumour = cube([3.0; 3], [7.0; 3]);
+    let mut pulled = tumour.clone();
+    pulled.positions[7] = [12.0; 3];
+    let tol = [0.25, 0.25];
+    let before = relations(&[&organ, &tumour], &tol);
+    let after = relations(&[&organ, &pulled], &tol);
+    let changed = changes(&before, &after);
+    assert_eq!(changed.left_inside, vec![(1, 0)], "{changed:?}");
+    // Pulled out, the tumour now holds the organ's corners at 8 and 10 too: a new crossing.
+    assert_eq!(changed.new_crossings, vec![(0, 1)], "{changed:?}");
+    let marked = marks(&[&organ, &pulled], &tol, &before, &changed);
+    assert_eq!(marked, vec![vec![7, 15], vec![7]]);
+    // Nothing changed, nothing marked.
+    let none = marks(
+        &[&organ, &tumour],
+        &tol,
+        &before,
+        &changes(&before, &before),
+    );
+    assert_eq!(none, vec![Vec::<u32>::new(); 2]);
+
+    // Two cubes apart, then one pushed 3 mm into the other: the corners of `a` inside `b` are
+    // marked; no corner of `b` lies in `a`.
+    let a = cube([0.0; 3], [10.0; 3]);
+    let apart = cube([12.0, -5.0, -5.0], [25.0, 15.0, 15.0]);
+    let into = cube([7.0, -5.0, -5.0], [20.0, 15.0, 15.0]);
+    let before = relations(&[&a, &apart], &[0.5, 0.5]);
+    let after = relations(&[&a, &into], &[0.5, 0.5]);
+    let changed = changes(&before, &after);
+    assert_eq!(changed.new_crossings, vec![(0, 1)], "{changed:?}");
+    let marked = marks(&[&a, &into], &[0.5, 0.5], &before, &changed);
+    assert_eq!(marked, vec![vec![1, 3, 5, 7], vec![]]);
+    // A tolerance past the 3 mm depth marks nothing.
+    let marked = marks(&[&a, &into], &[0.5, 4.0], &before, &changed);
+    assert_eq!(marked, vec![Vec::<u32>::new(); 2]);
+}
