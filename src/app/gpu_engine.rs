@@ -206,15 +206,21 @@ impl GpuEngine {
         Some(why)
     }
 
-    /// The revision whose run the buffers hold (submitted; maybe not finished yet).
-    pub fn submitted(&self) -> Option<u64> {
-        self.submitted
+    /// The revision whose run the buffers hold for the document's model `generation`
+    /// (submitted; maybe not finished yet). `None` while the engine still holds the model
+    /// before: a new model can reach the view before the engine takes it up.
+    pub fn submitted(&self, generation: u64) -> Option<u64> {
+        self.submitted.filter(|_| self.holds(generation))
     }
 
-    /// The buffers of the latest run: positions and normals, vec4 per vertex; `None` while
-    /// the next run is under way in them.
-    pub fn buffers(&self) -> Option<(&wgpu::Buffer, &wgpu::Buffer)> {
-        if self.running.is_some() {
+    fn holds(&self, generation: u64) -> bool {
+        self.mesh.as_ref().is_some_and(|(g, _)| *g == generation)
+    }
+
+    /// The buffers of the latest run of model `generation`: positions and normals, vec4 per
+    /// vertex; `None` while the next run is under way in them, or for another model.
+    pub fn buffers(&self, generation: u64) -> Option<(&wgpu::Buffer, &wgpu::Buffer)> {
+        if self.running.is_some() || !self.holds(generation) {
             return None;
         }
         let (_, mesh) = self.mesh.as_ref()?;

@@ -72,7 +72,7 @@ impl Shell {
         let wanted = if self.show_original {
             Positions::Original
         } else if let Some(gpu) = &self.gpu {
-            gpu.submitted().map_or(Positions::Original, Positions::Gpu)
+            (gpu.submitted(doc.model_generation)).map_or(Positions::Original, Positions::Gpu)
         } else {
             result.map_or(Positions::Original, |r| Positions::Cpu(r.revision))
         };
@@ -92,13 +92,15 @@ impl Shell {
                 }
                 // While a run is under way in the engine's buffers they hold none of its
                 // results: copy once it is done.
-                Positions::Gpu(_) => match self.gpu.as_ref().and_then(|g| g.buffers()) {
-                    Some((positions, normals)) => {
-                        viewer.copy_positions_from(rs, positions, normals);
-                        true
+                Positions::Gpu(_) => {
+                    match (self.gpu.as_ref()).and_then(|g| g.buffers(doc.model_generation)) {
+                        Some((positions, normals)) => {
+                            viewer.copy_positions_from(rs, positions, normals);
+                            true
+                        }
+                        None => false,
                     }
-                    None => false,
-                },
+                }
             };
             if shown {
                 self.shown.positions = Some(wanted);
