@@ -13,6 +13,8 @@ struct View {
     base_color: vec4<f32>,
     back_tint: vec4<f32>,
     wire_color: vec4<f32>,
+    // Fragments where dot(clip.xyz, p) > clip.w are cut away; a zero normal cuts nothing.
+    clip: vec4<f32>,
     flags: u32,
 }
 
@@ -89,6 +91,9 @@ fn vs_surface(v: SurfaceVertex) -> SurfaceFragment {
 
 @fragment
 fn fs_surface(f: SurfaceFragment, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    if dot(view.clip.xyz, f.world) > view.clip.w {
+        discard;
+    }
     let to_eye = normalize(view.eye.xyz - f.world);
     // Vertices without area have a zero normal: light them as if facing the eye.
     var n = to_eye;
@@ -120,14 +125,23 @@ fn fs_surface(f: SurfaceFragment, @builtin(front_facing) front: bool) -> @locati
 // win at silhouettes.)
 const WIRE_PULL: f32 = 0.003;
 
+struct WireFragment {
+    @builtin(position) clip: vec4<f32>,
+    // Where the line lies on the surface, for the clipping plane.
+    @location(0) world: vec3<f32>,
+}
+
 @vertex
-fn vs_wire(@location(0) position: vec4<f32>) -> @builtin(position) vec4<f32> {
+fn vs_wire(@location(0) position: vec4<f32>) -> WireFragment {
     let pulled = mix(position.xyz, view.eye.xyz, WIRE_PULL);
-    return view.view_proj * vec4<f32>(pulled, 1.0);
+    return WireFragment(view.view_proj * vec4<f32>(pulled, 1.0), position.xyz);
 }
 
 @fragment
-fn fs_wire() -> @location(0) vec4<f32> {
+fn fs_wire(f: WireFragment) -> @location(0) vec4<f32> {
+    if dot(view.clip.xyz, f.world) > view.clip.w {
+        discard;
+    }
     return encode(view.wire_color.rgb, view.wire_color.a);
 }
 

@@ -67,6 +67,7 @@ fn the_view_struct_matches_the_rust_record() {
         ("base_color", std::mem::offset_of!(ViewUniforms, base_color)),
         ("back_tint", std::mem::offset_of!(ViewUniforms, back_tint)),
         ("wire_color", std::mem::offset_of!(ViewUniforms, wire_color)),
+        ("clip", std::mem::offset_of!(ViewUniforms, clip)),
         ("flags", std::mem::offset_of!(ViewUniforms, flags)),
     ];
     let rust: Vec<(&str, u32)> = rust.iter().map(|&(n, o)| (n, o as u32)).collect();

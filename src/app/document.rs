@@ -6,6 +6,7 @@
 
 use crate::session::{Session, Timings};
 use crate::suggest::Offload;
+use crate::view::{Clip, StandardView};
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -165,6 +166,14 @@ pub enum Opening {
     Done,
 }
 
+/// What the view is asked to show beyond the camera the user moves: the clipping plane, and a
+/// standard side to look from (taken by the view in its next frame).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewAsks {
+    pub clip: Option<Clip>,
+    pub look_from: Option<StandardView>,
+}
+
 pub struct Document {
     pub session: Session,
     pub backend: Backend,
@@ -174,6 +183,9 @@ pub struct Document {
     pub model_generation: u64,
     /// What the 3D view reports to `state()`.
     pub view: ViewReport,
+    pub view_asks: ViewAsks,
+    /// The page is the viewer (`?mode=viewer`): it reads cases and edits none.
+    pub reading: bool,
     /// Where the graphs and gallery cards are, for `state()`.
     pub panel: PanelLayout,
     waiting: Vec<Waiter>,
@@ -200,6 +212,8 @@ impl Document {
             timings: None,
             model_generation: 0,
             view: ViewReport::default(),
+            view_asks: ViewAsks::default(),
+            reading: false,
             panel: PanelLayout::default(),
             waiting: Vec::new(),
             waiting_for: Vec::new(),
@@ -394,6 +408,7 @@ impl Document {
         let mut state = self.session.state_json(self.busy());
         state["guidance"] = self.session.guidance_json();
         state["backend"] = serde_json::json!(self.backend.name());
+        state["mode"] = serde_json::json!(if self.reading { "viewer" } else { "author" });
         state["guidance"]["engine"] = serde_json::json!(if self.guidance_on_gpu {
             "webgpu"
         } else {
@@ -409,6 +424,7 @@ impl Document {
         let v = &self.view;
         state["brush"] = serde_json::json!({"on": v.brush_on, "pick_ms": v.pick_ms});
         state["view"] = v.rect.to_json();
+        state["view"]["clip"] = serde_json::to_value(self.view_asks.clip).unwrap_or_default();
         state["layout"] = self.panel.to_json();
         state["checks"] = self.session.checks_json().unwrap_or_default();
         // WebAssembly memory only grows: its size is the page's peak.

@@ -14,6 +14,7 @@
 mod api;
 mod bottom_panel;
 mod brush;
+mod case_reader;
 mod controls;
 mod document;
 mod download;
@@ -34,6 +35,7 @@ mod shell;
 mod shortcuts;
 mod status;
 mod structure_list;
+mod view_tools;
 pub mod viewer;
 mod workers;
 

@@ -1,4 +1,4 @@
-//! `?model=URL`: open a mesh from the page's own origin at start. Any other origin is refused,
+//! `?model=URL` (or `?case=URL`): open a mesh or a case from the page's own origin at start. Any other origin is refused,
 //! so the page never sends a request beyond loading itself (patient data stays here).
 
 /// A model named in the page's query: its absolute URL and a file name for the format.
@@ -16,23 +16,26 @@ pub fn param(name: &str) -> Option<String> {
         .get(name)
 }
 
-/// The `model` query parameter, if there is one; an error when it names another origin.
+/// The `case` or else the `model` query parameter, if there is one; an error when it names
+/// another origin.
 pub fn model_url() -> Option<Result<ModelUrl, String>> {
     let location = web_sys::window()?.location();
-    let wanted = param("model")?;
+    let (key, wanted) =
+        (param("case").map(|c| ("case", c))).or_else(|| param("model").map(|m| ("model", m)))?;
     Some(resolve(
+        key,
         &wanted,
         &location.href().ok()?,
         &location.origin().ok()?,
     ))
 }
 
-fn resolve(wanted: &str, page: &str, origin: &str) -> Result<ModelUrl, String> {
+fn resolve(key: &str, wanted: &str, page: &str, origin: &str) -> Result<ModelUrl, String> {
     let url = web_sys::Url::new_with_base(wanted, page)
-        .map_err(|_| format!("?model={wanted} is not a URL"))?;
+        .map_err(|_| format!("?{key}={wanted} is not a URL"))?;
     if url.origin() != origin {
         return Err(format!(
-            "?model={wanted} is on another site ({}); only files from this page's own \
+            "?{key}={wanted} is on another site ({}); only files from this page's own \
              origin ({origin}) are opened, so nothing is requested from elsewhere",
             url.origin()
         ));
@@ -59,11 +62,11 @@ mod tests {
     fn only_the_pages_own_origin_is_opened() {
         let page = "http://localhost:8080/app/index.html?model=x";
         let origin = "http://localhost:8080";
-        let ok = resolve("models/liver.stl", page, origin).unwrap();
+        let ok = resolve("model", "models/liver.stl", page, origin).unwrap();
         assert_eq!(ok.url, "http://localhost:8080/app/models/liver.stl");
         assert_eq!(ok.name, "liver.stl");
-        let e = resolve("https://example.org/liver.stl", page, origin).unwrap_err();
-        assert!(e.contains("another site"), "{e}");
-        assert!(resolve("//evil.test/a.ply", page, origin).is_err());
+        let e = resolve("case", "https://example.org/liver.stl", page, origin).unwrap_err();
+        assert!(e.contains("another site") && e.starts_with("?case="), "{e}");
+        assert!(resolve("model", "//evil.test/a.ply", page, origin).is_err());
     }
 }

@@ -19,6 +19,18 @@ pub enum Action {
     CancelBackground,
 }
 
+/// Whether `action` only reads the case (the viewer takes those, and no other).
+pub fn reads(action: Action) -> bool {
+    matches!(
+        action,
+        Action::Open
+            | Action::ToggleWireframe
+            | Action::ResetView
+            | Action::NextColoring
+            | Action::ToggleHelp
+    )
+}
+
 const KEYS: [(egui::Key, Action, &str); 15] = [
     (egui::Key::O, Action::Open, "Open a mesh file"),
     (egui::Key::W, Action::ToggleWireframe, "Wireframe on/off"),

@@ -254,7 +254,7 @@ fn checks_report(ui: &mut egui::Ui, session: &Session) {
 /// A structure's smoothing and its measures as shown, a line each: the filter and parameters;
 /// the volume change and the local error, mean and maximum (mm, and in voxel diagonals where
 /// the voxel size is known).
-fn measures(s: &CaseStructure, session: &Session, i: usize) -> [String; 2] {
+pub fn measures(s: &CaseStructure, session: &Session, i: usize) -> [String; 2] {
     let params = session.structure_params(i).unwrap_or(s.params);
     let how = format!("{}: {}", params.filter.name(), params.describe());
     let what = match session.structure_metrics(i) {

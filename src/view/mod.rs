@@ -1,12 +1,14 @@
 //! What the 3D view computes without a GPU: the orbit camera and its matrices, the side a mesh
 //! is first shown from, the per-frame record the render shader reads, thumbnails drawn on
 //! the CPU with the same camera and lights, picking (the triangle under the cursor and the
-//! vertices under the brush) and the window/level-style parameter drag.
+//! vertices under the brush), the window/level-style parameter drag, and the clipping plane
+//! and standard views of a case.
 //!
 //! Free of egui and wgpu so that it builds and is unit-tested natively; the web app's
 //! renderer (`app::viewer`, wasm32) uploads what this module computes.
 
 mod camera;
+mod clip;
 mod orientation;
 mod param_drag;
 mod pick;
@@ -14,6 +16,7 @@ pub mod thumbnail;
 mod uniforms;
 
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
+pub use clip::{Clip, ClipAxis, StandardView, ViewRequest};
 pub use orientation::{face_on_direction, first_view};
 pub use param_drag::{
     default_drag_axes, drag_choices, drag_range, dragged_params, POINTS_PER_RANGE,

@@ -35,7 +35,7 @@ pub const KEY_LIGHT_OFFSET: [f32; 2] = [-0.35, 0.5];
 pub const WIRE_COLOR_SRGB: [f32; 4] = [0.08, 0.08, 0.10, 0.6];
 
 /// `View` in shaders/render.wgsl: std140-compatible (four-component members at 16-byte
-/// offsets), 160 bytes, a valid uniform block for WebGL2 too.
+/// offsets), 176 bytes, a valid uniform block for WebGL2 too.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct ViewUniforms {
@@ -51,12 +51,15 @@ pub struct ViewUniforms {
     pub back_tint: [f32; 4],
     /// Linear RGB and alpha of the wireframe (not premultiplied).
     pub wire_color: [f32; 4],
+    /// A clipping plane `(n, d)`: fragments where `n . p > d` are cut away; `n = 0` cuts
+    /// nothing.
+    pub clip: [f32; 4],
     pub flags: u32,
     pub _padding: [u32; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<ViewUniforms>() == 160);
-const _: () = assert!(std::mem::offset_of!(ViewUniforms, flags) == 144);
+const _: () = assert!(std::mem::size_of::<ViewUniforms>() == 176);
+const _: () = assert!(std::mem::offset_of!(ViewUniforms, flags) == 160);
 
 impl ViewUniforms {
     /// The record for `camera` in a viewport of this aspect ratio (width / height).
@@ -75,6 +78,7 @@ impl ViewUniforms {
             base_color: [r, g, b, 1.0],
             back_tint: [tr, tg, tb, BACK_TINT_AMOUNT],
             wire_color: [wr, wg, wb, WIRE_COLOR_SRGB[3]],
+            clip: [0.0; 4],
             flags,
             _padding: [0; 3],
         }
@@ -92,6 +96,13 @@ impl ViewUniforms {
     /// vertex colours' own).
     pub fn with_opacity(mut self, opacity: f32) -> Self {
         self.base_color[3] = opacity.clamp(0.0, 1.0);
+        self
+    }
+
+    /// The same record cutting away what lies beyond `plane` (`n . p > d`, see
+    /// [`ViewUniforms::clip`]).
+    pub fn with_clip(mut self, plane: [f32; 4]) -> Self {
+        self.clip = plane;
         self
     }
 

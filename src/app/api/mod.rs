@@ -47,13 +47,15 @@
 //!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
 //! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, loading,
-//!   open_stages, backend, timings, brush, view, layout, checks, guidance}` (`loading`: `{name, stage, stages,
+//!   open_stages, backend, mode, timings, brush, view, layout, checks, guidance}` (`mode`:
+//!   `"viewer"` with `?mode=viewer`, else `"author"`) (`loading`: `{name, stage, stages,
 //!   doing}` while a file opens, else null; `open_stages`: `[{doing, ms}]`, the latest opening's
 //!   stages and their times in the worker; `timings`: the last result's `smooth_ms` and `measure_ms`
 //!   of the CPU engine's own work, or `gpu_run_ms` from submitting a GPU run to having its
 //!   results back; `weights`: `{painted, locked, min, mean}` of the painted weights, or null;
 //!   `brush`: `{on, pick_ms}`, whether the weight brush is on and how long its latest pick took;
-//!   `view`: `{x, y, width, height}`, the 3D view's rectangle in CSS pixels; `layout`:
+//!   `view`: `{x, y, width, height, clip}`, the 3D view's rectangle in CSS pixels and its
+//!   clipping plane (as `setView` takes it, or null); `layout`:
 //!   `{graphs: [{param, strips: [{x, y, width, height, x0, x1}]}], gallery: [{x, y, width,
 //!   height}], structures: [{index, visible, solo, name}], structure_name}`, where the graphs'
 //!   plot areas (with the parameter values at their left and right edges), the gallery's
@@ -63,11 +65,15 @@
 //!   anew does not), or null; `guidance`:
 //!   background work under way, whether the graphs are current, the suggestion and the gallery)
 //! - `clearWeights()`: every vertex free again (undoes the weight brush)
+//! - `setView({from, clip})`: looks from a standard side (`"A" "P" "L" "R" "S" "I"`) and sets
+//!   the clipping plane that cuts every structure (`{axis: "axial" | "coronal" | "sagittal",
+//!   at: 0..1 across the scene, flip}`, or null for none); `state().view.clip` reads it back
 //!
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
 
 mod files;
+mod view;
 
 use super::document::SharedDocument;
 use crate::export::{Container, ExportFormat};
@@ -260,6 +266,8 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     for call in [FileCall::Mesh, FileCall::Case, FileCall::Add] {
         define(&api, call.name(), file_call(doc, ctx, call))?;
     }
+
+    define(&api, "setView", view::set_view(doc, ctx))?;
 
     let d = doc.clone();
     define(

@@ -14,7 +14,8 @@ use super::shortcuts::{self, Action};
 use super::structure_list::{StructureAction, StructureList};
 use super::viewer::{self, Viewer};
 use super::{
-    api, download, legend, page, query, report_view, status, workers, SAMPLE_BYTES, SAMPLE_NAME,
+    api, download, legend, page, query, report_view, status, view_tools, workers, SAMPLE_BYTES,
+    SAMPLE_NAME,
 };
 use crate::export::ExportFormat;
 use crate::session::ColorField;
@@ -29,6 +30,7 @@ use std::time::Duration;
 /// How often the page redraws while only the workers work: the progress bars move on.
 const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
 
+mod reading;
 mod view_sync;
 
 use view_sync::{Positions, Shown};
@@ -59,6 +61,8 @@ pub struct Shell {
     /// The segmentation the view framed whole (its file and structure count).
     framed_case: Option<(String, usize)>,
     structures: StructureList,
+    /// The page is the viewer (`?mode=viewer`): the case's structures and the view, no editing.
+    reading: bool,
     /// Whether the last frame asked for the next at once.
     repainting: bool,
 }
@@ -109,7 +113,9 @@ impl Shell {
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
         let files = FileInput::new(&cc.egui_ctx);
-        doc.borrow_mut().session.set_graphs_wanted(true);
+        let reading = query::param("mode").as_deref() == Some("viewer");
+        doc.borrow_mut().reading = reading;
+        doc.borrow_mut().session.set_graphs_wanted(!reading);
         open_start_model(&doc, &files, &cc.egui_ctx);
         if let Err(e) = api::install(&doc, &cc.egui_ctx) {
             log::error!("no embedding API: {e}");
@@ -122,7 +128,8 @@ impl Shell {
             bottom: BottomPanel::new(),
             brush: Brush::default(),
             drag_params: DragParams::default(),
-            coloring: Some(ColorField::LocalError),
+            // A student sees the structures' own colours until asking how far they moved.
+            coloring: (!reading).then_some(ColorField::LocalError),
             bake_colors: false,
             show_original: false,
             help_open: false,
@@ -133,6 +140,7 @@ impl Shell {
             shown: Shown::default(),
             framed_case: None,
             structures: StructureList::default(),
+            reading,
             repainting: false,
         }
     }
@@ -246,6 +254,10 @@ impl Shell {
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
+        if self.reading {
+            self.reading_top_bar(ui);
+            return;
+        }
         ui.horizontal(|ui| {
             ui.heading("meshsmooth");
             ui.separator();
@@ -402,13 +414,22 @@ impl Shell {
         let rect = match &mut self.view {
             Some((viewer, _)) => {
                 viewer.painting = self.brush.active;
+                let mut doc = self.doc.borrow_mut();
+                let doc = &mut *doc;
+                viewer.clip = doc.view_asks.clip;
+                if let Some(side) = doc.view_asks.look_from.take() {
+                    viewer.look_from(side);
+                }
                 let response = ui
                     .scope_builder(egui::UiBuilder::new().max_rect(view_rect), |ui| {
                         viewer.show(ui)
                     })
                     .inner;
-                let mut doc = self.doc.borrow_mut();
-                let doc = &mut *doc;
+                let asked = doc.view_asks;
+                view_tools::show(ui, response.rect, &mut doc.view_asks);
+                if doc.view_asks != asked {
+                    ui.ctx().request_repaint();
+                }
                 let shown = match self.shown.positions {
                     Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
                     _ => None,
@@ -458,7 +479,9 @@ impl eframe::App for Shell {
         let ctx = ui.ctx().clone();
         self.receive_files(&ctx);
         for action in shortcuts::pressed(&ctx) {
-            self.apply(action);
+            if !self.reading || shortcuts::reads(action) {
+                self.apply(action);
+            }
         }
         // The frame a new model arrives in takes it up; uploading it to the GPU takes the next.
         // While a worker opens a file, the open model is worked on as before.
@@ -503,6 +526,23 @@ impl eframe::App for Shell {
 
         egui::Panel::top("top_bar").show(ui, |ui| self.top_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        if self.reading {
+            self.reading_panel(ui);
+        } else {
+            self.authoring_panels(ui);
+        }
+        egui::CentralPanel::no_frame().show(ui, |ui| self.view(ui));
+        shortcuts::help_window(&ctx, &mut self.help_open);
+
+        if ctx.input(|i| !i.raw.hovered_files.is_empty()) {
+            drop_hint(&ctx);
+        }
+    }
+}
+
+impl Shell {
+    /// The author's panels: smoothing on the left, graphs below, the mesh report on the right.
+    fn authoring_panels(&mut self, ui: &mut egui::Ui) {
         egui::Panel::left("smoothing")
             .resizable(true)
             .default_size(300.0)
@@ -532,12 +572,6 @@ impl eframe::App for Shell {
                     }
                 });
             });
-        egui::CentralPanel::no_frame().show(ui, |ui| self.view(ui));
-        shortcuts::help_window(&ctx, &mut self.help_open);
-
-        if ctx.input(|i| !i.raw.hovered_files.is_empty()) {
-            drop_hint(&ctx);
-        }
     }
 }
 

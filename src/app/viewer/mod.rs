@@ -22,8 +22,11 @@ pub use context::ContextSurface;
 use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu};
 
-use crate::view::{first_view, OrbitCamera, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS};
+use crate::view::{
+    first_view, Clip, OrbitCamera, StandardView, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS,
+};
 use callback::{ViewCallback, ViewResources};
+use glam::Vec3;
 use pipelines::Pipelines;
 
 /// Bits of the depth buffer eframe gives egui's render pass (`WebOptions::depth_buffer`). The
@@ -65,6 +68,24 @@ pub struct Viewer {
     show_model: bool,
     /// Other structures are drawn around the model.
     has_context: bool,
+    /// The box the home view frames (the whole case): the clipping plane moves across it.
+    scene: (Vec3, Vec3),
+    /// The clipping plane, cutting every structure; `None` cuts nothing.
+    pub clip: Option<Clip>,
+}
+
+/// The camera, the home view and the scene box, kept across a new model of the same scene.
+#[derive(Clone, Copy)]
+pub struct ViewState {
+    camera: OrbitCamera,
+    home: OrbitCamera,
+    scene: (Vec3, Vec3),
+}
+
+fn box_of(points: &[[f32; 3]]) -> (Vec3, Vec3) {
+    crate::mesh::bounding_box(points).map_or((Vec3::ZERO, Vec3::ZERO), |(lo, hi)| {
+        (Vec3::from(lo), Vec3::from(hi))
+    })
 }
 
 impl Viewer {
@@ -101,6 +122,8 @@ impl Viewer {
             model_color: None,
             show_model: true,
             has_context: false,
+            scene: (Vec3::ZERO, Vec3::ZERO),
+            clip: None,
         }
     }
 
@@ -150,6 +173,7 @@ impl Viewer {
         let points: Vec<[f32; 3]> = surfaces.iter().flat_map(|s| s.iter().copied()).collect();
         if !points.is_empty() {
             self.home = first_view(&points);
+            self.scene = box_of(&points);
             self.reset_view();
         }
     }
@@ -172,6 +196,7 @@ impl Viewer {
                 self.vertex_count = positions.len();
                 self.has_colors = false;
                 self.home = first_view(positions);
+                self.scene = box_of(positions);
                 self.problem = None;
                 self.reset_view();
             }
@@ -255,6 +280,7 @@ impl Viewer {
             if let Some([r, g, b, a]) = self.model_color {
                 uniforms = uniforms.with_base_color([r, g, b]).with_opacity(a);
             }
+            uniforms = uniforms.with_clip(self.clip_plane());
             let callback = ViewCallback {
                 rect,
                 uniforms,
@@ -267,14 +293,30 @@ impl Viewer {
         response
     }
 
-    /// The camera and the home view, to keep across a new model of the same scene.
-    pub fn view_state(&self) -> (OrbitCamera, OrbitCamera) {
-        (self.camera, self.home)
+    /// The camera, the home view and the scene, to keep across a new model of the same scene.
+    pub fn view_state(&self) -> ViewState {
+        ViewState {
+            camera: self.camera,
+            home: self.home,
+            scene: self.scene,
+        }
     }
 
-    pub fn set_view_state(&mut self, (camera, home): (OrbitCamera, OrbitCamera)) {
-        self.camera = camera;
-        self.home = home;
+    pub fn set_view_state(&mut self, state: ViewState) {
+        self.camera = state.camera;
+        self.home = state.home;
+        self.scene = state.scene;
+    }
+
+    /// Looks at the whole scene from one of the standard sides.
+    pub fn look_from(&mut self, side: StandardView) {
+        self.camera = side.camera(&self.home);
+    }
+
+    /// The clipping plane `(n, d)` in the scene as it stands (zero with none).
+    fn clip_plane(&self) -> [f32; 4] {
+        self.clip
+            .map_or([0.0; 4], |c| c.plane(self.scene.0, self.scene.1))
     }
 
     /// The camera the view is drawn with (for picking).

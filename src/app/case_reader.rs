@@ -1,0 +1,167 @@
+//! The viewer's panel (`?mode=viewer`), for a student reading a case: its title and
+//! description, its structures by group to show, hide, isolate and make transparent, and the
+//! selected one's name, provenance and quality record, with its local error on demand. Nothing
+//! here edits the anatomy.
+
+use eframe::egui;
+
+use super::document::{PanelLayout, StructureRow};
+use super::structure_list::{measures, StructureAction};
+use crate::case::CaseStructure;
+use crate::session::{Session, StructureChange};
+
+/// Shows the panel; `error_colours` is whether the selected structure is coloured by how far
+/// it moved from the segmentation. `layout` gets where the rows were drawn.
+pub fn show(
+    ui: &mut egui::Ui,
+    session: &Session,
+    layout: &mut PanelLayout,
+    error_colours: &mut bool,
+) -> Vec<StructureAction> {
+    layout.structures.clear();
+    layout.structure_name = None;
+    let mut actions = Vec::new();
+    let Some(current) = session.current_structure() else {
+        return actions;
+    };
+    let list = session.case_structures();
+    let title = session.case_title();
+    ui.heading(if title.is_empty() {
+        session.case_file()
+    } else {
+        title
+    });
+    if !session.case_description().is_empty() {
+        ui.label(session.case_description());
+    }
+    ui.separator();
+    ui.horizontal(|ui| {
+        ui.strong("Structures");
+        if list.iter().any(|s| !s.visible) && ui.small_button("Show all").clicked() {
+            for (i, _) in list.iter().enumerate().filter(|(_, s)| !s.visible) {
+                let change = StructureChange {
+                    visible: Some(true),
+                    ..Default::default()
+                };
+                actions.push(StructureAction::Change(i, change));
+            }
+        }
+    });
+    let mut groups: Vec<Option<&str>> = vec![None];
+    for g in list.iter().filter_map(|s| s.group.as_deref()) {
+        if !groups.contains(&Some(g)) {
+            groups.push(Some(g));
+        }
+    }
+    egui::ScrollArea::vertical()
+        .max_height(ui.available_height() * 0.5)
+        .id_salt("case structures")
+        .show(ui, |ui| {
+            for group in groups {
+                if let Some(name) = group {
+                    ui.label(egui::RichText::new(name).strong());
+                }
+                for (i, s) in list.iter().enumerate() {
+                    if s.group.as_deref() == group {
+                        let drawn = row(ui, i, s, i == current, &mut actions);
+                        layout.structures.push(drawn);
+                    }
+                }
+            }
+        });
+    ui.separator();
+    if let Some(s) = list.get(current) {
+        record(ui, session, s, current, error_colours);
+    }
+    actions
+}
+
+/// One structure: show box, its colour, show alone, its opacity, its name to select.
+fn row(
+    ui: &mut egui::Ui,
+    i: usize,
+    s: &CaseStructure,
+    selected: bool,
+    actions: &mut Vec<StructureAction>,
+) -> StructureRow {
+    ui.horizontal(|ui| {
+        let mut visible = s.visible;
+        let visibility = ui.checkbox(&mut visible, "").on_hover_text("Show or hide");
+        if visibility.changed() {
+            let change = StructureChange {
+                visible: Some(visible),
+                ..Default::default()
+            };
+            actions.push(StructureAction::Change(i, change));
+        }
+        let [r, g, b, _] = s.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+        let (swatch, _) = ui.allocate_exact_size(egui::vec2(14.0, 14.0), egui::Sense::hover());
+        ui.painter()
+            .rect_filled(swatch, 3.0, egui::Color32::from_rgb(r, g, b));
+        let solo = ui
+            .small_button("S")
+            .on_hover_text("Show alone (again: show all)");
+        if solo.clicked() {
+            actions.push(StructureAction::Solo(i));
+        }
+        let mut opacity = s.color[3];
+        let slider = egui::Slider::new(&mut opacity, 0.0..=1.0).show_value(false);
+        if ui
+            .add_sized([60.0, 14.0], slider)
+            .on_hover_text("Opacity")
+            .changed()
+        {
+            let change = StructureChange {
+                opacity: Some(opacity),
+                ..Default::default()
+            };
+            actions.push(StructureAction::Change(i, change));
+        }
+        let name = ui.selectable_label(selected, &s.name);
+        if name.clicked() && !selected {
+            actions.push(StructureAction::Select(i));
+        }
+        StructureRow {
+            index: i,
+            visible: visibility.rect.into(),
+            solo: solo.rect.into(),
+            name: name.rect.into(),
+        }
+    })
+    .inner
+}
+
+/// The selected structure: what it is, where it came from, how it was smoothed and how far its
+/// surface lies from the segmentation.
+fn record(
+    ui: &mut egui::Ui,
+    session: &Session,
+    s: &CaseStructure,
+    index: usize,
+    error_colours: &mut bool,
+) {
+    ui.heading(&s.name);
+    if let Some(group) = &s.group {
+        ui.label(format!("in {group}"));
+    }
+    let mut about = format!(
+        "{} vertices, {} triangles",
+        s.original.vertex_count(),
+        s.original.triangle_count()
+    );
+    if let Some(source) = &s.source {
+        about = format!("from {source}; {about}");
+    }
+    if let Some(v) = s.voxel_size {
+        about = format!("{about}; voxels {:.2} × {:.2} × {:.2} mm", v[0], v[1], v[2]);
+    }
+    ui.small(about);
+    let [how, what] = measures(s, session, index);
+    ui.label(format!("Smoothed with {how}"));
+    ui.label(what);
+    ui.checkbox(error_colours, "Colour by how far it moved")
+        .on_hover_text(
+            "The local error: the distance from each point of the smooth surface to the \
+             segmentation's surface",
+        );
+}

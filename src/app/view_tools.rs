@@ -1,0 +1,57 @@
+//! The view's own tools, over its bottom-left corner: the standard views (A P L R S I) and the
+//! clipping plane (axial, coronal or sagittal, where along the scene, which side is kept). The
+//! view takes them up from the document, where the API sets them too.
+
+use eframe::egui;
+
+use super::document::ViewAsks;
+use crate::view::{Clip, ClipAxis, StandardView};
+
+/// Draws the tools along the bottom of `view` and records what was asked in `asks`.
+pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks) {
+    let height = 30.0;
+    let bar = egui::Rect::from_min_max(
+        egui::pos2(view.left() + 6.0, view.bottom() - height),
+        egui::pos2(view.right() - 6.0, view.bottom()),
+    );
+    let builder = egui::UiBuilder::new()
+        .max_rect(bar)
+        .layout(egui::Layout::left_to_right(egui::Align::Center));
+    ui.scope_builder(builder, |ui| {
+        ui.label("View");
+        for side in StandardView::ALL {
+            let tip = format!("Look from the patient's {side:?} side").to_lowercase();
+            if ui.small_button(side.letter()).on_hover_text(tip).clicked() {
+                asks.look_from = Some(side);
+            }
+        }
+        ui.separator();
+        let mut axis = asks.clip.map(|c| c.axis);
+        egui::ComboBox::from_id_salt("clip axis")
+            .width(82.0)
+            .selected_text(axis.map_or("no clip", ClipAxis::name))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut axis, None, "no clip");
+                for a in ClipAxis::ALL {
+                    ui.selectable_value(&mut axis, Some(a), a.name());
+                }
+            })
+            .response
+            .on_hover_text("A plane that cuts every structure, to see what lies inside");
+        asks.clip = match (axis, asks.clip) {
+            (None, _) => None,
+            (Some(a), Some(c)) => Some(Clip { axis: a, ..c }),
+            (Some(a), None) => Some(Clip {
+                axis: a,
+                at: 0.5,
+                flip: false,
+            }),
+        };
+        if let Some(clip) = &mut asks.clip {
+            ui.add(egui::Slider::new(&mut clip.at, 0.0..=1.0).show_value(false))
+                .on_hover_text("Where the plane lies across the scene");
+            ui.toggle_value(&mut clip.flip, "flip")
+                .on_hover_text("Keep the other side");
+        }
+    });
+}
