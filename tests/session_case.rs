@@ -587,3 +587,60 @@ fn the_session_checks_its_structures_as_they_stand() {
     session.smooth_cpu();
     assert_eq!(session.marks_key(), Some(key));
 }
+
+/// The structure under the pointer, as drawn: the nearest visible one along the ray, looking
+/// through hidden and transparent ones and past what the clipping plane cuts away.
+#[test]
+fn the_structure_under_the_pointer_is_the_nearest_drawn() {
+    use meshsmooth::view::Ray;
+    let mut session = Session::default();
+    let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
+    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    let tumour = &session.case_structures()[2].original.positions;
+    let centre = tumour
+        .iter()
+        .fold(glam::Vec3::ZERO, |sum, &p| sum + glam::Vec3::from(p))
+        / tumour.len() as f32;
+    // From the patient's left, level with the tumour: the liver holds it.
+    let ray = Ray {
+        origin: centre - glam::Vec3::X * 500.0,
+        direction: glam::Vec3::X,
+    };
+    let none = [0.0; 4];
+    let (first, hit) = session
+        .structure_at(&ray, none)
+        .expect("the case in the way");
+    assert_eq!(first, 0, "the liver first");
+    let clear = StructureChange {
+        opacity: Some(0.0),
+        ..Default::default()
+    };
+    session.set_structure(0, clear).unwrap();
+    let (seen, deeper) = session.structure_at(&ray, none).unwrap();
+    assert_eq!(seen, 2, "through the transparent liver, the tumour");
+    assert!(deeper.distance > hit.distance);
+    session.solo_structure(2).unwrap();
+    let (alone, near) = session.structure_at(&ray, none).unwrap();
+    assert_eq!(alone, 2);
+    // A plane through the tumour's centre cutting away its near half (x below the centre):
+    // the pointer meets its far half.
+    let cut_near = [-1.0, 0.0, 0.0, -centre.x];
+    let (_, far) = session.structure_at(&ray, cut_near).unwrap();
+    assert!(
+        far.point.x > centre.x && far.distance > near.distance,
+        "{far:?}"
+    );
+    // Cutting everything away leaves nothing to name.
+    assert!(session.structure_at(&ray, [0.0, 0.0, 0.0, -1.0]).is_none());
+    session.solo_structure(2).unwrap();
+    let hide = StructureChange {
+        visible: Some(false),
+        ..Default::default()
+    };
+    session.set_structure(2, hide).unwrap();
+    assert_ne!(
+        session.structure_at(&ray, none).map(|(i, _)| i),
+        Some(2),
+        "hidden"
+    );
+}

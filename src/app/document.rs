@@ -184,6 +184,8 @@ pub struct Document {
     /// What the 3D view reports to `state()`.
     pub view: ViewReport,
     pub view_asks: ViewAsks,
+    /// The name of the structure under the pointer in the view.
+    pub pointed: Option<String>,
     /// The page is the viewer (`?mode=viewer`): it reads cases and edits none.
     pub reading: bool,
     /// Where the graphs and gallery cards are, for `state()`.
@@ -213,6 +215,7 @@ impl Document {
             model_generation: 0,
             view: ViewReport::default(),
             view_asks: ViewAsks::default(),
+            pointed: None,
             reading: false,
             panel: PanelLayout::default(),
             waiting: Vec::new(),
@@ -425,6 +428,7 @@ impl Document {
         state["brush"] = serde_json::json!({"on": v.brush_on, "pick_ms": v.pick_ms});
         state["view"] = v.rect.to_json();
         state["view"]["clip"] = serde_json::to_value(self.view_asks.clip).unwrap_or_default();
+        state["view"]["pointed"] = serde_json::json!(self.pointed);
         state["layout"] = self.panel.to_json();
         state["checks"] = self.session.checks_json().unwrap_or_default();
         // WebAssembly memory only grows: its size is the page's peak.

@@ -28,6 +28,7 @@ mod graphs;
 mod guide;
 mod legend;
 mod page;
+mod pointing;
 mod query;
 mod read_bytes;
 mod report_view;

@@ -12,6 +12,7 @@ mod colors;
 mod cpu;
 mod guidance;
 mod opening;
+mod pointing;
 mod structures;
 mod suggest_all;
 mod weights;

@@ -21,7 +21,9 @@ pub use orientation::{face_on_direction, first_view};
 pub use param_drag::{
     default_drag_axes, drag_choices, drag_range, dragged_params, POINTS_PER_RANGE,
 };
-pub use pick::{brush_falloff, brush_footprint, moller_trumbore, pick_triangle, Hit, Ray};
+pub use pick::{
+    brush_falloff, brush_footprint, moller_trumbore, pick_triangle, pick_triangle_where, Hit, Ray,
+};
 pub use uniforms::{
     linear_from_srgb, ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS,
 };

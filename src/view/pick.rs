@@ -63,6 +63,16 @@ impl OrbitCamera {
 /// The nearest triangle `ray` hits (either side), if any. Triangles with indices outside
 /// `positions` are skipped.
 pub fn pick_triangle(positions: &[[f32; 3]], triangles: &[[u32; 3]], ray: &Ray) -> Option<Hit> {
+    pick_triangle_where(positions, triangles, ray, |_| true)
+}
+
+/// The nearest triangle `ray` hits at a point `shown` keeps (what a clipping plane leaves).
+pub fn pick_triangle_where(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    ray: &Ray,
+    shown: impl Fn(Vec3) -> bool,
+) -> Option<Hit> {
     let d = ray.direction;
     if !(d.is_finite() && d.length_squared() > 0.0) {
         return None;
@@ -95,11 +105,12 @@ pub fn pick_triangle(positions: &[[f32; 3]], triangles: &[[u32; 3]], ray: &Ray) 
         }
         let corner = |k: usize| Vec3::from(positions[tri[k] as usize]);
         if let Some(distance) = moller_trumbore(ray, corner(0), corner(1), corner(2)) {
-            if best.is_none_or(|h| distance < h.distance) {
+            let point = ray.origin + ray.direction * distance;
+            if best.is_none_or(|h| distance < h.distance) && shown(point) {
                 best = Some(Hit {
                     triangle: t as u32,
                     distance,
-                    point: ray.origin + ray.direction * distance,
+                    point,
                 });
             }
         }

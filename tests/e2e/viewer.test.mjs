@@ -53,6 +53,22 @@ function drawn(image, view) {
     return { count, meanX: count ? sumX / count : NaN };
 }
 
+/** Pixels of the view whose colour passes `test(r, g, b)`: their count and mean position. */
+function pixelsWhere(image, view, test) {
+    let [count, sumX, sumY] = [0, 0, 0];
+    for (let y = Math.round(view.y + 60); y < Math.round(view.y + view.height - 40); y++) {
+        for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) {
+            const i = (y * image.width + x) * 4;
+            if (test(image.rgba[i], image.rgba[i + 1], image.rgba[i + 2])) {
+                count++;
+                sumX += x;
+                sumY += y;
+            }
+        }
+    }
+    return { count, meanX: sumX / count, meanY: sumY / count };
+}
+
 testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clipping plane, the standard views, no editing", { timeout: TIMEOUT }, async () => {
     const file = join(E2E_OUT, MODE, "V1-phantom-case.glb");
     await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "-o", file, "--json");
@@ -113,5 +129,22 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
         await app.call("setView", { clip: null });
         await app.screenshotWhen("V1-unclipped", (i) => drawn(i, view).count > 0.95 * whole.count, "the whole case again");
         await assert.rejects(app.call("setView", { clip: { axis: "oblique" } }), /none of axial/);
+
+        // Through a transparent liver, the tumour (turned green) is named under the pointer, and a
+        // click selects it.
+        await app.call("setStructure", { index: 0, opacity: 0 });
+        await app.call("setStructure", { index: 2, color: [0, 1, 0] });
+        const green = (r, g, b) => g > 120 && g > r + 60 && g > b + 60;
+        const image = await app.screenshotWhen("V1-tumour-through-the-liver", (i) => pixelsWhere(i, view, green).count > 200, "the green tumour");
+        const tumour = pixelsWhere(image, view, green);
+        await app.page.mouse.move(tumour.meanX, tumour.meanY);
+        await stateWhen(app, (s) => s.view.pointed === "tumor", "the tumour named under the pointer");
+        await app.page.mouse.move(view.x + view.width - 10, view.y + 80);
+        await stateWhen(app, (s) => s.view.pointed === null, "nothing under the pointer");
+        await app.page.mouse.click(tumour.meanX, tumour.meanY);
+        await stateWhen(app, (s) => s.structures.current === 2 && s.loading === null, "the tumour selected");
+        await app.page.mouse.move(tumour.meanX, tumour.meanY + 1);
+        await stateWhen(app, (s) => s.view.pointed === "tumor", "the tumour named again");
+        await app.screenshot("V1-tumour-named-and-selected");
     }, { query: "?mode=viewer" });
 });

@@ -54,8 +54,9 @@
 //!   of the CPU engine's own work, or `gpu_run_ms` from submitting a GPU run to having its
 //!   results back; `weights`: `{painted, locked, min, mean}` of the painted weights, or null;
 //!   `brush`: `{on, pick_ms}`, whether the weight brush is on and how long its latest pick took;
-//!   `view`: `{x, y, width, height, clip}`, the 3D view's rectangle in CSS pixels and its
-//!   clipping plane (as `setView` takes it, or null); `layout`:
+//!   `view`: `{x, y, width, height, clip, pointed}`, the 3D view's rectangle in CSS pixels,
+//!   its clipping plane (as `setView` takes it, or null) and the name of the structure under
+//!   the pointer (or null); `layout`:
 //!   `{graphs: [{param, strips: [{x, y, width, height, x0, x1}]}], gallery: [{x, y, width,
 //!   height}], structures: [{index, visible, solo, name}], structure_name}`, where the graphs'
 //!   plot areas (with the parameter values at their left and right edges), the gallery's

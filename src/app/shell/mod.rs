@@ -5,18 +5,16 @@
 use super::bottom_panel::BottomPanel;
 use super::brush::Brush;
 use super::controls::{self, Controls};
-use super::document::{Backend, Document, Opening, SharedDocument, ViewReport};
+use super::document::{Backend, Document, Opening, SharedDocument};
 use super::drag_params::DragParams;
 use super::file_input::FileInput;
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
+use super::pointing::Pointing;
 use super::shortcuts::{self, Action};
 use super::structure_list::{StructureAction, StructureList};
-use super::viewer::{self, Viewer};
-use super::{
-    api, download, legend, page, query, report_view, status, view_tools, workers, SAMPLE_BYTES,
-    SAMPLE_NAME,
-};
+use super::viewer::Viewer;
+use super::{api, download, page, query, report_view, status, workers, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::export::ExportFormat;
 use crate::session::ColorField;
 use crate::smooth::Filter;
@@ -31,9 +29,10 @@ use std::time::Duration;
 const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
 
 mod reading;
+mod view_area;
 mod view_sync;
 
-use view_sync::{Positions, Shown};
+use view_sync::Shown;
 
 pub struct Shell {
     doc: SharedDocument,
@@ -63,6 +62,8 @@ pub struct Shell {
     structures: StructureList,
     /// The page is the viewer (`?mode=viewer`): the case's structures and the view, no editing.
     reading: bool,
+    /// The structure under the pointer.
+    pointing: Pointing,
     /// Whether the last frame asked for the next at once.
     repainting: bool,
 }
@@ -141,6 +142,7 @@ impl Shell {
             framed_case: None,
             structures: StructureList::default(),
             reading,
+            pointing: Pointing::default(),
             repainting: false,
         }
     }
@@ -397,66 +399,6 @@ impl Shell {
                 ui.small("Files are read inside this browser tab; nothing is uploaded.");
             });
         });
-    }
-
-    fn view(&mut self, ui: &mut egui::Ui) {
-        // The legend takes a strip at the right; the view has the rest.
-        let whole = ui.available_rect_before_wrap();
-        let strip = self.shown.legend.as_ref().map(|l| {
-            let width = legend::width(ui, l).min(whole.width() * 0.4);
-            let strip = whole.with_min_x(whole.max.x - width);
-            (strip, l)
-        });
-        let view_rect = strip.map_or(whole, |(s, _)| whole.with_max_x(s.min.x));
-        if let Some((strip, l)) = strip {
-            legend::paint(ui, strip, l, viewer::BACKGROUND);
-        }
-        let rect = match &mut self.view {
-            Some((viewer, _)) => {
-                viewer.painting = self.brush.active;
-                let mut doc = self.doc.borrow_mut();
-                let doc = &mut *doc;
-                viewer.clip = doc.view_asks.clip;
-                if let Some(side) = doc.view_asks.look_from.take() {
-                    viewer.look_from(side);
-                }
-                let response = ui
-                    .scope_builder(egui::UiBuilder::new().max_rect(view_rect), |ui| {
-                        viewer.show(ui)
-                    })
-                    .inner;
-                let asked = doc.view_asks;
-                view_tools::show(ui, response.rect, &mut doc.view_asks);
-                if doc.view_asks != asked {
-                    ui.ctx().request_repaint();
-                }
-                let shown = match self.shown.positions {
-                    Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
-                    _ => None,
-                };
-                let surface = (doc.model_generation, shown);
-                let camera = viewer.camera();
-                self.brush
-                    .interact(ui, &response, camera, &mut doc.session, surface);
-                self.drag_params.interact(ui, &response, &mut doc.session);
-                doc.view = ViewReport {
-                    rect: response.rect.into(),
-                    brush_on: self.brush.active,
-                    pick_ms: self.brush.pick_ms,
-                };
-                response.rect
-            }
-            None => {
-                ui.label("The 3D view needs WebGPU or WebGL2, which this browser did not provide.");
-                view_rect
-            }
-        };
-        // Messages over the view's top-left corner.
-        let doc = self.doc.borrow();
-        let reading = self.files.reading();
-        let error = self.export_error.as_deref();
-        let lines = status::view_messages(ui, &doc, error, &reading, self.show_original);
-        status::paint_messages(ui, rect, lines);
     }
 }
 

@@ -314,7 +314,7 @@ impl Viewer {
     }
 
     /// The clipping plane `(n, d)` in the scene as it stands (zero with none).
-    fn clip_plane(&self) -> [f32; 4] {
+    pub fn clip_plane(&self) -> [f32; 4] {
         self.clip
             .map_or([0.0; 4], |c| c.plane(self.scene.0, self.scene.1))
     }

@@ -1,0 +1,87 @@
+//! The middle of the page: the 3D view, its colour legend, its tools, the name of the
+//! structure under the pointer and the messages over its corner.
+
+use eframe::egui;
+
+use super::view_sync::Positions;
+use super::Shell;
+use crate::app::document::ViewReport;
+use crate::app::{legend, status, view_tools, viewer};
+
+impl Shell {
+    /// The 3D view with its legend, its tools and the messages over it; the structure under
+    /// the pointer is named (and, in the viewer, selected by a click).
+    pub(super) fn view(&mut self, ui: &mut egui::Ui) {
+        // The legend takes a strip at the right; the view has the rest.
+        let whole = ui.available_rect_before_wrap();
+        let strip = self.shown.legend.as_ref().map(|l| {
+            let width = legend::width(ui, l).min(whole.width() * 0.4);
+            let strip = whole.with_min_x(whole.max.x - width);
+            (strip, l)
+        });
+        let view_rect = strip.map_or(whole, |(s, _)| whole.with_max_x(s.min.x));
+        if let Some((strip, l)) = strip {
+            legend::paint(ui, strip, l, viewer::BACKGROUND);
+        }
+        let rect = match &mut self.view {
+            Some((viewer, _)) => {
+                viewer.painting = self.brush.active;
+                let mut doc = self.doc.borrow_mut();
+                let doc = &mut *doc;
+                viewer.clip = doc.view_asks.clip;
+                if let Some(side) = doc.view_asks.look_from.take() {
+                    viewer.look_from(side);
+                }
+                let response = ui
+                    .scope_builder(egui::UiBuilder::new().max_rect(view_rect), |ui| {
+                        viewer.show(ui)
+                    })
+                    .inner;
+                if !self.brush.active {
+                    let at = (viewer.camera(), viewer.clip_plane());
+                    let clicked = self.pointing.update(ui, &response, at, &doc.session);
+                    let current = doc.session.current_structure();
+                    if let (true, Some(i)) = (self.reading, clicked.filter(|&i| Some(i) != current))
+                    {
+                        if let Err(e) = doc.begin_open_structure(i, None) {
+                            log::warn!("{e}");
+                        }
+                    }
+                } else {
+                    self.pointing = Default::default();
+                }
+                doc.pointed = self.pointing.named.as_ref().map(|(_, name)| name.clone());
+                let asked = doc.view_asks;
+                view_tools::show(ui, response.rect, &mut doc.view_asks);
+                if doc.view_asks != asked {
+                    ui.ctx().request_repaint();
+                }
+                let shown = match self.shown.positions {
+                    Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
+                    _ => None,
+                };
+                let surface = (doc.model_generation, shown);
+                let camera = viewer.camera();
+                self.brush
+                    .interact(ui, &response, camera, &mut doc.session, surface);
+                self.drag_params.interact(ui, &response, &mut doc.session);
+                doc.view = ViewReport {
+                    rect: response.rect.into(),
+                    brush_on: self.brush.active,
+                    pick_ms: self.brush.pick_ms,
+                };
+                response.rect
+            }
+            None => {
+                ui.label("The 3D view needs WebGPU or WebGL2, which this browser did not provide.");
+                view_rect
+            }
+        };
+        // Messages over the view's top-left corner.
+        let doc = self.doc.borrow();
+        let reading = self.files.reading();
+        let error = self.export_error.as_deref();
+        let lines = status::view_messages(ui, &doc, error, &reading, self.show_original);
+        status::paint_messages(ui, rect, lines);
+    }
+}

@@ -1,0 +1,34 @@
+//! Which structure of the case lies under the pointer, as drawn: a student's click or hover
+//! names it. Hidden structures, those drawn all but transparent and what the clipping plane
+//! cuts away are passed through.
+
+use super::Session;
+use crate::view::{pick_triangle_where, Hit, Ray};
+use glam::Vec3;
+
+/// Below this opacity a structure is looked through, not at.
+const SEEN_THROUGH: f32 = 0.05;
+
+impl Session {
+    /// The structure `ray` meets first, and where, of those drawn; `plane` is the view's
+    /// clipping plane `(n, d)` (`n . p > d` is cut away; zero cuts nothing).
+    pub fn structure_at(&self, ray: &Ray, plane: [f32; 4]) -> Option<(usize, Hit)> {
+        let current = self.current_structure()?;
+        let normal = Vec3::new(plane[0], plane[1], plane[2]);
+        let kept = |p: Vec3| normal.dot(p) <= plane[3];
+        let model = self.model()?;
+        (self.case.structures.iter().enumerate())
+            .filter(|(_, s)| s.visible && s.color[3] >= SEEN_THROUGH)
+            .filter_map(|(i, s)| {
+                let positions: &[[f32; 3]] = if i == current {
+                    self.last_result()
+                        .map_or(&model.mesh().positions, |r| &r.positions)
+                } else {
+                    s.positions()
+                };
+                let triangles = &s.original.triangles;
+                pick_triangle_where(positions, triangles, ray, kept).map(|hit| (i, hit))
+            })
+            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))
+    }
+}
