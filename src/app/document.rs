@@ -172,6 +172,8 @@ pub enum Opening {
 pub struct ViewAsks {
     pub clip: Option<Clip>,
     pub look_from: Option<StandardView>,
+    /// How far every structure is drawn back towards its segmentation (0 as smoothed).
+    pub toward_segmentation: f32,
 }
 
 pub struct Document {
@@ -429,6 +431,8 @@ impl Document {
         state["view"] = v.rect.to_json();
         state["view"]["clip"] = serde_json::to_value(self.view_asks.clip).unwrap_or_default();
         state["view"]["pointed"] = serde_json::json!(self.pointed);
+        state["view"]["toward_segmentation"] =
+            serde_json::json!(self.view_asks.toward_segmentation);
         state["layout"] = self.panel.to_json();
         state["checks"] = self.session.checks_json().unwrap_or_default();
         // WebAssembly memory only grows: its size is the page's peak.

@@ -1,5 +1,6 @@
-//! The view's own tools, over its bottom-left corner: the standard views (A P L R S I) and the
-//! clipping plane (axial, coronal or sagittal, where along the scene, which side is kept). The
+//! The view's own tools, over its bottom-left corner: the standard views (A P L R S I), the
+//! clipping plane (axial, coronal or sagittal, where along the scene, which side is kept) and
+//! the slide from the segmentation to the smoothed surfaces. The
 //! view takes them up from the document, where the API sets them too.
 
 use eframe::egui;
@@ -53,5 +54,17 @@ pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks) {
             ui.toggle_value(&mut clip.flip, "flip")
                 .on_hover_text("Keep the other side");
         }
+        ui.separator();
+        ui.label("segmentation");
+        let mut smoothed = 1.0 - asks.toward_segmentation;
+        let slide = egui::Slider::new(&mut smoothed, 0.0..=1.0).show_value(false);
+        if ui
+            .add(slide)
+            .on_hover_text("Slide every structure back to the segmentation it was made from")
+            .changed()
+        {
+            asks.toward_segmentation = 1.0 - smoothed;
+        }
+        ui.label("smoothed");
     });
 }

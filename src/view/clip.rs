@@ -138,10 +138,14 @@ impl StandardView {
 pub struct ViewRequest {
     pub from: Option<StandardView>,
     pub clip: Option<Option<Clip>>,
+    /// How far every structure is drawn back towards its segmentation (0 smoothed, 1 the
+    /// segmentation).
+    pub toward_segmentation: Option<f32>,
 }
 
 impl ViewRequest {
-    /// `{from: "A", clip: {axis: "axial", at: 0.5, flip: false} | null}`, every key optional
+    /// `{from: "A", clip: {axis: "axial", at: 0.5, flip: false} | null, toward_segmentation:
+    /// 0..1}`, every key optional
     /// (`at` defaults to the middle, `flip` to false). Unknown keys and values are refused,
     /// naming them.
     pub fn from_json(value: &serde_json::Value) -> Result<Self, String> {
@@ -157,9 +161,21 @@ impl ViewRequest {
                         .ok_or_else(|| format!("setView: from {v} is none of A P L R S I"))?;
                     out.from = Some(side);
                 }
+                "toward_segmentation" => match v.as_f64() {
+                    Some(t) if (0.0..=1.0).contains(&t) => out.toward_segmentation = Some(t as f32),
+                    _ => {
+                        return Err(format!(
+                            "setView: toward_segmentation {v} must be a number in [0, 1]"
+                        ))
+                    }
+                },
                 "clip" if v.is_null() => out.clip = Some(None),
                 "clip" => out.clip = Some(Some(clip_from_json(v)?)),
-                other => return Err(format!("setView: unknown key {other} (from, clip)")),
+                other => {
+                    return Err(format!(
+                        "setView: unknown key {other} (from, clip, toward_segmentation)"
+                    ))
+                }
             }
         }
         Ok(out)
@@ -251,8 +267,10 @@ mod tests {
             flip: false,
         };
         assert_eq!(r.clip, Some(Some(clip)));
-        let r = ViewRequest::from_json(&json!({"clip": null})).unwrap();
+        let r =
+            ViewRequest::from_json(&json!({"clip": null, "toward_segmentation": 0.25})).unwrap();
         assert_eq!((r.from, r.clip), (None, Some(None)));
+        assert_eq!(r.toward_segmentation, Some(0.25));
         let r =
             ViewRequest::from_json(&json!({"clip": {"axis": "axial", "at": 0.2, "flip": true}}));
         assert_eq!(r.unwrap().clip.unwrap().unwrap().at, 0.2);
@@ -267,6 +285,7 @@ mod tests {
                 "unknown clip key tilt",
             ),
             (json!([1]), "takes an object"),
+            (json!({"toward_segmentation": 2}), "in [0, 1]"),
         ] {
             let e = ViewRequest::from_json(&bad).unwrap_err();
             assert!(e.contains(says), "{bad}: {e}");

@@ -9,6 +9,7 @@
 
 mod camera;
 mod clip;
+mod morph;
 mod orientation;
 mod param_drag;
 mod pick;
@@ -17,6 +18,7 @@ mod uniforms;
 
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
 pub use clip::{Clip, ClipAxis, StandardView, ViewRequest};
+pub use morph::toward_original;
 pub use orientation::{face_on_direction, first_view};
 pub use param_drag::{
     default_drag_axes, drag_choices, drag_range, dragged_params, POINTS_PER_RANGE,

@@ -1,6 +1,7 @@
 // End-to-end tests of the viewer (`?mode=viewer`): a student opens a case glTF, shows, hides and
-// isolates its structures in the panel by mouse, cuts them with the clipping plane and looks from
-// the standard sides; the editing controls are absent, their shortcuts do nothing.
+// isolates its structures in the panel by mouse, cuts them with the clipping plane, looks from
+// the standard sides, slides back to the segmentation and has a structure named under the
+// pointer; the editing controls are absent, their shortcuts do nothing.
 //
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/viewer.test.mjs   (tests/e2e/run.sh runs both)
 import assert from "node:assert/strict";
@@ -51,6 +52,18 @@ function drawn(image, view) {
         }
     }
     return { count, meanX: count ? sumX / count : NaN };
+}
+
+/** Pixels of the view (away from its messages and tools) that differ between two images. */
+function changedPixels(a, b, view) {
+    let count = 0;
+    for (let y = Math.round(view.y + 60); y < Math.round(view.y + view.height - 40); y++) {
+        for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) {
+            const i = (y * a.width + x) * 4;
+            if ([0, 1, 2].some((k) => Math.abs(a.rgba[i + k] - b.rgba[i + k]) > 16)) count++;
+        }
+    }
+    return count;
 }
 
 /** Pixels of the view whose colour passes `test(r, g, b)`: their count and mean position. */
@@ -129,6 +142,15 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
         await app.call("setView", { clip: null });
         await app.screenshotWhen("V1-unclipped", (i) => drawn(i, view).count > 0.95 * whole.count, "the whole case again");
         await assert.rejects(app.call("setView", { clip: { axis: "oblique" } }), /none of axial/);
+
+        // The slide back to the segmentation shows its staircase; back again, the same picture.
+        const smoothed = await app.screenshot("V1-smoothed");
+        await app.call("setView", { toward_segmentation: 1 });
+        assert.equal((await app.state()).view.toward_segmentation, 1);
+        const moved = (i) => changedPixels(i, smoothed, view);
+        await app.screenshotWhen("V1-toward-segmentation", (i) => moved(i) > 2000, "the segmentation's staircase");
+        await app.call("setView", { toward_segmentation: 0 });
+        await app.screenshotWhen("V1-smoothed-again", (i) => moved(i) < 50, "the smoothed surfaces again");
 
         // Through a transparent liver, the tumour (turned green) is named under the pointer, and a
         // click selects it.

@@ -68,7 +68,8 @@
 //! - `clearWeights()`: every vertex free again (undoes the weight brush)
 //! - `setView({from, clip})`: looks from a standard side (`"A" "P" "L" "R" "S" "I"`) and sets
 //!   the clipping plane that cuts every structure (`{axis: "axial" | "coronal" | "sagittal",
-//!   at: 0..1 across the scene, flip}`, or null for none); `state().view.clip` reads it back
+//!   at: 0..1 across the scene, flip}`, or null for none) and `toward_segmentation` (0: the
+//!   smoothed surfaces, 1: the segmentation's); `state().view` reads them back
 //!
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.

@@ -1,4 +1,5 @@
-//! `setView`: the view's standard sides and clipping plane, as its tools set them.
+//! `setView`: the view's standard sides, clipping plane and slide towards the segmentation, as
+//! its tools set them.
 
 use eframe::egui;
 use wasm_bindgen::closure::Closure;
@@ -23,6 +24,9 @@ pub(super) fn set_view(
         }
         if let Some(clip) = request.clip {
             doc.view_asks.clip = clip;
+        }
+        if let Some(t) = request.toward_segmentation {
+            doc.view_asks.toward_segmentation = t;
         }
         ctx.request_repaint();
         Ok(())

@@ -6,6 +6,7 @@
 use super::Shell;
 use crate::app::viewer;
 use crate::session::{ColorField, Legend};
+use crate::view;
 
 /// Where the view's positions come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,6 +16,9 @@ pub(super) enum Positions {
     Cpu(u64),
     /// The GPU engine's buffers after the run for this revision.
     Gpu(u64),
+    /// The CPU copy of this revision's result, moved back towards the original by this much
+    /// (bits of the f32).
+    Toward(u64, u32),
 }
 
 /// The state of the view's buffers.
@@ -25,8 +29,9 @@ pub(super) struct Shown {
     /// Field and result revision of the colours, `None` for plain shading.
     pub(super) colors: Option<(ColorField, u64)>,
     pub(super) legend: Option<Legend>,
-    /// The version of the structures' looks the other structures were uploaded for.
-    pub(super) looks: Option<u64>,
+    /// The version of the structures' looks and the slide towards the segmentation the other
+    /// structures were uploaded for.
+    pub(super) looks: Option<(u64, u32)>,
     /// The checks' marks and the looks' version they were uploaded for.
     pub(super) marks: (Option<u64>, u64),
 }
@@ -69,8 +74,13 @@ impl Shell {
             };
         }
         let result = session.last_result();
+        let toward = doc.view_asks.toward_segmentation;
         let wanted = if self.show_original {
             Positions::Original
+        } else if toward > 0.0 {
+            result.map_or(Positions::Original, |r| {
+                Positions::Toward(r.revision, toward.to_bits())
+            })
         } else if let Some(gpu) = &self.gpu {
             (gpu.submitted(doc.model_generation)).map_or(Positions::Original, Positions::Gpu)
         } else {
@@ -81,6 +91,15 @@ impl Shell {
                 Positions::Original => {
                     let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
                     viewer.set_positions(rs, &mesh.positions, &normals);
+                    true
+                }
+                Positions::Toward(..) => {
+                    let moved = result
+                        .and_then(|r| view::toward_original(&mesh.positions, &r.positions, toward));
+                    if let Some(p) = moved {
+                        let normals = crate::mesh::vertex_normals(&p, &mesh.triangles);
+                        viewer.set_positions(rs, &p, &normals);
+                    }
                     true
                 }
                 Positions::Cpu(_) => {
@@ -120,12 +139,21 @@ impl Shell {
             self.shown.legend = computed.map(|(_, l)| l);
             self.shown.colors = colors;
         }
-        if self.shown.looks != Some(session.case_version()) {
+        let looks = (session.case_version(), toward.to_bits());
+        if self.shown.looks != Some(looks) {
             let others = session.other_structures();
-            let surfaces: Vec<viewer::ContextSurface<'_>> = others
-                .iter()
-                .map(|o| viewer::ContextSurface {
-                    positions: o.positions,
+            let list = session.case_structures();
+            let moved: Vec<Option<Vec<[f32; 3]>>> = (others.iter())
+                .map(|o| {
+                    let original = &list[o.index].original.positions;
+                    (toward > 0.0)
+                        .then(|| view::toward_original(original, o.positions, toward))
+                        .flatten()
+                })
+                .collect();
+            let surfaces: Vec<viewer::ContextSurface<'_>> = (others.iter().zip(&moved))
+                .map(|(o, moved)| viewer::ContextSurface {
+                    positions: moved.as_deref().unwrap_or(o.positions),
                     triangles: o.triangles,
                     color: o.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
                 })
@@ -133,7 +161,7 @@ impl Shell {
             viewer.set_context(rs, &surfaces);
             let look = session.model_structure();
             viewer.set_model_look(look.map(|l| l.color), look.is_none_or(|l| l.visible));
-            self.shown.looks = Some(session.case_version());
+            self.shown.looks = Some(looks);
         }
         let marks = (session.marks_key(), session.case_version());
         if self.shown.marks != marks {
