@@ -6,7 +6,7 @@
 use eframe::egui;
 
 use super::document::{PanelLayout, StructureRow};
-use super::structure_list::{measures, StructureAction};
+use super::structure_list::{listed_groups, measures, show_box, solo_button, StructureAction};
 use crate::case::CaseStructure;
 use crate::session::{Session, StructureChange};
 
@@ -47,12 +47,7 @@ pub fn show(
             }
         }
     });
-    let mut groups: Vec<Option<&str>> = vec![None];
-    for g in list.iter().filter_map(|s| s.group.as_deref()) {
-        if !groups.contains(&Some(g)) {
-            groups.push(Some(g));
-        }
-    }
+    let groups = listed_groups(list);
     egui::ScrollArea::vertical()
         .max_height(ui.available_height() * 0.5)
         .id_salt("case structures")
@@ -85,25 +80,12 @@ fn row(
     actions: &mut Vec<StructureAction>,
 ) -> StructureRow {
     ui.horizontal(|ui| {
-        let mut visible = s.visible;
-        let visibility = ui.checkbox(&mut visible, "").on_hover_text("Show or hide");
-        if visibility.changed() {
-            let change = StructureChange {
-                visible: Some(visible),
-                ..Default::default()
-            };
-            actions.push(StructureAction::Change(i, change));
-        }
+        let visibility = show_box(ui, (i, s), actions);
         let [r, g, b, _] = s.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
         let (swatch, _) = ui.allocate_exact_size(egui::vec2(14.0, 14.0), egui::Sense::hover());
         ui.painter()
             .rect_filled(swatch, 3.0, egui::Color32::from_rgb(r, g, b));
-        let solo = ui
-            .small_button("S")
-            .on_hover_text("Show alone (again: show all)");
-        if solo.clicked() {
-            actions.push(StructureAction::Solo(i));
-        }
+        let solo = solo_button(ui, i, actions);
         let mut opacity = s.color[3];
         let slider = egui::Slider::new(&mut opacity, 0.0..=1.0).show_value(false);
         if ui

@@ -73,16 +73,7 @@ impl StructureList {
                 actions.push(StructureAction::AddFiles);
             }
         });
-        let mut groups: Vec<Option<&str>> = vec![None];
-        groups.extend(list.iter().filter_map(|s| s.group.as_deref().map(Some)));
-        groups.dedup();
-        let mut seen = Vec::new();
-        groups.retain(|g| {
-            !seen.contains(g) && {
-                seen.push(*g);
-                true
-            }
-        });
+        let groups = listed_groups(list);
         let flagged = session.flagged_structures();
         egui::ScrollArea::vertical()
             .max_height(220.0)
@@ -280,6 +271,51 @@ fn measured(m: &Metrics, diagonal: Option<f64>) -> String {
     )
 }
 
+/// The order a list shows groups in: ungrouped structures first, then each group where its
+/// first structure stands.
+pub fn listed_groups(list: &[CaseStructure]) -> Vec<Option<&str>> {
+    let mut groups: Vec<Option<&str>> = vec![None];
+    for g in list.iter().filter_map(|s| s.group.as_deref()) {
+        if !groups.contains(&Some(g)) {
+            groups.push(Some(g));
+        }
+    }
+    groups
+}
+
+/// The box that shows or hides structure `i` (`s`).
+pub fn show_box(
+    ui: &mut egui::Ui,
+    (i, s): (usize, &CaseStructure),
+    actions: &mut Vec<StructureAction>,
+) -> egui::Response {
+    let mut visible = s.visible;
+    let visibility = ui.checkbox(&mut visible, "").on_hover_text("Show or hide");
+    if visibility.changed() {
+        let change = StructureChange {
+            visible: Some(visible),
+            ..Default::default()
+        };
+        actions.push(StructureAction::Change(i, change));
+    }
+    visibility
+}
+
+/// The button that shows structure `i` alone (again: every structure).
+pub fn solo_button(
+    ui: &mut egui::Ui,
+    i: usize,
+    actions: &mut Vec<StructureAction>,
+) -> egui::Response {
+    let solo = ui
+        .small_button("S")
+        .on_hover_text("Show alone (again: show all)");
+    if solo.clicked() {
+        actions.push(StructureAction::Solo(i));
+    }
+    solo
+}
+
 /// One structure's row: visibility, colour with opacity, show alone, its name to select (its
 /// measures on hover), its volume change, and a warning sign when the last checks flagged it.
 fn row(
@@ -289,15 +325,7 @@ fn row(
     actions: &mut Vec<StructureAction>,
 ) -> StructureRow {
     ui.horizontal(|ui| {
-        let mut visible = s.visible;
-        let visibility = ui.checkbox(&mut visible, "").on_hover_text("Show or hide");
-        if visibility.changed() {
-            let change = StructureChange {
-                visible: Some(visible),
-                ..Default::default()
-            };
-            actions.push(StructureAction::Change(i, change));
-        }
+        let visibility = show_box(ui, (i, s), actions);
         let mut rgba = to_bytes(s.color);
         if ui.color_edit_button_srgba_unmultiplied(&mut rgba).changed() {
             let c = rgba.map(|v| f32::from(v) / 255.0);
@@ -308,10 +336,7 @@ fn row(
             };
             actions.push(StructureAction::Change(i, change));
         }
-        let solo = ui.small_button("S").on_hover_text("Show alone");
-        if solo.clicked() {
-            actions.push(StructureAction::Solo(i));
-        }
+        let solo = solo_button(ui, i, actions);
         let mut about = format!(
             "{} vertices, {} triangles",
             s.original.vertex_count(),

@@ -505,45 +505,33 @@ testIn(EVERY_RUN, "S9 files added to the case, and several dropped together, joi
     });
 });
 
-/** Polls `state()` until `test(state)` holds (20 s at most); returns that state. */
-async function stateWhen(app, test, what) {
-    const deadline = Date.now() + 20_000;
-    let state = await app.state();
-    while (!test(state)) {
-        assert.ok(Date.now() < deadline, `timed out waiting for ${what}`);
-        await new Promise((resolve) => setTimeout(resolve, 100));
-        state = await app.state();
-    }
-    return state;
-}
-
 testIn(WEBGPU_RUN, "S10 the Structures list by mouse and keyboard: select, show alone, hide, rename", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");
         const centre = (r) => [r.x + r.width / 2, r.y + r.height / 2];
         const click = (r) => app.page.mouse.click(...centre(r));
         const visible = (s) => s.structures.structures.map((x) => x.visible);
-        let state = await stateWhen(app, (s) => s.layout.structures.length === 4, "the list's four rows");
+        let state = await app.stateWhen((s) => s.layout.structures.length === 4, "the list's four rows");
         const rows = state.layout.structures;
         assert.deepEqual(rows.map((r) => r.index), [0, 1, 2, 3]);
 
         // Clicking a name makes that structure the model.
         await click(rows[2].name);
-        state = await stateWhen(app, (s) => s.structures.current === 2 && s.loading === null, "the tumour to open");
+        state = await app.stateWhen((s) => s.structures.current === 2 && s.loading === null, "the tumour to open");
         assert.equal(state.model, "case_phantom_shared.seg.nrrd: tumor");
         // S shows one alone; again, all of them. The box hides one.
         await click(rows[1].solo);
-        await stateWhen(app, (s) => visible(s).join() === "false,true,false,false", "the portal vein alone");
+        await app.stateWhen((s) => visible(s).join() === "false,true,false,false", "the portal vein alone");
         await click(rows[1].solo);
-        await stateWhen(app, (s) => visible(s).every((v) => v), "every structure shown again");
+        await app.stateWhen((s) => visible(s).every((v) => v), "every structure shown again");
         await click(rows[3].visible);
-        state = await stateWhen(app, (s) => visible(s).join() === "true,true,true,false", "the kidney hidden");
+        state = await app.stateWhen((s) => visible(s).join() === "true,true,true,false", "the kidney hidden");
         // The Name field renames the selected structure when it loses focus.
         await click(state.layout.structure_name);
         await app.page.keyboard.press("Control+A");
         await app.page.keyboard.type("tumour");
         await app.page.keyboard.press("Enter");
-        state = await stateWhen(app, (s) => s.structures.structures[2].name === "tumour", "the tumour renamed");
+        state = await app.stateWhen((s) => s.structures.structures[2].name === "tumour", "the tumour renamed");
         assert.deepEqual(state.structures.structures.map((s) => s.name), ["liver", "portal_vein", "tumour", "right_kidney"]);
         await app.metrics();
         await app.screenshot("S10-list-driven-by-mouse");

@@ -17,18 +17,6 @@ const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 const PHANTOM_NRRD = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
 const TIMEOUT = 240_000;
 
-/** Polls `state()` until `test(state)` holds (20 s at most); returns that state. */
-async function stateWhen(app, test, what) {
-    const deadline = Date.now() + 20_000;
-    let state = await app.state();
-    while (!test(state)) {
-        assert.ok(Date.now() < deadline, `timed out waiting for ${what}`);
-        await new Promise((resolve) => setTimeout(resolve, 100));
-        state = await app.state();
-    }
-    return state;
-}
-
 /**
  * The pixels of the 3D view that show a surface: unlike the background (read at the view's
  * top-right corner), away from the messages at its top and its tools at its bottom. Returns
@@ -88,7 +76,7 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
     await withApp(async (app) => {
         const opened = await app.loadMesh(readFileSync(file), "V1-phantom-case.glb", "loadCase");
         assert.deepEqual(opened.structures.map((s) => s.name), ["liver", "portal_vein", "tumor", "right_kidney"]);
-        let state = await stateWhen(app, (s) => s.layout.structures.length === 4 && s.loading === null, "the case's four rows");
+        let state = await app.stateWhen((s) => s.layout.structures.length === 4 && s.loading === null, "the case's four rows");
         assert.equal(state.mode, "viewer");
         assert.deepEqual(state.layout.graphs, [], "no quality graphs");
         const view = state.view;
@@ -111,7 +99,7 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
         // against the liver's 60: RAS, so towards the patient's left of the case's middle).
         // From the front the patient's left is on the screen's right; from behind, on its left.
         await click(rows[3].solo);
-        await stateWhen(app, (s) => visible(s).join() === "false,false,false,true", "the kidney alone");
+        await app.stateWhen((s) => visible(s).join() === "false,false,false,true", "the kidney alone");
         await app.call("setView", { from: "A" });
         const front = await app.screenshotWhen("V1-kidney-from-the-front", (i) => drawn(i, view).count > 500, "the kidney");
         await app.call("setView", { from: "P" });
@@ -121,12 +109,12 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
         assert.ok(f.meanX > middle && b.meanX < middle, `the kidney right from the front (${f.meanX}), left from behind (${b.meanX}) of ${middle}`);
         assert.ok(f.count < all.count, `alone, less is drawn: ${f.count} of ${all.count}`);
         await click(rows[3].solo);
-        await stateWhen(app, (s) => visible(s).every((v) => v), "every structure shown again");
+        await app.stateWhen((s) => visible(s).every((v) => v), "every structure shown again");
         // The box hides one.
         await click(rows[0].visible);
-        await stateWhen(app, (s) => visible(s).join() === "false,true,true,true", "the liver hidden");
+        await app.stateWhen((s) => visible(s).join() === "false,true,true,true", "the liver hidden");
         await click(rows[0].visible);
-        await stateWhen(app, (s) => visible(s).every((v) => v), "the liver shown again");
+        await app.stateWhen((s) => visible(s).every((v) => v), "the liver shown again");
 
         // A sagittal plane through the middle cuts away the patient's right half (the screen's
         // left, from the front).
@@ -160,13 +148,13 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
         const image = await app.screenshotWhen("V1-tumour-through-the-liver", (i) => pixelsWhere(i, view, green).count > 200, "the green tumour");
         const tumour = pixelsWhere(image, view, green);
         await app.page.mouse.move(tumour.meanX, tumour.meanY);
-        await stateWhen(app, (s) => s.view.pointed === "tumor", "the tumour named under the pointer");
+        await app.stateWhen((s) => s.view.pointed === "tumor", "the tumour named under the pointer");
         await app.page.mouse.move(view.x + view.width - 10, view.y + 80);
-        await stateWhen(app, (s) => s.view.pointed === null, "nothing under the pointer");
+        await app.stateWhen((s) => s.view.pointed === null, "nothing under the pointer");
         await app.page.mouse.click(tumour.meanX, tumour.meanY);
-        await stateWhen(app, (s) => s.structures.current === 2 && s.loading === null, "the tumour selected");
+        await app.stateWhen((s) => s.structures.current === 2 && s.loading === null, "the tumour selected");
         await app.page.mouse.move(tumour.meanX, tumour.meanY + 1);
-        await stateWhen(app, (s) => s.view.pointed === "tumor", "the tumour named again");
+        await app.stateWhen((s) => s.view.pointed === "tumor", "the tumour named again");
         await app.screenshot("V1-tumour-named-and-selected");
     }, { query: "?mode=viewer" });
 });

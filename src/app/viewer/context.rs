@@ -46,6 +46,17 @@ impl ContextMesh {
     }
 }
 
+/// Every one of `surfaces` on the GPU, or why not.
+pub fn upload_all(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    surfaces: &[ContextSurface<'_>],
+) -> Result<Vec<ContextMesh>, String> {
+    (surfaces.iter())
+        .map(|s| ContextMesh::new(device, queue, s))
+        .collect()
+}
+
 fn centre(positions: &[[f32; 3]]) -> [f32; 3] {
     crate::mesh::bounding_box(positions).map_or([0.0; 3], |(lo, hi)| {
         [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]))

@@ -137,11 +137,7 @@ impl Viewer {
     /// The case's other structures, drawn around the model (replacing those set before).
     pub fn set_context(&mut self, rs: &egui_wgpu::RenderState, surfaces: &[ContextSurface<'_>]) {
         let result = with_resources(rs, |view| {
-            let meshes: Result<Vec<_>, String> = surfaces
-                .iter()
-                .map(|s| context::ContextMesh::new(&rs.device, &rs.queue, s))
-                .collect();
-            view.context = meshes?;
+            view.context = context::upload_all(&rs.device, &rs.queue, surfaces)?;
             view.context_generation += 1;
             Ok(())
         });
@@ -155,11 +151,7 @@ impl Viewer {
     /// warnings lie.
     pub fn set_marks(&mut self, rs: &egui_wgpu::RenderState, surfaces: &[ContextSurface<'_>]) {
         let result = with_resources(rs, |view| {
-            let meshes: Result<Vec<_>, String> = surfaces
-                .iter()
-                .map(|s| context::ContextMesh::new(&rs.device, &rs.queue, s))
-                .collect();
-            view.marks = meshes?;
+            view.marks = context::upload_all(&rs.device, &rs.queue, surfaces)?;
             view.marks_generation += 1;
             Ok(())
         });

@@ -216,6 +216,20 @@ export class AppPage {
         return this.call("state");
     }
 
+    /** Polls `state()` until `test(state)` holds (20 s at most); returns that state. */
+    async stateWhen(test, what) {
+        const deadline = Date.now() + 20_000;
+        let state = await this.state();
+        while (!test(state)) {
+            if (Date.now() > deadline) {
+                throw new Error(`timed out waiting for ${what}`);
+            }
+            await new Promise((resolve) => setTimeout(resolve, 100));
+            state = await this.state();
+        }
+        return state;
+    }
+
     backend() {
         return this.call("backend");
     }
