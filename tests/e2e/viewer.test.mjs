@@ -95,8 +95,8 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
         assert.ok(all.count > 5000, `the case is drawn: ${all.count} pixels`);
 
         // S shows the kidney alone: fewer pixels; again, all of them. The view keeps the whole
-        // case's middle; the phantom's kidney lies medial to its liver (world x about 20 mm
-        // against the liver's 60: RAS, so towards the patient's left of the case's middle).
+        // case's middle; the phantom's kidney lies medial to its liver (centroid's x 20 mm
+        // against the liver's 64: RAS, so towards the patient's left of the case's middle).
         // From the front the patient's left is on the screen's right; from behind, on its left.
         await click(rows[3].solo);
         await app.stateWhen((s) => visible(s).join() === "false,false,false,true", "the kidney alone");
