@@ -342,7 +342,7 @@ fn farthest(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
 }
 
 /// #30's round trip in the page's session: export the case, open the file, export again; the
-/// same structures, looks, groups, parameters and positions (1e-6 mm), and the structure that
+/// same structures, looks, groups, descriptions, parameters and positions (1e-6 mm), and the structure that
 /// becomes the model takes up its own parameters.
 #[test]
 fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
@@ -354,6 +354,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     session.set_case_text(Some("Abdomen"), Some("Liver, tumour, vessels"));
     let vessels = StructureChange {
         group: Some(Some("Vessels".into())),
+        description: Some("  Carries blood from the gut to the liver. ".into()),
         ..Default::default()
     };
     session.set_structure(1, vessels).unwrap();
@@ -401,9 +402,10 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     assert_eq!(b.structures.len(), 4);
     for (x, y) in a.structures.iter().zip(&b.structures) {
         assert_eq!(
-            (&x.name, x.color, x.visible, &x.group, &x.source, x.label),
-            (&y.name, y.color, y.visible, &y.group, &y.source, y.label)
+            (&x.name, x.color, x.visible, &x.group, &x.description),
+            (&y.name, y.color, y.visible, &y.group, &y.description)
         );
+        assert_eq!((&x.source, x.label), (&y.source, y.label));
         assert_eq!(
             (x.params, x.tau, x.voxel_size, x.voxels),
             (y.params, y.tau, y.voxel_size, y.voxels)
@@ -422,6 +424,11 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     }
     assert!(a.structures[0].smoothed.is_some() && a.structures[3].smoothed.is_some());
     assert_eq!(a.structures[1].group.as_deref(), Some("Vessels"));
+    assert_eq!(
+        a.structures[1].description,
+        "Carries blood from the gut to the liver."
+    );
+    assert_eq!(a.structures[0].description, "", "none written, none read");
 }
 
 /// Files added to an open case join it as structures (a surface coloured by its place, a label

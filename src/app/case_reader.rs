@@ -1,7 +1,7 @@
 //! The viewer's panel (`?mode=viewer`), for a student reading a case: its title and
 //! description, its structures by group to show, hide, isolate and make transparent, and the
-//! selected one's name, provenance and quality record, with its local error on demand. Nothing
-//! here edits the anatomy.
+//! selected one's name, description, provenance and quality record, with its local error on
+//! demand. Nothing here edits the anatomy.
 
 use eframe::egui;
 
@@ -125,6 +125,9 @@ fn record(
     ui.heading(&s.name);
     if let Some(group) = &s.group {
         ui.label(format!("in {group}"));
+    }
+    if !s.description.is_empty() {
+        ui.label(&s.description);
     }
     let mut about = format!(
         "{} vertices, {} triangles",

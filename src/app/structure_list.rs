@@ -37,13 +37,13 @@ pub struct StructureList {
     case_text: ((String, String), (String, String)),
 }
 
-/// The model's name and group as edited, and what the session had when they were taken: a
-/// new model, or a change made elsewhere (the API), shows the session's again.
+/// The model's name, group and description as edited, and what the session had when they
+/// were taken: a new model, or a change made elsewhere (the API), shows the session's again.
 struct Editing {
     /// The session's model and the structure it is.
     key: (u64, usize),
-    taken: (String, String),
-    text: (String, String),
+    taken: (String, String, String),
+    text: (String, String, String),
 }
 
 fn to_bytes(c: [f32; 4]) -> [u8; 4] {
@@ -96,7 +96,8 @@ impl StructureList {
             });
         if let Some(s) = list.get(current) {
             let key = (session.model_id(), current);
-            let stored = (s.name.clone(), s.group.clone().unwrap_or_default());
+            let group = s.group.clone().unwrap_or_default();
+            let stored = (s.name.clone(), group, s.description.clone());
             let editing = match &mut self.editing {
                 Some(e) if e.key == key && e.taken == stored => e,
                 editing => editing.insert(Editing {
@@ -105,7 +106,7 @@ impl StructureList {
                     text: stored,
                 }),
             };
-            let (name, group) = &mut editing.text;
+            let (name, group, description) = &mut editing.text;
             ui.horizontal(|ui| {
                 ui.label("Name");
                 let edit = ui.add(egui::TextEdit::singleline(name).desired_width(110.0));
@@ -131,6 +132,19 @@ impl StructureList {
                     actions.push(StructureAction::Change(current, change));
                 }
             });
+            let edit = ui.add(
+                egui::TextEdit::multiline(description)
+                    .hint_text("description for readers")
+                    .desired_rows(2)
+                    .desired_width(f32::INFINITY),
+            );
+            if edit.lost_focus() && description.trim() != s.description {
+                let change = StructureChange {
+                    description: Some(description.clone()),
+                    ..Default::default()
+                };
+                actions.push(StructureAction::Change(current, change));
+            }
             let [how, what] = measures(s, session, current);
             ui.small(how);
             ui.small(what);

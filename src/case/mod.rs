@@ -45,6 +45,8 @@ pub struct CaseStructure {
     pub visible: bool,
     /// The group the structure is listed under ("Vessels"), if any.
     pub group: Option<String>,
+    /// What a reader is told about it (its anatomy, why it matters in this case); may be empty.
+    pub description: String,
     /// The name of the file it came from (never anything of the file's header).
     pub source: Option<String>,
     /// Its label value, when it came from a label map.
@@ -84,6 +86,7 @@ impl CaseStructure {
             color: [color[0], color[1], color[2], 1.0],
             visible: true,
             group: None,
+            description: String::new(),
             source: None,
             label: None,
             voxel_size: None,

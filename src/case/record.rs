@@ -1,5 +1,5 @@
 //! The quality record a case glTF carries in `extras`, under [`CASE_KEY`]: per structure its
-//! provenance (the source file's name, never its header), voxel size, filter, parameters, tau
+//! description, provenance (the source file's name, never its header), voxel size, filter, parameters, tau
 //! and measures; per scene the case's title and description. Reading a case glTF back turns
 //! the record and the meshes into the same case.
 
@@ -32,6 +32,7 @@ pub fn structure_record(s: &CaseStructure) -> Value {
         "source": s.source,
         "label": s.label,
         "group": s.group,
+        "description": s.description,
         "visible": s.visible,
         "color": s.color,
         "voxel_size_mm": s.voxel_size,
@@ -156,6 +157,9 @@ fn structure(
         .and_then(Value::as_str)
         .map(str::to_string)
         .or_else(|| (ours && node.ancestors.len() >= 2).then(|| node.ancestors[1].clone()));
+    s.description = (record.get("description").and_then(Value::as_str))
+        .unwrap_or_default()
+        .to_string();
     s.source = record
         .get("source")
         .and_then(Value::as_str)

@@ -22,6 +22,7 @@ pub struct StructureChange {
     pub visible: Option<bool>,
     /// `Some(None)` takes the structure out of its group.
     pub group: Option<Option<String>>,
+    pub description: Option<String>,
 }
 
 /// A structure drawn around the model.
@@ -61,7 +62,8 @@ impl Session {
         self.case.structures.get(self.current_structure()?)
     }
 
-    /// Changes structure `index`'s name, colour, opacity, visibility or group; all or nothing.
+    /// Changes structure `index`'s name, colour, opacity, visibility, group or description;
+    /// all or nothing.
     pub fn set_structure(&mut self, index: usize, change: StructureChange) -> Result<(), String> {
         let count = self.case.structures.len();
         let s = self
@@ -96,8 +98,12 @@ impl Session {
         if let Some(g) = change.group {
             group = g.map(|g| g.trim().to_string()).filter(|g| !g.is_empty());
         }
-        if (&s.name, s.color, s.visible, &s.group) != (&name, color, visible, &group) {
+        let description = (change.description.as_deref())
+            .map_or_else(|| s.description.clone(), |d| d.trim().to_string());
+        let was = (&s.name, s.color, s.visible, &s.group, &s.description);
+        if was != (&name, color, visible, &group, &description) {
             (s.name, s.color, s.visible, s.group) = (name, color, visible, group);
+            s.description = description;
             self.case_version += 1;
         }
         Ok(())
@@ -239,6 +245,7 @@ impl Session {
                     "opacity": s.color[3],
                     "visible": s.visible,
                     "group": s.group,
+                    "description": s.description,
                     "source": s.source,
                     "voxels": s.voxels,
                     "voxel_size": s.voxel_size,
@@ -260,14 +267,14 @@ impl Session {
 }
 
 impl StructureChange {
-    /// `{index, name, color: [r, g, b], opacity, visible, group}` as the page's
+    /// `{index, name, color: [r, g, b], opacity, visible, group, description}` as the page's
     /// `setStructure` takes it (every key optional; `index` defaults to the model's structure;
     /// `group` null or "" ungroups). Unknown keys and values of the wrong kind are refused,
     /// naming the key.
     pub fn from_json(value: &serde_json::Value) -> Result<(Option<usize>, Self), String> {
         let object = value
             .as_object()
-            .ok_or("setStructure takes an object: {index, name, color, opacity, visible, group}")?;
+            .ok_or("setStructure takes an object: {index, name, color, opacity, visible, group, description}")?;
         let mut change = Self::default();
         let mut index = None;
         for (key, v) in object {
@@ -299,9 +306,12 @@ impl StructureChange {
                     };
                     change.group = Some(group);
                 }
+                "description" => {
+                    change.description = Some(v.as_str().ok_or_else(|| wrong("a string"))?.into())
+                }
                 other => {
                     return Err(format!(
-                        "setStructure: unknown key {other} (index, name, color, opacity, visible, group)"
+                        "setStructure: unknown key {other} (index, name, color, opacity, visible, group, description)"
                     ))
                 }
             }
