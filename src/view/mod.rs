@@ -2,13 +2,14 @@
 //! is first shown from, the per-frame record the render shader reads, thumbnails drawn on
 //! the CPU with the same camera and lights, picking (the triangle under the cursor and the
 //! vertices under the brush), the window/level-style parameter drag, and the clipping plane
-//! and standard views of a case.
+//! and standard views of a case, and the link that restores a view.
 //!
 //! Free of egui and wgpu so that it builds and is unit-tested natively; the web app's
 //! renderer (`app::viewer`, wasm32) uploads what this module computes.
 
 mod camera;
 mod clip;
+mod link;
 mod morph;
 mod orientation;
 mod param_drag;
@@ -18,6 +19,7 @@ mod uniforms;
 
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
 pub use clip::{Clip, ClipAxis, StandardView, ViewRequest};
+pub use link::{CameraPose, ViewLink, LINK_KEYS};
 pub use morph::toward_original;
 pub use orientation::{face_on_direction, first_view};
 pub use param_drag::{
