@@ -431,6 +431,27 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     assert_eq!(a.structures[0].description, "", "none written, none read");
 }
 
+/// A structure left before its result came keeps the smoothed surface it had for its
+/// parameters: a case glTF's liver stays smooth when the tumour is selected at once.
+#[test]
+fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
+    let mut session = Session::default();
+    let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
+    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    session.smooth_cpu();
+    let case = session.export_case(Container::Glb).unwrap();
+
+    let mut again = Session::default();
+    open(&mut again, "case.glb", case);
+    let kept = again.case_structures()[0].smoothed.clone();
+    assert!(kept.is_some(), "the case glTF holds the liver smoothed");
+    assert!(again.last_result().is_none(), "nothing smoothed here yet");
+    again.begin_open_structure(2).unwrap();
+    again.poll_opening().expect("done").expect("opens");
+    assert_eq!(again.current_structure(), Some(2));
+    assert_eq!(again.case_structures()[0].smoothed, kept);
+}
+
 /// Files added to an open case join it as structures (a surface coloured by its place, a label
 /// map's with its bound) while the model stays; files added while one opens wait for it, and
 /// are dropped when it fails to open.

@@ -177,6 +177,10 @@ impl Session {
             local_error: Some(r.vertex.local_error.clone()),
         });
         move |s: &mut CaseStructure| {
+            // Left before its result came, it keeps the surface it had for these parameters
+            // (a case glTF's, or its own from before).
+            let same = s.params == params && s.weights == weights;
+            let smoothed = smoothed.or_else(|| s.smoothed.take().filter(|_| same));
             (s.params, s.tau, s.weights, s.smoothed) = (params, tau, weights, smoothed);
         }
     }
