@@ -1,5 +1,6 @@
-// An engine worker of the page: loads the page's own wasm module (its URLs come in the first
-// message) and answers every later message, a request's bytes, with the reply's bytes.
+// An engine worker of the page: runs the page's own wasm module (the glue's URL and the compiled
+// module come in the first message) and answers every later message, a request's bytes,
+// with the reply's bytes.
 // Requests are done one after another, in the order they came.
 let engine = null;
 

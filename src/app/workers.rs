@@ -51,7 +51,9 @@ impl WebWorkers {
 
     /// Starts `count` workers on the page's own wasm, waking `ctx` when a reply comes.
     pub fn start(count: usize, ctx: &egui::Context) -> Result<Self, String> {
-        let (glue, wasm) = own_module_urls()?;
+        let glue = own_glue_url()?;
+        // The page's compiled module itself: no worker downloads or compiles it again.
+        let wasm = wasm_bindgen::module();
         let inbox: Inbox = Rc::default();
         let on_reply: OnReply = Rc::default();
         let mut workers = Vec::new();
@@ -66,8 +68,10 @@ impl WebWorkers {
             let handler = reply_handler(index, inbox.clone(), on_reply.clone(), ctx.clone());
             worker.set_onmessage(Some(handler.as_ref().unchecked_ref()));
             let start = js_sys::Object::new();
-            let set = |k: &str, v: &str| js_sys::Reflect::set(&start, &k.into(), &v.into());
-            set("glue", &glue).and_then(|_| set("wasm", &wasm)).ok();
+            let set = |k: &str, v: &JsValue| js_sys::Reflect::set(&start, &k.into(), v);
+            set("glue", &glue.as_str().into())
+                .and_then(|_| set("wasm", &wasm))
+                .ok();
             worker.post_message(&start).map_err(|e| {
                 format!("cannot start a worker: {}", super::page::js_error_text(&e))
             })?;
@@ -113,24 +117,19 @@ fn reply_handler(
     })
 }
 
-/// The URLs of the page's wasm-bindgen glue and wasm, as the build linked them (hashed names).
-fn own_module_urls() -> Result<(String, String), String> {
+/// The URL of the page's wasm-bindgen glue, as the build linked it (a hashed name).
+fn own_glue_url() -> Result<String, String> {
     let document = web_sys::window()
         .and_then(|w| w.document())
         .ok_or("no document")?;
-    let href = |selector: &str| {
-        document
-            .query_selector(selector)
-            .ok()
-            .flatten()
-            .and_then(|e| e.get_attribute("href"))
-            .and_then(|h| web_sys::Url::new_with_base(&h, &document.base_uri().ok()??).ok())
-            .map(|u| u.href())
-    };
-    let glue = href("link[rel=modulepreload][href$='.js']");
-    let wasm = href("link[rel=preload][href$='.wasm']");
-    glue.zip(wasm)
-        .ok_or_else(|| "the page does not name its wasm module".to_string())
+    document
+        .query_selector("link[rel=modulepreload][href$='.js']")
+        .ok()
+        .flatten()
+        .and_then(|e| e.get_attribute("href"))
+        .and_then(|h| web_sys::Url::new_with_base(&h, &document.base_uri().ok()??).ok())
+        .map(|u| u.href())
+        .ok_or_else(|| "the page does not name its wasm module's glue".to_string())
 }
 
 impl Carrier for WebWorkers {
