@@ -6,7 +6,7 @@
 
 use crate::session::{Session, Timings};
 use crate::suggest::Offload;
-use crate::view::{Clip, StandardView};
+use crate::view::{CameraPose, Clip, StandardView, ViewLink};
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -61,6 +61,9 @@ impl EngineTimings {
     }
 }
 
+/// A call waiting for a picture of the view (the API's `screenshot()`): PNG bytes, or why not.
+pub type PictureWaiter = Box<dyn FnOnce(Result<Vec<u8>, String>)>;
+
 /// When a waiting call is answered.
 pub type Ready = fn(&Session) -> bool;
 
@@ -95,6 +98,8 @@ impl From<eframe::egui::Rect> for PageRect {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ViewReport {
     pub rect: PageRect,
+    /// Where the camera is.
+    pub pose: Option<CameraPose>,
     pub brush_on: bool,
     pub pick_ms: Option<f64>,
 }
@@ -190,6 +195,11 @@ pub struct Document {
     pub pointed: Option<String>,
     /// The page is the viewer (`?mode=viewer`): it reads cases and edits none.
     pub reading: bool,
+    /// Whether keys act (an embedding page can turn them off).
+    pub shortcuts: bool,
+    /// How the latest files asked to open ended, once all of them have: for the embedding
+    /// page's `loaded` event, which takes it.
+    pub finished_opening: Option<Result<(), String>>,
     /// Where the graphs and gallery cards are, for `state()`.
     pub panel: PanelLayout,
     waiting: Vec<Waiter>,
@@ -201,6 +211,8 @@ pub struct Document {
     pub guidance_on_gpu: bool,
     /// Calls waiting for the file being opened.
     waiting_for_load: Vec<LoadWaiter>,
+    /// Calls waiting for a picture of the view.
+    pub waiting_for_picture: Vec<PictureWaiter>,
     /// The first failure among the files opened since the waiters last heard.
     load_failure: Option<String>,
 }
@@ -219,12 +231,15 @@ impl Document {
             view_asks: ViewAsks::default(),
             pointed: None,
             reading: false,
+            shortcuts: true,
+            finished_opening: None,
             panel: PanelLayout::default(),
             waiting: Vec::new(),
             waiting_for: Vec::new(),
             show_gallery: false,
             guidance_on_gpu: false,
             waiting_for_load: Vec::new(),
+            waiting_for_picture: Vec::new(),
             load_failure: None,
         }
     }
@@ -303,6 +318,7 @@ impl Document {
         }
         if self.session.loading().is_none() {
             let outcome = self.load_failure.take();
+            self.finished_opening = Some(outcome.clone().map_or(Ok(()), Err));
             for w in std::mem::take(&mut self.waiting_for_load) {
                 w(outcome.clone().map_or(Ok(&self.session), Err));
             }
@@ -414,6 +430,7 @@ impl Document {
         state["guidance"] = self.session.guidance_json();
         state["backend"] = serde_json::json!(self.backend.name());
         state["mode"] = serde_json::json!(if self.reading { "viewer" } else { "author" });
+        state["shortcuts"] = serde_json::json!(self.shortcuts);
         state["guidance"]["engine"] = serde_json::json!(if self.guidance_on_gpu {
             "webgpu"
         } else {
@@ -433,11 +450,49 @@ impl Document {
         state["view"]["pointed"] = serde_json::json!(self.pointed);
         state["view"]["toward_segmentation"] =
             serde_json::json!(self.view_asks.toward_segmentation);
+        state["view"]["link"] = serde_json::json!(self.view_link_url());
+        state["view"]["camera"] = match self.view.pose {
+            Some(p) => serde_json::json!({"yaw": p.yaw, "pitch": p.pitch, "distance": p.distance,
+                "target": p.target.to_array()}),
+            None => serde_json::Value::Null,
+        };
         state["layout"] = self.panel.to_json();
         state["checks"] = self.session.checks_json().unwrap_or_default();
         // WebAssembly memory only grows: its size is the page's peak.
         state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state
+    }
+}
+
+impl Document {
+    /// The view as it stands: camera, hidden and see-through structures, the selected one,
+    /// the clipping plane and the slide towards the segmentation.
+    pub fn view_link(&self) -> ViewLink {
+        let listed = self.session.case_structures().iter().enumerate();
+        ViewLink {
+            camera: self.view.pose,
+            hidden: (listed.clone().filter(|(_, s)| !s.visible))
+                .map(|(i, _)| i)
+                .collect(),
+            opacity: (listed.filter(|(_, s)| s.color[3] < 1.0))
+                .map(|(i, s)| (i, s.color[3]))
+                .collect(),
+            selected: self.session.current_structure().filter(|&i| i > 0),
+            clip: self.view_asks.clip,
+            toward_segmentation: self.view_asks.toward_segmentation,
+        }
+    }
+
+    /// The viewer's address that opens the case as it is shown now, where the case came from
+    /// an address (`?case=`); `None` for a file dropped or handed over.
+    pub fn view_link_url(&self) -> Option<String> {
+        let case = super::query::param("case").or_else(|| super::query::param("model"))?;
+        let location = web_sys::window()?.location();
+        let page = format!("{}{}", location.origin().ok()?, location.pathname().ok()?);
+        let case = String::from(js_sys::encode_uri_component(&case));
+        let link = self.view_link().to_query();
+        let sep = if link.is_empty() { "" } else { "&" };
+        Some(format!("{page}?mode=viewer&case={case}{sep}{link}"))
     }
 }
 

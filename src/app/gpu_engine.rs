@@ -65,7 +65,7 @@ pub enum GuidancePolicy {
 
 impl GuidancePolicy {
     pub fn from_query(software_adapter: bool) -> Self {
-        match super::page::query_value("guidance").as_deref() {
+        match super::query::param("guidance").as_deref() {
             Some("gpu") => GuidancePolicy::Gpu,
             Some("cpu") => GuidancePolicy::Cpu,
             _ if software_adapter => GuidancePolicy::Cpu,

@@ -56,18 +56,7 @@ pub fn install_crash_message_hook() {
 /// True when the page's URL sets the flag `name` in its query: `?name`, `?name=1` or
 /// `?name=true` (for example `?wireframe=1`, which screenshots and tests use).
 pub fn query_flag(name: &str) -> bool {
-    let search = web_sys::window()
-        .and_then(|w| w.location().search().ok())
-        .unwrap_or_default();
-    query_has_flag(&search, name)
-}
-
-/// The value of the query parameter `name` (the first one), if any.
-pub fn query_value(name: &str) -> Option<String> {
-    let search = web_sys::window()?.location().search().ok()?;
-    web_sys::UrlSearchParams::new_with_str(&search)
-        .ok()?
-        .get(name)
+    query_has_flag(&super::query::search(), name)
 }
 
 fn query_has_flag(search: &str, name: &str) -> bool {

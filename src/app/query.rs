@@ -8,10 +8,14 @@ pub struct ModelUrl {
     pub name: String,
 }
 
-/// The page's query parameter `name`, if it has one.
+/// The page's query string (`?a=b&...`, empty without one).
+pub fn search() -> String {
+    (web_sys::window().and_then(|w| w.location().search().ok())).unwrap_or_default()
+}
+
+/// The page's query parameter `name` (the first one), if it has one.
 pub fn param(name: &str) -> Option<String> {
-    let search = web_sys::window()?.location().search().ok()?;
-    web_sys::UrlSearchParams::new_with_str(&search)
+    web_sys::UrlSearchParams::new_with_str(&search())
         .ok()?
         .get(name)
 }

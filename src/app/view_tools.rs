@@ -8,63 +8,92 @@ use eframe::egui;
 use super::document::ViewAsks;
 use crate::view::{Clip, ClipAxis, StandardView};
 
-/// Draws the tools along the bottom of `view` and records what was asked in `asks`.
+/// Draws the tools along the bottom of `view` and records what was asked in `asks`: one row,
+/// or two on a narrow view (a phone).
 pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks) {
-    let height = 30.0;
+    let narrow = view.width() < 560.0;
+    let height = if narrow { 56.0 } else { 30.0 };
     let bar = egui::Rect::from_min_max(
         egui::pos2(view.left() + 6.0, view.bottom() - height),
         egui::pos2(view.right() - 6.0, view.bottom()),
     );
-    let builder = egui::UiBuilder::new()
-        .max_rect(bar)
-        .layout(egui::Layout::left_to_right(egui::Align::Center));
-    ui.scope_builder(builder, |ui| {
-        ui.label("View");
-        for side in StandardView::ALL {
-            let tip = format!("Look from the patient's {side:?} side").to_lowercase();
-            if ui.small_button(side.letter()).on_hover_text(tip).clicked() {
-                asks.look_from = Some(side);
+    let row = egui::Layout::left_to_right(egui::Align::Center);
+    if narrow {
+        let builder = egui::UiBuilder::new()
+            .max_rect(bar)
+            .layout(egui::Layout::top_down(egui::Align::Min));
+        ui.scope_builder(builder, |ui| {
+            ui.horizontal(|ui| {
+                sides(ui, asks);
+                ui.separator();
+                clip(ui, asks);
+            });
+            ui.horizontal(|ui| slide(ui, asks));
+        });
+    } else {
+        ui.scope_builder(egui::UiBuilder::new().max_rect(bar).layout(row), |ui| {
+            sides(ui, asks);
+            ui.separator();
+            clip(ui, asks);
+            ui.separator();
+            slide(ui, asks);
+        });
+    }
+}
+
+/// A P L R S I: look from that side of the patient.
+fn sides(ui: &mut egui::Ui, asks: &mut ViewAsks) {
+    ui.label("View");
+    for side in StandardView::ALL {
+        let tip = format!("Look from the patient's {side:?} side").to_lowercase();
+        if ui.small_button(side.letter()).on_hover_text(tip).clicked() {
+            asks.look_from = Some(side);
+        }
+    }
+}
+
+/// The clipping plane: its axis (or none), where it lies, which side is kept.
+fn clip(ui: &mut egui::Ui, asks: &mut ViewAsks) {
+    let mut axis = asks.clip.map(|c| c.axis);
+    egui::ComboBox::from_id_salt("clip axis")
+        .width(82.0)
+        .selected_text(axis.map_or("no clip", ClipAxis::name))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut axis, None, "no clip");
+            for a in ClipAxis::ALL {
+                ui.selectable_value(&mut axis, Some(a), a.name());
             }
-        }
-        ui.separator();
-        let mut axis = asks.clip.map(|c| c.axis);
-        egui::ComboBox::from_id_salt("clip axis")
-            .width(82.0)
-            .selected_text(axis.map_or("no clip", ClipAxis::name))
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut axis, None, "no clip");
-                for a in ClipAxis::ALL {
-                    ui.selectable_value(&mut axis, Some(a), a.name());
-                }
-            })
-            .response
-            .on_hover_text("A plane that cuts every structure, to see what lies inside");
-        asks.clip = match (axis, asks.clip) {
-            (None, _) => None,
-            (Some(a), Some(c)) => Some(Clip { axis: a, ..c }),
-            (Some(a), None) => Some(Clip {
-                axis: a,
-                at: 0.5,
-                flip: false,
-            }),
-        };
-        if let Some(clip) = &mut asks.clip {
-            ui.add(egui::Slider::new(&mut clip.at, 0.0..=1.0).show_value(false))
-                .on_hover_text("Where the plane lies across the scene");
-            ui.toggle_value(&mut clip.flip, "flip")
-                .on_hover_text("Keep the other side");
-        }
-        ui.separator();
-        ui.label("segmentation");
-        let mut smoothed = 1.0 - asks.toward_segmentation;
-        let slide = egui::Slider::new(&mut smoothed, 0.0..=1.0).show_value(false);
-        if ui
-            .add(slide)
-            .on_hover_text("Slide every structure back to the segmentation it was made from")
-            .changed()
-        {
-            asks.toward_segmentation = 1.0 - smoothed;
-        }
-        ui.label("smoothed");
-    });
+        })
+        .response
+        .on_hover_text("A plane that cuts every structure, to see what lies inside");
+    asks.clip = match (axis, asks.clip) {
+        (None, _) => None,
+        (Some(a), Some(c)) => Some(Clip { axis: a, ..c }),
+        (Some(a), None) => Some(Clip {
+            axis: a,
+            at: 0.5,
+            flip: false,
+        }),
+    };
+    if let Some(clip) = &mut asks.clip {
+        ui.add(egui::Slider::new(&mut clip.at, 0.0..=1.0).show_value(false))
+            .on_hover_text("Where the plane lies across the scene");
+        ui.toggle_value(&mut clip.flip, "flip")
+            .on_hover_text("Keep the other side");
+    }
+}
+
+/// The slide from the segmentation to the smoothed surfaces.
+fn slide(ui: &mut egui::Ui, asks: &mut ViewAsks) {
+    ui.label("segmentation");
+    let mut smoothed = 1.0 - asks.toward_segmentation;
+    let slide = egui::Slider::new(&mut smoothed, 0.0..=1.0).show_value(false);
+    if ui
+        .add(slide)
+        .on_hover_text("Slide every structure back to the segmentation it was made from")
+        .changed()
+    {
+        asks.toward_segmentation = 1.0 - smoothed;
+    }
+    ui.label("smoothed");
 }

@@ -14,6 +14,7 @@ import * as cli from "./lib/cli.mjs";
 import { metricDifferences } from "./lib/compare.mjs";
 import { brushOn, frames, settled, viewCentre } from "./lib/input.mjs";
 import { E2E_OUT, meshPath } from "./lib/paths.mjs";
+import { colourAt } from "./lib/png.mjs";
 import { CPU_RUN, EVERY_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const tmp = mkdtempSync(join(tmpdir(), "meshsmooth-bench-"));
@@ -447,4 +448,38 @@ testIn(CPU_RUN, "B7 Suggest all on the JHU atlas (48 structures) in the page's C
         same_params_as_cli: [same(pages[1]), same(pages[2])],
     });
     assert.deepEqual([same(pages[1]), same(pages[2])], [48, 48], "every structure's suggestion is the CLI's");
+});
+
+testIn(EVERY_RUN, "B8 the viewer's first frame of the JHU atlas's case (48 structures), and the bytes it downloads", { timeout: 30 * 60_000 }, async () => {
+    const atlas = meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz");
+    const names = meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.txt");
+    const file = join(tmp, "jhu-case.glb");
+    await cli.cliJson("case", "build", atlas, "--colors", names, "--search", "local", "-o", file, "--json");
+    const glb = readFileSync(file);
+    const figures = await withApp(async (app) => {
+        // From the navigation's start (performance.timeOrigin): the page's first frame with every
+        // structure open, two frames after the case came (the engines take it up, then the view).
+        const ms = await app.page.evaluate(() => new Promise((resolve) => {
+            const look = () => {
+                const s = window.meshsmooth.state();
+                if (s.structures?.structures.length === 48 && s.loading === null) {
+                    requestAnimationFrame(() => requestAnimationFrame(() => resolve(performance.now())));
+                } else {
+                    requestAnimationFrame(look);
+                }
+            };
+            look();
+        }));
+        const image = await app.screenshot("B8-jhu-case-in-the-viewer");
+        const { view, open_stages: stages } = await state(app);
+        const centre = colourAt(image, Math.round(view.x + view.width / 2), Math.round(view.y + view.height / 2));
+        return { ms, centre, stages, startSeconds: app.startSeconds, requested: app.requests.length, received: await app.bytesReceived() };
+    }, { query: "?mode=viewer&case=cases/jhu.glb", routes: { "cases/jhu.glb": glb } });
+    emit({
+        bench: "viewer-first-frame", file: "JHU-WhiteMatter-labels-1mm.nii.gz", structures: 48,
+        first_frame_ms: Math.round(figures.ms), app_started_s: figures.startSeconds,
+        case_bytes: glb.length, downloaded_bytes: figures.received, requests: figures.requested,
+        opening_ms: Object.fromEntries(figures.stages.map((s) => [s.doing, Math.round(s.ms)])),
+    });
+    assert.notEqual(figures.centre, 0x000000, "the case is drawn");
 });

@@ -5,22 +5,26 @@
 //
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/viewer.test.mjs   (tests/e2e/run.sh runs both)
 import assert from "node:assert/strict";
-import { readFileSync } from "node:fs";
+import { readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 
 import * as cli from "./lib/cli.mjs";
 import { E2E_OUT, meshPath } from "./lib/paths.mjs";
-import { EVERY_RUN, appSuite, testIn } from "./lib/suite.mjs";
+import { colourAt, decodePng } from "./lib/png.mjs";
+import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
-const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
+const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 
 const PHANTOM_NRRD = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
 const TIMEOUT = 240_000;
 
+/** Whether (x, y) lies on the orientation marker, in the view's top-right corner. */
+const onMarker = (x, y, view) => x > view.x + view.width - 100 && y < view.y + 100;
+
 /**
  * The pixels of the 3D view that show a surface: unlike the background (read at the view's
- * top-right corner), away from the messages at its top and its tools at its bottom. Returns
- * their count and mean x (CSS pixels).
+ * top-right corner), away from the messages at its top, the orientation marker and its tools
+ * at its bottom. Returns their count and mean x (CSS pixels).
  */
 function drawn(image, view) {
     const at = (x, y) => {
@@ -33,6 +37,7 @@ function drawn(image, view) {
     for (let y = Math.round(view.y + 60); y < Math.round(view.y + view.height - 40); y++) {
         for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) {
             const c = at(x, y);
+            if (onMarker(x, y, view)) continue;
             if (c.some((v, k) => Math.abs(v - background[k]) > 24)) {
                 count++;
                 sumX += x;
@@ -42,12 +47,13 @@ function drawn(image, view) {
     return { count, meanX: count ? sumX / count : NaN };
 }
 
-/** Pixels of the view (away from its messages and tools) that differ between two images. */
+/** Pixels of the view (away from its messages, marker and tools) that differ between two images. */
 function changedPixels(a, b, view) {
     let count = 0;
     for (let y = Math.round(view.y + 60); y < Math.round(view.y + view.height - 40); y++) {
         for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) {
             const i = (y * a.width + x) * 4;
+            if (onMarker(x, y, view)) continue;
             if ([0, 1, 2].some((k) => Math.abs(a.rgba[i + k] - b.rgba[i + k]) > 16)) count++;
         }
     }
@@ -70,11 +76,29 @@ function pixelsWhere(image, view, test) {
     return { count, meanX: sumX / count, meanY: sumY / count };
 }
 
+/** The phantom's case glTF as the CLI builds it (once per run of this file). */
+let phantomCase = null;
+function phantomCaseBytes() {
+    phantomCase ??= (async () => {
+        const file = join(E2E_OUT, MODE, "phantom-case.glb");
+        await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "-o", file, "--json");
+        return readFileSync(file);
+    })();
+    return phantomCase;
+}
+
+/** Page options that open the phantom's case from the page's own origin, as `?case=` does. */
+async function viewingThePhantom(extra = "") {
+    return { query: `?mode=viewer&case=cases/phantom.glb${extra}`, routes: { "cases/phantom.glb": await phantomCaseBytes() } };
+}
+
+/** Waits for the viewer to show the phantom's four structures. */
+const phantomShown = (app) => app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.layout.structures.length === 4, "the phantom's four structures");
+
 testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clipping plane, the standard views, no editing", { timeout: TIMEOUT }, async () => {
-    const file = join(E2E_OUT, MODE, "V1-phantom-case.glb");
-    await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "-o", file, "--json");
+    const bytes = await phantomCaseBytes();
     await withApp(async (app) => {
-        const opened = await app.loadMesh(readFileSync(file), "V1-phantom-case.glb", "loadCase");
+        const opened = await app.loadMesh(bytes, "V1-phantom-case.glb", "loadCase");
         assert.deepEqual(opened.structures.map((s) => s.name), ["liver", "portal_vein", "tumor", "right_kidney"]);
         let state = await app.stateWhen((s) => s.layout.structures.length === 4 && s.loading === null, "the case's four rows");
         assert.equal(state.mode, "viewer");
@@ -157,4 +181,134 @@ testIn(EVERY_RUN, "V1 the viewer reads a case: its structures by mouse, the clip
         await app.stateWhen((s) => s.view.pointed === "tumor", "the tumour named again");
         await app.screenshot("V1-tumour-named-and-selected");
     }, { query: "?mode=viewer" });
+});
+
+testIn(EVERY_RUN, "V2 a link restores the view; the view's picture; the case in words for screen readers", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        let state = await phantomShown(app);
+        // Opened as it was, the link holds only the camera.
+        const [page, cam] = state.view.link.split("&cam=");
+        assert.equal(page, `${app.server.url}?mode=viewer&case=cases%2Fphantom.glb`);
+        const { yaw, pitch, distance, target } = state.view.camera;
+        cam.split(",").map(Number).forEach((v, k) => {
+            const want = [yaw, pitch, distance, ...target][k];
+            assert.ok(Math.abs(v - want) <= 1e-6 * Math.abs(want), `the link's camera ${cam} holds ${want}`);
+        });
+        const canvasLabel = () => app.page.getAttribute("#meshsmooth_canvas", "aria-label");
+        const listed = () => app.page.locator("#case_structures li").allTextContents();
+        assert.match(await canvasLabel(), /^3D view of .+: 4 structures, 4 shown; selected: liver$/);
+        assert.deepEqual(await listed(), ["liver, shown, selected", "portal_vein, shown", "tumor, shown", "right_kidney, shown"]);
+
+        // A view of the case: from the left, a little turned by the mouse, the liver see-through,
+        // the kidney hidden, the tumour selected, cut axially.
+        await app.call("setView", { from: "L", clip: { axis: "axial", at: 0.6 } });
+        await app.call("setStructure", { index: 0, opacity: 0.4 });
+        await app.call("setStructure", { index: 3, visible: false });
+        await app.call("selectStructure", 2);
+        const centre = [state.view.x + state.view.width / 2, state.view.y + state.view.height / 2];
+        await app.page.mouse.move(...centre);
+        await app.page.mouse.down();
+        await app.page.mouse.move(centre[0] + 60, centre[1] + 25, { steps: 6 });
+        await app.page.mouse.up();
+        await app.page.mouse.move(state.view.x + 5, state.view.y + state.view.height - 60);
+        state = await app.stateWhen((s) => s.structures.current === 2 && s.loading === null && !s.busy, "the tumour selected");
+        const link = new URL(state.view.link);
+        assert.deepEqual([...link.searchParams.keys()], ["mode", "case", "cam", "hide", "opacity", "select", "clip"]);
+        assert.deepEqual(
+            ["hide", "opacity", "select", "clip"].map((k) => link.searchParams.get(k)),
+            ["3", "0:0.4", "2", "axial,0.6"],
+        );
+        assert.match(await canvasLabel(), /4 structures, 3 shown; selected: tumor$/);
+        assert.deepEqual(await listed(), ["liver, shown, 40% opaque", "portal_vein, shown", "tumor, shown, selected", "right_kidney, hidden"]);
+        const seen = await app.screenshot("V2-the-view-linked");
+
+        // The view's picture: the view alone, its size, what the page shows there.
+        const pngBytes = await app.callBytes("screenshot");
+        writeFileSync(join(OUT, "V2-picture.png"), pngBytes);
+        const png = decodePng(pngBytes);
+        const view = state.view;
+        assert.deepEqual([png.width, png.height], [Math.round(view.width), Math.round(view.height)], "the picture is the view's size");
+        // The mean colour of the view's middle (80 x 80 pixels), in the picture and on the page.
+        const middle = (image, x0, y0) => {
+            const sum = [0, 0, 0];
+            for (let y = -40; y < 40; y++) {
+                for (let x = -40; x < 40; x++) {
+                    const c = colourAt(image, x0 + Math.round(view.width / 2) + x, y0 + Math.round(view.height / 2) + y);
+                    [c >> 16, (c >> 8) & 255, c & 255].forEach((v, k) => (sum[k] += v / 6400));
+                }
+            }
+            return sum.map(Math.round);
+        };
+        const [inPicture, onPage] = [middle(png, 0, 0), middle(seen, Math.round(view.x), Math.round(view.y))];
+        assert.ok(inPicture.every((v, k) => Math.abs(v - onPage[k]) <= 12), `the picture's middle ${inPicture} is the page's ${onPage}`);
+
+        // The link opens the case as it was shown, in a page of its own.
+        await withApp(async (linked) => {
+            const restored = await linked.stateWhen((s) => s.structures?.structures.length === 4 && s.structures.current === 2 && s.loading === null && !s.busy, "the linked view");
+            const looks = (s) => s.structures.structures.map((x) => [x.visible, x.opacity]);
+            assert.deepEqual(looks(restored), looks(state));
+            assert.deepEqual(restored.view.clip, state.view.clip);
+            for (const key of ["yaw", "pitch", "distance"]) {
+                assert.ok(Math.abs(restored.view.camera[key] - state.view.camera[key]) <= 1e-5 * Math.abs(state.view.camera[key]) + 1e-6, `camera ${key}: ${restored.view.camera[key]} vs ${state.view.camera[key]}`);
+            }
+            assert.equal(restored.view.link, state.view.link, "the same link again");
+            await linked.page.mouse.move(view.x + 5, view.y + view.height - 60);
+            const again = await linked.screenshotWhen("V2-the-view-restored", (i) => changedPixels(i, seen, view) < 0.01 * view.width * view.height, "the same picture as the linked page's");
+            console.log(`viewer ${MODE}: a linked view differs in ${changedPixels(again, seen, view)} pixels`);
+        }, await viewingThePhantom(link.search.replace(/^\?mode=viewer&case=[^&]*/, "")));
+    }, await viewingThePhantom());
+
+    // A link that does not read says so, and the case opens as it is.
+    await withApp(async (app) => {
+        const state = await app.stateWhen((s) => s.error !== null, "the broken link reported");
+        assert.match(state.error, /the link's cam=1,2: six numbers/);
+    }, await viewingThePhantom("&cam=1,2"));
+});
+
+testIn(WEBGPU_RUN, "V3 on a phone: the case under the view, one finger orbits, two pan and pinch, a tap hides a structure", { timeout: TIMEOUT }, async () => {
+    const phone = { viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true, deviceScaleFactor: 1 };
+    await withApp(async (app) => {
+        const state = await phantomShown(app);
+        const { view } = state;
+        assert.ok(view.width >= 380, `the view takes the phone's width: ${view.width}`);
+        const rows = state.layout.structures;
+        assert.ok(rows.every((r) => r.name.y > view.y + view.height), "the structures are listed under the view");
+        const first = drawn(await app.screenshot("V3-phone-case"), view);
+        assert.ok(first.count > 3000, `the case is drawn: ${first.count} pixels`);
+
+        const cdp = await app.context.newCDPSession(app.page);
+        const touch = (type, points) => cdp.send("Input.dispatchTouchEvent", { type, touchPoints: points.map(([x, y], id) => ({ x, y, id })) });
+        /** Moves fingers from `from` to `to` ([[x, y], ...]) in steps, then lifts them. */
+        const gesture = async (from, to) => {
+            await touch("touchStart", from);
+            for (let k = 1; k <= 8; k++) {
+                await touch("touchMove", from.map(([x, y], i) => [x + ((to[i][0] - x) * k) / 8, y + ((to[i][1] - y) * k) / 8]));
+                await app.page.evaluate(() => new Promise((r) => requestAnimationFrame(r)));
+            }
+            await touch("touchEnd", []);
+        };
+        const camera = async () => (await app.state()).view.camera;
+        const [cx, cy] = [view.x + view.width / 2, view.y + view.height / 2];
+
+        const before = await camera();
+        await gesture([[cx - 60, cy]], [[cx + 60, cy]]);
+        const orbited = await camera();
+        assert.ok(Math.abs(orbited.yaw - before.yaw) > 0.3, `one finger orbits: yaw ${before.yaw} -> ${orbited.yaw}`);
+
+        await gesture([[cx - 40, cy], [cx + 40, cy]], [[cx - 120, cy], [cx + 120, cy]]);
+        const pinched = await camera();
+        assert.ok(pinched.distance < 0.7 * orbited.distance, `spreading two fingers zooms in: ${orbited.distance} -> ${pinched.distance}`);
+        assert.ok(Math.abs(pinched.yaw - orbited.yaw) < 0.05, `and does not orbit: yaw ${orbited.yaw} -> ${pinched.yaw}`);
+
+        await gesture([[cx - 40, cy], [cx + 40, cy]], [[cx - 40, cy + 100], [cx + 40, cy + 100]]);
+        const panned = await camera();
+        const moved = Math.hypot(...panned.target.map((t, k) => t - pinched.target[k]));
+        assert.ok(moved > 0.05 * pinched.distance, `two fingers moving together pan: the target moved ${moved}`);
+        assert.ok(Math.abs(panned.yaw - pinched.yaw) < 0.05, `and do not orbit: yaw ${pinched.yaw} -> ${panned.yaw}`);
+        await app.screenshot("V3-phone-moved");
+
+        await app.page.touchscreen.tap(rows[3].visible.x + rows[3].visible.width / 2, rows[3].visible.y + rows[3].visible.height / 2);
+        await app.stateWhen((s) => s.structures.structures[3].visible === false, "the kidney hidden by a tap");
+        await app.screenshot("V3-phone-kidney-hidden");
+    }, { ...(await viewingThePhantom()), device: phone });
 });

@@ -1,5 +1,7 @@
 //! The embedding API, `window.meshsmooth`, for the authoring page and for tests. Installed when
-//! the app has started, announced by a `meshsmooth-ready` event on `window`.
+//! the app has started, announced by a `meshsmooth-ready` event on `window`. The viewer
+//! (`?mode=viewer`) offers the calls that read a case ([`READING_CALLS`]). An embedding page
+//! in another origin makes the same calls by `postMessage` (see `messages`).
 //!
 //! - `loadMesh(bytes: Uint8Array, name): Promise<info>` (the CLI's `info --json` keys), once the
 //!   file is open: a worker opens it (`state().loading` tells the stage), the current model
@@ -66,6 +68,12 @@
 //!   anew does not), or null; `guidance`:
 //!   background work under way, whether the graphs are current, the suggestion and the gallery)
 //! - `clearWeights()`: every vertex free again (undoes the weight brush)
+//! - `screenshot(): Promise<Uint8Array>`: a PNG of the 3D view as the next frame draws it
+//!   (without the view's tools); `setShortcuts(on)`: keys act or not (`?shortcuts=off` at
+//!   start), for an embedding page that keeps its own; `state().shortcuts` reads it
+//! - `state().view.link`: the viewer's address that opens the case as shown now (camera,
+//!   hidden and see-through structures, the selected one, clip, slide), where the case came
+//!   from `?case=`; else null
 //! - `setView({from, clip})`: looks from a standard side (`"A" "P" "L" "R" "S" "I"`) and sets
 //!   the clipping plane that cuts every structure (`{axis: "axial" | "coronal" | "sagittal",
 //!   at: 0..1 across the scene, flip}`, or null for none) and `toward_segmentation` (0: the
@@ -74,13 +82,17 @@
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
 
+mod case;
 mod files;
+mod messages;
 mod view;
+
+pub use messages::Embedding;
 
 use super::document::SharedDocument;
 use crate::export::{Container, ExportFormat};
 use eframe::egui;
-use files::{file_call, info_waiter, FileCall};
+use files::{file_call, FileCall};
 use js_sys::{Function, Promise, Uint8Array};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::{JsCast, JsValue};
@@ -247,98 +259,67 @@ fn setter(
     })
 }
 
-/// Sets `f` as `object[name]` for the page's lifetime.
-fn define<F: ?Sized + wasm_bindgen::closure::WasmClosure>(
-    object: &js_sys::Object,
-    name: &str,
-    f: Closure<F>,
-) -> Result<(), String> {
-    js_sys::Reflect::set(object, &name.into(), f.as_ref().unchecked_ref())
-        .map_err(|e| super::page::js_error_text(&e))?;
-    // The API lives as long as the page.
-    f.forget();
-    Ok(())
+/// The calls the viewer offers: those that read a case and change only how it is shown.
+const READING_CALLS: [&str; 10] = [
+    "loadCase",
+    "screenshot",
+    "structures",
+    "selectStructure",
+    "setStructure",
+    "soloStructure",
+    "setView",
+    "setShortcuts",
+    "backend",
+    "state",
+];
+
+/// `window.meshsmooth` as it is built: in the viewer, only [`READING_CALLS`] are defined.
+struct Api {
+    object: js_sys::Object,
+    reading: bool,
 }
 
-/// Creates `window.meshsmooth` and fires `meshsmooth-ready`.
-pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
+impl Api {
+    /// Sets `f` as `object[name]` for the page's lifetime (unless the viewer lacks the call).
+    fn define<F: ?Sized + wasm_bindgen::closure::WasmClosure>(
+        &self,
+        name: &str,
+        f: Closure<F>,
+    ) -> Result<(), String> {
+        if self.reading && !READING_CALLS.contains(&name) {
+            return Ok(());
+        }
+        js_sys::Reflect::set(&self.object, &name.into(), f.as_ref().unchecked_ref())
+            .map_err(|e| super::page::js_error_text(&e))?;
+        // The API lives as long as the page.
+        f.forget();
+        Ok(())
+    }
+}
+
+/// Creates `window.meshsmooth`, fires `meshsmooth-ready` and returns the API.
+pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Object, String> {
     let window = web_sys::window().ok_or("no window")?;
-    let api = js_sys::Object::new();
+    let api = Api {
+        object: js_sys::Object::new(),
+        reading: doc.borrow().reading,
+    };
 
     for call in [FileCall::Mesh, FileCall::Case, FileCall::Add] {
-        define(&api, call.name(), file_call(doc, ctx, call))?;
+        api.define(call.name(), file_call(doc, ctx, call))?;
     }
 
-    define(&api, "setView", view::set_view(doc, ctx))?;
+    api.define("setView", view::set_view(doc, ctx))?;
+    view::define_screenshot(&api, doc, ctx)?;
+    case::define(&api, doc, ctx)?;
 
-    let d = doc.clone();
-    define(
-        &api,
-        "structures",
-        Closure::<dyn FnMut() -> JsValue>::new(move || {
-            let doc = d.borrow();
-            match doc.session.structures_json() {
-                Some(s) => to_js(&s),
-                None => JsValue::NULL,
-            }
-        }),
-    )?;
-
-    let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
-        "selectStructure",
-        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |index: JsValue| {
-            let Some(index) = index.as_f64().filter(|i| *i >= 0.0 && i.fract() == 0.0) else {
-                return settled(Err(
-                    "selectStructure(index): index must be a whole number >= 0".into(),
-                ));
-            };
-            let (d, c) = (d.clone(), c.clone());
-            let mut result = None;
-            let promise = Promise::new(&mut |resolve: Function, reject: Function| {
-                let waiter = info_waiter(resolve, reject);
-                result = Some(
-                    d.borrow_mut()
-                        .begin_open_structure(index as usize, Some(waiter)),
-                );
-                c.request_repaint();
-            });
-            match result {
-                Some(Err(e)) => settled(Err(e)),
-                _ => promise,
-            }
-        }),
-    )?;
-
-    define(
-        &api,
+    api.define(
         "setFilter",
         setter(doc, ctx, |session, name| {
             session.set_filter_name(&name.as_string().unwrap_or_default())
         }),
     )?;
-    define(
-        &api,
-        "setStructure",
-        setter(doc, ctx, |session, values| {
-            let (index, change) = crate::session::StructureChange::from_json(&from_js(&values)?)?;
-            let index = (index.or(session.current_structure())).ok_or("nothing is open")?;
-            session.set_structure(index, change)
-        }),
-    )?;
-    define(
-        &api,
-        "soloStructure",
-        setter(doc, ctx, |session, index| {
-            let index = (index.as_f64())
-                .filter(|i| *i >= 0.0 && i.fract() == 0.0)
-                .ok_or("soloStructure(index): index must be a whole number >= 0")?;
-            session.solo_structure(index as usize)
-        }),
-    )?;
-    define(
-        &api,
+    api.define(
         "setParams",
         setter(doc, ctx, |session, values| {
             session.set_params_json(&from_js(&values)?)
@@ -346,8 +327,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "metrics",
         Closure::<dyn FnMut() -> Promise>::new(move || {
             when_current(&d, &c, |session| {
@@ -360,8 +340,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "suggest",
         Closure::<dyn FnMut(JsValue) -> Promise>::new(move |options: JsValue| match start_suggest(
             &d, &options,
@@ -385,8 +364,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "sweep",
         Closure::<dyn FnMut() -> Promise>::new(move || {
             if d.borrow().session.model().is_none() {
@@ -407,8 +385,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "suggestAll",
         Closure::<dyn FnMut(JsValue) -> Promise>::new(move |options: JsValue| {
             let started = {
@@ -427,8 +404,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "checkStructures",
         Closure::<dyn FnMut() -> Promise>::new(move || {
             let started = d.borrow_mut().session.start_checks();
@@ -437,8 +413,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "gallery",
         Closure::<dyn FnMut() -> Promise>::new(move || {
             {
@@ -467,8 +442,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "exportMesh",
         Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
             let name = format.as_string().unwrap_or_default();
@@ -485,8 +459,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "exportCase",
         Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
             let name = format.as_string().unwrap_or_else(|| "glb".into());
@@ -505,41 +478,15 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
             })
         }),
     )?;
-    define(
-        &api,
-        "setCase",
-        setter(doc, ctx, |session, values| {
-            let values = from_js(&values)?;
-            let text = |key: &str| match values.get(key) {
-                None => Ok(None),
-                Some(v) => v
-                    .as_str()
-                    .map(Some)
-                    .ok_or_else(|| format!("setCase: {key} must be a string")),
-            };
-            if let Some(key) = values
-                .as_object()
-                .ok_or("setCase takes an object: {title, description}")?
-                .keys()
-                .find(|k| !["title", "description"].contains(&k.as_str()))
-            {
-                return Err(format!("setCase: unknown key {key} (title, description)"));
-            }
-            session.set_case_text(text("title")?, text("description")?);
-            Ok(())
-        }),
-    )?;
 
     let d = doc.clone();
-    define(
-        &api,
+    api.define(
         "backend",
         Closure::<dyn FnMut() -> JsValue>::new(move || d.borrow().backend.name().into()),
     )?;
 
     let (d, c) = (doc.clone(), ctx.clone());
-    define(
-        &api,
+    api.define(
         "clearWeights",
         Closure::<dyn FnMut()>::new(move || {
             d.borrow_mut().session.clear_weights();
@@ -548,17 +495,28 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> 
     )?;
 
     let d = doc.clone();
-    define(
-        &api,
+    api.define(
+        "setShortcuts",
+        Closure::<dyn FnMut(JsValue) -> Result<(), JsValue>>::new(move |on: JsValue| {
+            let on = on
+                .as_bool()
+                .ok_or_else(|| error("setShortcuts(on): on must be true or false"))?;
+            d.borrow_mut().shortcuts = on;
+            Ok(())
+        }),
+    )?;
+
+    let d = doc.clone();
+    api.define(
         "state",
         Closure::<dyn FnMut() -> JsValue>::new(move || to_js(&d.borrow().state_json())),
     )?;
 
-    js_sys::Reflect::set(&window, &"meshsmooth".into(), &api)
+    js_sys::Reflect::set(&window, &"meshsmooth".into(), &api.object)
         .map_err(|e| super::page::js_error_text(&e))?;
     let event = web_sys::Event::new(READY_EVENT).map_err(|e| super::page::js_error_text(&e))?;
     window
         .dispatch_event(&event)
         .map_err(|e| super::page::js_error_text(&e))?;
-    Ok(())
+    Ok(api.object)
 }

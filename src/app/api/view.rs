@@ -1,11 +1,12 @@
-//! `setView`: the view's standard sides, clipping plane and slide towards the segmentation, as
-//! its tools set them.
+//! The API's calls on the view: `setView` (its standard sides, clipping plane and slide towards
+//! the segmentation, as its tools set them) and `screenshot` (a PNG of it).
 
 use eframe::egui;
+use js_sys::{Function, Promise, Uint8Array};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsValue;
 
-use super::{error, from_js};
+use super::{error, from_js, Api};
 use crate::app::document::SharedDocument;
 use crate::view::ViewRequest;
 
@@ -31,4 +32,29 @@ pub(super) fn set_view(
         ctx.request_repaint();
         Ok(())
     })
+}
+
+pub(super) fn define_screenshot(
+    api: &Api,
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+) -> Result<(), String> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    api.define(
+        "screenshot",
+        Closure::<dyn FnMut() -> Promise>::new(move || {
+            let (d, c) = (d.clone(), c.clone());
+            Promise::new(&mut |resolve: Function, reject: Function| {
+                let waiter = Box::new(move |png: Result<Vec<u8>, String>| {
+                    let _ = match png {
+                        Ok(bytes) => resolve.call1(&JsValue::NULL, &Uint8Array::from(&bytes[..])),
+                        Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
+                    };
+                });
+                d.borrow_mut().waiting_for_picture.push(waiter);
+                c.request_repaint();
+            })
+        }),
+    )?;
+    Ok(())
 }

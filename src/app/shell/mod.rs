@@ -4,20 +4,23 @@
 
 use super::bottom_panel::BottomPanel;
 use super::brush::Brush;
+use super::case_text::CaseText;
 use super::controls::{self, Controls};
 use super::document::{Backend, Document, Opening, SharedDocument};
 use super::drag_params::DragParams;
 use super::file_input::FileInput;
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
+use super::picture::Picture;
 use super::pointing::Pointing;
 use super::shortcuts::{self, Action};
 use super::structure_list::{StructureAction, StructureList};
 use super::viewer::Viewer;
-use super::{api, download, page, query, report_view, status, workers, SAMPLE_BYTES, SAMPLE_NAME};
+use super::{api, download, page, query, report_view, status, workers};
 use crate::export::ExportFormat;
 use crate::session::ColorField;
 use crate::smooth::Filter;
+use crate::view::{CameraPose, ViewLink};
 use crate::worker::Pool;
 use eframe::egui;
 use eframe::egui_wgpu;
@@ -29,9 +32,12 @@ use std::time::Duration;
 const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
 
 mod reading;
+mod sharing;
+mod start;
 mod view_area;
 mod view_sync;
 
+use start::{embed, open_start_model};
 use view_sync::Shown;
 
 pub struct Shell {
@@ -64,6 +70,19 @@ pub struct Shell {
     reading: bool,
     /// The structure under the pointer.
     pointing: Pointing,
+    /// The page that embeds this one (`?parent=ORIGIN`), told what happens here.
+    embedding: Option<api::Embedding>,
+    /// A picture of the view asked for.
+    picture: Picture,
+    /// The view the page's link asks for (or why it does not read), until the case it came
+    /// with is open.
+    link: Option<Result<ViewLink, String>>,
+    /// The link's camera, until the view has framed that case.
+    pending_pose: Option<CameraPose>,
+    /// "Copy link" was clicked (and is still hovered).
+    link_copied: bool,
+    /// The case in words for screen readers.
+    case_text: CaseText,
     /// Whether the last frame asked for the next at once.
     repainting: bool,
 }
@@ -117,10 +136,12 @@ impl Shell {
         let reading = query::param("mode").as_deref() == Some("viewer");
         doc.borrow_mut().reading = reading;
         doc.borrow_mut().session.set_graphs_wanted(!reading);
+        doc.borrow_mut().shortcuts = query::param("shortcuts").as_deref() != Some("off");
+        // A link's view is of the case it names.
+        let named = query::param("case").or_else(|| query::param("model"));
+        let link = named.and(ViewLink::from_query(&query::search()).transpose());
         open_start_model(&doc, &files, &cc.egui_ctx);
-        if let Err(e) = api::install(&doc, &cc.egui_ctx) {
-            log::error!("no embedding API: {e}");
-        }
+        let embedding = embed(&doc, &cc.egui_ctx);
         Self {
             doc,
             files,
@@ -143,6 +164,12 @@ impl Shell {
             structures: StructureList::default(),
             reading,
             pointing: Pointing::default(),
+            embedding,
+            picture: Picture::default(),
+            link,
+            pending_pose: None,
+            link_copied: false,
+            case_text: CaseText::default(),
             repainting: false,
         }
     }
@@ -298,6 +325,7 @@ impl Shell {
                 if ui.button("Reset view").on_hover_text("R").clicked() {
                     viewer.reset_view();
                 }
+                self.sharing_buttons(ui);
             }
             ui.separator();
             if ui.button("Help").on_hover_text("H").clicked() {
@@ -402,32 +430,29 @@ impl Shell {
     }
 }
 
-/// Opens `?model=URL` (same origin only) or else the bundled sample.
-fn open_start_model(doc: &SharedDocument, files: &FileInput, ctx: &egui::Context) {
-    match query::model_url() {
-        None => {
-            let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
-        }
-        Some(Err(e)) => {
-            let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
-            doc.borrow_mut().session.fail("?model", &e);
-        }
-        Some(Ok(model)) => files.fetch(model.url, model.name, ctx),
-    }
-}
-
 impl eframe::App for Shell {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.receive_files(&ctx);
-        for action in shortcuts::pressed(&ctx) {
+        let keys = self.doc.borrow().shortcuts;
+        let pressed = if keys {
+            shortcuts::pressed(&ctx)
+        } else {
+            Vec::new()
+        };
+        for action in pressed {
             if !self.reading || shortcuts::reads(action) {
                 self.apply(action);
             }
         }
         // The frame a new model arrives in takes it up; uploading it to the GPU takes the next.
         // While a worker opens a file, the open model is worked on as before.
+        self.pictures(&ctx);
         let opening = self.doc.borrow_mut().step_loading();
+        let opened = opening == Opening::Done && self.doc.borrow().session.loading().is_none();
+        if let Some(link) = self.link.take_if(|_| opened) {
+            self.take_up_link(link);
+        }
         {
             let session = &mut self.doc.borrow_mut().session;
             session.step_suggest_all();
@@ -456,6 +481,10 @@ impl eframe::App for Shell {
         {
             let mut doc = self.doc.borrow_mut();
             doc.answer_waiting();
+            if let Some(embedding) = &mut self.embedding {
+                embedding.after_frame(&mut doc);
+            }
+            self.case_text.update(&doc.session);
             self.repainting = doc.working();
             if self.repainting && doc.working_elsewhere() {
                 // The replies wake the page; this only moves the progress on. Frames drawn

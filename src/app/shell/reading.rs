@@ -8,9 +8,13 @@ use crate::app::case_reader;
 use crate::app::structure_list::StructureAction;
 use crate::session::ColorField;
 
+/// Below this page width (points) the case's panel goes under the view: a phone held upright.
+const NARROW: f32 = 700.0;
+
 impl Shell {
     pub(super) fn reading_top_bar(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
+        let narrow = ui.ctx().content_rect().width() < NARROW;
+        ui.horizontal_wrapped(|ui| {
             ui.heading("meshsmooth viewer");
             ui.separator();
             if ui.button("Open…").on_hover_text("O").clicked() {
@@ -20,45 +24,53 @@ impl Shell {
                 if ui.button("Reset view").on_hover_text("R").clicked() {
                     viewer.reset_view();
                 }
+                ui.separator();
+                self.sharing_buttons(ui);
             }
             ui.separator();
             if ui.button("Help").on_hover_text("H").clicked() {
                 self.help_open = !self.help_open;
             }
-            ui.label("Drop a case glTF on the page to open it.");
+            if !narrow {
+                ui.label("Drop a case glTF on the page to open it.");
+            }
         });
     }
 
-    /// The case's title, its structures and the selected one's record.
+    /// The case's title, its structures and the selected one's record: left of the view, or
+    /// under it on a narrow page.
     pub(super) fn reading_panel(&mut self, ui: &mut egui::Ui) {
-        egui::Panel::left("case")
-            .resizable(true)
-            .default_size(300.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    let mut guard = self.doc.borrow_mut();
-                    let doc = &mut *guard;
-                    let was = self.coloring == Some(ColorField::LocalError);
-                    let mut error_colours = was;
-                    let actions =
-                        case_reader::show(ui, &doc.session, &mut doc.panel, &mut error_colours);
-                    if error_colours != was {
-                        self.coloring = error_colours.then_some(ColorField::LocalError);
+        let page = ui.ctx().content_rect();
+        let panel = if page.width() < NARROW {
+            egui::Panel::bottom("case below").default_size(page.height() * 0.38)
+        } else {
+            egui::Panel::left("case").default_size(300.0)
+        };
+        panel.resizable(true).show(ui, |ui| {
+            // Filling the panel: under the view it would otherwise shrink to its first lines.
+            let scroll = egui::ScrollArea::vertical().auto_shrink([false, false]);
+            scroll.show(ui, |ui| {
+                let mut guard = self.doc.borrow_mut();
+                let doc = &mut *guard;
+                let was = self.coloring == Some(ColorField::LocalError);
+                let mut error_colours = was;
+                let actions =
+                    case_reader::show(ui, &doc.session, &mut doc.panel, &mut error_colours);
+                if error_colours != was {
+                    self.coloring = error_colours.then_some(ColorField::LocalError);
+                }
+                for action in actions {
+                    let done = match action {
+                        StructureAction::Select(i) => doc.begin_open_structure(i, None),
+                        StructureAction::Change(i, change) => doc.session.set_structure(i, change),
+                        StructureAction::Solo(i) => doc.session.solo_structure(i),
+                        _ => Ok(()),
+                    };
+                    if let Err(e) = done {
+                        log::warn!("{e}");
                     }
-                    for action in actions {
-                        let done = match action {
-                            StructureAction::Select(i) => doc.begin_open_structure(i, None),
-                            StructureAction::Change(i, change) => {
-                                doc.session.set_structure(i, change)
-                            }
-                            StructureAction::Solo(i) => doc.session.solo_structure(i),
-                            _ => Ok(()),
-                        };
-                        if let Err(e) = done {
-                            log::warn!("{e}");
-                        }
-                    }
-                });
+                }
             });
+        });
     }
 }

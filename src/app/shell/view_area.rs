@@ -1,12 +1,12 @@
-//! The middle of the page: the 3D view, its colour legend, its tools, the name of the
-//! structure under the pointer and the messages over its corner.
+//! The middle of the page: the 3D view, its colour legend, its tools, the orientation marker,
+//! the name of the structure under the pointer and the messages over its corner.
 
 use eframe::egui;
 
 use super::view_sync::Positions;
 use super::Shell;
 use crate::app::document::ViewReport;
-use crate::app::{legend, status, view_tools, viewer};
+use crate::app::{legend, orientation_marker, status, view_tools, viewer};
 
 impl Shell {
     /// The 3D view with its legend, its tools and the messages over it; the structure under
@@ -37,7 +37,7 @@ impl Shell {
                         viewer.show(ui)
                     })
                     .inner;
-                if !self.brush.active {
+                if !self.brush.active && !self.picture.pending {
                     let at = (viewer.camera(), viewer.clip_plane());
                     let clicked = self.pointing.update(ui, &response, at, &doc.session);
                     let current = doc.session.current_structure();
@@ -52,7 +52,11 @@ impl Shell {
                 }
                 doc.pointed = self.pointing.named.as_ref().map(|(_, name)| name.clone());
                 let asked = doc.view_asks;
-                view_tools::show(ui, response.rect, &mut doc.view_asks);
+                orientation_marker::paint(ui, response.rect, viewer.camera());
+                // A picture shows the view alone (and which way the patient lies).
+                if !self.picture.pending {
+                    view_tools::show(ui, response.rect, &mut doc.view_asks);
+                }
                 if doc.view_asks != asked {
                     ui.ctx().request_repaint();
                 }
@@ -67,6 +71,7 @@ impl Shell {
                 self.drag_params.interact(ui, &response, &mut doc.session);
                 doc.view = ViewReport {
                     rect: response.rect.into(),
+                    pose: Some(viewer.pose()),
                     brush_on: self.brush.active,
                     pick_ms: self.brush.pick_ms,
                 };
@@ -77,6 +82,9 @@ impl Shell {
                 view_rect
             }
         };
+        if self.picture.pending {
+            return;
+        }
         // Messages over the view's top-left corner.
         let doc = self.doc.borrow();
         let reading = self.files.reading();

@@ -67,6 +67,10 @@ impl Shell {
                 (None, _) => {}
             }
             self.framed_case = case;
+            // A link's camera, now that the view frames the case it was made for.
+            if let Some(pose) = self.pending_pose.take() {
+                viewer.set_pose(pose);
+            }
             self.shown = Shown {
                 generation: doc.model_generation,
                 positions: Some(Positions::Original),

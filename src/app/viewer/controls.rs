@@ -1,7 +1,8 @@
 //! Mouse, touch and wheel input over the view, turned into camera moves.
 //!
 //! The primary button drags the camera (drag orbits, shift+drag pans, double click resets),
-//! the middle button orbits: right drags are left to the caller through the view's `Response`.
+//! the middle button orbits; on a touch screen one finger orbits, two pan and pinch to zoom.
+//! Right drags are left to the caller through the view's `Response`.
 //! While the caller paints with the primary button (`painting`), a plain primary drag is the
 //! caller's too, and Ctrl/⌘ + drag orbits instead.
 
@@ -17,7 +18,15 @@ const ZOOM_PER_SCROLL_POINT: f32 = 0.002;
 pub fn apply(camera: &mut OrbitCamera, ui: &egui::Ui, response: &egui::Response, painting: bool) {
     let (shift, command) = ui.input(|i| (i.modifiers.shift, i.modifiers.command));
     let primary = response.dragged_by(egui::PointerButton::Primary);
-    if primary && shift {
+    // Two fingers pan (and pinch, below); the first finger's drag does not orbit meanwhile.
+    let fingers = ui
+        .input(|i| i.multi_touch())
+        .filter(|t| t.num_touches >= 2 && response.rect.contains(t.center_pos));
+    if let Some(touch) = fingers {
+        let size = response.rect.size();
+        let moved = touch.translation_delta;
+        camera.pan(moved.x, moved.y, Vec2::new(size.x, size.y));
+    } else if primary && shift {
         let delta = response.drag_delta();
         let size = response.rect.size();
         camera.pan(delta.x, delta.y, Vec2::new(size.x, size.y));

@@ -23,7 +23,8 @@ use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu};
 
 use crate::view::{
-    first_view, Clip, OrbitCamera, StandardView, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS,
+    first_view, CameraPose, Clip, OrbitCamera, StandardView, ViewUniforms, OUTPUT_LINEAR,
+    VERTEX_COLORS,
 };
 use callback::{ViewCallback, ViewResources};
 use glam::Vec3;
@@ -309,6 +310,16 @@ impl Viewer {
     pub fn clip_plane(&self) -> [f32; 4] {
         self.clip
             .map_or([0.0; 4], |c| c.plane(self.scene.0, self.scene.1))
+    }
+
+    /// Where the camera is, as a link keeps it.
+    pub fn pose(&self) -> CameraPose {
+        CameraPose::of(&self.camera)
+    }
+
+    /// Moves the camera to `pose`.
+    pub fn set_pose(&mut self, pose: CameraPose) {
+        self.camera = pose.applied_to(&self.camera);
     }
 
     /// The camera the view is drawn with (for picking).

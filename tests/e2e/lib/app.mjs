@@ -17,8 +17,13 @@ export class AppPage {
      * text) or crashed (then throws with the page's crash message). Requests and console
      * messages are recorded from before the first navigation.
      */
-    static async open(browser, server, outDir, { startTimeoutMs = 60_000, query = "" } = {}) {
-        const context = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1 });
+    static async open(browser, server, outDir, { startTimeoutMs = 60_000, query = "", device = {}, routes = {} } = {}) {
+        const context = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1, ...device });
+        // Files the page fetches from its own origin (`?case=cases/x.glb`) without being in dist/.
+        for (const [path, body] of Object.entries(routes)) {
+            await context.route(new URL(path, server.url).href, (route) =>
+                route.fulfill({ status: 200, body, contentType: "application/octet-stream", headers: { "Cache-Control": "no-store" } }));
+        }
         const page = await context.newPage();
         const app = new AppPage(context, page, server, outDir);
         const started = Date.now();
@@ -40,6 +45,9 @@ export class AppPage {
         this.pageErrors = [];
         this.consoleWaiters = new Set();
         page.on("request", (request) => this.requests.push(request.url()));
+        /** The sizes of the responses the page received, as they finish (promises). */
+        this.received = [];
+        page.on("requestfinished", (request) => this.received.push(request.sizes().catch(() => null)));
         page.on("pageerror", (error) => this.pageErrors.push(error));
         page.on("console", (message) => {
             const line = { type: message.type(), text: message.text() };
@@ -48,6 +56,12 @@ export class AppPage {
                 waiter(line);
             }
         });
+    }
+
+    /** Bytes the page received so far (bodies and headers; files its workers fetched too). */
+    async bytesReceived() {
+        const sizes = await Promise.all(this.received);
+        return sizes.reduce((sum, s) => sum + (s ? s.responseBodySize + s.responseHeadersSize : 0), 0);
     }
 
     async close() {
@@ -279,19 +293,24 @@ export class AppPage {
     }
 
     /** `exportMesh(format)` as a Node Buffer; throws unless it resolves with a Uint8Array. */
-    async exportMesh(format) {
+    exportMesh(format) {
+        return this.callBytes("exportMesh", format);
+    }
+
+    /** `method(...args)` as a Node Buffer; throws unless it resolves with a Uint8Array. */
+    async callBytes(method, ...args) {
         await this.api();
-        const result = await this.page.evaluate(async (format) => {
-            const bytes = await window.meshsmooth.exportMesh(format);
+        const result = await this.page.evaluate(async ([method, args]) => {
+            const bytes = await window.meshsmooth[method](...args);
             if (!(bytes instanceof Uint8Array)) {
-                return { error: `exportMesh(${format}) resolved with ${Object.prototype.toString.call(bytes)}, not a Uint8Array` };
+                return { error: `${method}(${args.join(", ")}) resolved with ${Object.prototype.toString.call(bytes)}, not a Uint8Array` };
             }
             let text = "";
             for (let i = 0; i < bytes.length; i += 0x8000) {
                 text += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
             }
             return { base64: btoa(text) };
-        }, format);
+        }, [method, args]);
         if (result.error) {
             throw new Error(result.error);
         }

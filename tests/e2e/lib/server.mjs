@@ -1,7 +1,10 @@
 // A static file server for dist/ on a free port of 127.0.0.1: what Trunk built, nothing else.
+// Also by hand, to serve a folder on a port (the example platform beside `bash web/serve.sh`):
+//   node tests/e2e/lib/server.mjs web/examples/platform 8081
 import { createServer } from "node:http";
 import { readFile, stat } from "node:fs/promises";
 import { extname, join, normalize, sep } from "node:path";
+import { fileURLToPath } from "node:url";
 
 const CONTENT_TYPES = {
     ".html": "text/html; charset=utf-8",
@@ -20,7 +23,7 @@ const CONTENT_TYPES = {
  * Serves `root` until `close()`. Every request is recorded in `served` (method and path), so a
  * test can see what the page asked for from this side too.
  */
-export async function serveDirectory(root) {
+export async function serveDirectory(root, port = 0) {
     const rootDir = normalize(root + sep);
     const served = [];
     const server = createServer(async (request, response) => {
@@ -48,9 +51,9 @@ export async function serveDirectory(root) {
     });
     await new Promise((resolve, reject) => {
         server.once("error", reject);
-        server.listen(0, "127.0.0.1", resolve);
+        server.listen(port, "127.0.0.1", resolve);
     });
-    const { port } = server.address();
+    port = server.address().port;
     return {
         url: `http://127.0.0.1:${port}/`,
         origin: `http://127.0.0.1:${port}`,
@@ -61,4 +64,14 @@ export async function serveDirectory(root) {
                 server.close(() => resolve());
             }),
     };
+}
+
+if (process.argv[1] === fileURLToPath(import.meta.url)) {
+    const [root, port] = process.argv.slice(2);
+    if (!root) {
+        console.error("usage: node tests/e2e/lib/server.mjs FOLDER [PORT]");
+        process.exit(2);
+    }
+    const served = await serveDirectory(root, Number(port ?? 0));
+    console.log(`serving ${root} at ${served.url} (Ctrl+C stops)`);
 }

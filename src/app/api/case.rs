@@ -1,0 +1,103 @@
+//! The API's calls on the case's structures: `structures`, `selectStructure`,
+//! `setStructure`, `soloStructure` and `setCase`.
+
+use eframe::egui;
+use js_sys::{Function, Promise};
+use wasm_bindgen::closure::Closure;
+use wasm_bindgen::JsValue;
+
+use super::files::info_waiter;
+use super::{from_js, setter, settled, to_js, Api};
+use crate::app::document::SharedDocument;
+
+pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
+    let d = doc.clone();
+    api.define(
+        "structures",
+        Closure::<dyn FnMut() -> JsValue>::new(move || {
+            let doc = d.borrow();
+            match doc.session.structures_json() {
+                Some(s) => to_js(&s),
+                None => JsValue::NULL,
+            }
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    api.define(
+        "selectStructure",
+        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |index: JsValue| {
+            let Some(index) = index.as_f64().filter(|i| *i >= 0.0 && i.fract() == 0.0) else {
+                return settled(Err(
+                    "selectStructure(index): index must be a whole number >= 0".into(),
+                ));
+            };
+            let (d, c) = (d.clone(), c.clone());
+            let mut result = None;
+            let promise = Promise::new(&mut |resolve: Function, reject: Function| {
+                let waiter = info_waiter(resolve, reject);
+                result = Some(
+                    d.borrow_mut()
+                        .begin_open_structure(index as usize, Some(waiter)),
+                );
+                c.request_repaint();
+            });
+            match result {
+                Some(Err(e)) => settled(Err(e)),
+                _ => promise,
+            }
+        }),
+    )?;
+
+    let reading = api.reading;
+    api.define(
+        "setStructure",
+        setter(doc, ctx, move |session, values| {
+            let (index, change) = crate::session::StructureChange::from_json(&from_js(&values)?)?;
+            if reading
+                && (change.name.is_some() || change.group.is_some() || change.description.is_some())
+            {
+                return Err("setStructure: the viewer changes how a structure is shown \
+                    (visible, opacity, color), not its name, group or description"
+                    .into());
+            }
+            let index = (index.or(session.current_structure())).ok_or("nothing is open")?;
+            session.set_structure(index, change)
+        }),
+    )?;
+
+    api.define(
+        "soloStructure",
+        setter(doc, ctx, |session, index| {
+            let index = (index.as_f64())
+                .filter(|i| *i >= 0.0 && i.fract() == 0.0)
+                .ok_or("soloStructure(index): index must be a whole number >= 0")?;
+            session.solo_structure(index as usize)
+        }),
+    )?;
+
+    api.define(
+        "setCase",
+        setter(doc, ctx, |session, values| {
+            let values = from_js(&values)?;
+            let text = |key: &str| match values.get(key) {
+                None => Ok(None),
+                Some(v) => v
+                    .as_str()
+                    .map(Some)
+                    .ok_or_else(|| format!("setCase: {key} must be a string")),
+            };
+            if let Some(key) = values
+                .as_object()
+                .ok_or("setCase takes an object: {title, description}")?
+                .keys()
+                .find(|k| !["title", "description"].contains(&k.as_str()))
+            {
+                return Err(format!("setCase: unknown key {key} (title, description)"));
+            }
+            session.set_case_text(text("title")?, text("description")?);
+            Ok(())
+        }),
+    )?;
+    Ok(())
+}

@@ -1,0 +1,110 @@
+//! What a reader takes away from the view: a picture of it (PNG) and a link that opens the
+//! case as it is shown now; and taking up such a link when the page opens with one.
+
+use eframe::egui;
+
+use super::Shell;
+use crate::app::download;
+use crate::session::StructureChange;
+use crate::view::ViewLink;
+
+impl Shell {
+    /// Hands a picture that arrived to whoever asked for it, and asks for one the API wants.
+    pub(super) fn pictures(&mut self, ctx: &egui::Context) {
+        let mut doc = self.doc.borrow_mut();
+        let r = doc.view.rect;
+        let view =
+            egui::Rect::from_min_size(egui::pos2(r.left, r.top), egui::vec2(r.width, r.height));
+        if let Some(png) = self.picture.take(view, ctx.pixels_per_point()) {
+            if std::mem::take(&mut self.picture.download) {
+                let stem = doc.session.case_file().split('.').next().unwrap_or("");
+                let name = format!("{}_view.png", if stem.is_empty() { "case" } else { stem });
+                if let Err(e) = (png.as_ref())
+                    .map_err(String::clone)
+                    .and_then(|b| download::save(&name, b, "image/png"))
+                {
+                    log::warn!("the picture was not saved: {e}");
+                }
+            }
+            for waiter in std::mem::take(&mut doc.waiting_for_picture) {
+                waiter(png.clone());
+            }
+        }
+        if !doc.waiting_for_picture.is_empty() {
+            self.picture.ask(ctx, false);
+        }
+    }
+
+    /// The view's sharing buttons: save a picture, copy a link to the view (where the case came
+    /// from an address).
+    pub(super) fn sharing_buttons(&mut self, ui: &mut egui::Ui) {
+        if ui
+            .button("Save picture")
+            .on_hover_text("Save the view as a PNG image")
+            .clicked()
+        {
+            self.picture.ask(ui.ctx(), true);
+        }
+        let url = self.doc.borrow().view_link_url();
+        let tip = "Copy an address that opens this case as it is shown now";
+        let button = ui.add_enabled(url.is_some(), egui::Button::new("Copy link"));
+        let button = button
+            .on_hover_text(tip)
+            .on_disabled_hover_text("Only a case opened from an address (?case=) has a link");
+        if let (true, Some(url)) = (button.clicked(), url) {
+            ui.ctx().copy_text(url);
+            self.link_copied = true;
+        }
+        if self.link_copied && !button.hovered() {
+            self.link_copied = false;
+        }
+        if self.link_copied {
+            ui.weak("copied");
+        }
+    }
+
+    /// Shows the case as the page's link asks, once the case it came with is open (or says
+    /// why the link does not read).
+    pub(super) fn take_up_link(&mut self, link: Result<ViewLink, String>) {
+        let mut doc = self.doc.borrow_mut();
+        let link = match link {
+            Ok(link) => link,
+            Err(e) => {
+                doc.session.fail("the link", &e);
+                return;
+            }
+        };
+        let count = doc.session.case_structures().len();
+        let mut problems = Vec::new();
+        for &i in link
+            .hidden
+            .iter()
+            .chain(link.opacity.iter().map(|(i, _)| i))
+        {
+            if i >= count {
+                problems.push(format!("the case has no structure {i}"));
+            }
+        }
+        for i in 0..count {
+            let change = StructureChange {
+                visible: Some(!link.hidden.contains(&i)),
+                opacity: (link.opacity.iter().find(|(j, _)| *j == i)).map(|(_, a)| *a),
+                ..Default::default()
+            };
+            if let Err(e) = doc.session.set_structure(i, change) {
+                problems.push(e);
+            }
+        }
+        doc.view_asks.clip = link.clip;
+        doc.view_asks.toward_segmentation = link.toward_segmentation;
+        if let Some(i) = link.selected {
+            if let Err(e) = doc.begin_open_structure(i, None) {
+                problems.push(e);
+            }
+        }
+        self.pending_pose = link.camera;
+        if !problems.is_empty() {
+            doc.session.fail("the link", &problems.join("; "));
+        }
+    }
+}
