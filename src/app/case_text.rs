@@ -7,19 +7,25 @@ use crate::session::Session;
 const CANVAS_ID: &str = "meshsmooth_canvas";
 const LIST_ID: &str = "case_structures";
 
-/// What the page's words were last written as.
+/// What the page's words were last written for: the structures' version, the selected one,
+/// the case's file and title.
 #[derive(Default)]
 pub struct CaseText {
-    written: Option<(String, Vec<String>)>,
+    written: Option<(u64, Option<usize>, String, String)>,
 }
 
 impl CaseText {
-    /// Rewrites the canvas's label and the structures' list where they changed.
+    /// Rewrites the canvas's label and the structures' list where the case changed.
     pub fn update(&mut self, session: &Session) {
-        let words = (label(session), lines(session));
-        if self.written.as_ref() == Some(&words) {
-            return;
+        let (version, current) = (session.case_version(), session.current_structure());
+        let (file, title) = (session.case_file(), session.case_title());
+        if let Some((v, c, f, t)) = &self.written {
+            if (*v, *c, f.as_str(), t.as_str()) == (version, current, file, title) {
+                return;
+            }
         }
+        self.written = Some((version, current, file.to_string(), title.to_string()));
+        let words = (label(session), lines(session));
         let Some(document) = web_sys::window().and_then(|w| w.document()) else {
             return;
         };
@@ -35,7 +41,6 @@ impl CaseText {
                 }
             }
         }
-        self.written = Some(words);
     }
 }
 

@@ -486,7 +486,7 @@ impl Document {
     /// The viewer's address that opens the case as it is shown now, where the case came from
     /// an address (`?case=`); `None` for a file dropped or handed over.
     pub fn view_link_url(&self) -> Option<String> {
-        let case = super::query::param("case").or_else(|| super::query::param("model"))?;
+        let (_, case) = super::query::case_param()?;
         let location = web_sys::window()?.location();
         let page = format!("{}{}", location.origin().ok()?, location.pathname().ok()?);
         let case = String::from(js_sys::encode_uri_component(&case));

@@ -20,12 +20,16 @@ pub fn param(name: &str) -> Option<String> {
         .get(name)
 }
 
+/// The `case` or else the `model` query parameter (its key and value), if there is one.
+pub fn case_param() -> Option<(&'static str, String)> {
+    (param("case").map(|c| ("case", c))).or_else(|| param("model").map(|m| ("model", m)))
+}
+
 /// The `case` or else the `model` query parameter, if there is one; an error when it names
 /// another origin.
 pub fn model_url() -> Option<Result<ModelUrl, String>> {
     let location = web_sys::window()?.location();
-    let (key, wanted) =
-        (param("case").map(|c| ("case", c))).or_else(|| param("model").map(|m| ("model", m)))?;
+    let (key, wanted) = case_param()?;
     Some(resolve(
         key,
         &wanted,

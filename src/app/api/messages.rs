@@ -12,8 +12,6 @@
 //!   (`{error}`); `changed` (`structures()`) when the case changed (a structure shown,
 //!   hidden, renamed, selected or smoothed anew) and its results are computed.
 
-use std::hash::{Hash, Hasher};
-
 use js_sys::{Array, Function, Object, Promise, Reflect};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::{JsCast, JsValue};
@@ -27,7 +25,7 @@ use crate::app::page::js_error_text;
 pub struct Embedding {
     parent: String,
     /// What the case was when the parent last heard (see [`case_key`]).
-    heard: Option<u64>,
+    heard: Option<CaseKey>,
 }
 
 impl Embedding {
@@ -117,16 +115,13 @@ fn parent_origin(value: &str) -> Result<String, String> {
     Ok(origin)
 }
 
-/// What the parent's `changed` event follows: the structures' looks and count, which one is
-/// open, and its filter and parameters.
-fn case_key(doc: &Document) -> u64 {
+/// The session's counters of what the parent's `changed` event follows: the structures'
+/// looks and count, which one is open, and the revision of its filter and parameters.
+type CaseKey = (u64, Option<usize>, u64);
+
+fn case_key(doc: &Document) -> CaseKey {
     let s = &doc.session;
-    let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    s.case_version().hash(&mut hasher);
-    s.current_structure().hash(&mut hasher);
-    s.filter().name().hash(&mut hasher);
-    format!("{:?}", s.params()).hash(&mut hasher);
-    hasher.finish()
+    (s.case_version(), s.current_structure(), s.revision())
 }
 
 fn set(object: &Object, key: &str, value: &JsValue) {

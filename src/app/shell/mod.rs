@@ -138,8 +138,7 @@ impl Shell {
         doc.borrow_mut().session.set_graphs_wanted(!reading);
         doc.borrow_mut().shortcuts = query::param("shortcuts").as_deref() != Some("off");
         // A link's view is of the case it names.
-        let named = query::param("case").or_else(|| query::param("model"));
-        let link = named.and(ViewLink::from_query(&query::search()).transpose());
+        let link = query::case_param().and(ViewLink::from_query(&query::search()).transpose());
         open_start_model(&doc, &files, &cc.egui_ctx);
         let embedding = embed(&doc, &cc.egui_ctx);
         Self {

@@ -45,13 +45,14 @@ impl Shell {
         {
             self.picture.ask(ui.ctx(), true);
         }
-        let url = self.doc.borrow().view_link_url();
+        // The address is made when asked for, not every frame.
+        let linkable = crate::app::query::case_param().is_some();
         let tip = "Copy an address that opens this case as it is shown now";
-        let button = ui.add_enabled(url.is_some(), egui::Button::new("Copy link"));
+        let button = ui.add_enabled(linkable, egui::Button::new("Copy link"));
         let button = button
             .on_hover_text(tip)
             .on_disabled_hover_text("Only a case opened from an address (?case=) has a link");
-        if let (true, Some(url)) = (button.clicked(), url) {
+        if let (true, Some(url)) = (button.clicked(), self.doc.borrow().view_link_url()) {
             ui.ctx().copy_text(url);
             self.link_copied = true;
         }
