@@ -6,10 +6,14 @@
 use eframe::egui;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
+use std::time::Duration;
 
 use super::read_bytes::{self, OnProgress};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsCast;
+
+/// How often a file's reading progress is drawn.
+const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
 
 /// The extensions `io::load` and `io::load_label_map` understand, for the picker's filter
 /// (`.gz` for `.nii.gz`, which the filter cannot name as one extension).
@@ -75,7 +79,12 @@ struct Inbox {
     next: Rc<Cell<u64>>,
     /// Whether the picker was opened to add files to the open case.
     adding: Rc<Cell<bool>>,
+    /// Takes files up as they arrive, between frames (see [`FileInput::on_arrival`]).
+    on_arrival: Rc<RefCell<Option<ArrivalHook>>>,
 }
+
+/// Called with the files arrived so far; it takes those it opens out of the list.
+pub type ArrivalHook = Box<dyn FnMut(&mut Vec<ArrivedFile>)>;
 
 impl Inbox {
     /// Registers a read of `name`; the returned callback reports its progress.
@@ -94,7 +103,8 @@ impl Inbox {
                 r.read = read;
                 r.total = total;
             }
-            ctx.request_repaint();
+            // A frame for each chunk would take the machine from the reading.
+            ctx.request_repaint_after(PROGRESS_REPAINT);
         });
         (id, progress)
     }
@@ -102,6 +112,14 @@ impl Inbox {
     fn deliver(&self, id: u64, file: ArrivedFile, ctx: &egui::Context) {
         self.reading.borrow_mut().retain(|(i, _)| *i != id);
         self.arrived.borrow_mut().push(file);
+        if let (Ok(mut hook), Ok(mut arrived)) = (
+            self.on_arrival.try_borrow_mut(),
+            self.arrived.try_borrow_mut(),
+        ) {
+            if let Some(hook) = hook.as_mut() {
+                hook(&mut arrived);
+            }
+        }
         ctx.request_repaint();
     }
 
@@ -207,6 +225,11 @@ impl FileInput {
             let add = false;
             inbox.deliver(id, ArrivedFile { name, bytes, add }, &ctx);
         });
+    }
+
+    /// Lets `hook` take files up as they arrive, rather than at the next frame.
+    pub fn on_arrival(&self, hook: ArrivalHook) {
+        *self.inbox.on_arrival.borrow_mut() = Some(hook);
     }
 
     /// Files whose reading finished since the last call, oldest first.

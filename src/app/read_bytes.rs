@@ -31,6 +31,9 @@ pub async fn read_file(file: &web_sys::File, mut progress: OnProgress) -> Result
 /// Fetches `url`'s bytes (same origin, checked by `query::model_url`).
 pub async fn fetch(url: &str, mut progress: OnProgress) -> Result<Vec<u8>, String> {
     let window = web_sys::window().ok_or("no window")?;
+    if let Some(early) = early_read(&window, url) {
+        return read_early(&early, progress).await;
+    }
     let response = JsFuture::from(window.fetch_with_str(url))
         .await
         .map_err(|e| format!("cannot fetch it: {}", text(&e)))?
@@ -51,6 +54,53 @@ pub async fn fetch(url: &str, mut progress: OnProgress) -> Result<Vec<u8>, Strin
     read_stream(&body, total, progress)
         .await
         .map_err(|e| format!("cannot read it: {e}"))
+}
+
+/// The reading index.html began for `url` (the page's `?case=` or `?model=`) while the app's
+/// module was still loading, taken once: the file downloads beside the app's start.
+fn early_read(window: &web_sys::Window, url: &str) -> Option<JsValue> {
+    let key = JsValue::from_str("meshsmoothEarly");
+    let early = Reflect::get(window, &key).ok().filter(JsValue::is_object)?;
+    let _ = Reflect::delete_property(window, &key);
+    let same = Reflect::get(&early, &"url".into()).ok()?.as_string()? == url;
+    same.then_some(early)
+}
+
+/// Waits for index.html's reading (`early`), reporting its progress meanwhile.
+async fn read_early(early: &JsValue, progress: OnProgress) -> Result<Vec<u8>, String> {
+    let progress = std::rc::Rc::new(std::cell::RefCell::new(progress));
+    let number = |key: &str| {
+        Reflect::get(early, &key.into())
+            .ok()
+            .and_then(|v| v.as_f64())
+    };
+    let report = {
+        let progress = progress.clone();
+        move |read: f64, total: Option<f64>| {
+            if let Ok(mut p) = progress.try_borrow_mut() {
+                p(read as u64, total.map(|t| t as u64));
+            }
+        }
+    };
+    report(number("read").unwrap_or(0.0), number("total"));
+    let hear = wasm_bindgen::closure::Closure::<dyn FnMut(f64, JsValue)>::new({
+        let report = report.clone();
+        move |read: f64, total: JsValue| report(read, total.as_f64())
+    });
+    let _ = Reflect::set(early, &"progress".into(), hear.as_ref());
+    let bytes = Reflect::get(early, &"bytes".into())
+        .ok()
+        .and_then(|b| b.dyn_into::<js_sys::Promise>().ok())
+        .ok_or("the page's early reading has no bytes")?;
+    let outcome = JsFuture::from(bytes).await;
+    let _ = Reflect::set(early, &"progress".into(), &JsValue::NULL);
+    drop(hear);
+    let bytes = outcome
+        .map_err(|e| format!("cannot fetch it: {}", text(&e)))?
+        .dyn_into::<Uint8Array>()
+        .map_err(|_| "the early reading gave something other than bytes".to_string())?;
+    report(f64::from(bytes.length()), number("total"));
+    Ok(bytes.to_vec())
 }
 
 fn too_large(bytes: u64) -> String {

@@ -96,10 +96,14 @@ fn reply_handler(
 ) -> Closure<dyn FnMut(web_sys::MessageEvent)> {
     Closure::new(move |event: web_sys::MessageEvent| {
         let data = event.data();
+        let mut progress = false;
         if let Some(buffer) = data.dyn_ref::<js_sys::ArrayBuffer>() {
             let bytes = js_sys::Uint8Array::new(buffer).to_vec();
             match decode::<Reply>(&bytes) {
-                Ok(reply) => inbox.borrow_mut().push((index, reply)),
+                Ok(reply) => {
+                    progress = matches!(reply, Reply::Progress { .. });
+                    inbox.borrow_mut().push((index, reply))
+                }
                 Err(why) => log::error!("engine worker {}: {why}", index + 1),
             }
         } else {
@@ -113,7 +117,12 @@ fn reply_handler(
                 hook();
             }
         }
-        ctx.request_repaint();
+        if progress {
+            // A stage's name on screen can wait; the frame's drawing would slow the stage.
+            ctx.request_repaint_after(std::time::Duration::from_millis(200));
+        } else {
+            ctx.request_repaint();
+        }
     })
 }
 

@@ -94,6 +94,9 @@ pub struct Session {
     additions: std::collections::VecDeque<(String, Vec<u8>)>,
     suggest_all: suggest_all::SuggestAll,
     checks: checks::Checks,
+    /// Whether a newly opened model gets a suggestion search (not in the viewer, which shows
+    /// no suggestion).
+    suggest_on_open: bool,
 }
 
 impl Default for Session {
@@ -122,6 +125,7 @@ impl Default for Session {
             additions: Default::default(),
             suggest_all: Default::default(),
             checks: Default::default(),
+            suggest_on_open: true,
         }
     }
 }
@@ -204,8 +208,15 @@ impl Session {
         self.weights_version += 1;
         self.reset_guidance();
         // A suggestion for the new model, ready to apply with one click.
-        self.queue_suggest(crate::suggest::SearchMethod::Local);
+        if self.suggest_on_open {
+            self.queue_suggest(crate::suggest::SearchMethod::Local);
+        }
         self.model.insert(model)
+    }
+
+    /// Whether each model opened from now on gets a suggestion search at once.
+    pub fn set_suggest_on_open(&mut self, on: bool) {
+        self.suggest_on_open = on;
     }
 
     /// Records that `name` could not be opened because of `reason`; returns the message.

@@ -150,6 +150,16 @@ testIn(WEBGPU_RUN, "2 every request the page makes goes to its own origin", { ti
             { query: `?model=${encodeURIComponent(model)}` },
         );
     }
+    // One of its own origin that is not there: index.html asked for it before the app started,
+    // and the app names it with the server's answer.
+    await withApp(
+        async (app) => {
+            const error = await app.page.waitForFunction(() => window.meshsmooth.state().error, null, { timeout: 60_000 });
+            assert.match(await error.jsonValue(), /^Cannot open missing\.ply: .*the server answered 404/);
+            assert.deepEqual(app.requests.filter((u) => new URL(u).pathname === "/missing.ply").length, 1, "asked for once");
+        },
+        { query: "?model=missing.ply" },
+    );
 });
 
 // --- 3: the Open button and the file input ---

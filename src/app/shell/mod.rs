@@ -8,7 +8,7 @@ use super::case_text::CaseText;
 use super::controls::{self, Controls};
 use super::document::{Backend, Document, Opening, SharedDocument};
 use super::drag_params::DragParams;
-use super::file_input::FileInput;
+use super::file_input::{ArrivedFile, FileInput};
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
 use super::picture::Picture;
@@ -87,16 +87,35 @@ pub struct Shell {
     repainting: bool,
 }
 
+/// WebGPU: the GPU engine on eframe's device. WebGL2 (no compute shaders): the CPU engine. The
+/// viewer smooths nothing of its own (a case carries its surfaces), so it has no GPU engine and
+/// compiles no smoothing kernels, which a software adapter takes long over: WebGPU only draws.
+fn gpu_engine(cc: &eframe::CreationContext<'_>, reading: bool) -> Option<GpuEngine> {
+    let rs = cc.wgpu_render_state.as_ref()?;
+    let info = rs.adapter.get_info();
+    log::info!("adapter: {} ({:?})", info.name, info.backend);
+    let software = crate::gpu::is_software_adapter(&info);
+    (info.backend == wgpu::Backend::BrowserWebGpu && !reading)
+        .then(|| GpuEngine::new(&rs.device, &rs.queue, software))
+}
+
+/// Opens the files that arrived (or adds them to the case).
+fn open_arrived(files: Vec<ArrivedFile>, doc: &mut Document) {
+    for file in files {
+        match file.bytes {
+            Ok(bytes) if file.add => doc.begin_add(&file.name, bytes, None),
+            Ok(bytes) => doc.begin_open(&file.name, bytes, None),
+            Err(reason) => {
+                doc.session.fail(&file.name, &reason);
+            }
+        }
+    }
+}
+
 impl Shell {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Self {
-        // WebGPU: the GPU engine on eframe's device. WebGL2 (no compute shaders): the CPU engine.
-        let gpu = cc.wgpu_render_state.as_ref().and_then(|rs| {
-            let info = rs.adapter.get_info();
-            log::info!("adapter: {} ({:?})", info.name, info.backend);
-            let software = crate::gpu::is_software_adapter(&info);
-            (info.backend == wgpu::Backend::BrowserWebGpu)
-                .then(|| GpuEngine::new(&rs.device, &rs.queue, software))
-        });
+        let reading = query::param("mode").as_deref() == Some("viewer");
+        let gpu = gpu_engine(cc, reading);
         let backend = if gpu.is_some() {
             Backend::WebGpu
         } else {
@@ -133,9 +152,20 @@ impl Shell {
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
         let files = FileInput::new(&cc.egui_ctx);
-        let reading = query::param("mode").as_deref() == Some("viewer");
-        doc.borrow_mut().reading = reading;
-        doc.borrow_mut().session.set_graphs_wanted(!reading);
+        // A file goes to the workers as soon as it is read, not a frame later.
+        let weak = Rc::downgrade(&doc);
+        files.on_arrival(Box::new(move |arrived| {
+            if let Some(Ok(mut doc)) = weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
+                open_arrived(std::mem::take(arrived), &mut doc);
+            }
+        }));
+        {
+            // The viewer shows no guidance: nothing runs for it in the background.
+            let mut doc = doc.borrow_mut();
+            doc.reading = reading;
+            doc.session.set_graphs_wanted(!reading);
+            doc.session.set_suggest_on_open(!reading);
+        }
         doc.borrow_mut().shortcuts = query::param("shortcuts").as_deref() != Some("off");
         // A link's view is of the case it names.
         let link = query::case_param().and(ViewLink::from_query(&query::search()).transpose());
@@ -194,16 +224,7 @@ impl Shell {
 
     fn receive_files(&mut self, ctx: &egui::Context) {
         self.files.collect_dropped(ctx);
-        for file in self.files.take_arrived() {
-            let mut doc = self.doc.borrow_mut();
-            match file.bytes {
-                Ok(bytes) if file.add => doc.begin_add(&file.name, bytes, None),
-                Ok(bytes) => doc.begin_open(&file.name, bytes, None),
-                Err(reason) => {
-                    doc.session.fail(&file.name, &reason);
-                }
-            }
-        }
+        open_arrived(self.files.take_arrived(), &mut self.doc.borrow_mut());
     }
 
     /// The file dialog, to open files as a case or (`add`) to add them to the open one.
