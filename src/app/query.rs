@@ -20,6 +20,11 @@ pub fn param(name: &str) -> Option<String> {
         .get(name)
 }
 
+/// Whether the page is the case viewer (`?mode=viewer`) rather than the authoring page.
+pub fn viewer_mode() -> bool {
+    param("mode").as_deref() == Some("viewer")
+}
+
 /// The `case` or else the `model` query parameter (its key and value), if there is one.
 pub fn case_param() -> Option<(&'static str, String)> {
     (param("case").map(|c| ("case", c))).or_else(|| param("model").map(|m| ("model", m)))

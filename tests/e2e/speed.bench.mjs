@@ -474,7 +474,7 @@ testIn(EVERY_RUN, "B8 the viewer's first frame of the JHU atlas's case (48 struc
         const { view, open_stages: stages } = await state(app);
         const centre = colourAt(image, Math.round(view.x + view.width / 2), Math.round(view.y + view.height / 2));
         return { ms, centre, stages, startSeconds: app.startSeconds, requested: app.requests.length, received: await app.bytesReceived() };
-    }, { query: "?mode=viewer&case=cases/jhu.glb", routes: { "cases/jhu.glb": glb } });
+    }, { query: "?mode=viewer&case=cases/jhu.glb", files: { "cases/jhu.glb": glb } });
     emit({
         bench: "viewer-first-frame", file: "JHU-WhiteMatter-labels-1mm.nii.gz", structures: 48,
         first_frame_ms: Math.round(figures.ms), app_started_s: figures.startSeconds,

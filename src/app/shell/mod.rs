@@ -114,7 +114,7 @@ fn open_arrived(files: Vec<ArrivedFile>, doc: &mut Document) {
 
 impl Shell {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Self {
-        let reading = query::param("mode").as_deref() == Some("viewer");
+        let reading = query::viewer_mode();
         let gpu = gpu_engine(cc, reading);
         let backend = if gpu.is_some() {
             Backend::WebGpu
@@ -124,8 +124,13 @@ impl Shell {
         let doc = Rc::new(RefCell::new(Document::new(backend)));
         // The CPU engine runs in workers; without them (a page that cannot start any) it runs
         // here, blocking frames, rather than not at all.
-        // The background's workers, and one more kept for the view.
-        match workers::WebWorkers::start(workers::pool_size() + 1, &cc.egui_ctx) {
+        // The background's workers, and one more kept for the view; the viewer only opens and
+        // shows, which one does.
+        let count = match reading {
+            true => 1,
+            false => workers::pool_size() + 1,
+        };
+        match workers::WebWorkers::start(count, &cc.egui_ctx) {
             Ok(w) => {
                 log::info!(
                     "CPU engine: {} workers, one of them the view's",
@@ -494,8 +499,9 @@ impl eframe::App for Shell {
             }
         }
         self.bottom.update(&ctx, &mut self.doc.borrow_mut());
-        // The view takes up a new model once the engines have (a frame later).
-        if opening != Opening::Done && !uploading {
+        // The view takes up a new model once the GPU engine has (a frame later); the CPU
+        // engine's take-up is a message to a worker, so the view need not wait a frame.
+        if (opening != Opening::Done || self.gpu.is_none()) && !uploading {
             self.sync_view();
         }
         {

@@ -44,7 +44,10 @@ impl Shell {
         let panel = if page.width() < NARROW {
             egui::Panel::bottom("case below").default_size(page.height() * 0.38)
         } else {
-            egui::Panel::left("case").default_size(300.0)
+            // The view comes first: a list of long names would otherwise take the page.
+            egui::Panel::left("case")
+                .default_size(300.0)
+                .max_size((page.width() * 0.4).max(300.0))
         };
         panel.resizable(true).show(ui, |ui| {
             // Filling the panel: under the view it would otherwise shrink to its first lines.

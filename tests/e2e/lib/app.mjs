@@ -17,8 +17,12 @@ export class AppPage {
      * text) or crashed (then throws with the page's crash message). Requests and console
      * messages are recorded from before the first navigation.
      */
-    static async open(browser, server, outDir, { startTimeoutMs = 60_000, query = "", device = {}, routes = {} } = {}) {
+    static async open(browser, server, outDir, { startTimeoutMs = 60_000, query = "", device = {}, routes = {}, files = {} } = {}) {
         const context = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1, ...device });
+        // Files the server serves as its own (what a timing must see: routes pass through Node).
+        for (const [path, body] of Object.entries(files)) {
+            server.files.set(new URL(path, server.url).pathname, body);
+        }
         // Files the page fetches from its own origin (`?case=cases/x.glb`) without being in dist/.
         for (const [path, body] of Object.entries(routes)) {
             await context.route(new URL(path, server.url).href, (route) =>

@@ -26,6 +26,7 @@ const CONTENT_TYPES = {
 export async function serveDirectory(root, port = 0) {
     const rootDir = normalize(root + sep);
     const served = [];
+    const files = new Map();
     const server = createServer(async (request, response) => {
         const path = decodeURIComponent(new URL(request.url, "http://localhost").pathname);
         served.push(`${request.method} ${path}`);
@@ -35,10 +36,11 @@ export async function serveDirectory(root, port = 0) {
             return;
         }
         try {
-            if (!(await stat(file)).isFile()) {
+            const kept = files.get(path);
+            if (kept === undefined && !(await stat(file)).isFile()) {
                 throw new Error("not a file");
             }
-            const body = await readFile(file);
+            const body = kept ?? (await readFile(file));
             response.writeHead(200, {
                 "Content-Type": CONTENT_TYPES[extname(file)] ?? "application/octet-stream",
                 "Content-Length": body.length,
@@ -58,6 +60,8 @@ export async function serveDirectory(root, port = 0) {
         url: `http://127.0.0.1:${port}/`,
         origin: `http://127.0.0.1:${port}`,
         served,
+        /** Bodies served by path (`/cases/x.glb`) as if they were files of the folder. */
+        files,
         close: () =>
             new Promise((resolve) => {
                 server.closeAllConnections();

@@ -29,7 +29,7 @@ export function testIn(modes, name, options, body) {
  * Returns `{MODE, OUT, withApp}`, where `withApp(body, options)` runs `body(app)` on a freshly
  * opened page and closes it. The server and browser start with the file's first page
  * (`beforeAll` just before them) and stop after its last test (then `afterAll`), so a file
- * with no test in this run starts nothing. `options` go to `AppPage.open` (`query`, `device`, `routes`,
+ * with no test in this run starts nothing. `options` go to `AppPage.open` (`query`, `device`, `routes`, `files`,
  * `startTimeoutMs`); the page's API is awaited first unless the suite was made with
  * `waitForApi: false` (tests of the start itself).
  */
