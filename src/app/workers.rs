@@ -38,10 +38,6 @@ pub fn pool_size() -> usize {
 }
 
 impl WebWorkers {
-    pub fn workers(&self) -> usize {
-        self.workers.len()
-    }
-
     /// Runs `hook` whenever a reply lands, between frames: the pool hands the worker its next
     /// job there, instead of leaving it idle until the next frame (which can take long while a
     /// large mesh is drawn).

@@ -112,6 +112,31 @@ fn open_arrived(files: Vec<ArrivedFile>, doc: &mut Document) {
     }
 }
 
+/// Starts the CPU engine's workers: the background's and one more kept for the view; the
+/// viewer only opens and shows, which one worker does. Without workers (a page that cannot start
+/// any) the engine runs on the page, blocking frames, rather than not at all.
+fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Context) {
+    let count = match reading {
+        true => 1,
+        false => workers::pool_size() + 1,
+    };
+    match workers::WebWorkers::start(count, ctx) {
+        Ok(w) => {
+            let weak = Rc::downgrade(doc);
+            w.on_reply(Box::new(move || {
+                // Between frames the document is free; skipped should it not be.
+                if let Some(Ok(mut doc)) = weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
+                    doc.step_cpu_engine();
+                }
+            }));
+            let pool = Pool::with_view_worker(Box::new(w));
+            log::info!("CPU engine: {}", pool.to_json());
+            doc.borrow_mut().session.set_cpu_engine(pool);
+        }
+        Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
+    }
+}
+
 impl Shell {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Self {
         let reading = query::viewer_mode();
@@ -122,33 +147,7 @@ impl Shell {
             Backend::Cpu
         };
         let doc = Rc::new(RefCell::new(Document::new(backend)));
-        // The CPU engine runs in workers; without them (a page that cannot start any) it runs
-        // here, blocking frames, rather than not at all.
-        // The background's workers, and one more kept for the view; the viewer only opens and
-        // shows, which one does.
-        let count = match reading {
-            true => 1,
-            false => workers::pool_size() + 1,
-        };
-        match workers::WebWorkers::start(count, &cc.egui_ctx) {
-            Ok(w) => {
-                log::info!(
-                    "CPU engine: {} workers, one of them the view's",
-                    w.workers()
-                );
-                let weak = Rc::downgrade(&doc);
-                w.on_reply(Box::new(move || {
-                    // Between frames the document is free; skipped should it not be.
-                    if let Some(Ok(mut doc)) = weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
-                        doc.step_cpu_engine();
-                    }
-                }));
-                doc.borrow_mut()
-                    .session
-                    .set_cpu_engine(Pool::with_view_worker(Box::new(w)));
-            }
-            Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
-        }
+        start_workers(&doc, reading, &cc.egui_ctx);
         let view = cc.wgpu_render_state.as_ref().map(|rs| {
             let mut viewer = Viewer::new(rs);
             viewer.wireframe = page::query_flag("wireframe");
