@@ -33,6 +33,11 @@ impl Shell {
         if !doc.waiting_for_picture.is_empty() {
             self.picture.ask(ctx, false);
         }
+        if self.picture.pending {
+            // The frame read back reaches the app in a frame after it, which an idle viewer
+            // would not draw.
+            ctx.request_repaint_after(std::time::Duration::from_millis(50));
+        }
     }
 
     /// The view's sharing buttons: save a picture, copy a link to the view (where the case came
