@@ -54,13 +54,12 @@ impl WebWorkers {
         let on_reply: OnReply = Rc::default();
         let mut workers = Vec::new();
         let mut handlers = Vec::new();
+        let mut first = started_by_page();
         for index in 0..count.max(1) {
-            let options = web_sys::WorkerOptions::new();
-            options.set_type(web_sys::WorkerType::Module);
-            options.set_name(&format!("meshsmooth engine {}", index + 1));
-            let worker = web_sys::Worker::new_with_options("worker.js", &options).map_err(|e| {
-                format!("cannot start a worker: {}", super::page::js_error_text(&e))
-            })?;
+            let worker = match first.take() {
+                Some(worker) => worker,
+                None => new_worker(index)?,
+            };
             let handler = reply_handler(index, inbox.clone(), on_reply.clone(), ctx.clone());
             worker.set_onmessage(Some(handler.as_ref().unchecked_ref()));
             let start = js_sys::Object::new();
@@ -81,6 +80,23 @@ impl WebWorkers {
             _handlers: handlers,
         })
     }
+}
+
+/// The first worker, if index.html started it (`window.meshsmoothWorker`); taken once.
+fn started_by_page() -> Option<web_sys::Worker> {
+    let window = web_sys::window()?;
+    let key = JsValue::from_str("meshsmoothWorker");
+    let worker = js_sys::Reflect::get(&window, &key).ok()?;
+    let _ = js_sys::Reflect::delete_property(&window, &key);
+    worker.dyn_into::<web_sys::Worker>().ok()
+}
+
+fn new_worker(index: usize) -> Result<web_sys::Worker, String> {
+    let options = web_sys::WorkerOptions::new();
+    options.set_type(web_sys::WorkerType::Module);
+    options.set_name(&format!("meshsmooth engine {}", index + 1));
+    web_sys::Worker::new_with_options("worker.js", &options)
+        .map_err(|e| format!("cannot start a worker: {}", super::page::js_error_text(&e)))
 }
 
 /// The handler of worker `index`'s messages: a reply's bytes, or why the worker failed.
