@@ -13,6 +13,7 @@ struct View {
     base_color: vec4<f32>,
     back_tint: vec4<f32>,
     wire_color: vec4<f32>,
+    background: vec4<f32>,
     // Fragments where dot(clip.xyz, p) > clip.w are cut away; a zero normal cuts nothing.
     clip: vec4<f32>,
     flags: u32,
@@ -148,6 +149,8 @@ fn fs_wire(f: WireFragment) -> @location(0) vec4<f32> {
 // Composite: egui's render pass has no multisampling on the web, so the view is drawn with 4x
 // MSAA into its own target and this copies the resolved image into egui's pass, one texel per
 // pixel (the viewport is the view's rectangle). Colours are already encoded and premultiplied.
+// It lays them over the view's background itself, so no other pass fills the view's pixels
+// (a software rasteriser pays for every pass over them).
 
 @group(1) @binding(0) var frame: texture_2d<f32>;
 @group(1) @binding(1) var frame_sampler: sampler;
@@ -169,5 +172,7 @@ fn vs_composite(@builtin(vertex_index) index: u32) -> CompositeFragment {
 
 @fragment
 fn fs_composite(f: CompositeFragment) -> @location(0) vec4<f32> {
-    return textureSample(frame, frame_sampler, f.uv);
+    let view_color = textureSample(frame, frame_sampler, f.uv);
+    let background = encode(view.background.rgb, 1.0).rgb;
+    return vec4<f32>(view_color.rgb + background * (1.0 - view_color.a), 1.0);
 }

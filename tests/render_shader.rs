@@ -67,6 +67,7 @@ fn the_view_struct_matches_the_rust_record() {
         ("base_color", std::mem::offset_of!(ViewUniforms, base_color)),
         ("back_tint", std::mem::offset_of!(ViewUniforms, back_tint)),
         ("wire_color", std::mem::offset_of!(ViewUniforms, wire_color)),
+        ("background", std::mem::offset_of!(ViewUniforms, background)),
         ("clip", std::mem::offset_of!(ViewUniforms, clip)),
         ("flags", std::mem::offset_of!(ViewUniforms, flags)),
     ];

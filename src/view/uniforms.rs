@@ -4,6 +4,7 @@
 //! Colours are linear RGB in the record: lighting is computed in linear light and encoded for
 //! the framebuffer at the end, the way egui's own shader does (see [`OUTPUT_LINEAR`]).
 
+use super::thumbnail::BACKGROUND_SRGBA;
 use super::OrbitCamera;
 use bytemuck::{Pod, Zeroable};
 
@@ -35,7 +36,7 @@ pub const KEY_LIGHT_OFFSET: [f32; 2] = [-0.35, 0.5];
 pub const WIRE_COLOR_SRGB: [f32; 4] = [0.08, 0.08, 0.10, 0.6];
 
 /// `View` in shaders/render.wgsl: std140-compatible (four-component members at 16-byte
-/// offsets), 176 bytes, a valid uniform block for WebGL2 too.
+/// offsets), 192 bytes, a valid uniform block for WebGL2 too.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct ViewUniforms {
@@ -51,6 +52,8 @@ pub struct ViewUniforms {
     pub back_tint: [f32; 4],
     /// Linear RGB and alpha of the wireframe (not premultiplied).
     pub wire_color: [f32; 4],
+    /// Linear RGB behind the meshes (alpha 1): the composite lays the view over it.
+    pub background: [f32; 4],
     /// A clipping plane `(n, d)`: fragments where `n . p > d` are cut away; `n = 0` cuts
     /// nothing.
     pub clip: [f32; 4],
@@ -58,8 +61,8 @@ pub struct ViewUniforms {
     pub _padding: [u32; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<ViewUniforms>() == 176);
-const _: () = assert!(std::mem::offset_of!(ViewUniforms, flags) == 160);
+const _: () = assert!(std::mem::size_of::<ViewUniforms>() == 192);
+const _: () = assert!(std::mem::offset_of!(ViewUniforms, flags) == 176);
 
 impl ViewUniforms {
     /// The record for `camera` in a viewport of this aspect ratio (width / height).
@@ -68,6 +71,7 @@ impl ViewUniforms {
         let [r, g, b] = srgb(BASE_COLOR_SRGB);
         let [tr, tg, tb] = srgb(BACK_TINT_SRGB);
         let [wr, wg, wb] = srgb([WIRE_COLOR_SRGB[0], WIRE_COLOR_SRGB[1], WIRE_COLOR_SRGB[2]]);
+        let [br, bg, bb] = srgb([0, 1, 2].map(|k| f32::from(BACKGROUND_SRGBA[k]) / 255.0));
         let (right, up) = camera.screen_axes();
         let light = (camera.direction() + KEY_LIGHT_OFFSET[0] * right + KEY_LIGHT_OFFSET[1] * up)
             .normalize();
@@ -78,6 +82,7 @@ impl ViewUniforms {
             base_color: [r, g, b, 1.0],
             back_tint: [tr, tg, tb, BACK_TINT_AMOUNT],
             wire_color: [wr, wg, wb, WIRE_COLOR_SRGB[3]],
+            background: [br, bg, bb, 1.0],
             clip: [0.0; 4],
             flags,
             _padding: [0; 3],

@@ -256,12 +256,12 @@ impl Viewer {
             self.reset_view();
         }
 
-        ui.painter().rect_filled(rect, 0.0, BACKGROUND);
         if let Some(problem) = &self.problem {
+            ui.painter().rect_filled(rect, 0.0, BACKGROUND);
             centered_note(ui, rect, problem, ui.visuals().error_fg_color);
-        } else if self.vertex_count == 0 && !self.has_context {
-            centered_note(ui, rect, "Nothing to show", ui.visuals().weak_text_color());
         } else if rect.width() >= 1.0 && rect.height() >= 1.0 {
+            // The composite lays the view over its background: no egui rectangle lies under it,
+            // and with nothing to show it shows the background alone.
             let mut flags = 0;
             if self.has_colors {
                 flags |= VERTEX_COLORS;
@@ -282,6 +282,9 @@ impl Viewer {
             };
             ui.painter()
                 .add(egui_wgpu::Callback::new_paint_callback(rect, callback));
+            if self.vertex_count == 0 && !self.has_context {
+                centered_note(ui, rect, "Nothing to show", ui.visuals().weak_text_color());
+            }
         }
         response
     }

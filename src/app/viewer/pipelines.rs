@@ -260,8 +260,8 @@ impl Pipelines {
                 module: &module,
                 entry_point: Some("fs_composite"),
                 compilation_options: Default::default(),
-                // Premultiplied over the view's background; transparent where there is no mesh.
-                targets: &target(Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)),
+                // Opaque: the shader lays the view over its background.
+                targets: &target(None),
             }),
             multiview_mask: None,
             cache: None,
