@@ -11,6 +11,17 @@ const API_WAIT_MS = Number(process.env.E2E_API_WAIT_MS ?? 10_000);
 
 export const VIEWPORT = { width: 1280, height: 800 };
 
+/**
+ * The bytes a request received (body and headers). Chromium sometimes reports the case that
+ * index.html reads as a stream as aborted once it has read it all, without sizes: then its
+ * Content-Length counts.
+ */
+async function responseBytes(request) {
+    const sizes = await request.sizes().catch(() => null);
+    const length = Number((await request.response().catch(() => null))?.headers()["content-length"] ?? 0);
+    return Math.max(sizes ? sizes.responseBodySize + sizes.responseHeadersSize : 0, length);
+}
+
 export class AppPage {
     /**
      * Opens the served page and waits until the app has started (eframe removed the loading
@@ -51,7 +62,8 @@ export class AppPage {
         page.on("request", (request) => this.requests.push(request.url()));
         /** The sizes of the responses the page received, as they finish (promises). */
         this.received = [];
-        page.on("requestfinished", (request) => this.received.push(request.sizes().catch(() => null)));
+        page.on("requestfinished", (request) => this.received.push(responseBytes(request)));
+        page.on("requestfailed", (request) => this.received.push(responseBytes(request)));
         page.on("pageerror", (error) => this.pageErrors.push(error));
         page.on("console", (message) => {
             const line = { type: message.type(), text: message.text() };
@@ -65,7 +77,7 @@ export class AppPage {
     /** Bytes the page received so far (bodies and headers; files its workers fetched too). */
     async bytesReceived() {
         const sizes = await Promise.all(this.received);
-        return sizes.reduce((sum, s) => sum + (s ? s.responseBodySize + s.responseHeadersSize : 0), 0);
+        return sizes.reduce((sum, s) => sum + s, 0);
     }
 
     async close() {
