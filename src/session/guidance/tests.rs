@@ -46,6 +46,16 @@ fn a_loaded_model_gets_the_local_search_suggestion() {
 }
 
 #[test]
+fn a_session_that_only_shows_starts_no_search_for_a_model() {
+    let mut s = Session::default();
+    s.set_suggest_on_open(false);
+    s.open("sample.ply", SAMPLE).unwrap();
+    assert!(!s.suggesting(), "no search starts with the model");
+    assert!(!s.guidance_busy(), "nothing runs in the background");
+    assert!(s.suggestion().is_none());
+}
+
+#[test]
 fn a_grid_suggestion_follows_tau_without_smoothing_again() {
     let mut s = session("laplace");
     s.set_params_json(&serde_json::json!({"max_displacement": 0.4}))
