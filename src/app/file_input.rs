@@ -6,14 +6,10 @@
 use eframe::egui;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
-use std::time::Duration;
 
 use super::read_bytes::{self, OnProgress};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsCast;
-
-/// How often a file's reading progress is drawn.
-const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
 
 /// The extensions `io::load` and `io::load_label_map` understand, for the picker's filter
 /// (`.gz` for `.nii.gz`, which the filter cannot name as one extension).
@@ -104,7 +100,7 @@ impl Inbox {
                 r.total = total;
             }
             // A frame for each chunk would take the machine from the reading.
-            ctx.request_repaint_after(PROGRESS_REPAINT);
+            ctx.request_repaint_after(super::PROGRESS_REPAINT);
         });
         (id, progress)
     }

@@ -45,6 +45,10 @@ mod workers;
 
 pub use document::{Backend, Document};
 
+/// How often the page redraws only to move a progress on (bytes read, an opening's stage, the
+/// workers' jobs): each frame drawn for that takes a core from the work it shows.
+const PROGRESS_REPAINT: std::time::Duration = std::time::Duration::from_millis(200);
+
 /// The mesh shown when the app opens: a voxelised bent tube (a staircase vessel surface).
 pub const SAMPLE_NAME: &str = "bent_tube_staircase.ply";
 pub const SAMPLE_BYTES: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");

@@ -131,7 +131,7 @@ fn reply_handler(
         }
         if progress {
             // A stage's name on screen can wait; the frame's drawing would slow the stage.
-            ctx.request_repaint_after(std::time::Duration::from_millis(200));
+            ctx.request_repaint_after(super::PROGRESS_REPAINT);
         } else {
             ctx.request_repaint();
         }

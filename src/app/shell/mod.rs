@@ -26,10 +26,6 @@ use eframe::egui;
 use eframe::egui_wgpu;
 use std::cell::RefCell;
 use std::rc::Rc;
-use std::time::Duration;
-
-/// How often the page redraws while only the workers work: the progress bars move on.
-const PROGRESS_REPAINT: Duration = Duration::from_millis(200);
 
 mod reading;
 mod sharing;
@@ -514,7 +510,7 @@ impl eframe::App for Shell {
             if self.repainting && doc.working_elsewhere() {
                 // The replies wake the page; this only moves the progress on. Frames drawn
                 // for nothing would take a core from the workers.
-                ctx.request_repaint_after(PROGRESS_REPAINT);
+                ctx.request_repaint_after(crate::app::PROGRESS_REPAINT);
             } else if self.repainting {
                 ctx.request_repaint();
             }
