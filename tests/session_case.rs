@@ -5,15 +5,9 @@
 #[path = "common/label_maps.rs"]
 mod label_maps;
 
-use label_maps::read;
+use label_maps::{open_in_session, read};
 use meshsmooth::export::Container;
 use meshsmooth::session::{Session, StructureChange};
-
-/// Opens `name` in `session` (its workers run on this thread) and checks it opened.
-fn open(session: &mut Session, name: &str, bytes: Vec<u8>) {
-    session.begin_open(name, bytes);
-    session.poll_opening().expect("done").expect("opens");
-}
 
 /// The page's session opens a label map in a worker (read, extract, then a mesh's stages), makes the
 /// first structure the model with its voxel size, and opens another structure on request.
@@ -350,7 +344,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     use meshsmooth::smooth::{Filter, Params};
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
-    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
     session.set_case_text(Some("Abdomen"), Some("Liver, tumour, vessels"));
     let vessels = StructureChange {
         group: Some(Some("Vessels".into())),
@@ -376,7 +370,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     let first = session.export_case(Container::Glb).unwrap();
 
     let mut again = Session::default();
-    open(&mut again, "abdomen_case.glb", first.clone());
+    open_in_session(&mut again, "abdomen_case.glb", first.clone());
     assert_eq!(again.current_structure(), Some(0));
     assert_eq!(again.model().unwrap().name, "abdomen_case.glb: liver");
     assert_eq!(*again.params(), liver_params, "the liver's own parameters");
@@ -437,12 +431,12 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
 fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
-    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
     session.smooth_cpu();
     let case = session.export_case(Container::Glb).unwrap();
 
     let mut again = Session::default();
-    open(&mut again, "case.glb", case);
+    open_in_session(&mut again, "case.glb", case);
     let kept = again.case_structures()[0].smoothed.clone();
     assert!(kept.is_some(), "the case glTF holds the liver smoothed");
     assert!(again.last_result().is_none(), "nothing smoothed here yet");
@@ -460,7 +454,7 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     let sphere = read("synthetic/synthetic_sphere_r20.stl");
     let mut session = Session::default();
-    open(
+    open_in_session(
         &mut session,
         "case_phantom_shared.seg.nrrd",
         phantom.clone(),

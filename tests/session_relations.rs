@@ -5,14 +5,8 @@
 #[path = "common/label_maps.rs"]
 mod label_maps;
 
-use label_maps::read;
+use label_maps::{open_in_session, read};
 use meshsmooth::session::{Session, StructureChange};
-
-/// Opens `name` in `session` (its workers run on this thread) and checks it opened.
-fn open(session: &mut Session, name: &str, bytes: Vec<u8>) {
-    session.begin_open(name, bytes);
-    session.poll_opening().expect("done").expect("opens");
-}
 
 /// The page's checks between structures report what the CLI's `case build` reports for the
 /// case as it stands: the tumour lies inside the liver, until the liver is shrunk around it.
@@ -21,7 +15,7 @@ fn the_session_checks_its_structures_as_they_stand() {
     use meshsmooth::smooth::{Filter, Params};
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
-    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
     session.smooth_cpu();
     session.start_checks().unwrap();
     assert!(
@@ -120,7 +114,7 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
     use meshsmooth::view::Ray;
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
-    open(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
     let tumour = &session.case_structures()[2].original.positions;
     let centre = tumour
         .iter()

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use meshsmooth::segmentation::{self, NamedBytes, OpenOptions, Structure};
+use meshsmooth::session::Session;
 use serde_json::Value;
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/");
@@ -10,6 +11,12 @@ const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/");
 /// A file below ../shared/data.
 pub fn read(path: &str) -> Vec<u8> {
     std::fs::read(format!("{DATA}{path}")).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// Opens `name` in the page's `session` (its workers run on this thread) and checks it opened.
+pub fn open_in_session(session: &mut Session, name: &str, bytes: Vec<u8>) {
+    session.begin_open(name, bytes);
+    session.poll_opening().expect("done").expect("opens");
 }
 
 /// The label map's structures, named by its colour table when it has one.
