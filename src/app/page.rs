@@ -69,6 +69,16 @@ fn query_has_flag(search: &str, name: &str) -> bool {
         })
 }
 
+/// What index.html's script left on the window under `key` for the app, taken once (the key is
+/// removed): work it began before the app's module ran.
+pub fn take_from_window(key: &str) -> Option<wasm_bindgen::JsValue> {
+    let window = web_sys::window()?;
+    let key = wasm_bindgen::JsValue::from_str(key);
+    let value = js_sys::Reflect::get(&window, &key).ok()?;
+    let _ = js_sys::Reflect::delete_property(&window, &key);
+    Some(value)
+}
+
 /// Best-effort text of a JavaScript error value.
 pub fn js_error_text(value: &wasm_bindgen::JsValue) -> String {
     if let Some(error) = value.dyn_ref::<js_sys::Error>() {

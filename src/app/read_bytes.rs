@@ -31,7 +31,7 @@ pub async fn read_file(file: &web_sys::File, mut progress: OnProgress) -> Result
 /// Fetches `url`'s bytes (same origin, checked by `query::model_url`).
 pub async fn fetch(url: &str, mut progress: OnProgress) -> Result<Vec<u8>, String> {
     let window = web_sys::window().ok_or("no window")?;
-    if let Some(early) = early_read(&window, url) {
+    if let Some(early) = early_read(url) {
         return read_early(&early, progress).await;
     }
     let response = JsFuture::from(window.fetch_with_str(url))
@@ -58,10 +58,8 @@ pub async fn fetch(url: &str, mut progress: OnProgress) -> Result<Vec<u8>, Strin
 
 /// The reading index.html began for `url` (the page's `?case=` or `?model=`) while the app's
 /// module was still loading, taken once: the file downloads beside the app's start.
-fn early_read(window: &web_sys::Window, url: &str) -> Option<JsValue> {
-    let key = JsValue::from_str("meshsmoothEarly");
-    let early = Reflect::get(window, &key).ok().filter(JsValue::is_object)?;
-    let _ = Reflect::delete_property(window, &key);
+fn early_read(url: &str) -> Option<JsValue> {
+    let early = super::page::take_from_window("meshsmoothEarly").filter(JsValue::is_object)?;
     let same = Reflect::get(&early, &"url".into()).ok()?.as_string()? == url;
     same.then_some(early)
 }

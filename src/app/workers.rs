@@ -84,11 +84,9 @@ impl WebWorkers {
 
 /// The first worker, if index.html started it (`window.meshsmoothWorker`); taken once.
 fn started_by_page() -> Option<web_sys::Worker> {
-    let window = web_sys::window()?;
-    let key = JsValue::from_str("meshsmoothWorker");
-    let worker = js_sys::Reflect::get(&window, &key).ok()?;
-    let _ = js_sys::Reflect::delete_property(&window, &key);
-    worker.dyn_into::<web_sys::Worker>().ok()
+    super::page::take_from_window("meshsmoothWorker")?
+        .dyn_into::<web_sys::Worker>()
+        .ok()
 }
 
 fn new_worker(index: usize) -> Result<web_sys::Worker, String> {
