@@ -446,6 +446,43 @@ fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
     assert_eq!(again.case_structures()[0].smoothed, kept);
 }
 
+/// While the engine recomputes a case glTF's structure, the page shows the surface the case
+/// holds for its parameters; the engine finds that same surface, and other parameters have none.
+#[test]
+fn a_case_glb_structure_shows_its_kept_surface_until_the_engine_recomputes_it() {
+    let mut session = Session::default();
+    let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
+    open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
+    assert!(
+        session.kept_surface().is_none(),
+        "a label map holds no surfaces"
+    );
+    session.smooth_cpu();
+    let case = session.export_case(Container::Glb).unwrap();
+
+    let mut again = Session::default();
+    open_in_session(&mut again, "case.glb", case);
+    let kept = again
+        .kept_surface()
+        .expect("the liver's smoothed surface")
+        .to_vec();
+    let segmentation = &again.model().unwrap().mesh().positions;
+    assert!(
+        farthest(&kept, segmentation) > 0.1,
+        "smoothed, not the segmentation"
+    );
+    again.smooth_cpu();
+    assert_eq!(
+        again.result().unwrap().positions,
+        kept,
+        "the engine's surface is the case's"
+    );
+    let mut other = *again.params();
+    other.iterations += 1;
+    again.set_params(other).unwrap();
+    assert!(again.kept_surface().is_none(), "none for other parameters");
+}
+
 /// Files added to an open case join it as structures (a surface coloured by its place, a label
 /// map's with its bound) while the model stays; files added while one opens wait for it, and
 /// are dropped when it fails to open.

@@ -62,6 +62,15 @@ impl Session {
         self.case.structures.get(self.current_structure()?)
     }
 
+    /// The surface the model's structure keeps for the current parameters (a case glTF's
+    /// smoothed surface, or its own from before), shown while the engine recomputes it.
+    pub fn kept_surface(&self) -> Option<&[[f32; 3]]> {
+        let s = self.model_structure()?;
+        let same = s.params == *self.params() && s.weights.as_deref() == self.weights();
+        let kept = s.smoothed.as_ref().filter(|_| same)?;
+        (kept.positions.len() == s.original.positions.len()).then_some(&kept.positions[..])
+    }
+
     /// Changes structure `index`'s name, colour, opacity, visibility, group or description;
     /// all or nothing.
     pub fn set_structure(&mut self, index: usize, change: StructureChange) -> Result<(), String> {

@@ -12,6 +12,8 @@ use crate::view;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Positions {
     Original,
+    /// The surface the model's structure keeps for these parameters, until the engine's.
+    Kept,
     /// The CPU engine's result for this revision.
     Cpu(u64),
     /// The GPU engine's buffers after the run for this revision.
@@ -79,6 +81,12 @@ impl Shell {
         }
         let result = session.last_result();
         let toward = doc.view_asks.toward_segmentation;
+        let kept = session.kept_surface();
+        let before_result = if kept.is_some() {
+            Positions::Kept
+        } else {
+            Positions::Original
+        };
         let wanted = if self.show_original {
             Positions::Original
         } else if toward > 0.0 {
@@ -86,9 +94,9 @@ impl Shell {
                 Positions::Toward(r.revision, toward.to_bits())
             })
         } else if let Some(gpu) = &self.gpu {
-            (gpu.submitted(doc.model_generation)).map_or(Positions::Original, Positions::Gpu)
+            (gpu.submitted(doc.model_generation)).map_or(before_result, Positions::Gpu)
         } else {
-            result.map_or(Positions::Original, |r| Positions::Cpu(r.revision))
+            result.map_or(before_result, |r| Positions::Cpu(r.revision))
         };
         if self.shown.positions != Some(wanted) {
             let shown = match wanted {
@@ -106,8 +114,19 @@ impl Shell {
                     }
                     true
                 }
+                Positions::Kept => {
+                    if let Some(p) = kept {
+                        let normals = crate::mesh::vertex_normals(p, &mesh.triangles);
+                        viewer.set_positions(rs, p, &normals);
+                    }
+                    true
+                }
                 Positions::Cpu(_) => {
-                    if let Some(r) = result {
+                    // The engine recomputing the kept surface finds the same one: the view
+                    // need not draw it again.
+                    let unchanged = self.shown.positions == Some(Positions::Kept)
+                        && result.map(|r| &r.positions[..]) == kept;
+                    if let Some(r) = result.filter(|_| !unchanged) {
                         let normals = crate::mesh::vertex_normals(&r.positions, &mesh.triangles);
                         viewer.set_positions(rs, &r.positions, &normals);
                     }
