@@ -97,6 +97,11 @@ fn a_case_glb_reads_back_as_the_same_case() {
                 a.name
             );
             assert_eq!(a.positions(), b.positions(), "{}", a.name);
+            assert!(
+                a.closed_outward() && b.closed_outward(),
+                "{}: the viewer draws only its front faces",
+                a.name
+            );
             assert_eq!(
                 a.smoothed.as_ref().map(|s| &s.metrics),
                 b.smoothed.as_ref().map(|s| &s.metrics)

@@ -139,6 +139,13 @@ impl CaseStructure {
         }
     }
 
+    /// Whether its surface is closed and wound outward, so that from outside only its front
+    /// faces can be seen: a label map's structure (closed by construction) enclosing a positive
+    /// volume.
+    pub fn closed_outward(&self) -> bool {
+        self.label.is_some() && self.original.signed_volume() > 0.0
+    }
+
     /// The positions as shown.
     pub fn positions(&self) -> &[[f32; 3]] {
         match &self.smoothed {

@@ -35,6 +35,33 @@ fn a_surface_mesh_has_no_bound_and_a_label_map_structure_half_its_voxel_diagonal
     assert_eq!(labelled.color, [0.0, 0.5, 1.0, 1.0]);
 }
 
+/// Only a label map's structure is known closed; its winding is checked by its volume.
+#[test]
+fn a_label_maps_structure_wound_outward_is_closed_and_outward() {
+    let labelled = |mesh| {
+        let structure = Structure {
+            label: 1,
+            layer: 0,
+            name: "kidney".into(),
+            color: [1.0, 0.0, 0.0],
+            voxels: 1,
+            voxel_size: [1.0; 3],
+            mesh,
+        };
+        CaseStructure::from_label_map(structure, None)
+    };
+    let mut outward = tetra();
+    if outward.signed_volume() < 0.0 {
+        outward.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    let mut inward = outward.clone();
+    inward.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    assert!(labelled(outward.clone()).closed_outward());
+    assert!(!labelled(inward).closed_outward(), "wound inward");
+    let surface = CaseStructure::from_mesh("skull", outward, [1.0; 3]);
+    assert!(!surface.closed_outward(), "a surface file may be open");
+}
+
 #[test]
 fn changing_the_filter_keeps_the_bound_and_drops_the_result() {
     let mut s = CaseStructure::from_mesh("a", tetra(), [1.0, 0.0, 0.0]);

@@ -32,6 +32,8 @@ pub struct OtherStructure<'a> {
     pub triangles: &'a [[u32; 3]],
     /// Display (sRGB) colour and opacity.
     pub color: [f32; 4],
+    /// Closed and wound outward (see [`CaseStructure::closed_outward`]).
+    pub closed: bool,
 }
 
 impl Session {
@@ -146,6 +148,7 @@ impl Session {
                 positions: s.positions(),
                 triangles: &s.original.triangles,
                 color: s.color,
+                closed: s.closed_outward(),
             })
             .collect()
     }

@@ -179,11 +179,13 @@ impl Shell {
                     positions: moved.as_deref().unwrap_or(o.positions),
                     triangles: o.triangles,
                     color: o.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
+                    closed: o.closed,
                 })
                 .collect();
             viewer.set_context(rs, &surfaces);
             let look = session.model_structure();
             viewer.set_model_look(look.map(|l| l.color), look.is_none_or(|l| l.visible));
+            viewer.model_closed = look.is_some_and(|l| l.closed_outward());
             self.shown.looks = Some(looks);
         }
         let marks = (session.marks_key(), session.case_version());
@@ -194,6 +196,7 @@ impl Shell {
                     positions: &p.positions,
                     triangles: &p.triangles,
                     color: viewer::MARK_COLOR,
+                    closed: false,
                 })
                 .collect();
             viewer.set_marks(rs, &surfaces);

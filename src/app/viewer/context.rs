@@ -11,12 +11,15 @@ pub struct ContextSurface<'a> {
     pub positions: &'a [[f32; 3]],
     pub triangles: &'a [[u32; 3]],
     pub color: [u8; 4],
+    /// Closed and wound outward: its back faces are never seen unless a plane cuts it.
+    pub closed: bool,
 }
 
 /// One such structure on the GPU.
 pub struct ContextMesh {
     pub buffers: MeshBuffers,
     pub opaque: bool,
+    pub closed: bool,
     /// The middle of its bounding box: translucent structures are drawn far to near.
     pub centre: [f32; 3],
 }
@@ -41,6 +44,7 @@ impl ContextMesh {
         Ok(Self {
             buffers,
             opaque: surface.color[3] == 255,
+            closed: surface.closed,
             centre: centre(surface.positions),
         })
     }

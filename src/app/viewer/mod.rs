@@ -1,6 +1,7 @@
 //! The 3D view: the mesh drawn with wgpu inside egui (a paint callback), lit by lights fixed to
-//! the camera, two-sided, anti-aliased (4x MSAA in its own target, composited into egui's
-//! pass), with an optional wireframe; orbit, pan and zoom.
+//! the camera, two-sided (front faces only for closed structures no plane cuts), anti-aliased
+//! (4x MSAA in its own target, composited into egui's pass), with an optional wireframe; orbit,
+//! pan and zoom.
 //!
 //! Works on WebGPU and on WebGL2. The camera math and the per-frame record are in
 //! [`crate::view`].
@@ -67,6 +68,8 @@ pub struct Viewer {
     model_color: Option<[f32; 4]>,
     /// Whether the model is drawn (a case's structure can be hidden).
     show_model: bool,
+    /// The model is closed and wound outward (see [`crate::case::CaseStructure::closed_outward`]).
+    pub model_closed: bool,
     /// Other structures are drawn around the model.
     has_context: bool,
     /// The box the home view frames (the whole case): the clipping plane moves across it.
@@ -122,6 +125,7 @@ impl Viewer {
             problem: None,
             model_color: None,
             show_model: true,
+            model_closed: false,
             has_context: false,
             scene: (Vec3::ZERO, Vec3::ZERO),
             clip: None,
@@ -279,6 +283,7 @@ impl Viewer {
                 uniforms,
                 wireframe: self.wireframe,
                 show_model: self.show_model,
+                model_closed: self.model_closed,
             };
             ui.painter()
                 .add(egui_wgpu::Callback::new_paint_callback(rect, callback));

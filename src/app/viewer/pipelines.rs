@@ -32,6 +32,8 @@ pub struct Pipelines {
     pub composite_layout: wgpu::BindGroupLayout,
     /// Lit, two-sided triangles; writes depth.
     pub surface: wgpu::RenderPipeline,
+    /// The same, front faces only: for closed surfaces wound outward, none cut open.
+    pub front_faces: wgpu::RenderPipeline,
     /// The same, translucent: blended over what is drawn, tests depth, writes none.
     pub translucent: wgpu::RenderPipeline,
     /// The same, blended over everything whatever lies in front: marks that must show
@@ -168,7 +170,7 @@ impl Pipelines {
             per_vertex(VEC4_STRIDE, &NORMAL),
             per_vertex(COLOR_STRIDE, &COLOR),
         ];
-        let surface_pipeline = |label, write_depth, compare, blend| {
+        let surface_pipeline = |label, cull_mode, write_depth, compare, blend| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(&layout),
@@ -181,8 +183,7 @@ impl Pipelines {
                 primitive: wgpu::PrimitiveState {
                     topology: wgpu::PrimitiveTopology::TriangleList,
                     front_face: wgpu::FrontFace::Ccw,
-                    // Two-sided: open meshes show their inside.
-                    cull_mode: None,
+                    cull_mode,
                     ..Default::default()
                 },
                 depth_stencil: depth(write_depth, compare),
@@ -198,12 +199,17 @@ impl Pipelines {
             })
         };
         let less = wgpu::CompareFunction::Less;
-        let surface = surface_pipeline("meshsmooth surface", true, less, None);
+        // Two-sided: open meshes show their inside.
+        let surface = surface_pipeline("meshsmooth surface", None, true, less, None);
+        let back = Some(wgpu::Face::Back);
+        let front_faces = surface_pipeline("meshsmooth front faces", back, true, less, None);
         // The shader writes premultiplied alpha.
         let blend = Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
-        let translucent = surface_pipeline("meshsmooth translucent surface", false, less, blend);
+        let translucent =
+            surface_pipeline("meshsmooth translucent surface", None, false, less, blend);
         let over = surface_pipeline(
             "meshsmooth surface over all",
+            None,
             false,
             wgpu::CompareFunction::Always,
             blend,
@@ -271,6 +277,7 @@ impl Pipelines {
             view_layout,
             composite_layout,
             surface,
+            front_faces,
             translucent,
             over,
             wire,
