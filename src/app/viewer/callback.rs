@@ -126,9 +126,12 @@ impl ViewResources {
         // A closed surface's back faces lie behind its front ones, unless a plane cuts it open:
         // not drawing them spares the rasteriser about half its work.
         let cut = frame.uniforms.clip[..3].iter().any(|&n| n != 0.0);
-        let opaque = |closed: bool| match closed && !cut {
-            true => &self.pipelines.front_faces,
-            false => &self.pipelines.surface,
+        let opaque = |closed: bool| {
+            if closed && !cut {
+                &self.pipelines.front_faces
+            } else {
+                &self.pipelines.surface
+            }
         };
         pass.set_bind_group(0, &self.view_group, &[]);
         if frame.show_model && !model_translucent {
