@@ -139,6 +139,11 @@ impl CaseStructure {
         }
     }
 
+    /// Whether what it keeps as smoothed was smoothed with `params` and `weights`.
+    pub fn smoothed_with(&self, params: &Params, weights: Option<&[f32]>) -> bool {
+        self.smoothed.is_some() && self.params == *params && self.weights.as_deref() == weights
+    }
+
     /// Whether its surface is closed and wound outward, so that from outside only its front
     /// faces can be seen: a label map's structure (closed by construction) enclosing a positive
     /// volume.

@@ -68,7 +68,7 @@ impl Session {
     /// smoothed surface, or its own from before), shown while the engine recomputes it.
     pub fn kept_surface(&self) -> Option<&[[f32; 3]]> {
         let s = self.model_structure()?;
-        let same = s.params == *self.params() && s.weights.as_deref() == self.weights();
+        let same = s.smoothed_with(self.params(), self.weights());
         let kept = s.smoothed.as_ref().filter(|_| same)?;
         (kept.positions.len() == s.original.positions.len()).then_some(&kept.positions[..])
     }
@@ -191,7 +191,7 @@ impl Session {
         move |s: &mut CaseStructure| {
             // Left before its result came, it keeps the surface it had for these parameters
             // (a case glTF's, or its own from before).
-            let same = s.params == params && s.weights == weights;
+            let same = s.smoothed_with(&params, weights.as_deref());
             let smoothed = smoothed.or_else(|| s.smoothed.take().filter(|_| same));
             (s.params, s.tau, s.weights, s.smoothed) = (params, tau, weights, smoothed);
         }

@@ -184,8 +184,11 @@ impl Shell {
                 .collect();
             viewer.set_context(rs, &surfaces);
             let look = session.model_structure();
-            viewer.set_model_look(look.map(|l| l.color), look.is_none_or(|l| l.visible));
-            viewer.model_closed = look.is_some_and(|l| l.closed_outward());
+            viewer.set_model_look(
+                look.map(|l| l.color),
+                look.is_none_or(|l| l.visible),
+                look.is_some_and(|l| l.closed_outward()),
+            );
             self.shown.looks = Some(looks);
         }
         let marks = (session.marks_key(), session.case_version());

@@ -69,7 +69,7 @@ pub struct Viewer {
     /// Whether the model is drawn (a case's structure can be hidden).
     show_model: bool,
     /// The model is closed and wound outward (see [`crate::case::CaseStructure::closed_outward`]).
-    pub model_closed: bool,
+    model_closed: bool,
     /// Other structures are drawn around the model.
     has_context: bool,
     /// The box the home view frames (the whole case): the clipping plane moves across it.
@@ -133,10 +133,11 @@ impl Viewer {
     }
 
     /// How the model is shown as a case's structure: its colour and opacity (`None`: the
-    /// default, opaque) and whether it is drawn at all.
-    pub fn set_model_look(&mut self, color: Option<[f32; 4]>, visible: bool) {
+    /// default, opaque), whether it is drawn at all, and whether it is closed and wound outward.
+    pub fn set_model_look(&mut self, color: Option<[f32; 4]>, visible: bool, closed: bool) {
         self.model_color = color;
         self.show_model = visible;
+        self.model_closed = closed;
     }
 
     /// The case's other structures, drawn around the model (replacing those set before).
