@@ -395,33 +395,39 @@ impl Document {
     }
 
     /// The CPU engine's share of this frame: asks its workers for the current parameters'
-    /// result, or takes it once it came.
-    pub fn compute_on_cpu(&mut self) {
-        if let Some(t) = self.session.compute_cpu() {
-            self.timings = Some(EngineTimings::Cpu(t));
-        }
+    /// result, or takes it once it came (then true).
+    pub fn compute_on_cpu(&mut self) -> bool {
+        let Some(t) = self.session.compute_cpu() else {
+            return false;
+        };
+        self.timings = Some(EngineTimings::Cpu(t));
+        true
     }
 
     /// Between frames (an API call, a worker's reply): with the CPU engine in workers, sends
-    /// the current parameters' smoothing or takes its result now, and answers the calls
-    /// waiting for it, rather than a frame of a large mesh later.
-    pub fn step_cpu_engine(&mut self) {
+    /// the current parameters' smoothing or takes its result now, moves the background work
+    /// on, and answers the calls waiting, rather than a frame of a large mesh later. True when
+    /// what the page shows changed (a result taken, a search or graph finished): a frame is due.
+    pub fn step_cpu_engine(&mut self) -> bool {
         self.session.pump_cpu_engine();
-        if self.backend == Backend::Cpu && self.session.cpu_engine_threaded() {
-            self.compute_on_cpu();
-            self.answer_waiting();
+        if self.backend != Backend::Cpu || !self.session.cpu_engine_threaded() {
+            return false;
         }
+        let took = self.compute_on_cpu();
+        let finished = !self.guidance_on_gpu && self.compute_guidance(None);
+        self.answer_waiting();
+        took || finished
     }
 
     /// The background work's share of this frame (graphs, suggestions, the gallery): hands
     /// its runs to the CPU engine's workers, or to the GPU engine's evaluator when one is lent.
     /// With the CPU engine it waits until the current parameters' result is there: what the
-    /// user is looking at comes first.
-    pub fn compute_guidance(&mut self, offload: Option<&mut dyn Offload>) {
+    /// user is looking at comes first. True when a job finished.
+    pub fn compute_guidance(&mut self, offload: Option<&mut dyn Offload>) -> bool {
         if self.backend == Backend::Cpu && self.busy() {
-            return;
+            return false;
         }
-        self.session.step_guidance_on(&now_ms, offload);
+        self.session.step_guidance_on(&now_ms, offload)
     }
 
     /// What the API's `state()` returns.
@@ -525,6 +531,33 @@ mod tests {
         assert_eq!(state["model"], crate::app::SAMPLE_NAME);
         assert_eq!(state["error"], error.as_str());
         assert!(doc.open("empty.stl", b"").unwrap_err().contains("empty"));
+    }
+
+    #[wasm_bindgen_test]
+    fn a_workers_reply_asks_for_a_frame_only_when_what_is_shown_changed() {
+        let mut doc = Document::new(Backend::Cpu);
+        let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
+        let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
+        doc.session.set_cpu_engine(pool);
+        doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
+            .unwrap();
+        assert!(
+            !doc.step_cpu_engine(),
+            "the smoothing is asked, not answered"
+        );
+        assert!(doc.busy());
+        deliver.set(true);
+        assert!(doc.step_cpu_engine(), "the result came");
+        assert!(!doc.busy() && doc.timings.is_some());
+        assert!(!doc.step_cpu_engine(), "nothing new");
+
+        deliver.set(false);
+        doc.session.set_graphs_wanted(true);
+        assert!(!doc.step_cpu_engine(), "the graphs' runs are asked");
+        assert!(doc.session.guidance_busy());
+        deliver.set(true);
+        assert!(doc.step_cpu_engine(), "the graphs are done, between frames");
+        assert!(!doc.session.guidance_busy() && doc.session.graphs_current());
     }
 
     #[wasm_bindgen_test]

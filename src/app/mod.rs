@@ -46,8 +46,9 @@ mod workers;
 pub use document::{Backend, Document};
 
 /// How often the page redraws only to move a progress on (bytes read, an opening's stage, the
-/// workers' jobs): each frame drawn for that takes a core from the work it shows.
-const PROGRESS_REPAINT: std::time::Duration = std::time::Duration::from_millis(200);
+/// workers' jobs). Each frame draws the whole page and its model, which a software GPU pays
+/// for on the CPU the workers need: a bar moving once a second keeps that share small.
+const PROGRESS_REPAINT: std::time::Duration = std::time::Duration::from_millis(1000);
 
 /// The mesh shown when the app opens: a voxelised bent tube (a staircase vessel surface).
 pub const SAMPLE_NAME: &str = "bent_tube_staircase.ply";

@@ -15,7 +15,7 @@ use crate::worker::{decode, encode, Carrier, Reply, Request};
 type Inbox = Rc<RefCell<Vec<(usize, Reply)>>>;
 
 /// What runs as a reply lands, between frames.
-type OnReply = Rc<RefCell<Option<Box<dyn FnMut()>>>>;
+type OnReply = Rc<RefCell<Option<Box<dyn FnMut() -> bool>>>>;
 
 /// The workers, with the message handlers that must live as long as they do.
 pub struct WebWorkers {
@@ -40,8 +40,9 @@ pub fn pool_size() -> usize {
 impl WebWorkers {
     /// Runs `hook` whenever a reply lands, between frames: the pool hands the worker its next
     /// job there, instead of leaving it idle until the next frame (which can take long while a
-    /// large mesh is drawn).
-    pub fn on_reply(&self, hook: Box<dyn FnMut()>) {
+    /// large mesh is drawn). The hook says whether what the page shows changed, so that a
+    /// frame is due at once.
+    pub fn on_reply(&self, hook: Box<dyn FnMut() -> bool>) {
         *self.on_reply.borrow_mut() = Some(hook);
     }
 
@@ -106,12 +107,14 @@ fn reply_handler(
 ) -> Closure<dyn FnMut(web_sys::MessageEvent)> {
     Closure::new(move |event: web_sys::MessageEvent| {
         let data = event.data();
-        let mut progress = false;
+        // Progress and the runs of background work (graphs, searches) only move a bar on; a
+        // frame for each would take a core from the workers with a software GPU.
+        let mut paced = false;
         if let Some(buffer) = data.dyn_ref::<js_sys::ArrayBuffer>() {
             let bytes = js_sys::Uint8Array::new(buffer).to_vec();
             match decode::<Reply>(&bytes) {
                 Ok(reply) => {
-                    progress = matches!(reply, Reply::Progress { .. });
+                    paced = matches!(reply, Reply::Progress { .. } | Reply::Terms { .. });
                     inbox.borrow_mut().push((index, reply))
                 }
                 Err(why) => log::error!("engine worker {}: {why}", index + 1),
@@ -122,13 +125,13 @@ fn reply_handler(
             let why = format!("engine worker {} failed: {why}", index + 1);
             inbox.borrow_mut().push((index, Reply::Broken { why }));
         }
+        let mut shown_changed = false;
         if let Ok(mut hook) = on_reply.try_borrow_mut() {
             if let Some(hook) = hook.as_mut() {
-                hook();
+                shown_changed = hook();
             }
         }
-        if progress {
-            // A stage's name on screen can wait; the frame's drawing would slow the stage.
+        if paced && !shown_changed {
             ctx.request_repaint_after(super::PROGRESS_REPAINT);
         } else {
             ctx.request_repaint();

@@ -10,6 +10,7 @@ pub(crate) struct Deferred {
     posted: Vec<(usize, Request)>,
     deliver: Rc<Cell<bool>>,
     log: Log,
+    threaded: bool,
 }
 
 /// Which worker was sent which request, in order.
@@ -31,8 +32,17 @@ impl Deferred {
             posted: Vec::new(),
             deliver: deliver.clone(),
             log: log.clone(),
+            threaded: false,
         };
         (carrier, deliver, log)
+    }
+
+    /// Says it runs in workers of its own, as the page's do: their replies come between
+    /// frames, and the page steps the engine then (only the page's tests ask).
+    #[cfg(target_arch = "wasm32")]
+    pub(crate) fn in_workers(mut self) -> Self {
+        self.threaded = true;
+        self
     }
 }
 
@@ -57,6 +67,6 @@ impl Carrier for Deferred {
     }
 
     fn threaded(&self) -> bool {
-        false
+        self.threaded
     }
 }

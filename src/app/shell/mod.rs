@@ -121,8 +121,9 @@ fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Context) {
             let weak = Rc::downgrade(doc);
             w.on_reply(Box::new(move || {
                 // Between frames the document is free; skipped should it not be.
-                if let Some(Ok(mut doc)) = weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
-                    doc.step_cpu_engine();
+                match weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
+                    Some(Ok(mut doc)) => doc.step_cpu_engine(),
+                    _ => false,
                 }
             }));
             let pool = Pool::with_view_worker(Box::new(w));
