@@ -6,7 +6,7 @@ use super::file_input::Reading;
 use eframe::egui;
 
 /// The status bar's progress: the file opening, else the file being read, else the CPU
-/// engine's run; a spinner for work without a measure of progress.
+/// engine's run; a spinner for work on the page without a measure of progress.
 pub fn progress(ui: &mut egui::Ui, doc: &Document, reading: &[Reading]) {
     let bar = |ui: &mut egui::Ui, fraction: f32, width: f32, text: String| {
         ui.add(
@@ -25,6 +25,9 @@ pub fn progress(ui: &mut egui::Ui, doc: &Document, reading: &[Reading]) {
             220.0,
             format!("reading {:.0}%", 100.0 * fraction),
         );
+    } else if doc.busy() && reading.is_empty() && doc.working_elsewhere() {
+        // A spinner asks for every frame it can get; the worker's reply wakes the page.
+        ui.label("smoothing…");
     } else if doc.busy() || !reading.is_empty() {
         ui.spinner();
     }

@@ -217,7 +217,7 @@ impl StructureList {
                 actions.push(StructureAction::ExportCase);
             }
             if session.checking() {
-                ui.spinner();
+                // No spinner: it would draw frames for as long as a worker checks.
                 ui.label("checking…");
             } else if ui
                 .button("Check structures")
