@@ -119,6 +119,13 @@ struct Job {
     at: Vec<(usize, u32)>,
 }
 
+impl Job {
+    /// Iterations the run smooths, and so about how long it takes.
+    fn run_length(&self) -> u32 {
+        self.at.last().map_or(0, |&(_, k)| k)
+    }
+}
+
 /// Computes the quality graphs one smoothing run per [`Task::step`].
 pub struct QualitySweep {
     graphs: QualityGraphs,
@@ -183,6 +190,9 @@ impl QualitySweep {
                 best: None,
             });
         }
+        // Longest runs first: handed out last, the iteration curve's one long run would keep a
+        // worker busy while the others have nothing left to do.
+        jobs.sort_by_key(|job| std::cmp::Reverse(job.run_length()));
         let total = curves.iter().map(|c| c.samples.len()).sum();
         Ok(Self {
             graphs: QualityGraphs {
@@ -259,6 +269,23 @@ mod tests {
             let now = sweep(&p, 0.5, &mut FnEvaluator::new(smoothing_model(filter)));
             let mut slow = Slow::new(FnEvaluator::new(smoothing_model(filter)), 3);
             assert_eq!(sweep(&p, 0.5, &mut slow), now, "{filter:?}");
+        }
+    }
+
+    #[test]
+    fn the_longest_runs_are_handed_out_first() {
+        for filter in Filter::ALL {
+            let task = QualitySweep::new(&Params::defaults(filter), 0.5).unwrap();
+            let lengths: Vec<u32> = task.jobs.iter().map(Job::run_length).collect();
+            assert!(
+                lengths.is_sorted_by(|a, b| a >= b),
+                "{filter:?}: {lengths:?}"
+            );
+            let longest = match filter {
+                Filter::Sinc => 100,
+                _ => crate::suggest::space::MAX_ITERATIONS,
+            };
+            assert_eq!(lengths[0], longest, "{filter:?}");
         }
     }
 
@@ -373,8 +400,9 @@ mod tests {
         });
         assert_eq!(seen.last().map(|p| (p.done, p.total)), Some((72, 72)));
         let mut ev = FnEvaluator::new(smoothing_model(Filter::Laplace));
+        // The iteration curve's one run fills its 51 samples first, then a run per sample.
         let r = run(QualitySweep::new(&p, 0.5).unwrap(), &mut ev, &mut |pr| {
-            pr.done < 5
+            pr.done < 51 + 4
         });
         assert!(r.is_err());
         assert_eq!(ev.runs, 5);
