@@ -152,6 +152,13 @@ impl Shell {
         });
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
+        // Glyphs drawn plain: hinting runs each glyph through the font's bytecode interpreter and
+        // binning rasterises it at up to four offsets, work that lies on the first frame's path
+        // (compiled and then recompiled by the browser) for text that reads the same.
+        cc.egui_ctx.all_styles_mut(|s| {
+            s.visuals.text_options.font_hinting = false;
+            s.visuals.text_options.subpixel_binning = false;
+        });
         let files = FileInput::new(&cc.egui_ctx);
         // A file goes to the workers as soon as it is read, not a frame later.
         let weak = Rc::downgrade(&doc);
