@@ -153,7 +153,6 @@ fn fs_wire(f: WireFragment) -> @location(0) vec4<f32> {
 // (a software rasteriser pays for every pass over them).
 
 @group(1) @binding(0) var frame: texture_2d<f32>;
-@group(1) @binding(1) var frame_sampler: sampler;
 
 struct CompositeFragment {
     @builtin(position) clip: vec4<f32>,
@@ -172,7 +171,9 @@ fn vs_composite(@builtin(vertex_index) index: u32) -> CompositeFragment {
 
 @fragment
 fn fs_composite(f: CompositeFragment) -> @location(0) vec4<f32> {
-    let view_color = textureSample(frame, frame_sampler, f.uv);
+    // Loaded, not sampled: texel for pixel, and a software rasteriser filters nothing.
+    let texel = vec2<i32>(f.uv * vec2<f32>(textureDimensions(frame)));
+    let view_color = textureLoad(frame, texel, 0);
     let background = encode(view.background.rgb, 1.0).rgb;
     return vec4<f32>(view_color.rgb + background * (1.0 - view_color.a), 1.0);
 }

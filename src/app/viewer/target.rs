@@ -14,7 +14,7 @@ pub struct Target {
     pub multisampled: Option<wgpu::TextureView>,
     pub resolved: wgpu::TextureView,
     pub depth: wgpu::TextureView,
-    /// Group 1 of the composite: `resolved` and a sampler.
+    /// Group 1 of the composite: `resolved`.
     pub composite_group: wgpu::BindGroup,
 }
 
@@ -60,25 +60,13 @@ impl Target {
             attachment | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let depth = texture("meshsmooth view depth", DEPTH_FORMAT, samples, attachment);
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("meshsmooth view composite"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
         let composite_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("meshsmooth view composite"),
             layout: &pipelines.composite_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&resolved),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(&sampler),
-                },
-            ],
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&resolved),
+            }],
         });
         Self {
             size,
