@@ -66,8 +66,8 @@ fn per_vertex(
 }
 
 /// 4x when the adapter can multisample both the colour format and the depth format, else 1;
-/// 1 on a software adapter, where every sample costs CPU time (SwiftShader in headless Chromium,
-/// orbiting the 206k-vertex mesh: about 620 ms a frame at 4x, 320 ms at 1x).
+/// 1 on a software adapter (SwiftShader in headless Chromium), where every sample costs CPU
+/// time: orbiting a large mesh there takes about twice as long a frame at 4x.
 fn sample_count(adapter: &wgpu::Adapter, color_format: wgpu::TextureFormat) -> u32 {
     if crate::gpu::is_software_adapter(&adapter.get_info()) {
         return 1;
