@@ -16,12 +16,11 @@ use super::pointing::Pointing;
 use super::shortcuts::{self, Action};
 use super::structure_list::{StructureAction, StructureList};
 use super::viewer::Viewer;
-use super::{api, download, page, query, report_view, status, workers};
+use super::{api, download, page, query, report_view, status};
 use crate::export::ExportFormat;
 use crate::session::ColorField;
 use crate::smooth::Filter;
 use crate::view::{CameraPose, ViewLink};
-use crate::worker::Pool;
 use eframe::egui;
 use eframe::egui_wgpu;
 use std::cell::RefCell;
@@ -33,7 +32,7 @@ mod start;
 mod view_area;
 mod view_sync;
 
-use start::{embed, open_start_model};
+use start::{embed, gpu_engine, open_start_model, start_workers};
 use view_sync::Shown;
 
 pub struct Shell {
@@ -83,18 +82,6 @@ pub struct Shell {
     repainting: bool,
 }
 
-/// WebGPU: the GPU engine on eframe's device. WebGL2 (no compute shaders): the CPU engine. The
-/// viewer smooths nothing of its own (a case carries its surfaces), so it has no GPU engine and
-/// compiles no smoothing kernels, which a software adapter takes long over: WebGPU only draws.
-fn gpu_engine(cc: &eframe::CreationContext<'_>, reading: bool) -> Option<GpuEngine> {
-    let rs = cc.wgpu_render_state.as_ref()?;
-    let info = rs.adapter.get_info();
-    log::info!("adapter: {} ({:?})", info.name, info.backend);
-    let software = crate::gpu::is_software_adapter(&info);
-    (info.backend == wgpu::Backend::BrowserWebGpu && !reading)
-        .then(|| GpuEngine::new(&rs.device, &rs.queue, software))
-}
-
 /// Opens the files that arrived (or adds them to the case).
 fn open_arrived(files: Vec<ArrivedFile>, doc: &mut Document) {
     for file in files {
@@ -105,32 +92,6 @@ fn open_arrived(files: Vec<ArrivedFile>, doc: &mut Document) {
                 doc.session.fail(&file.name, &reason);
             }
         }
-    }
-}
-
-/// Starts the CPU engine's workers: the background's and one more kept for the view; the
-/// viewer only opens and shows, which one worker does. Without workers (a page that cannot start
-/// any) the engine runs on the page, blocking frames, rather than not at all.
-fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Context) {
-    let count = match reading {
-        true => 1,
-        false => workers::pool_size() + 1,
-    };
-    match workers::WebWorkers::start(count, ctx) {
-        Ok(w) => {
-            let weak = Rc::downgrade(doc);
-            w.on_reply(Box::new(move || {
-                // Between frames the document is free; skipped should it not be.
-                match weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
-                    Some(Ok(mut doc)) => doc.step_cpu_engine(),
-                    _ => false,
-                }
-            }));
-            let pool = Pool::with_view_worker(Box::new(w));
-            log::info!("CPU engine: {}", pool.to_json());
-            doc.borrow_mut().session.set_cpu_engine(pool);
-        }
-        Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
     }
 }
 

@@ -1,11 +1,15 @@
-//! What the page does once, as it starts: open the file its address names (or the bundled
-//! sample), install `window.meshsmooth`, and answer the page that embeds it.
+//! What the page does once, as it starts: choose the engines, start the workers, open the file
+//! its address names (or the bundled sample), install `window.meshsmooth`, and answer the page
+//! that embeds it.
 
 use eframe::egui;
+use std::rc::Rc;
 
 use crate::app::document::SharedDocument;
 use crate::app::file_input::FileInput;
-use crate::app::{api, query, SAMPLE_BYTES, SAMPLE_NAME};
+use crate::app::gpu_engine::GpuEngine;
+use crate::app::{api, query, workers, SAMPLE_BYTES, SAMPLE_NAME};
+use crate::worker::Pool;
 
 /// Opens `?model=URL` (same origin only) or else the bundled sample.
 pub(super) fn open_start_model(doc: &SharedDocument, files: &FileInput, ctx: &egui::Context) {
@@ -47,4 +51,42 @@ pub(super) fn embed(doc: &SharedDocument, ctx: &egui::Context) -> Option<api::Em
         return None;
     }
     Some(embedding)
+}
+
+/// WebGPU: the GPU engine on eframe's device. WebGL2 (no compute shaders): the CPU engine. The
+/// viewer smooths nothing of its own (a case carries its surfaces), so it has no GPU engine and
+/// compiles no smoothing kernels, which a software adapter takes long over: WebGPU only draws.
+pub(super) fn gpu_engine(cc: &eframe::CreationContext<'_>, reading: bool) -> Option<GpuEngine> {
+    let rs = cc.wgpu_render_state.as_ref()?;
+    let info = rs.adapter.get_info();
+    log::info!("adapter: {} ({:?})", info.name, info.backend);
+    let software = crate::gpu::is_software_adapter(&info);
+    (info.backend == wgpu::Backend::BrowserWebGpu && !reading)
+        .then(|| GpuEngine::new(&rs.device, &rs.queue, software))
+}
+
+/// Starts the CPU engine's workers: the background's and one more kept for the view; the
+/// viewer only opens and shows, which one worker does. Without workers (a page that cannot start
+/// any) the engine runs on the page, blocking frames, rather than not at all.
+pub(super) fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Context) {
+    let count = match reading {
+        true => 1,
+        false => workers::pool_size() + 1,
+    };
+    match workers::WebWorkers::start(count, ctx) {
+        Ok(w) => {
+            let weak = Rc::downgrade(doc);
+            w.on_reply(Box::new(move || {
+                // Between frames the document is free; skipped should it not be.
+                match weak.upgrade().as_ref().map(|d| d.try_borrow_mut()) {
+                    Some(Ok(mut doc)) => doc.step_cpu_engine(),
+                    _ => false,
+                }
+            }));
+            let pool = Pool::with_view_worker(Box::new(w));
+            log::info!("CPU engine: {}", pool.to_json());
+            doc.borrow_mut().session.set_cpu_engine(pool);
+        }
+        Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
+    }
 }
