@@ -114,6 +114,10 @@ impl Viewer {
             .write()
             .callback_resources
             .insert(resources);
+        // A browser holds WebGPU's commands until something flushes them; a submit, even of
+        // nothing, sends the pipelines now, to be compiled while the first file is read rather
+        // than with the first frame.
+        render_state.queue.submit([]);
         Self {
             wireframe: false,
             painting: false,
