@@ -82,7 +82,8 @@ pub fn start() {
             Err(e) => Err(e),
         };
         match result {
-            Ok(()) => page::remove_loading_text(),
+            // The shell removes the loading text as it paints its first frame.
+            Ok(()) => {}
             Err(message) => {
                 log::error!("meshsmooth failed to start: {message}");
                 page::show_crash_message(&format!("meshsmooth failed to start: {message}"));

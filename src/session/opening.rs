@@ -172,6 +172,14 @@ impl Session {
         &self.open_stages
     }
 
+    /// Whether the file opening now has its worker's answer, for the next frame to take up
+    /// (false when nothing is opening).
+    pub fn opening_answered(&self) -> bool {
+        self.opening
+            .as_ref()
+            .is_some_and(|o| self.cpu.has_loaded(o.job))
+    }
+
     /// How far the file being opened got, while one is.
     pub fn loading(&self) -> Option<LoadProgress> {
         let opening = self.opening.as_ref()?;

@@ -297,6 +297,11 @@ impl Pool {
         reply
     }
 
+    /// Whether `job`'s reply came (as of the last pump), to be taken with [`Self::take_loaded`].
+    pub fn has_loaded(&self, job: LoadJob) -> bool {
+        self.loaded.contains_key(&job.0)
+    }
+
     /// The stage `job` is at, once its worker began it.
     pub fn load_stage(&self, job: LoadJob) -> Option<&LoadStage> {
         self.load_stages.get(&job.0)

@@ -6,7 +6,7 @@ use super::bottom_panel::BottomPanel;
 use super::brush::Brush;
 use super::case_text::CaseText;
 use super::controls::{self, Controls};
-use super::document::{Backend, Document, Opening, SharedDocument};
+use super::document::{now_ms, Backend, Document, Opening, SharedDocument};
 use super::drag_params::DragParams;
 use super::file_input::{ArrivedFile, FileInput};
 use super::gpu_engine::{GpuEngine, Sent};
@@ -26,12 +26,14 @@ use eframe::egui_wgpu;
 use std::cell::RefCell;
 use std::rc::Rc;
 
+mod first_paint;
 mod reading;
 mod sharing;
 mod start;
 mod view_area;
 mod view_sync;
 
+use first_paint::FirstPaint;
 use start::{embed, gpu_engine, open_start_model, start_workers};
 use view_sync::Shown;
 
@@ -80,6 +82,7 @@ pub struct Shell {
     case_text: CaseText,
     /// Whether the last frame asked for the next at once.
     repainting: bool,
+    first_paint: FirstPaint,
 }
 
 /// Opens the files that arrived (or adds them to the case).
@@ -138,7 +141,8 @@ impl Shell {
         doc.borrow_mut().shortcuts = query::param("shortcuts").as_deref() != Some("off");
         // A link's view is of the case it names.
         let link = query::case_param().and(ViewLink::from_query(&query::search()).transpose());
-        open_start_model(&doc, &files, &cc.egui_ctx);
+        let fetching = open_start_model(&doc, &files, &cc.egui_ctx);
+        let first_paint = FirstPaint::new(fetching, now_ms());
         let embedding = embed(&doc, &cc.egui_ctx);
         Self {
             doc,
@@ -169,7 +173,21 @@ impl Shell {
             link_copied: false,
             case_text: CaseText::default(),
             repainting: false,
+            first_paint,
         }
+    }
+
+    /// Whether the file the address names is open (or failed), or waits for a frame to take
+    /// it up: nothing is being read, and a worker answered the opening.
+    fn start_file_open(&self) -> bool {
+        let Ok(doc) = self.doc.try_borrow() else {
+            return false;
+        };
+        let session = &doc.session;
+        self.files.reading().is_empty()
+            && (session.loading().is_none()
+                || session.opening_answered()
+                || !session.cpu_engine_threaded())
     }
 
     /// This frame's engine work: the GPU engine where there is one, else the CPU engine.
@@ -420,6 +438,12 @@ impl Shell {
 }
 
 impl eframe::App for Shell {
+    fn raw_input_hook(&mut self, ctx: &egui::Context, raw_input: &mut egui::RawInput) {
+        let open = self.first_paint.waiting() && self.start_file_open();
+        self.first_paint
+            .before_frame(open, now_ms(), ctx, raw_input);
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.receive_files(&ctx);

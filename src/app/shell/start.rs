@@ -11,17 +11,27 @@ use crate::app::gpu_engine::GpuEngine;
 use crate::app::{api, query, workers, SAMPLE_BYTES, SAMPLE_NAME};
 use crate::worker::Pool;
 
-/// Opens `?model=URL` (same origin only) or else the bundled sample.
-pub(super) fn open_start_model(doc: &SharedDocument, files: &FileInput, ctx: &egui::Context) {
+/// Opens `?model=URL` (same origin only) or else the bundled sample. True when it fetches
+/// the address's file (the sample opens at once).
+pub(super) fn open_start_model(
+    doc: &SharedDocument,
+    files: &FileInput,
+    ctx: &egui::Context,
+) -> bool {
     match query::model_url() {
         None => {
             let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
+            false
         }
         Some(Err(e)) => {
             let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
             doc.borrow_mut().session.fail("?model", &e);
+            false
         }
-        Some(Ok(model)) => files.fetch(model.url, model.name, ctx),
+        Some(Ok(model)) => {
+            files.fetch(model.url, model.name, ctx);
+            true
+        }
     }
 }
 
