@@ -472,6 +472,12 @@ impl eframe::App for Shell {
             session.step_checks();
         }
         let arrived = opening == Opening::Done;
+        if arrived {
+            // A new case shows widgets egui has not seen; it styles them from their last pass,
+            // so it would paint twice more to settle. A second pass now settles them in this
+            // frame: frames cost a whole canvas on a software GPU.
+            ctx.request_discard("a new case's widgets, seen for the first time");
+        }
         let uploading = !arrived && self.compute();
         if !arrived && !uploading {
             let mut doc = self.doc.borrow_mut();
