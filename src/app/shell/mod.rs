@@ -116,12 +116,21 @@ impl Shell {
         });
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
+        let software = cc
+            .wgpu_render_state
+            .as_ref()
+            .is_some_and(|rs| crate::gpu::is_software_adapter(&rs.adapter.get_info()));
         // Glyphs drawn plain: hinting runs each glyph through the font's bytecode interpreter and
         // binning rasterises it at up to four offsets, work that lies on the first frame's path
-        // (compiled and then recompiled by the browser) for text that reads the same.
+        // (compiled and then recompiled by the browser) for text that reads the same. On a
+        // software GPU each frame costs a whole canvas of CPU time, and comes a few times a
+        // second: widgets change at once rather than animate over frames.
         cc.egui_ctx.all_styles_mut(|s| {
             s.visuals.text_options.font_hinting = false;
             s.visuals.text_options.subpixel_binning = false;
+            if software {
+                s.animation_time = 0.0;
+            }
         });
         let files = FileInput::new(&cc.egui_ctx);
         // A file goes to the workers as soon as it is read, not a frame later.
