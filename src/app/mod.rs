@@ -87,8 +87,7 @@ pub fn start() {
             Err(e) => Err(e),
         };
         match result {
-            // The shell removes the loading text as it paints its first frame.
-            Ok(()) => {}
+            Ok(()) => page::remove_loading_text(),
             Err(message) => {
                 log::error!("meshsmooth failed to start: {message}");
                 page::show_crash_message(&format!("meshsmooth failed to start: {message}"));

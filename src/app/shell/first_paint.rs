@@ -3,8 +3,7 @@
 //! painted shows it open, rather than frames for each step of the opening. Every painted frame
 //! costs a whole canvas, which on a software or weak GPU took most of the time between the
 //! page and its case; the first frame's own work (the first use of every pipeline and of the
-//! text) is done while a worker reads the file. The page's "Loading" text stays until the first
-//! frame is painted.
+//! text) is done while a worker reads the file.
 
 use eframe::egui;
 use std::time::Duration;
@@ -16,15 +15,13 @@ const LONGEST_WAIT_MS: f64 = 1500.0;
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum State {
     /// The next frame is the first painted; frames wait after it (until `until`).
-    FirstThenWait {
+    First {
         until: f64,
     },
     /// Frames are not painted until the file is open or this time (ms, the page's clock) came.
     Waiting {
         until: f64,
     },
-    /// The next frame is the first painted, and nothing waits.
-    First,
     Painting,
 }
 
@@ -36,10 +33,10 @@ impl FirstPaint {
     /// `waits`: the page started reading a file its address names, at `now` (ms).
     pub fn new(waits: bool, now: f64) -> Self {
         let state = match waits {
-            true => State::FirstThenWait {
+            true => State::First {
                 until: now + LONGEST_WAIT_MS,
             },
-            false => State::First,
+            false => State::Painting,
         };
         Self { state }
     }
@@ -51,8 +48,7 @@ impl FirstPaint {
 
     /// Before a frame's input reaches egui (eframe's `raw_input_hook`): while waiting, and the
     /// file is not `open` yet, marks the page as not visible, so that eframe runs no ui and
-    /// paints nothing, and asks for a frame when the wait ends. The first frame painted removes
-    /// the page's loading text.
+    /// paints nothing, and asks for a frame when the wait ends.
     pub fn before_frame(
         &mut self,
         open: bool,
@@ -60,9 +56,6 @@ impl FirstPaint {
         ctx: &egui::Context,
         raw_input: &mut egui::RawInput,
     ) {
-        if matches!(self.state, State::First | State::FirstThenWait { .. }) {
-            crate::app::page::remove_loading_text();
-        }
         if let Some(left_ms) = self.step(open, now) {
             if let Some(viewport) = raw_input.viewports.get_mut(&raw_input.viewport_id) {
                 viewport.occluded = Some(true);
@@ -74,12 +67,12 @@ impl FirstPaint {
     /// The wait left (ms) when this frame is not to be painted.
     fn step(&mut self, open: bool, now: f64) -> Option<f64> {
         match self.state {
-            State::FirstThenWait { until } => {
+            State::First { until } => {
                 self.state = State::Waiting { until };
                 None
             }
             State::Waiting { until } if !open && now < until => Some(until - now),
-            State::Waiting { .. } | State::First => {
+            State::Waiting { .. } => {
                 self.state = State::Painting;
                 None
             }
