@@ -101,7 +101,11 @@ fn open_arrived(files: Vec<ArrivedFile>, doc: &mut Document) {
 impl Shell {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Self {
         let reading = query::viewer_mode();
-        let gpu = gpu_engine(cc, reading);
+        let software = cc
+            .wgpu_render_state
+            .as_ref()
+            .is_some_and(|rs| crate::gpu::is_software_adapter(&rs.adapter.get_info()));
+        let gpu = gpu_engine(cc, reading, software);
         let backend = if gpu.is_some() {
             Backend::WebGpu
         } else {
@@ -116,10 +120,6 @@ impl Shell {
         });
         // Dark, as on radiology workstations: the model stands out and colours read true.
         cc.egui_ctx.set_theme(egui::Theme::Dark);
-        let software = cc
-            .wgpu_render_state
-            .as_ref()
-            .is_some_and(|rs| crate::gpu::is_software_adapter(&rs.adapter.get_info()));
         // Glyphs drawn plain: hinting runs each glyph through the font's bytecode interpreter and
         // binning rasterises it at up to four offsets, work that lies on the first frame's path
         // (compiled and then recompiled by the browser) for text that reads the same. On a

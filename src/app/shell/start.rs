@@ -66,11 +66,14 @@ pub(super) fn embed(doc: &SharedDocument, ctx: &egui::Context) -> Option<api::Em
 /// WebGPU: the GPU engine on eframe's device. WebGL2 (no compute shaders): the CPU engine. The
 /// viewer smooths nothing of its own (a case carries its surfaces), so it has no GPU engine and
 /// compiles no smoothing kernels, which a software adapter takes long over: WebGPU only draws.
-pub(super) fn gpu_engine(cc: &eframe::CreationContext<'_>, reading: bool) -> Option<GpuEngine> {
+pub(super) fn gpu_engine(
+    cc: &eframe::CreationContext<'_>,
+    reading: bool,
+    software: bool,
+) -> Option<GpuEngine> {
     let rs = cc.wgpu_render_state.as_ref()?;
     let info = rs.adapter.get_info();
     log::info!("adapter: {} ({:?})", info.name, info.backend);
-    let software = crate::gpu::is_software_adapter(&info);
     (info.backend == wgpu::Backend::BrowserWebGpu && !reading)
         .then(|| GpuEngine::new(&rs.device, &rs.queue, software))
 }
