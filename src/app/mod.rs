@@ -21,7 +21,6 @@ mod document;
 mod download;
 mod drag_params;
 mod file_input;
-// Not shown yet: the shell wires it in next.
 mod gallery;
 mod gallery_view;
 mod gpu_engine;
