@@ -116,7 +116,7 @@ impl Inbox {
                 hook(&mut arrived);
             }
         }
-        ctx.request_repaint();
+        super::wake(ctx);
     }
 
     /// Reads `files` one after another and delivers each in turn, so they arrive in order:

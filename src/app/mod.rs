@@ -49,10 +49,13 @@ pub use document::{Backend, Document};
 /// for on the CPU the workers need: a bar moving once a second keeps that share small.
 const PROGRESS_REPAINT: std::time::Duration = std::time::Duration::from_millis(1000);
 
-/// A frame as soon as the browser draws the next: what a worker's reply changed is drawn in
-/// one. egui answers a request for a frame at once with two (for widgets whose response comes
-/// a frame late), and a software GPU pays for each with a whole canvas.
-const NEXT_FRAME: std::time::Duration = std::time::Duration::from_millis(1);
+/// Asks for one frame, as soon as the browser draws the next, for a change made between frames
+/// (a worker's reply, a call of `window.meshsmooth`, a file read, a picture taken). egui
+/// answers a request for a frame at once with two (for widgets whose response comes a frame
+/// late), and a software GPU pays for each with a whole canvas.
+fn wake(ctx: &eframe::egui::Context) {
+    ctx.request_repaint_after(std::time::Duration::from_millis(1));
+}
 
 /// The mesh shown when the app opens: a voxelised bent tube (a staircase vessel surface).
 pub const SAMPLE_NAME: &str = "bent_tube_staircase.ply";

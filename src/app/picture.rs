@@ -30,7 +30,7 @@ impl Picture {
             if let Ok(mut slot) = arrived.lock() {
                 *slot = Some(image);
             }
-            wake.request_repaint();
+            super::wake(&wake);
         });
         ctx.request_repaint();
     }

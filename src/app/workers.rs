@@ -134,7 +134,7 @@ fn reply_handler(
         if paced && !shown_changed {
             ctx.request_repaint_after(super::PROGRESS_REPAINT);
         } else {
-            ctx.request_repaint_after(super::NEXT_FRAME);
+            super::wake(&ctx);
         }
     })
 }

@@ -40,7 +40,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
                     d.borrow_mut()
                         .begin_open_structure(index as usize, Some(waiter)),
                 );
-                c.request_repaint();
+                crate::app::wake(&c);
             });
             match result {
                 Some(Err(e)) => settled(Err(e)),

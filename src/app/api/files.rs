@@ -87,7 +87,7 @@ pub(super) fn file_call(
                     doc.begin_add(&name, bytes, Some(waiter))
                 }
             }
-            c.request_repaint();
+            crate::app::wake(&c);
         })
     })
 }

@@ -144,7 +144,7 @@ fn when_current(
                 Err(e) => reject.call1(&JsValue::NULL, &error(&e)),
             };
         }));
-        ctx.request_repaint();
+        crate::app::wake(&ctx);
     })
 }
 
@@ -169,7 +169,7 @@ fn when_ready(
                 };
             }),
         );
-        ctx.request_repaint();
+        crate::app::wake(&ctx);
     })
 }
 
@@ -185,7 +185,7 @@ fn started_work(
     if let Err(e) = started {
         return settled(Err(e));
     }
-    ctx.request_repaint();
+    crate::app::wake(ctx);
     when_ready(doc, ctx, ready, move |s| {
         report(s)
             .map(|v| to_js(&v))
@@ -253,7 +253,7 @@ fn setter(
         // With the work in the CPU engine's workers, their reply wakes the page: a frame now
         // would only draw the old surface while the new one is computed.
         if !doc.working_elsewhere() || !doc.busy() {
-            ctx.request_repaint();
+            crate::app::wake(&ctx);
         }
         Ok(())
     })
@@ -490,7 +490,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
         "clearWeights",
         Closure::<dyn FnMut()>::new(move || {
             d.borrow_mut().session.clear_weights();
-            c.request_repaint();
+            crate::app::wake(&c);
         }),
     )?;
 

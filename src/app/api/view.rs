@@ -29,7 +29,7 @@ pub(super) fn set_view(
         if let Some(t) = request.toward_segmentation {
             doc.view_asks.toward_segmentation = t;
         }
-        ctx.request_repaint();
+        crate::app::wake(&ctx);
         Ok(())
     })
 }
@@ -52,7 +52,7 @@ pub(super) fn define_screenshot(
                     };
                 });
                 d.borrow_mut().waiting_for_picture.push(waiter);
-                c.request_repaint();
+                crate::app::wake(&c);
             })
         }),
     )?;
