@@ -89,38 +89,7 @@ impl ViewResources {
     /// Draws the model, the other structures and the marks into the target (cleared to transparent) and
     /// resolves it.
     fn draw(&self, encoder: &mut wgpu::CommandEncoder, target: &Target, frame: &Frame) {
-        let (color, resolve_target) = match &target.multisampled {
-            Some(multisampled) => (multisampled, Some(&target.resolved)),
-            None => (&target.resolved, None),
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("meshsmooth view"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color,
-                depth_slice: None,
-                resolve_target,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    // Only the resolved image is read later.
-                    store: if resolve_target.is_some() {
-                        wgpu::StoreOp::Discard
-                    } else {
-                        wgpu::StoreOp::Store
-                    },
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &target.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = view_pass(encoder, target);
         // A translucent model is drawn with the translucent structures, first.
         let model_translucent = frame.uniforms.base_color[3] < 1.0;
         // A closed surface's back faces lie behind its front ones, unless a plane cuts it open:
@@ -171,6 +140,117 @@ impl ViewResources {
             draw_surface(&mut pass, &marks.buffers);
         }
     }
+
+    /// A software GPU (SwiftShader) compiles what runs a pipeline when a draw first uses it, on
+    /// the GPU process's thread, in the frame that draws. One triangle drawn with each of the
+    /// view's pipelines into a few pixels as the view is created has that done while the page
+    /// starts and its first file is read, rather than in the frame that first shows a mesh.
+    /// The submit also sends the pipelines themselves on, which a browser holds until a flush.
+    pub fn warm_up(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<(), String> {
+        const SIDE: u32 = 4;
+        let p = &self.pipelines;
+        let target = Target::new(device, p, [SIDE, SIDE]);
+        let mut mesh = MeshBuffers::default();
+        let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let normals = [[0.0, 0.0, 1.0]; 3];
+        mesh.set_mesh(device, queue, &corners, &normals, &[[0, 1, 2]], &[[0, 1]])?;
+        mesh.set_colors(queue, &[[255; 4]; 3])?;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("meshsmooth view warm-up"),
+        });
+        {
+            let mut pass = view_pass(&mut encoder, &target);
+            pass.set_bind_group(0, &self.view_group, &[]);
+            for pipeline in [&p.surface, &p.front_faces, &p.translucent, &p.over] {
+                pass.set_pipeline(pipeline);
+                draw_surface(&mut pass, &mesh);
+            }
+            if let (Some(positions), Some(edges)) = (&mesh.positions, &mesh.edges) {
+                pass.set_pipeline(&p.wire);
+                pass.set_vertex_buffer(0, positions.slice(..));
+                pass.set_index_buffer(edges.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..mesh.edge_indices, 0, 0..1);
+            }
+        }
+        // The composite, into a few pixels of egui's format as egui's pass has them.
+        let out = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("meshsmooth view warm-up"),
+                size: wgpu::Extent3d {
+                    width: SIDE,
+                    height: SIDE,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: p.color_format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("meshsmooth view warm-up composite"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &out,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&p.composite);
+            pass.set_bind_group(0, &self.view_group, &[]);
+            pass.set_bind_group(1, &target.composite_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        queue.submit([encoder.finish()]);
+        Ok(())
+    }
+}
+
+/// The view's pass into `target`: colour cleared to transparent, depth cleared; only the
+/// resolved image is kept.
+fn view_pass<'e>(encoder: &'e mut wgpu::CommandEncoder, target: &Target) -> wgpu::RenderPass<'e> {
+    let (color, resolve_target) = match &target.multisampled {
+        Some(multisampled) => (multisampled, Some(&target.resolved)),
+        None => (&target.resolved, None),
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("meshsmooth view"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                // Only the resolved image is read later.
+                store: if resolve_target.is_some() {
+                    wgpu::StoreOp::Discard
+                } else {
+                    wgpu::StoreOp::Store
+                },
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &target.depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
 }
 
 /// Draws `mesh`'s triangles with the pipeline and record set.

@@ -109,15 +109,14 @@ impl Viewer {
             pipelines.samples
         );
         let resources = ViewResources::new(&render_state.device, pipelines);
+        if let Err(e) = resources.warm_up(&render_state.device, &render_state.queue) {
+            log::warn!("the view's pipelines were not tried before the first frame: {e}");
+        }
         render_state
             .renderer
             .write()
             .callback_resources
             .insert(resources);
-        // A browser holds WebGPU's commands until something flushes them; a submit, even of
-        // nothing, sends the pipelines now, to be compiled while the first file is read rather
-        // than with the first frame.
-        render_state.queue.submit([]);
         Self {
             wireframe: false,
             painting: false,
