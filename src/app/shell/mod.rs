@@ -34,7 +34,7 @@ mod view_area;
 mod view_sync;
 
 use first_paint::FirstPaint;
-use start::{embed, gpu_engine, open_start_model, start_workers};
+use start::{embed, gpu_engine, open_start_model, set_style, start_workers};
 use view_sync::Shown;
 
 pub struct Shell {
@@ -118,20 +118,7 @@ impl Shell {
             viewer.wireframe = page::query_flag("wireframe");
             (viewer, rs.clone())
         });
-        // Dark, as on radiology workstations: the model stands out and colours read true.
-        cc.egui_ctx.set_theme(egui::Theme::Dark);
-        // Glyphs drawn plain: hinting runs each glyph through the font's bytecode interpreter and
-        // binning rasterises it at up to four offsets, work that lies on the first frame's path
-        // (compiled and then recompiled by the browser) for text that reads the same. On a
-        // software GPU each frame costs a whole canvas of CPU time, and comes a few times a
-        // second: widgets change at once rather than animate over frames.
-        cc.egui_ctx.all_styles_mut(|s| {
-            s.visuals.text_options.font_hinting = false;
-            s.visuals.text_options.subpixel_binning = false;
-            if software {
-                s.animation_time = 0.0;
-            }
-        });
+        set_style(&cc.egui_ctx, software);
         let files = FileInput::new(&cc.egui_ctx);
         // A file goes to the workers as soon as it is read, not a frame later.
         let weak = Rc::downgrade(&doc);

@@ -1,6 +1,6 @@
-//! What the page does once, as it starts: choose the engines, start the workers, open the file
-//! its address names (or the bundled sample), install `window.meshsmooth`, and answer the page
-//! that embeds it.
+//! What the page does once, as it starts: choose the engines and the look, start the workers,
+//! open the file its address names (or the bundled sample), install `window.meshsmooth`, and
+//! answer the page that embeds it.
 
 use eframe::egui;
 use std::rc::Rc;
@@ -102,4 +102,21 @@ pub(super) fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Con
         }
         Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
     }
+}
+
+/// The page's look: dark, as on radiology workstations, where the model stands out and colours
+/// read true. Glyphs drawn plain: hinting runs each glyph through the font's bytecode
+/// interpreter and binning rasterises it at up to four offsets, work that lies on the first
+/// frame's path (compiled and then recompiled by the browser) for text that reads the same. On
+/// a `software` GPU each frame costs a whole canvas of CPU time, and comes a few times a second:
+/// widgets change at once rather than animate over frames.
+pub(super) fn set_style(ctx: &egui::Context, software: bool) {
+    ctx.set_theme(egui::Theme::Dark);
+    ctx.all_styles_mut(|s| {
+        s.visuals.text_options.font_hinting = false;
+        s.visuals.text_options.subpixel_binning = false;
+        if software {
+            s.animation_time = 0.0;
+        }
+    });
 }
