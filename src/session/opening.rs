@@ -172,12 +172,12 @@ impl Session {
         &self.open_stages
     }
 
-    /// Whether the file opening now has its worker's answer, for the next frame to take up
-    /// (false when nothing is opening).
-    pub fn opening_answered(&self) -> bool {
+    /// Whether a file is opening and its worker has not answered yet (an answer waits for the
+    /// next frame to take it up).
+    pub fn opening_unanswered(&self) -> bool {
         self.opening
             .as_ref()
-            .is_some_and(|o| self.cpu.has_loaded(o.job))
+            .is_some_and(|o| !self.cpu.has_loaded(o.job))
     }
 
     /// How far the file being opened got, while one is.

@@ -257,8 +257,11 @@ fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
     let (mut s, deliver) = deferred_session();
     s.open("first.ply", SAMPLE).unwrap();
     let at_once = Model::load("second.ply", SAMPLE).unwrap().model;
+    assert!(!s.opening_unanswered(), "nothing is opening");
     assert_eq!(s.begin_open("second.ply", SAMPLE.to_vec()), None);
     for _ in 0..3 {
+        s.pump_cpu_engine();
+        assert!(s.opening_unanswered(), "the worker is busy");
         let p = s.loading().expect("opening");
         assert_eq!((p.name.as_str(), p.stage), ("second.ply", 0));
         assert_eq!(s.state_json(false)["loading"]["doing"], p.doing);
@@ -266,7 +269,11 @@ fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
         assert_eq!(s.model().unwrap().name, "first.ply", "the model stays");
     }
     deliver.set(true);
+    s.pump_cpu_engine();
+    assert!(!s.opening_unanswered(), "answered, to be taken up");
+    assert!(s.loading().is_some(), "not taken up yet");
     assert_eq!(s.poll_opening(), Some(Ok(())));
+    assert!(!s.opening_unanswered());
     let timed: Vec<&str> = s.open_stages().iter().map(|(d, _)| d.as_str()).collect();
     assert_eq!(
         timed,

@@ -181,9 +181,7 @@ impl Shell {
         };
         let session = &doc.session;
         self.files.reading().is_empty()
-            && (session.loading().is_none()
-                || session.opening_answered()
-                || !session.cpu_engine_threaded())
+            && (!session.opening_unanswered() || !session.cpu_engine_threaded())
     }
 
     /// This frame's engine work: the GPU engine where there is one, else the CPU engine.
