@@ -11,6 +11,17 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export PATH="$PWD/web/node_modules/.bin:$HOME/.cargo/bin:$PATH"
 # GPU tests must find an adapter (lavapipe on CI machines) instead of skipping.
 export REQUIRE_GPU=1
+# Build outputs live outside the checkout, so a fresh clone on the same machine reuses the
+# compiled dependencies (native, wasm32 tests, the web build, fuzz) and compiles only this crate.
+# Every install step still runs (.ci/install.sh); a new machine starts with an empty cache.
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/meshsmooth/target}"
+mkdir -p "$CARGO_TARGET_DIR"
+# Each clone path adds its own copy of this crate's outputs; start over once they pile up.
+cache_kib=$(du -sk "$CARGO_TARGET_DIR" 2>/dev/null | cut -f1)
+if [ "${cache_kib:-0}" -gt $((40 * 1024 * 1024)) ]; then
+    echo "tests/run.sh: build cache $CARGO_TARGET_DIR past 40 GiB: emptying it"
+    rm -rf "$CARGO_TARGET_DIR" && mkdir -p "$CARGO_TARGET_DIR"
+fi
 
 if [ ! -d ../shared/data ]; then
     echo "tests/run.sh: the test meshes are missing: expected ../shared/data beside the checkout" >&2
