@@ -17,6 +17,7 @@ pub mod model;
 pub mod segmentation;
 pub mod session;
 pub mod smooth;
+pub mod srgb;
 pub mod suggest;
 pub mod view;
 pub mod worker;

@@ -6,12 +6,12 @@
 use serde_json::{json, Value};
 
 use super::{Case, CaseStructure, Smoothed};
-use crate::export::linear_to_srgb;
 use crate::io::{GltfNode, GltfScene, Mat4};
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
 use crate::segmentation::default_color;
 use crate::smooth::{Filter, Params};
+use crate::srgb;
 
 /// The key of meshsmooth's record in a glTF `extras` object.
 pub const CASE_KEY: &str = "meshsmooth";
@@ -132,9 +132,14 @@ fn structure(
         }
         None => None,
     };
-    let color = node
-        .base_color
-        .map(|[r, g, b, a]| [linear_to_srgb(r), linear_to_srgb(g), linear_to_srgb(b), a]);
+    let color = node.base_color.map(|[r, g, b, a]| {
+        [
+            srgb::from_linear(r),
+            srgb::from_linear(g),
+            srgb::from_linear(b),
+            a,
+        ]
+    });
     let record = node.extras.as_ref().and_then(|e| e.get(CASE_KEY));
     let fallback = default_color(ordinal);
     let mut s = CaseStructure::from_mesh(&name, shown.clone(), fallback);

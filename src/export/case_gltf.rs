@@ -21,6 +21,7 @@ use super::glb::{
 use super::{check, ExportError, ExportOptions};
 use crate::case::{structure_record, Case, CaseStructure, CASE_KEY};
 use crate::mesh::{bounding_box, vertex_normals, Mesh};
+use crate::srgb;
 
 /// Which frame the file's coordinates are in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,26 +80,6 @@ pub const RAS_MM_TO_GLTF: [f64; 16] = [
     0.0, 0.001, 0.0, 0.0, // S -> +Y
     0.0, 0.0, 0.0, 1.0,
 ];
-
-/// Converts a display (sRGB) channel to glTF's linear factor.
-pub fn srgb_to_linear(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Converts glTF's linear factor back to a display (sRGB) channel.
-pub fn linear_to_srgb(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
 
 /// Serialises the case.
 pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, ExportError> {
@@ -304,7 +285,7 @@ fn material(s: &CaseStructure, unlit: bool) -> Value {
     let mut m = json!({
         "name": s.name,
         "pbrMetallicRoughness": {
-            "baseColorFactor": [srgb_to_linear(r), srgb_to_linear(g), srgb_to_linear(b), alpha],
+            "baseColorFactor": [srgb::to_linear(r), srgb::to_linear(g), srgb::to_linear(b), alpha],
             "metallicFactor": 0.0,
             "roughnessFactor": 0.6,
         },

@@ -8,10 +8,7 @@ mod obj;
 mod ply;
 mod stl;
 
-pub use case_gltf::{
-    linear_to_srgb, srgb_to_linear, write_case, CaseGltfOptions, Container, SceneFrame,
-    RAS_MM_TO_GLTF,
-};
+pub use case_gltf::{write_case, CaseGltfOptions, Container, SceneFrame, RAS_MM_TO_GLTF};
 
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;

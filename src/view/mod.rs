@@ -28,6 +28,4 @@ pub use param_drag::{
 pub use pick::{
     brush_falloff, brush_footprint, moller_trumbore, pick_triangle, pick_triangle_where, Hit, Ray,
 };
-pub use uniforms::{
-    linear_from_srgb, ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS,
-};
+pub use uniforms::{ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS};

@@ -13,7 +13,8 @@
 //! are triangles without area on screen; parts beyond the camera's near and far planes are cut
 //! per sample.
 
-use super::{linear_from_srgb, OrbitCamera, ViewUniforms};
+use super::{OrbitCamera, ViewUniforms};
+use crate::srgb;
 use glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
 
 /// The 3D view's background (`BACKGROUND` in the app's viewer), sRGB and opaque.
@@ -99,7 +100,7 @@ pub fn render_on(
 
     // Premultiplied linear background; samples are averaged premultiplied, as blending does.
     let bg_alpha = background[3] as f32 / 255.0;
-    let bg = Vec3::from_array([0, 1, 2].map(|k| linear_from_srgb(background[k] as f32 / 255.0)))
+    let bg = Vec3::from_array([0, 1, 2].map(|k| srgb::to_linear(background[k] as f32 / 255.0)))
         * bg_alpha;
     let samples = (SUPERSAMPLING * SUPERSAMPLING) as f32;
     let mut pixels = Vec::with_capacity(width * height);
@@ -356,16 +357,7 @@ impl Shading {
 
 /// Linear light of each sRGB byte value.
 fn srgb_decoding_table() -> [f32; 256] {
-    std::array::from_fn(|v| linear_from_srgb(v as f32 / 255.0))
-}
-
-/// The sRGB transfer function (the inverse of [`linear_from_srgb`]).
-fn srgb_from_linear(c: f32) -> f32 {
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
+    std::array::from_fn(|v| srgb::to_linear(v as f32 / 255.0))
 }
 
 /// A pixel from premultiplied linear RGB and coverage: sRGB bytes, straight alpha.
@@ -376,9 +368,9 @@ fn encode(rgb: Vec3, alpha: f32) -> [u8; 4] {
     }
     let straight = rgb / alpha;
     [
-        byte(srgb_from_linear(straight.x.clamp(0.0, 1.0))),
-        byte(srgb_from_linear(straight.y.clamp(0.0, 1.0))),
-        byte(srgb_from_linear(straight.z.clamp(0.0, 1.0))),
+        byte(srgb::from_linear(straight.x)),
+        byte(srgb::from_linear(straight.y)),
+        byte(srgb::from_linear(straight.z)),
         byte(alpha),
     ]
 }

@@ -6,6 +6,7 @@
 
 use super::thumbnail::BACKGROUND_SRGBA;
 use super::OrbitCamera;
+use crate::srgb;
 use bytemuck::{Pod, Zeroable};
 
 /// The render shader, as the app loads it; tests/render_shader.rs validates it with naga.
@@ -67,7 +68,7 @@ const _: () = assert!(std::mem::offset_of!(ViewUniforms, flags) == 176);
 impl ViewUniforms {
     /// The record for `camera` in a viewport of this aspect ratio (width / height).
     pub fn new(camera: &OrbitCamera, aspect: f32, flags: u32) -> Self {
-        let srgb = |c: [f32; 3]| c.map(linear_from_srgb);
+        let srgb = |c: [f32; 3]| c.map(srgb::to_linear);
         let [r, g, b] = srgb(BASE_COLOR_SRGB);
         let [tr, tg, tb] = srgb(BACK_TINT_SRGB);
         let [wr, wg, wb] = srgb([WIRE_COLOR_SRGB[0], WIRE_COLOR_SRGB[1], WIRE_COLOR_SRGB[2]]);
@@ -92,7 +93,7 @@ impl ViewUniforms {
     /// The same record with `srgb` (display colour, each in [0, 1]) as the colour of a mesh
     /// without vertex colours: a case's structure in its own colour.
     pub fn with_base_color(mut self, srgb: [f32; 3]) -> Self {
-        let [r, g, b] = srgb.map(|c| linear_from_srgb(c.clamp(0.0, 1.0)));
+        let [r, g, b] = srgb.map(srgb::to_linear);
         self.base_color = [r, g, b, 1.0];
         self
     }
@@ -118,16 +119,6 @@ impl ViewUniforms {
     }
 }
 
-/// Linear light from an sRGB-encoded value in 0..1 (the sRGB transfer function's inverse;
-/// shaders/render.wgsl has the same function for vertex colours).
-pub fn linear_from_srgb(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,15 +130,6 @@ mod tests {
         assert!((u.base_color[1] - 0.214).abs() < 1e-3, "{:?}", u.base_color);
         assert_eq!((u.base_color[2], u.base_color[3]), (0.0, 1.0));
         assert_eq!(u.with_flags(VERTEX_COLORS).flags, VERTEX_COLORS);
-    }
-
-    #[test]
-    fn srgb_decoding_matches_known_values() {
-        assert_eq!(linear_from_srgb(0.0), 0.0);
-        assert!((linear_from_srgb(1.0) - 1.0).abs() < 1e-6);
-        // sRGB 0.5 is about 21.4% linear light; the linear segment ends at 0.04045.
-        assert!((linear_from_srgb(0.5) - 0.214_041).abs() < 1e-5);
-        assert!((linear_from_srgb(0.04045) - 0.04045 / 12.92).abs() < 1e-7);
     }
 
     #[test]

@@ -227,7 +227,7 @@ fn the_lights_are_those_of_the_render_shader() {
 #[test]
 fn srgb_encoding_inverts_decoding() {
     for v in 0..=255u8 {
-        let linear = linear_from_srgb(v as f32 / 255.0);
+        let linear = crate::srgb::to_linear(v as f32 / 255.0);
         assert_eq!(encode(Vec3::splat(linear), 1.0)[0], v);
     }
     assert_eq!(encode(Vec3::ZERO, 0.0), [0; 4]);
