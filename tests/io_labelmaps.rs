@@ -6,7 +6,7 @@
 use meshsmooth::io::{
     is_label_map, load, load_label_map, parse_color_table, LabelMapOptions, LoadError,
 };
-use meshsmooth::segmentation::{Affine, LabelMap};
+use meshsmooth::io::{Affine, LabelMap};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::time::{Duration, Instant};

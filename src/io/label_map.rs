@@ -1,19 +1,5 @@
-//! Label maps in: NIfTI-1 and NIfTI-2 (`.nii`, `.nii.gz`) and NRRD (`.nrrd`, 3D Slicer's
-//! `.seg.nrrd`) into a [`LabelMap`]; colour tables that name the labels are in `color_table`.
-//!
-//! Both formats are parsed here by hand rather than with the `nifti` crate: that crate reads
-//! NIfTI-1 only and allocates the volume from the header's dims before anything can bound them.
-//! Here every size is checked against the bytes (for gzip: against the most deflate can expand
-//! to) before a buffer is made, gzip is inflated under a hard limit, and voxels are decoded chunk
-//! by chunk straight into two-byte label codes, so a large volume never sits in memory both as
-//! raw voxels and as codes.
-//!
-//! Values become labels when they are whole numbers (after NIfTI's `scl_slope`/`scl_inter`); an
-//! image with other values (a probability map, a float mask) is read as a mask instead: value 1
-//! where the voxel is at least the level, background elsewhere and at NaN.
-
-use super::{nifti, nrrd, Format, LoadError, Location};
-use crate::segmentation::{Affine, LabelMap};
+//! The label map as the parsers hand it over: a voxel grid of label codes, its affine into world
+//! millimetres (RAS), and the segment names and colours the file carried; and how to read one.
 
 /// How to read a label map.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -28,230 +14,89 @@ pub struct LabelMapOptions {
 /// The level used when [`LabelMapOptions::level`] is `None`.
 pub(super) const DEFAULT_LEVEL: f64 = 0.5;
 
-/// The most voxel data (and the most label codes) a label map may hold.
-const MAX_VOXEL_BYTES: u64 = 4 << 30;
+/// The most distinct labels one layer can hold (codes are `u16`, code 0 is background).
+pub const MAX_LABELS: usize = u16::MAX as usize;
 
-/// The most layers a label map may hold (3D Slicer writes one per group of overlapping segments;
-/// older files one per segment). Each layer costs a few small buffers beyond its codes.
-const MAX_LAYERS: usize = 1024;
+/// Voxel index `(i, j, k)` to world RAS millimetres: `world = m * [i, j, k, 1]`, row-major rows
+/// of a 3 x 4 matrix.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Affine(pub [[f64; 4]; 3]);
 
-/// Whether a file name is a label map this module reads (`.nii`, `.nii.gz`, `.nrrd` including
-/// `.seg.nrrd`, and detached `.nhdr` headers, which are refused with a reason), ignoring case.
-pub fn is_label_map(name: &str) -> bool {
-    label_format_of(name).is_some()
-}
-
-pub(super) fn label_format_of(name: &str) -> Option<Format> {
-    let lower = name.to_ascii_lowercase();
-    if lower.ends_with(".nii") || lower.ends_with(".nii.gz") {
-        Some(Format::Nifti)
-    } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
-        Some(Format::Nrrd)
-    } else {
-        None
-    }
-}
-
-/// Reads a label map, choosing the parser by the file name (or, for other names, by the bytes:
-/// `NRRD` magic, gzip, or a NIfTI header size). A gzip-compressed `.nii` is read as `.nii.gz`.
-pub fn load_label_map(
-    bytes: &[u8],
-    name: &str,
-    options: &LabelMapOptions,
-) -> Result<LabelMap, LoadError> {
-    let format = match label_format_of(name) {
-        Some(format) => format,
-        None => sniff(bytes, name)?,
-    };
-    if bytes.is_empty() {
-        return Err(LoadError::Empty { format });
-    }
-    if let Some(level) = options.level.filter(|l| !l.is_finite()) {
-        return Err(LoadError::Unsupported {
-            format,
-            detail: format!("the mask level {level} is not a finite number"),
-        });
-    }
-    match format {
-        Format::Nrrd => nrrd::parse(bytes, options),
-        _ => nifti::parse(bytes, options),
-    }
-}
-
-/// The label-map format of a file whose name does not say.
-fn sniff(bytes: &[u8], name: &str) -> Result<Format, LoadError> {
-    let size = |big: bool| {
-        let b = <[u8; 4]>::try_from(bytes.get(..4)?).ok()?;
-        Some(if big {
-            i32::from_be_bytes(b)
-        } else {
-            i32::from_le_bytes(b)
-        })
-    };
-    let nifti_size = |s: Option<i32>| matches!(s, Some(348 | 540));
-    if bytes.starts_with(b"NRRD") {
-        Ok(Format::Nrrd)
-    } else if super::gzip::is_gzip(bytes) || nifti_size(size(false)) || nifti_size(size(true)) {
-        Ok(Format::Nifti)
-    } else if let Some(format) = Format::from_name(name) {
-        Err(LoadError::Unsupported {
-            format,
-            detail: format!("'{name}' is a mesh, not a label map: open it as a mesh"),
-        })
-    } else {
-        Err(LoadError::UnknownFormat {
-            name: name.to_string(),
-        })
-    }
-}
-
-/// Voxel sample types both formats share.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Sample {
-    U8,
-    I8,
-    U16,
-    I16,
-    U32,
-    I32,
-    F32,
-    F64,
-}
-
-impl Sample {
-    pub(super) fn size(self) -> usize {
-        match self {
-            Sample::U8 | Sample::I8 => 1,
-            Sample::U16 | Sample::I16 => 2,
-            Sample::U32 | Sample::I32 | Sample::F32 => 4,
-            Sample::F64 => 8,
+impl Affine {
+    /// Axis-aligned grid with the given spacing and origin (voxel (0,0,0) at `origin`).
+    pub fn scaled(spacing: [f64; 3], origin: [f64; 3]) -> Self {
+        let mut m = [[0.0; 4]; 3];
+        for r in 0..3 {
+            m[r][r] = spacing[r];
+            m[r][3] = origin[r];
         }
+        Affine(m)
     }
 
-    pub(super) fn is_float(self) -> bool {
-        matches!(self, Sample::F32 | Sample::F64)
+    /// The world point of a (possibly fractional) voxel index.
+    pub fn apply(&self, ijk: [f64; 3]) -> [f64; 3] {
+        let m = &self.0;
+        std::array::from_fn(|r| m[r][0] * ijk[0] + m[r][1] * ijk[1] + m[r][2] * ijk[2] + m[r][3])
     }
 
-    fn name(self) -> &'static str {
-        match self {
-            Sample::U8 => "uint8",
-            Sample::I8 => "int8",
-            Sample::U16 => "uint16",
-            Sample::I16 => "int16",
-            Sample::U32 => "uint32",
-            Sample::I32 => "int32",
-            Sample::F32 => "float32",
-            Sample::F64 => "float64",
-        }
+    /// Length of each voxel axis in mm (the columns' norms).
+    pub fn spacing(&self) -> [f64; 3] {
+        let m = &self.0;
+        std::array::from_fn(|c| (0..3).map(|r| m[r][c] * m[r][c]).sum::<f64>().sqrt())
+    }
+
+    /// Determinant of the linear part: negative when the grid is mirrored against RAS (its
+    /// triangles must then be wound the other way to face outward).
+    pub fn determinant(&self) -> f64 {
+        let m = &self.0;
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
     }
 }
 
-/// How a file lays out its voxel values: the grid, the layers and the encoding of each value.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct VoxelLayout {
+/// One volume of labels. Voxels are stored as dense codes (`i` fastest, then `j`, then `k`) into
+/// `values`, so that any integer label type costs two bytes a voxel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelLayer {
+    /// Per voxel, an index into `values`; code 0 is background.
+    pub codes: Vec<u16>,
+    /// The label value (as the file stores it, after `scl_slope`/`scl_inter`) of each code;
+    /// `values[0]` is 0, the background.
+    pub values: Vec<i64>,
+}
+
+/// A named segment the file declares (3D Slicer's `SegmentN_*` keys): which layer and label
+/// value it occupies, its name and its display colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Segment {
+    pub layer: usize,
+    pub value: i64,
+    pub name: String,
+    /// Display (sRGB) colour, each channel in [0, 1].
+    pub color: Option<[f32; 3]>,
+}
+
+/// A segmentation on one voxel grid: one layer (NIfTI, a plain NRRD) or several (a `.seg.nrrd`
+/// whose segments overlap), every layer the same size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelMap {
+    /// Voxels along i, j, k.
     pub dims: [usize; 3],
-    pub layers: usize,
-    /// Layers interleaved voxel by voxel (NRRD's list axis first) rather than one after another.
-    pub interleaved: bool,
-    pub sample: Sample,
-    pub big_endian: bool,
-    /// `value * slope + inter` (NIfTI's scaling; 1 and 0 elsewhere).
-    pub slope: f64,
-    pub inter: f64,
+    pub affine: Affine,
+    pub layers: Vec<LabelLayer>,
+    /// Segments the file names; empty when it names none (then a colour table or the default
+    /// names apply).
+    pub segments: Vec<Segment>,
 }
 
-impl VoxelLayout {
-    /// Bytes of voxel data the layout declares, after refusing one past [`MAX_VOXEL_BYTES`] of
-    /// data or of codes.
-    pub(super) fn data_bytes(&self, format: Format) -> Result<u64, LoadError> {
-        if self.layers > MAX_LAYERS {
-            return Err(LoadError::Unsupported {
-                format,
-                detail: format!(
-                    "{} layers: a label map may hold at most {MAX_LAYERS}",
-                    self.layers
-                ),
-            });
-        }
-        let [i, j, k] = self.dims.map(|d| d as u128);
-        let elements = i * j * k * self.layers as u128;
-        let bytes = elements * self.sample.size() as u128;
-        if bytes.max(elements * 2) > u128::from(MAX_VOXEL_BYTES) {
-            return Err(LoadError::Unsupported {
-                format,
-                detail: format!(
-                    "{i} x {j} x {k} voxels x {} layer(s) of {}: {bytes} bytes of voxel data, \
-                     more than the 4 GiB limit",
-                    self.layers,
-                    self.sample.name()
-                ),
-            });
-        }
-        Ok(bytes as u64)
-    }
-
-    pub(super) fn voxel_count(&self) -> usize {
+impl LabelMap {
+    pub fn voxel_count(&self) -> usize {
         self.dims.iter().product()
     }
-}
 
-/// Refuses data bytes that the raw bytes after the header cannot hold.
-pub(super) fn check_raw(declared: u64, available: usize, format: Format) -> Result<(), LoadError> {
-    if declared > available as u64 {
-        return Err(LoadError::CountTooLarge {
-            format,
-            what: "bytes of voxel data",
-            claimed: declared,
-            possible: available as u64,
-        });
+    /// Voxel size along i, j, k in mm.
+    pub fn spacing(&self) -> [f64; 3] {
+        self.affine.spacing()
     }
-    Ok(())
-}
-
-/// Checks an affine the grid will be placed by: finite, positive voxel sizes, not singular.
-/// `source` names the header fields it came from, `location` where they are.
-pub(super) fn check_affine(
-    affine: &Affine,
-    format: Format,
-    location: Location,
-    source: &str,
-) -> Result<(), LoadError> {
-    let error = |detail: String| LoadError::Syntax {
-        format,
-        location,
-        detail: format!("{source}: {detail}"),
-    };
-    if let Some(v) = affine.0.iter().flatten().find(|v| !v.is_finite()) {
-        return Err(error(format!("{v} is not a finite number")));
-    }
-    let spacing = affine.spacing();
-    if let Some(axis) = spacing.iter().position(|&s| !(s > 0.0 && s.is_finite())) {
-        return Err(error(format!("the voxel size along axis {axis} is 0")));
-    }
-    let det = affine.determinant();
-    let volume: f64 = spacing.iter().product();
-    if !det.is_finite() || det.abs() <= 1e-6 * volume {
-        return Err(error(format!(
-            "the affine is singular (determinant {det:.3e} for voxel sizes {spacing:?}): its \
-             voxel axes are parallel"
-        )));
-    }
-    Ok(())
-}
-
-/// Checks a voxel size read from a header field (NIfTI's pixdim, NRRD's spacings).
-pub(super) fn check_spacing(
-    value: f64,
-    format: Format,
-    location: Location,
-    field: &str,
-) -> Result<f64, LoadError> {
-    if value > 0.0 && value.is_finite() {
-        return Ok(value);
-    }
-    Err(LoadError::Syntax {
-        format,
-        location,
-        detail: format!("{field}: voxel size {value} must be positive and finite"),
-    })
 }

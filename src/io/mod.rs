@@ -7,12 +7,14 @@ mod error;
 mod gltf;
 mod gzip;
 mod label_map;
+mod label_map_checks;
 mod nifti;
 mod nrrd;
 mod obj;
 mod ply;
 mod ply_ascii;
 mod ply_binary;
+mod read_label_map;
 mod stl;
 mod text;
 mod voxels;
@@ -21,7 +23,8 @@ mod weld;
 pub use color_table::{parse_color_table, LabelEntry};
 pub use error::{LoadError, Location};
 pub use gltf::{GltfNode, GltfScene, Mat4};
-pub use label_map::{is_label_map, load_label_map, LabelMapOptions};
+pub use label_map::{Affine, LabelLayer, LabelMap, LabelMapOptions, Segment, MAX_LABELS};
+pub use read_label_map::{is_label_map, load_label_map};
 pub use weld::weld_exact;
 
 use crate::mesh::Mesh;
@@ -61,7 +64,7 @@ impl Format {
     /// The format named by a file name's extension (case-insensitive): a mesh format, or a
     /// label-map one (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`).
     pub fn from_name(name: &str) -> Option<Format> {
-        if let Some(format) = label_map::label_format_of(name) {
+        if let Some(format) = read_label_map::label_format_of(name) {
             return Some(format);
         }
         let ext = name.rsplit_once('.')?.1.to_ascii_lowercase();

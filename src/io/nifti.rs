@@ -5,10 +5,11 @@
 //! else the qform when `qform_code > 0`, else `diag(pixdim)` (the standard's "method 1").
 
 use super::gzip::{self, Inflater};
-use super::label_map::{self, check_affine, check_spacing, LabelMapOptions, Sample, VoxelLayout};
+use super::label_map::LabelMapOptions;
+use super::label_map::{Affine, LabelMap};
+use super::label_map_checks::{check_affine, check_raw, check_spacing, Sample, VoxelLayout};
 use super::voxels::{self, VoxelSink};
 use super::{Format, LoadError, Location};
-use crate::segmentation::{Affine, LabelMap};
 
 const FORMAT: Format = Format::Nifti;
 
@@ -31,7 +32,7 @@ fn parse_raw(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadEr
         offset: bytes.len(),
         detail: format!("the voxel data starts at byte {start} (vox_offset), past the end"),
     })?;
-    label_map::check_raw(data_bytes, data.len(), FORMAT)?;
+    check_raw(data_bytes, data.len(), FORMAT)?;
     let mut sink = VoxelSink::new(&layout, options, FORMAT)?;
     sink.feed(&data[..data_bytes as usize])?;
     Ok(LabelMap {

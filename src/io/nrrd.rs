@@ -9,11 +9,12 @@
 use std::collections::BTreeMap;
 
 use super::gzip::Inflater;
-use super::label_map::{self, check_affine, check_spacing, LabelMapOptions, Sample, VoxelLayout};
+use super::label_map::LabelMapOptions;
+use super::label_map::{Affine, LabelMap, Segment};
+use super::label_map_checks::{check_affine, check_raw, check_spacing, Sample, VoxelLayout};
 use super::text::Lines;
 use super::voxels::{self, VoxelSink};
 use super::{Format, LoadError, Location};
-use crate::segmentation::{Affine, LabelMap, Segment};
 
 const FORMAT: Format = Format::Nrrd;
 
@@ -27,7 +28,7 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     let mut sink;
     match header.encoding {
         Some(Encoding::Raw) => {
-            label_map::check_raw(data_bytes, data.len(), FORMAT)?;
+            check_raw(data_bytes, data.len(), FORMAT)?;
             sink = VoxelSink::new(&layout, options, FORMAT)?;
             sink.feed(&data[..data_bytes as usize])?;
         }

@@ -7,9 +7,9 @@
 use std::collections::HashMap;
 
 use super::gzip::Inflater;
-use super::label_map::{LabelMapOptions, Sample, VoxelLayout, DEFAULT_LEVEL};
+use super::label_map::{LabelLayer, LabelMapOptions, DEFAULT_LEVEL, MAX_LABELS};
+use super::label_map_checks::{Sample, VoxelLayout};
 use super::{Format, LoadError};
-use crate::segmentation::{LabelLayer, MAX_LABELS};
 
 /// Decodes the declared voxel bytes from a gzip stream into `sink`, then checks the stream ends.
 pub(super) fn decode_gzip(

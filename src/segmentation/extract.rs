@@ -8,7 +8,7 @@
 //! one slot for the label at each end, since both labels' surfaces pass through that point.
 
 use super::cube_table::{case_table, EDGE_CORNERS};
-use super::{LabelLayer, LabelMap};
+use crate::io::{LabelLayer, LabelMap};
 use crate::mesh::{Mesh, NONE};
 
 /// Triangles of every case, flattened: case `c` owns `TRIANGLES[offsets[c]..offsets[c + 1]]`.

@@ -1,18 +1,16 @@
 //! Segmentations: label maps (one integer per voxel, one label per structure) and the named,
 //! coloured structure surfaces extracted from them.
 //!
-//! Bytes -> [`crate::io`] (NIfTI, NRRD, colour tables) -> [`LabelMap`] -> [`extract`] -> one
+//! Bytes -> [`crate::io`] (NIfTI, NRRD, colour tables) -> [`crate::io::LabelMap`] -> [`extract`] -> one
 //! closed [`crate::mesh::Mesh`] per label, in world millimetres (RAS).
 
 mod cube_table;
 mod extract;
-mod label_map;
 mod open;
 mod palette;
 mod specks;
 mod structure;
 
-pub use label_map::{Affine, LabelLayer, LabelMap, Segment, MAX_LABELS};
 pub use open::{open, structure_name, NamedBytes, OpenError, OpenOptions};
 pub use palette::default_color;
 pub use structure::{extract, labels, ExtractError, ExtractOptions, LabelInfo, Structure};

@@ -2,8 +2,8 @@
 //! masks (each file a structure, named by its file name, as TotalSegmentator writes them), with
 //! an optional colour table that names the labels. Shared by the CLI and the page.
 
-use super::{extract, ExtractError, ExtractOptions, LabelMap, Segment, Structure};
-use crate::io::{self, LabelMapOptions, LoadError};
+use super::{extract, ExtractError, ExtractOptions, Structure};
+use crate::io::{self, LabelMap, LabelMapOptions, LoadError, Segment};
 
 /// A file's name and bytes.
 #[derive(Clone, Copy, Debug)]

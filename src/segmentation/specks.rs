@@ -2,7 +2,7 @@
 //! surfaces are made. Components are 18-connected, as the surfaces join them (voxels that share
 //! a face or an edge are one piece; voxels that touch only at a corner get surfaces of their own).
 
-use super::LabelLayer;
+use crate::io::LabelLayer;
 
 /// The 18 neighbour offsets: the 6 face neighbours and the 12 edge neighbours.
 fn neighbour_offsets() -> Vec<[i64; 3]> {

@@ -4,7 +4,7 @@
 use super::extract::{surfaces_by_code, to_world};
 use super::palette::default_color;
 use super::specks::drop_small_components;
-use super::{LabelMap, Segment};
+use crate::io::{LabelMap, Segment};
 use crate::mesh::Mesh;
 
 /// Which labels to extract.

@@ -1,6 +1,7 @@
 //! Surfaces of small label maps built here: closed, manifold, outward, the right volume.
 
 use super::*;
+use crate::io::{Affine, LabelLayer, LabelMap, Segment};
 use crate::mesh::{MeshReport, Topology};
 
 /// A one-layer label map on a unit grid from a closure of the voxel index.

@@ -4,7 +4,7 @@
 use super::build::{gzip, i16s, nrrd};
 use super::{load_named, voxel_values};
 use meshsmooth::io::parse_color_table;
-use meshsmooth::segmentation::Affine;
+use meshsmooth::io::Affine;
 
 #[test]
 fn seg_nrrd_layers_and_segments() {

@@ -27,7 +27,7 @@ pub fn check(data: &[u8], format: Format) {
 /// What the label-map targets check: a label map with finite affine and codes in range, whose
 /// small enough maps give closed, manifold surfaces (or are refused).
 #[allow(dead_code)]
-pub fn check_label_map(map: &meshsmooth::segmentation::LabelMap) {
+pub fn check_label_map(map: &meshsmooth::io::LabelMap) {
     let voxels = map.voxel_count();
     assert!(
         map.affine.0.iter().flatten().all(|v| v.is_finite()),
