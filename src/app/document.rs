@@ -186,8 +186,6 @@ pub struct Document {
     pub backend: Backend,
     /// Timings of the last result.
     pub timings: Option<EngineTimings>,
-    /// Bumped when a new model is opened, so views re-upload it.
-    pub model_generation: u64,
     /// What the 3D view reports to `state()`.
     pub view: ViewReport,
     pub view_asks: ViewAsks,
@@ -226,7 +224,6 @@ impl Document {
             session: Session::default(),
             backend,
             timings: None,
-            model_generation: 0,
             view: ViewReport::default(),
             view_asks: ViewAsks::default(),
             pointed: None,
@@ -336,7 +333,6 @@ impl Document {
                 model.report.faces
             );
         }
-        self.model_generation += 1;
         self.timings = None;
     }
 
@@ -522,11 +518,11 @@ mod tests {
         let mut doc = Document::new(Backend::Cpu);
         doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
             .unwrap();
-        let generation = doc.model_generation;
+        let generation = doc.session.model_id();
         let error = doc.open("notes.txt", b"not a mesh").unwrap_err();
         assert!(error.starts_with("Cannot open notes.txt: "), "{error}");
         assert!(error.contains(".stl .obj .ply"), "{error}");
-        assert_eq!(doc.model_generation, generation);
+        assert_eq!(doc.session.model_id(), generation);
         let state = doc.state_json();
         assert_eq!(state["model"], crate::app::SAMPLE_NAME);
         assert_eq!(state["error"], error.as_str());

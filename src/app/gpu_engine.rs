@@ -240,7 +240,7 @@ impl GpuEngine {
         if self.in_flight.is_some() || self.device_work.waiting {
             return Ok(Sent::Nothing);
         }
-        let generation = doc.model_generation;
+        let generation = doc.session.model_id();
         if self
             .running
             .as_ref()
@@ -332,7 +332,7 @@ impl GpuEngine {
         let Some(run) = self.in_flight.as_mut() else {
             return Ok(());
         };
-        if run.generation != doc.model_generation {
+        if run.generation != doc.session.model_id() {
             // A run for a model that is no longer open: its measures belong to another
             // original. Dropping it drops its pending mappings.
             self.in_flight = None;

@@ -64,7 +64,7 @@ impl Shell {
                     Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
                     _ => None,
                 };
-                let surface = (doc.model_generation, shown);
+                let surface = (doc.session.model_id(), shown);
                 let camera = viewer.camera();
                 self.brush
                     .interact(ui, &response, camera, &mut doc.session, surface);

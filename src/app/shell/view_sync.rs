@@ -51,7 +51,7 @@ impl Shell {
             return;
         };
         let mesh = model.mesh();
-        if self.shown.generation != doc.model_generation || self.shown.positions.is_none() {
+        if self.shown.generation != doc.session.model_id() || self.shown.positions.is_none() {
             let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
             let kept_view = viewer.view_state();
             viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
@@ -74,7 +74,7 @@ impl Shell {
                 viewer.set_pose(pose);
             }
             self.shown = Shown {
-                generation: doc.model_generation,
+                generation: doc.session.model_id(),
                 positions: Some(Positions::Original),
                 ..Shown::default()
             };
@@ -94,7 +94,7 @@ impl Shell {
                 Positions::Toward(r.revision, toward.to_bits())
             })
         } else if let Some(gpu) = &self.gpu {
-            (gpu.submitted(doc.model_generation)).map_or(before_result, Positions::Gpu)
+            (gpu.submitted(doc.session.model_id())).map_or(before_result, Positions::Gpu)
         } else {
             result.map_or(before_result, |r| Positions::Cpu(r.revision))
         };
@@ -135,7 +135,7 @@ impl Shell {
                 // While a run is under way in the engine's buffers they hold none of its
                 // results: copy once it is done.
                 Positions::Gpu(_) => {
-                    match (self.gpu.as_ref()).and_then(|g| g.buffers(doc.model_generation)) {
+                    match (self.gpu.as_ref()).and_then(|g| g.buffers(doc.session.model_id())) {
                         Some((positions, normals)) => {
                             viewer.copy_positions_from(rs, positions, normals);
                             true
