@@ -9,6 +9,7 @@ use wasm_bindgen::JsValue;
 use super::files::info_waiter;
 use super::{from_js, setter, settled, to_js, Api};
 use crate::app::document::SharedDocument;
+use crate::session::Session;
 
 pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
     let d = doc.clone();
@@ -23,31 +24,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
         }),
     )?;
 
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "selectStructure",
-        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |index: JsValue| {
-            let Some(index) = index.as_f64().filter(|i| *i >= 0.0 && i.fract() == 0.0) else {
-                return settled(Err(
-                    "selectStructure(index): index must be a whole number >= 0".into(),
-                ));
-            };
-            let (d, c) = (d.clone(), c.clone());
-            let mut result = None;
-            let promise = Promise::new(&mut |resolve: Function, reject: Function| {
-                let waiter = info_waiter(resolve, reject);
-                result = Some(
-                    d.borrow_mut()
-                        .begin_open_structure(index as usize, Some(waiter)),
-                );
-                crate::app::wake(&c);
-            });
-            match result {
-                Some(Err(e)) => settled(Err(e)),
-                _ => promise,
-            }
-        }),
-    )?;
+    api.define("selectStructure", select_structure(doc, ctx))?;
 
     let reading = api.reading;
     api.define(
@@ -76,28 +53,57 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
         }),
     )?;
 
-    api.define(
-        "setCase",
-        setter(doc, ctx, |session, values| {
-            let values = from_js(&values)?;
-            let text = |key: &str| match values.get(key) {
-                None => Ok(None),
-                Some(v) => v
-                    .as_str()
-                    .map(Some)
-                    .ok_or_else(|| format!("setCase: {key} must be a string")),
-            };
-            if let Some(key) = values
-                .as_object()
-                .ok_or("setCase takes an object: {title, description}")?
-                .keys()
-                .find(|k| !["title", "description"].contains(&k.as_str()))
-            {
-                return Err(format!("setCase: unknown key {key} (title, description)"));
-            }
-            session.set_case_text(text("title")?, text("description")?);
-            Ok(())
-        }),
-    )?;
+    api.define("setCase", setter(doc, ctx, set_case))?;
+    Ok(())
+}
+
+/// `selectStructure(index)`: opens that structure as the model; settles as `loadMesh` does.
+fn select_structure(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+) -> Closure<dyn FnMut(JsValue) -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move |index: JsValue| {
+        let Some(index) = index.as_f64().filter(|i| *i >= 0.0 && i.fract() == 0.0) else {
+            return settled(Err(
+                "selectStructure(index): index must be a whole number >= 0".into(),
+            ));
+        };
+        let (d, c) = (d.clone(), c.clone());
+        let mut result = None;
+        let promise = Promise::new(&mut |resolve: Function, reject: Function| {
+            let waiter = info_waiter(resolve, reject);
+            result = Some(
+                d.borrow_mut()
+                    .begin_open_structure(index as usize, Some(waiter)),
+            );
+            crate::app::wake(&c);
+        });
+        match result {
+            Some(Err(e)) => settled(Err(e)),
+            _ => promise,
+        }
+    })
+}
+
+/// `setCase({title, description})`: names the case; unknown keys are refused.
+fn set_case(session: &mut Session, values: JsValue) -> Result<(), String> {
+    let values = from_js(&values)?;
+    let text = |key: &str| match values.get(key) {
+        None => Ok(None),
+        Some(v) => v
+            .as_str()
+            .map(Some)
+            .ok_or_else(|| format!("setCase: {key} must be a string")),
+    };
+    if let Some(key) = values
+        .as_object()
+        .ok_or("setCase takes an object: {title, description}")?
+        .keys()
+        .find(|k| !["title", "description"].contains(&k.as_str()))
+    {
+        return Err(format!("setCase: unknown key {key} (title, description)"));
+    }
+    session.set_case_text(text("title")?, text("description")?);
     Ok(())
 }

@@ -84,6 +84,7 @@
 
 mod case;
 mod files;
+mod guidance;
 mod messages;
 mod view;
 
@@ -193,51 +194,6 @@ fn started_work(
     })
 }
 
-/// `suggest({tau, search})`: sets tau (default: the current one) and starts the search
-/// (default: grid, as the CLI); returns what the answer must match.
-fn start_suggest(
-    doc: &SharedDocument,
-    options: &JsValue,
-) -> Result<(f64, crate::suggest::SearchMethod), String> {
-    let mut doc = doc.borrow_mut();
-    let session = &mut doc.session;
-    let (tau, method) = tau_and_search(session, options, "suggest")?;
-    session.set_tau(tau)?;
-    session.start_suggest(method);
-    Ok((tau, method))
-}
-
-/// `{tau, search}` of `suggest` and `suggestAll` (tau: the session's, search: grid by default).
-fn tau_and_search(
-    session: &crate::session::Session,
-    options: &JsValue,
-    what: &str,
-) -> Result<(f64, crate::suggest::SearchMethod), String> {
-    use crate::suggest::SearchMethod;
-    let options = if options.is_undefined() || options.is_null() {
-        serde_json::json!({})
-    } else {
-        from_js(options)?
-    };
-    if session.model().is_none() {
-        return Err("no mesh is open: call loadMesh first".into());
-    }
-    let tau = match options.get("tau") {
-        None | Some(serde_json::Value::Null) => session.tau(),
-        Some(v) => v
-            .as_f64()
-            .ok_or_else(|| format!("{what}: tau must be a number in [0, 1], got {v}"))?,
-    };
-    let method = match options.get("search") {
-        None | Some(serde_json::Value::Null) => SearchMethod::Grid,
-        Some(v) => v
-            .as_str()
-            .and_then(SearchMethod::from_name)
-            .ok_or_else(|| format!("{what}: unknown search {v}: use grid or local"))?,
-    };
-    Ok((tau, method))
-}
-
 /// A function of one argument that edits the session, throwing the engine's message when it
 /// refuses, and redraws the page when it accepts.
 fn setter(
@@ -312,7 +268,22 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
     api.define("setView", view::set_view(doc, ctx))?;
     view::define_screenshot(&api, doc, ctx)?;
     case::define(&api, doc, ctx)?;
+    guidance::define(&api, doc, ctx)?;
+    define_smoothing(&api, doc, ctx)?;
+    define_export(&api, doc, ctx)?;
+    define_page(&api, doc)?;
 
+    js_sys::Reflect::set(&window, &"meshsmooth".into(), &api.object)
+        .map_err(|e| super::page::js_error_text(&e))?;
+    let event = web_sys::Event::new(READY_EVENT).map_err(|e| super::page::js_error_text(&e))?;
+    window
+        .dispatch_event(&event)
+        .map_err(|e| super::page::js_error_text(&e))?;
+    Ok(api.object)
+}
+
+/// `setFilter`, `setParams`, `metrics` and `clearWeights`: the current structure's smoothing.
+fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
     api.define(
         "setFilter",
         setter(doc, ctx, |session, name| {
@@ -341,106 +312,16 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
 
     let (d, c) = (doc.clone(), ctx.clone());
     api.define(
-        "suggest",
-        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |options: JsValue| match start_suggest(
-            &d, &options,
-        ) {
-            Ok((tau, method)) => when_ready(
-                &d,
-                &c,
-                |s| !s.suggesting(),
-                move |s| match s.suggestion() {
-                    Some(x) if x.suggestion.tau == tau && x.suggestion.search == method => {
-                        Ok(to_js(&x.suggestion.to_json(x.elapsed_ms / 1000.0)))
-                    }
-                    _ => Err(s
-                        .guidance_problem()
-                        .unwrap_or("the suggestion was cancelled or replaced")
-                        .to_string()),
-                },
-            ),
-            Err(e) => settled(Err(e)),
+        "clearWeights",
+        Closure::<dyn FnMut()>::new(move || {
+            d.borrow_mut().session.clear_weights();
+            crate::app::wake(&c);
         }),
-    )?;
+    )
+}
 
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "sweep",
-        Closure::<dyn FnMut() -> Promise>::new(move || {
-            if d.borrow().session.model().is_none() {
-                return settled(Err("no mesh is open: call loadMesh first".into()));
-            }
-            d.borrow_mut().session.set_graphs_wanted(true);
-            when_ready(
-                &d,
-                &c,
-                |s| s.graphs_current(),
-                |s| {
-                    s.graphs_json()
-                        .map(|v| to_js(&v))
-                        .ok_or_else(|| "no quality graphs".to_string())
-                },
-            )
-        }),
-    )?;
-
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "suggestAll",
-        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |options: JsValue| {
-            let started = {
-                let mut doc = d.borrow_mut();
-                tau_and_search(&doc.session, &options, "suggestAll")
-                    .and_then(|(tau, method)| doc.session.start_suggest_all(tau, method))
-            };
-            started_work(
-                &d,
-                &c,
-                started,
-                |s| !s.suggesting_all(),
-                |s| s.suggest_all_json(),
-            )
-        }),
-    )?;
-
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "checkStructures",
-        Closure::<dyn FnMut() -> Promise>::new(move || {
-            let started = d.borrow_mut().session.start_checks();
-            started_work(&d, &c, started, |s| !s.checking(), |s| s.checks_json())
-        }),
-    )?;
-
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "gallery",
-        Closure::<dyn FnMut() -> Promise>::new(move || {
-            {
-                let mut doc = d.borrow_mut();
-                if doc.session.model().is_none() {
-                    return settled(Err("no mesh is open: call loadMesh first".into()));
-                }
-                doc.session.start_gallery();
-                doc.show_gallery = true;
-            }
-            when_ready(
-                &d,
-                &c,
-                |s| !s.making_gallery(),
-                |s| {
-                    if s.gallery().is_empty() {
-                        return Err(s
-                            .guidance_problem()
-                            .unwrap_or("the gallery was cancelled")
-                            .to_string());
-                    }
-                    Ok(to_js(&s.guidance_json()["gallery"]))
-                },
-            )
-        }),
-    )?;
-
+/// `exportMesh` and `exportCase`, once the current parameters' result is there.
+fn define_export(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
     let (d, c) = (doc.clone(), ctx.clone());
     api.define(
         "exportMesh",
@@ -477,21 +358,15 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
                 Ok(Uint8Array::from(bytes.as_slice()).into())
             })
         }),
-    )?;
+    )
+}
 
+/// `backend`, `setShortcuts` and `state`: the page itself.
+fn define_page(api: &Api, doc: &SharedDocument) -> Result<(), String> {
     let d = doc.clone();
     api.define(
         "backend",
         Closure::<dyn FnMut() -> JsValue>::new(move || d.borrow().backend.name().into()),
-    )?;
-
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "clearWeights",
-        Closure::<dyn FnMut()>::new(move || {
-            d.borrow_mut().session.clear_weights();
-            crate::app::wake(&c);
-        }),
     )?;
 
     let d = doc.clone();
@@ -510,13 +385,5 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
     api.define(
         "state",
         Closure::<dyn FnMut() -> JsValue>::new(move || to_js(&d.borrow().state_json())),
-    )?;
-
-    js_sys::Reflect::set(&window, &"meshsmooth".into(), &api.object)
-        .map_err(|e| super::page::js_error_text(&e))?;
-    let event = web_sys::Event::new(READY_EVENT).map_err(|e| super::page::js_error_text(&e))?;
-    window
-        .dispatch_event(&event)
-        .map_err(|e| super::page::js_error_text(&e))?;
-    Ok(api.object)
+    )
 }

@@ -1,0 +1,165 @@
+//! The API's calls on background work: `suggest`, `sweep`, `suggestAll`, `checkStructures`
+//! and `gallery`, each a promise settled once its work is done.
+
+use eframe::egui;
+use js_sys::Promise;
+use wasm_bindgen::closure::Closure;
+use wasm_bindgen::JsValue;
+
+use super::{from_js, settled, started_work, to_js, when_ready, Api};
+use crate::app::document::SharedDocument;
+use crate::session::Session;
+use crate::suggest::SearchMethod;
+
+pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
+    api.define("suggest", suggest(doc, ctx))?;
+    api.define("sweep", sweep(doc, ctx))?;
+    api.define("suggestAll", suggest_all(doc, ctx))?;
+    api.define("checkStructures", check_structures(doc, ctx))?;
+    api.define("gallery", gallery(doc, ctx))?;
+    Ok(())
+}
+
+/// `suggest({tau, search})`: the suggestion for the active filter, once searched.
+fn suggest(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut(JsValue) -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move |options: JsValue| match start_suggest(&d, &options) {
+        Ok((tau, method)) => when_ready(
+            &d,
+            &c,
+            |s| !s.suggesting(),
+            move |s| match s.suggestion() {
+                Some(x) if x.suggestion.tau == tau && x.suggestion.search == method => {
+                    Ok(to_js(&x.suggestion.to_json(x.elapsed_ms / 1000.0)))
+                }
+                _ => Err(s
+                    .guidance_problem()
+                    .unwrap_or("the suggestion was cancelled or replaced")
+                    .to_string()),
+            },
+        ),
+        Err(e) => settled(Err(e)),
+    })
+}
+
+/// `sweep()`: the quality graphs around the current parameters, once computed.
+fn sweep(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move || {
+        if d.borrow().session.model().is_none() {
+            return settled(Err("no mesh is open: call loadMesh first".into()));
+        }
+        d.borrow_mut().session.set_graphs_wanted(true);
+        when_ready(
+            &d,
+            &c,
+            |s| s.graphs_current(),
+            |s| {
+                s.graphs_json()
+                    .map(|v| to_js(&v))
+                    .ok_or_else(|| "no quality graphs".to_string())
+            },
+        )
+    })
+}
+
+/// `suggestAll({tau, search})`: every structure's suggestion, once all are searched.
+fn suggest_all(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+) -> Closure<dyn FnMut(JsValue) -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move |options: JsValue| {
+        let started = {
+            let mut doc = d.borrow_mut();
+            tau_and_search(&doc.session, &options, "suggestAll")
+                .and_then(|(tau, method)| doc.session.start_suggest_all(tau, method))
+        };
+        started_work(
+            &d,
+            &c,
+            started,
+            |s| !s.suggesting_all(),
+            |s| s.suggest_all_json(),
+        )
+    })
+}
+
+/// `checkStructures()`: the checks between the structures as they stand.
+fn check_structures(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move || {
+        let started = d.borrow_mut().session.start_checks();
+        started_work(&d, &c, started, |s| !s.checking(), |s| s.checks_json())
+    })
+}
+
+/// `gallery()`: the gallery of the active filter, shown, once made.
+fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move || {
+        {
+            let mut doc = d.borrow_mut();
+            if doc.session.model().is_none() {
+                return settled(Err("no mesh is open: call loadMesh first".into()));
+            }
+            doc.session.start_gallery();
+            doc.show_gallery = true;
+        }
+        when_ready(
+            &d,
+            &c,
+            |s| !s.making_gallery(),
+            |s| {
+                if s.gallery().is_empty() {
+                    return Err(s
+                        .guidance_problem()
+                        .unwrap_or("the gallery was cancelled")
+                        .to_string());
+                }
+                Ok(to_js(&s.guidance_json()["gallery"]))
+            },
+        )
+    })
+}
+
+/// `suggest({tau, search})`: sets tau (default: the current one) and starts the search
+/// (default: grid, as the CLI); returns what the answer must match.
+fn start_suggest(doc: &SharedDocument, options: &JsValue) -> Result<(f64, SearchMethod), String> {
+    let mut doc = doc.borrow_mut();
+    let session = &mut doc.session;
+    let (tau, method) = tau_and_search(session, options, "suggest")?;
+    session.set_tau(tau)?;
+    session.start_suggest(method);
+    Ok((tau, method))
+}
+
+/// `{tau, search}` of `suggest` and `suggestAll` (tau: the session's, search: grid by default).
+fn tau_and_search(
+    session: &Session,
+    options: &JsValue,
+    what: &str,
+) -> Result<(f64, SearchMethod), String> {
+    let options = if options.is_undefined() || options.is_null() {
+        serde_json::json!({})
+    } else {
+        from_js(options)?
+    };
+    if session.model().is_none() {
+        return Err("no mesh is open: call loadMesh first".into());
+    }
+    let tau = match options.get("tau") {
+        None | Some(serde_json::Value::Null) => session.tau(),
+        Some(v) => v
+            .as_f64()
+            .ok_or_else(|| format!("{what}: tau must be a number in [0, 1], got {v}"))?,
+    };
+    let method = match options.get("search") {
+        None | Some(serde_json::Value::Null) => SearchMethod::Grid,
+        Some(v) => v
+            .as_str()
+            .and_then(SearchMethod::from_name)
+            .ok_or_else(|| format!("{what}: unknown search {v}: use grid or local"))?,
+    };
+    Ok((tau, method))
+}
