@@ -95,6 +95,48 @@ impl Pipelines {
         egui_depth_format: Option<wgpu::TextureFormat>,
     ) -> Self {
         let samples = sample_count(adapter, target_format);
+        let build = Builder::new(device, target_format, samples);
+        let less = wgpu::CompareFunction::Less;
+        // The shader writes premultiplied alpha.
+        let blend = Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
+        let back = Some(wgpu::Face::Back);
+        Self {
+            // Two-sided: open meshes show their inside.
+            surface: build.surface("meshsmooth surface", None, true, less, None),
+            front_faces: build.surface("meshsmooth front faces", back, true, less, None),
+            translucent: build.surface("meshsmooth translucent surface", None, false, less, blend),
+            over: build.surface(
+                "meshsmooth surface over all",
+                None,
+                false,
+                wgpu::CompareFunction::Always,
+                blend,
+            ),
+            wire: build.wire(),
+            composite: build.composite(egui_depth_format),
+            samples,
+            color_format: target_format,
+            view_layout: build.view_layout,
+            composite_layout: build.composite_layout,
+        }
+    }
+}
+
+/// What every pipeline of the view shares: the shader, the bind group layouts, the sample
+/// count and egui's colour format.
+struct Builder<'a> {
+    device: &'a wgpu::Device,
+    module: wgpu::ShaderModule,
+    view_layout: wgpu::BindGroupLayout,
+    composite_layout: wgpu::BindGroupLayout,
+    layout: wgpu::PipelineLayout,
+    composite_pipeline_layout: wgpu::PipelineLayout,
+    multisample: wgpu::MultisampleState,
+    target_format: wgpu::TextureFormat,
+}
+
+impl<'a> Builder<'a> {
+    fn new(device: &'a wgpu::Device, target_format: wgpu::TextureFormat, samples: u32) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("meshsmooth view"),
             source: wgpu::ShaderSource::Wgsl(Cow::Borrowed(RENDER_SHADER)),
@@ -137,82 +179,90 @@ impl Pipelines {
                 bind_group_layouts: &[Some(&view_layout), Some(&composite_layout)],
                 immediate_size: 0,
             });
-        let multisample = wgpu::MultisampleState {
-            count: samples,
-            ..Default::default()
-        };
-        let depth = |write: bool, compare| {
-            Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(write),
-                depth_compare: Some(compare),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            })
-        };
-        let target = |blend| {
-            [Some(wgpu::ColorTargetState {
-                format: target_format,
-                blend,
-                write_mask: wgpu::ColorWrites::ALL,
-            })]
-        };
+        Self {
+            device,
+            module,
+            view_layout,
+            composite_layout,
+            layout,
+            composite_pipeline_layout,
+            multisample: wgpu::MultisampleState {
+                count: samples,
+                ..Default::default()
+            },
+            target_format,
+        }
+    }
 
-        let surface_buffers = [
+    /// The view's depth buffer, tested with `compare`, written when `write`.
+    fn depth(write: bool, compare: wgpu::CompareFunction) -> Option<wgpu::DepthStencilState> {
+        Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(write),
+            depth_compare: Some(compare),
+            stencil: wgpu::StencilState::default(),
+            bias: wgpu::DepthBiasState::default(),
+        })
+    }
+
+    /// egui's colour format, blended by `blend`.
+    fn target(&self, blend: Option<wgpu::BlendState>) -> [Option<wgpu::ColorTargetState>; 1] {
+        [Some(wgpu::ColorTargetState {
+            format: self.target_format,
+            blend,
+            write_mask: wgpu::ColorWrites::ALL,
+        })]
+    }
+
+    /// Lit triangles from positions, normals and colours.
+    fn surface(
+        &self,
+        label: &str,
+        cull_mode: Option<wgpu::Face>,
+        write_depth: bool,
+        compare: wgpu::CompareFunction,
+        blend: Option<wgpu::BlendState>,
+    ) -> wgpu::RenderPipeline {
+        let buffers = [
             per_vertex(VEC4_STRIDE, &POSITION),
             per_vertex(VEC4_STRIDE, &NORMAL),
             per_vertex(COLOR_STRIDE, &COLOR),
         ];
-        let surface_pipeline = |label, cull_mode, write_depth, compare, blend| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_surface"),
-                    compilation_options: Default::default(),
-                    buffers: &surface_buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    front_face: wgpu::FrontFace::Ccw,
-                    cull_mode,
-                    ..Default::default()
-                },
-                depth_stencil: depth(write_depth, compare),
-                multisample,
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_surface"),
-                    compilation_options: Default::default(),
-                    targets: &target(blend),
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let less = wgpu::CompareFunction::Less;
-        // Two-sided: open meshes show their inside.
-        let surface = surface_pipeline("meshsmooth surface", None, true, less, None);
-        let back = Some(wgpu::Face::Back);
-        let front_faces = surface_pipeline("meshsmooth front faces", back, true, less, None);
-        // The shader writes premultiplied alpha.
-        let blend = Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
-        let translucent =
-            surface_pipeline("meshsmooth translucent surface", None, false, less, blend);
-        let over = surface_pipeline(
-            "meshsmooth surface over all",
-            None,
-            false,
-            wgpu::CompareFunction::Always,
-            blend,
-        );
-
-        let wire = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("meshsmooth wireframe"),
-            layout: Some(&layout),
+        (self.device).create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&self.layout),
             vertex: wgpu::VertexState {
-                module: &module,
+                module: &self.module,
+                entry_point: Some("vs_surface"),
+                compilation_options: Default::default(),
+                buffers: &buffers,
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode,
+                ..Default::default()
+            },
+            depth_stencil: Self::depth(write_depth, compare),
+            multisample: self.multisample,
+            fragment: Some(wgpu::FragmentState {
+                module: &self.module,
+                entry_point: Some("fs_surface"),
+                compilation_options: Default::default(),
+                targets: &self.target(blend),
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    /// Edges as a line list over the surface's positions.
+    fn wire(&self) -> wgpu::RenderPipeline {
+        (self.device).create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("meshsmooth wireframe"),
+            layout: Some(&self.layout),
+            vertex: wgpu::VertexState {
+                module: &self.module,
                 entry_point: Some("vs_wire"),
                 compilation_options: Default::default(),
                 buffers: &[per_vertex(VEC4_STRIDE, &POSITION)],
@@ -223,24 +273,27 @@ impl Pipelines {
             },
             // Lines are pulled towards the eye in the shader (`WIRE_PULL`), so the surface
             // they lie on does not hide them while anything nearer still does.
-            depth_stencil: depth(false, wgpu::CompareFunction::LessEqual),
-            multisample,
+            depth_stencil: Self::depth(false, wgpu::CompareFunction::LessEqual),
+            multisample: self.multisample,
             fragment: Some(wgpu::FragmentState {
-                module: &module,
+                module: &self.module,
                 entry_point: Some("fs_wire"),
                 compilation_options: Default::default(),
                 // The shader writes premultiplied alpha, as egui blends.
-                targets: &target(Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)),
+                targets: &self.target(Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)),
             }),
             multiview_mask: None,
             cache: None,
-        });
+        })
+    }
 
-        let composite = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    /// The resolved image into egui's pass, whose depth buffer (if any) it must match.
+    fn composite(&self, egui_depth_format: Option<wgpu::TextureFormat>) -> wgpu::RenderPipeline {
+        (self.device).create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("meshsmooth view composite"),
-            layout: Some(&composite_pipeline_layout),
+            layout: Some(&self.composite_pipeline_layout),
             vertex: wgpu::VertexState {
-                module: &module,
+                module: &self.module,
                 entry_point: Some("vs_composite"),
                 compilation_options: Default::default(),
                 buffers: &[],
@@ -256,27 +309,14 @@ impl Pipelines {
             }),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
-                module: &module,
+                module: &self.module,
                 entry_point: Some("fs_composite"),
                 compilation_options: Default::default(),
                 // Opaque: the shader lays the view over its background.
-                targets: &target(None),
+                targets: &self.target(None),
             }),
             multiview_mask: None,
             cache: None,
-        });
-
-        Self {
-            view_layout,
-            composite_layout,
-            surface,
-            front_faces,
-            translucent,
-            over,
-            wire,
-            composite,
-            samples,
-            color_format: target_format,
-        }
+        })
     }
 }
