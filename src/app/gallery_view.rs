@@ -1,5 +1,5 @@
 //! The gallery tab: makes the gallery (with progress and cancel), draws its pictures one per
-//! frame once it is finished (about 50 ms each on wasm for a 200k-vertex mesh), all on one
+//! frame once it is finished (a large mesh's picture takes a good part of a frame), all on one
 //! local-error scale, and hands back the picked result's parameters and tau.
 
 use super::gallery::{self, GalleryItem};

@@ -45,17 +45,14 @@ struct InFlight {
 
 /// Meshes from this many vertices have the background's runs on the GPU by default. Below it
 /// the CPU, sliced into the frame budget, finishes sooner: a GPU request's results come back a
-/// frame or more later, while the CPU does a whole run of a small mesh in a millisecond or two
-/// (the 2,296-vertex sample's local search: 0.24 s on the CPU natively; on SwiftShader WebGPU
-/// at 5 frames/s, one request in three frames).
+/// frame or more later, while the CPU does a whole run of a small mesh within a frame.
 const GPU_GUIDANCE_MIN_VERTICES: usize = 50_000;
 
 /// Where the background's runs go: `?guidance=gpu` or `?guidance=cpu` in the page's query
 /// decides, else the CPU on a software adapter, else the mesh size. A software adapter runs
-/// the kernels on the same CPU, only slower than the engine's own loops: in headless Chromium
-/// on SwiftShader (2 cores), the quality graphs of HC on the 206k-vertex mesh got through 1 of
-/// their 93 samples in 8 s on the GPU engine and 23 to 25 on the CPU engine, at frames of 117
-/// to 150 ms (median) either way.
+/// the kernels on the same CPU, only slower than the engine's own loops (the quality graphs
+/// on SwiftShader got through a fraction of the samples the CPU engine did in the same time,
+/// at the same frame times).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GuidancePolicy {
     BySize,

@@ -4,12 +4,21 @@
 //! starts eframe's `WebRunner`. The app owns no algorithm: it edits a
 //! [`crate::session::Session`] and shows what the engine computed.
 //!
-//! Modules: `document` (the session shared by the UI and the API, waiting API calls, timings),
-//! `api` (`window.meshsmooth`), `file_input` and `query` (bytes in: picker, drops, `?model=`),
-//! `download` (bytes out), `controls`, `legend`, `report_view`, `shortcuts` (the panels),
-//! `gallery` (thumbnails of results at several target smoothness values),
-//! `brush` and `drag_params` (painting weights and dragging parameters over the view),
-//! `shell` (the `eframe::App` that lays these out), `viewer` (the 3D view).
+//! Modules, from the page in to the pixels out:
+//! - the page and its inputs: `page` (canvas, loading text, crash message), `query`
+//!   (`?model=`, `?case=`), `file_input` and `read_bytes` (picker, drops, chunked reads),
+//!   `download` (bytes out), `api` (`window.meshsmooth` and the embedding's messages);
+//! - the document and its engines: `document` (the session shared by the UI and the API, the
+//!   calls waiting on it), `workers` (the CPU engine's dedicated workers), `gpu_engine` (the
+//!   WebGPU engine's driver);
+//! - the authoring page's panels: `controls`, `guide`, `structure_list`, `report_view`,
+//!   `legend`, `status`, `shortcuts`, `bottom_panel` with `graphs` and `gallery` /
+//!   `gallery_view`;
+//! - the viewer's panel (`?mode=viewer`): `case_reader`, and `case_text` for screen readers;
+//! - over the view: `brush` and `drag_params` (painting weights, dragging parameters),
+//!   `pointing` (the name under the pointer), `view_tools` (standard views, clip),
+//!   `orientation_marker`, `picture` (the view as PNG);
+//! - `shell` (the `eframe::App` that lays these out each frame) and `viewer` (the 3D view).
 
 mod api;
 mod bottom_panel;

@@ -1,6 +1,14 @@
-//! The document the app and its embedding API edit: the open model, the active filter with each
-//! filter's parameters, and the latest smoothing result with its measures. Free of any UI, so
-//! the browser app, its JavaScript API and the native tests drive the same state the same way.
+//! The document the app and its embedding API edit, free of any UI, so the browser app, its
+//! JavaScript API and the native tests drive the same state the same way: the open case and
+//! which structure is the model (`structures`, `case`), the model's filter, parameters, tau,
+//! weights and latest result (here and `weights`), the files being opened by the workers
+//! (`opening`), the CPU engine's runs (`cpu`), the background work that guides the author
+//! (`guidance`: graphs, suggestion, gallery; `suggest_all`; `checks`), and the colours and
+//! pointing the view asks for (`colors`, `pointing`).
+//!
+//! While a structure is the model, its filter, parameters, tau and weights are the session's
+//! and its entry in the case catches up when another structure is selected (see
+//! `structures`).
 //!
 //! Every change (a new model, filter or parameter) bumps `revision`; a result belongs to the
 //! revision it was computed for, so a result that arrives late (from the GPU) for an older
