@@ -7,6 +7,7 @@
 use crate::session::{Session, Timings};
 use crate::suggest::Offload;
 use crate::view::{CameraPose, Clip, StandardView, ViewLink};
+use crate::worker::NamedFile;
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -260,7 +261,14 @@ impl Document {
     /// model stays until it is open. `waiter`, when given, hears how it ended. A file still
     /// opening is dropped for this one, and its waiters hear so.
     pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>, waiter: Option<LoadWaiter>) {
-        if let Some(replaced) = self.session.begin_open(name, bytes) {
+        let name = name.to_string();
+        self.begin_open_files(vec![NamedFile { name, bytes }], waiter);
+    }
+
+    /// [`Self::begin_open`] of files chosen or dropped together, opened as one case.
+    pub fn begin_open_files(&mut self, files: Vec<NamedFile>, waiter: Option<LoadWaiter>) {
+        let name = files.first().map_or_else(String::new, |f| f.name.clone());
+        if let Some(replaced) = self.session.begin_open_files(files) {
             let why = format!("{replaced} was not opened: {name} was opened before it finished");
             for w in std::mem::take(&mut self.waiting_for_load) {
                 w(Err(why.clone()));

@@ -13,14 +13,19 @@ use wasm_bindgen::JsCast;
 
 /// The extensions `io::load` and `io::load_label_map` understand, for the picker's filter
 /// (`.gz` for `.nii.gz`, which the filter cannot name as one extension).
-const ACCEPT: &str = ".stl,.obj,.ply,.glb,.gltf,.nii,.gz,.nrrd";
+const ACCEPT: &str = ".stl,.obj,.ply,.glb,.gltf,.nii,.gz,.nrrd,.txt,.ctbl";
 
 /// A file whose reading finished (or failed).
 pub struct ArrivedFile {
     pub name: String,
     pub bytes: Result<Vec<u8>, String>,
-    /// Whether its structures join the open case (the Add button, or a file after the first
-    /// of several chosen or dropped together) instead of opening as a new one.
+}
+
+/// Files chosen or dropped together, once every one of them was read.
+pub struct Arrived {
+    pub files: Vec<ArrivedFile>,
+    /// Whether their structures join the open case (the Add button) instead of opening
+    /// together as a new one.
     pub add: bool,
 }
 
@@ -69,7 +74,7 @@ impl Reading {
 /// Shared between the app and the reads in flight.
 #[derive(Clone, Default)]
 struct Inbox {
-    arrived: Rc<RefCell<Vec<ArrivedFile>>>,
+    arrived: Rc<RefCell<Vec<Arrived>>>,
     /// The reads in flight, by number.
     reading: Rc<RefCell<Vec<(u64, Reading)>>>,
     next: Rc<Cell<u64>>,
@@ -80,7 +85,7 @@ struct Inbox {
 }
 
 /// Called with the files arrived so far; it takes those it opens out of the list.
-pub type ArrivalHook = Box<dyn FnMut(&mut Vec<ArrivedFile>)>;
+pub type ArrivalHook = Box<dyn FnMut(&mut Vec<Arrived>)>;
 
 impl Inbox {
     /// Registers a read of `name`; the returned callback reports its progress.
@@ -105,9 +110,8 @@ impl Inbox {
         (id, progress)
     }
 
-    fn deliver(&self, id: u64, file: ArrivedFile, ctx: &egui::Context) {
-        self.reading.borrow_mut().retain(|(i, _)| *i != id);
-        self.arrived.borrow_mut().push(file);
+    fn deliver(&self, files: Arrived, ctx: &egui::Context) {
+        self.arrived.borrow_mut().push(files);
         if let (Ok(mut hook), Ok(mut arrived)) = (
             self.on_arrival.try_borrow_mut(),
             self.arrived.try_borrow_mut(),
@@ -119,23 +123,24 @@ impl Inbox {
         super::wake(ctx);
     }
 
-    /// Reads `files` one after another and delivers each in turn, so they arrive in order:
-    /// the first opens (unless `add`), the others join its case.
-    fn read_in_order(&self, files: Vec<PendingRead>, add: bool, ctx: &egui::Context) {
-        let reads: Vec<_> = files
-            .into_iter()
-            .enumerate()
-            .map(|(i, (name, read))| {
+    /// Reads `files` one after another and delivers them together once all are read: they
+    /// open as one case, or (`add`) each joins the open one.
+    fn read_together(&self, files: Vec<PendingRead>, add: bool, ctx: &egui::Context) {
+        let reads: Vec<_> = (files.into_iter())
+            .map(|(name, read)| {
                 let (id, progress) = self.begin(&name, ctx);
-                (id, name, add || i > 0, read(progress))
+                (id, name, read(progress))
             })
             .collect();
         let (inbox, ctx) = (self.clone(), ctx.clone());
         wasm_bindgen_futures::spawn_local(async move {
-            for (id, name, add, read) in reads {
+            let mut files = Vec::with_capacity(reads.len());
+            for (id, name, read) in reads {
                 let bytes = read.await;
-                inbox.deliver(id, ArrivedFile { name, bytes, add }, &ctx);
+                inbox.reading.borrow_mut().retain(|(i, _)| *i != id);
+                files.push(ArrivedFile { name, bytes });
             }
+            inbox.deliver(Arrived { files, add }, &ctx);
         });
     }
 }
@@ -182,8 +187,7 @@ impl FileInput {
         Ok(())
     }
 
-    /// Starts reading the files dropped on the page this frame: the first opens, the others
-    /// join its case.
+    /// Starts reading the files dropped on the page this frame, to open together as one case.
     pub fn collect_dropped(&self, ctx: &egui::Context) {
         let dropped = ctx.input(|i| i.raw.dropped_files.clone());
         let files: Vec<PendingRead> = dropped
@@ -207,7 +211,7 @@ impl FileInput {
             })
             .collect();
         if !files.is_empty() {
-            self.inbox.read_in_order(files, false, ctx);
+            self.inbox.read_together(files, false, ctx);
         }
     }
 
@@ -219,7 +223,9 @@ impl FileInput {
         wasm_bindgen_futures::spawn_local(async move {
             let bytes = read_bytes::fetch(&url, progress).await;
             let add = false;
-            inbox.deliver(id, ArrivedFile { name, bytes, add }, &ctx);
+            inbox.reading.borrow_mut().retain(|(i, _)| *i != id);
+            let files = vec![ArrivedFile { name, bytes }];
+            inbox.deliver(Arrived { files, add }, &ctx);
         });
     }
 
@@ -229,7 +235,7 @@ impl FileInput {
     }
 
     /// Files whose reading finished since the last call, oldest first.
-    pub fn take_arrived(&self) -> Vec<ArrivedFile> {
+    pub fn take_arrived(&self) -> Vec<Arrived> {
         std::mem::take(&mut *self.inbox.arrived.borrow_mut())
     }
 
@@ -285,7 +291,7 @@ fn create_picker(
                 })
                 .collect();
             if !files.is_empty() {
-                inbox.read_in_order(files, inbox.adding.get(), &ctx);
+                inbox.read_together(files, inbox.adding.get(), &ctx);
             }
         })
     };

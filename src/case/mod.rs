@@ -2,17 +2,20 @@
 //! ordered list of structures (liver, vessels, tumour), each with its own filter, parameters
 //! and measures, smoothed independently and written as one glTF.
 //!
-//! Layout: the document here; smoothing and "Suggest all" in `pipeline`; the quality record
+//! Layout: the document here; opening files as a case in `from_files`; smoothing and "Suggest all" in `pipeline`; the quality record
 //! the glTF carries (and reads back) in `record`; checks between structures in `relations`.
 
 mod checks;
-mod open;
+mod from_files;
 mod pipeline;
 mod record;
 pub mod relations;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
-pub use open::{file_name, open, surface_structure, CaseOpenError};
+pub use from_files::{
+    file_name, open, open_staged, reading_stages, split_color_table, surface_structure,
+    CaseOpenError,
+};
 pub use pipeline::{
     smooth_structure, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllProgress,
 };

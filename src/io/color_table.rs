@@ -21,6 +21,13 @@ pub struct LabelEntry {
     pub color: Option<[f32; 3]>,
 }
 
+/// Whether a file name is one a colour table comes in (`.txt`: FreeSurfer, FSL, ITK-SNAP;
+/// `.ctbl`: 3D Slicer), ignoring case. Only beside a label map is such a file read as one.
+pub fn is_color_table(name: &str) -> bool {
+    let lower = name.to_ascii_lowercase();
+    lower.ends_with(".txt") || lower.ends_with(".ctbl")
+}
+
 /// Reads a colour table; entries come in file order (a later entry for the same value is a
 /// later line, which callers may let win).
 pub fn parse_color_table(text: &[u8]) -> Result<Vec<LabelEntry>, LoadError> {

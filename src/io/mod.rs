@@ -20,7 +20,7 @@ mod text;
 mod voxels;
 mod weld;
 
-pub use color_table::{parse_color_table, LabelEntry};
+pub use color_table::{is_color_table, parse_color_table, LabelEntry};
 pub use error::{LoadError, Location};
 pub use gltf::{GltfNode, GltfScene, Mat4};
 pub use label_map::{Affine, LabelLayer, LabelMap, LabelMapOptions, Segment, MAX_LABELS};

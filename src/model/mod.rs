@@ -1,16 +1,17 @@
 //! The open model: a mesh with its topology, its report and its original's measures, as opening
-//! a file (or one structure of a case) builds it. The engine workers build it and send it
+//! files (or one structure of a case) builds it (`build`). The engine workers build it and send it
 //! whole; the session holds it beside the case it is a structure of.
 
-mod open;
+mod build;
 
-pub use open::{open_case, open_file, open_structure, OpenFailure, Stage};
+pub use build::{open_case, open_files, open_structure, OpenFailure, Stage};
 
 use serde::{Deserialize, Serialize};
 
 use crate::case::Case;
 use crate::mesh::{Mesh, MeshReport, Topology};
 use crate::metrics::Original;
+use crate::segmentation::NamedBytes;
 
 /// A mesh the session opened, with what the measures precompute from it.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -34,10 +35,10 @@ pub struct Opened {
 
 impl Model {
     /// Parses `bytes` (the format chosen by `name`'s extension), builds topology, report and
-    /// the original's measures of its first structure: [`open_file`] without watching its
-    /// stages.
+    /// the original's measures of its first structure: [`open_files`] of one file, without
+    /// watching its stages.
     pub fn load(name: &str, bytes: &[u8]) -> Result<Opened, OpenFailure> {
-        open_file(name, bytes, &mut |_| {})
+        open_files(&[NamedBytes { name, bytes }], &mut |_| {})
     }
 
     pub fn mesh(&self) -> &Mesh {

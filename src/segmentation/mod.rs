@@ -6,12 +6,14 @@
 
 mod cube_table;
 mod extract;
-mod open;
+mod from_label_maps;
 mod palette;
 mod specks;
 mod structure;
 
-pub use open::{open, structure_name, NamedBytes, OpenError, OpenOptions};
+pub use from_label_maps::{
+    open, open_staged, reading_stages, structure_name, NamedBytes, OpenError, OpenOptions,
+};
 pub use palette::default_color;
 pub use structure::{extract, labels, ExtractError, ExtractOptions, LabelInfo, Structure};
 

@@ -7,7 +7,7 @@ use super::{Model, Session};
 use crate::case::Case;
 use crate::io::{self, Format};
 use crate::model::Opened;
-use crate::worker::{Input, LoadJob, Reply};
+use crate::worker::{Input, LoadJob, NamedFile, Reply};
 
 /// How far an opening got: the stage under way (0-based) of [`LoadProgress::total`].
 #[derive(Clone, Debug, PartialEq)]
@@ -37,6 +37,8 @@ pub(super) struct Opening {
     name: String,
     job: LoadJob,
     purpose: Purpose,
+    /// The file the model comes from (the first label map, else the first file).
+    first_file: String,
 }
 
 impl Session {
@@ -45,19 +47,39 @@ impl Session {
     pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<&Model, String> {
         match Model::load(name, bytes) {
             Ok(Opened { case, model }) => {
-                self.take_file(name, case, model);
+                self.take_file(name, name, case, model);
                 Ok(self.model.as_ref().expect("just set"))
             }
-            Err(e) => Err(self.fail(name, &e.to_string())),
+            Err(e) => Err(self.fail(name, &e.reason())),
         }
     }
 
     /// Starts opening a file's bytes in a worker ([`Self::poll_opening`] takes the model); the
     /// current model stays open meanwhile. Returns the name of an opening this one replaces.
     pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>) -> Option<String> {
+        let name = name.to_string();
+        self.begin_open_files(vec![NamedFile { name, bytes }])
+    }
+
+    /// Starts opening files chosen or dropped together as one case, as the CLI's `case build`
+    /// opens them: several masks one structure each, a colour table naming a label map's
+    /// labels, surfaces and case glTFs after them. Otherwise as [`Self::begin_open`].
+    pub fn begin_open_files(&mut self, files: Vec<NamedFile>) -> Option<String> {
         // Files to add were meant for the case open or opening now, not this one.
         self.additions.clear();
-        self.begin(name.to_string(), Input::File(bytes), Purpose::File)
+        let first_file = (files.iter().find(|f| io::is_label_map(&f.name)))
+            .or(files.first())
+            .map_or_else(String::new, |f| f.name.clone());
+        // A colour table beside a label map names its labels: the case is the label map's.
+        let table = |f: &&NamedFile| io::is_label_map(&first_file) && io::is_color_table(&f.name);
+        let shown: Vec<&NamedFile> = files.iter().filter(|f| !table(f)).collect();
+        let name = match shown.as_slice() {
+            [one] => one.name.clone(),
+            [a, b] => format!("{} and {}", a.name, b.name),
+            [a, rest @ ..] => format!("{} and {} more files", a.name, rest.len()),
+            [] => String::new(),
+        };
+        self.begin(name, first_file, Input::Files(files), Purpose::File)
     }
 
     /// Starts adding a file's structures (a label map's, a case glTF's, a surface) to the open
@@ -69,7 +91,13 @@ impl Session {
         } else if self.model.is_none() {
             self.begin_open(name, bytes);
         } else {
-            self.begin(name.to_string(), Input::Addition(bytes), Purpose::Addition);
+            let first_file = name.to_string();
+            self.begin(
+                first_file.clone(),
+                first_file,
+                Input::Addition(bytes),
+                Purpose::Addition,
+            );
         }
     }
 
@@ -96,14 +124,26 @@ impl Session {
         };
         let name = format!("{}: {}", self.case_file, structure.name);
         let input = Input::Structure(structure.original.clone());
-        Ok(self.begin(name, input, Purpose::Structure(index)))
+        let first_file = self.case_file.clone();
+        Ok(self.begin(name, first_file, input, Purpose::Structure(index)))
     }
 
-    fn begin(&mut self, name: String, input: Input, purpose: Purpose) -> Option<String> {
+    fn begin(
+        &mut self,
+        name: String,
+        first_file: String,
+        input: Input,
+        purpose: Purpose,
+    ) -> Option<String> {
         let replaced = self.opening.take().map(|o| o.name);
         self.open_stages.clear();
         let job = self.cpu.load(&name, input);
-        self.opening = Some(Opening { name, job, purpose });
+        self.opening = Some(Opening {
+            name,
+            job,
+            purpose,
+            first_file,
+        });
         replaced
     }
 
@@ -113,8 +153,13 @@ impl Session {
     pub fn poll_opening(&mut self) -> Option<Result<(), String>> {
         let opening = self.opening.as_ref()?;
         let reply = self.cpu.take_loaded(opening.job)?;
-        let Opening { name, purpose, .. } = self.opening.take()?;
-        let outcome = self.take_opened(&name, purpose, reply);
+        let Opening {
+            name,
+            purpose,
+            first_file,
+            ..
+        } = self.opening.take()?;
+        let outcome = self.take_opened(&name, &first_file, purpose, reply);
         if outcome.is_err() && purpose == Purpose::File {
             // Files to add to a case that did not open.
             self.additions.clear();
@@ -123,7 +168,13 @@ impl Session {
         Some(outcome)
     }
 
-    fn take_opened(&mut self, name: &str, purpose: Purpose, reply: Reply) -> Result<(), String> {
+    fn take_opened(
+        &mut self,
+        name: &str,
+        first_file: &str,
+        purpose: Purpose,
+        reply: Reply,
+    ) -> Result<(), String> {
         let (model, case, stages) = match reply {
             Reply::Loaded {
                 model,
@@ -136,7 +187,9 @@ impl Session {
         };
         self.open_stages = stages;
         match (purpose, model, case) {
-            (Purpose::File, Some(model), Some(case)) => self.take_file(name, *case, *model),
+            (Purpose::File, Some(model), Some(case)) => {
+                self.take_file(name, first_file, *case, *model)
+            }
             (Purpose::Structure(index), Some(model), _) => {
                 // The structure leaving keeps its smoothing, the one coming gets back what it
                 // kept.
@@ -154,14 +207,18 @@ impl Session {
         Ok(())
     }
 
-    /// Makes a file's case the open one and `model` (its first structure) the model. A label
-    /// map's or a case glTF's structure brings its own filter and parameters (a label map's
-    /// with the bound at half its voxel diagonal); a surface takes the session's.
-    fn take_file(&mut self, name: &str, case: Case, model: Model) {
+    /// Makes the case of files opened as `name` the open one and `model` (its first structure,
+    /// from `first_file`) the model. A label map's or a case glTF's structure brings its own
+    /// filter and parameters (a label map's with the bound at half its voxel diagonal); a
+    /// surface takes the session's.
+    fn take_file(&mut self, name: &str, first_file: &str, case: Case, model: Model) {
         self.adopt_case(case, name);
         self.set_model(model);
-        let own_params = io::is_label_map(name)
-            || matches!(Format::from_name(name), Some(Format::Glb | Format::Gltf));
+        let own_params = io::is_label_map(first_file)
+            || matches!(
+                Format::from_name(first_file),
+                Some(Format::Glb | Format::Gltf)
+            );
         if own_params {
             self.restore_model_structure();
         }

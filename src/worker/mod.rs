@@ -16,15 +16,24 @@ use crate::evaluate::{Evaluator, Terms};
 use crate::mesh::{Mesh, Topology};
 use crate::metrics::{self, Metrics, Original, VertexMeasures};
 use crate::model::{self, Model};
+use crate::segmentation::NamedBytes;
 use crate::smooth::Params;
 use crate::suggest::MeshEvaluator;
+
+/// A file's name and bytes, as a message carries them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NamedFile {
+    pub name: String,
+    #[serde(with = "crate::mesh::flat_bytes")]
+    pub bytes: Vec<u8>,
+}
 
 /// What a [`Request::Load`] opens.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub enum Input {
-    /// A file's bytes (the format from the name's extension): its case, and its first
-    /// structure as the model.
-    File(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
+    /// Files opened together as one case (one file, several masks, a label map with its colour
+    /// table: [`model::open_files`]), its first structure as the model.
+    Files(Vec<NamedFile>),
     /// A file's bytes read as a case only, to add its structures to the open one.
     Addition(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
     /// A structure of the open case, by its mesh: the model only.
@@ -247,8 +256,14 @@ impl Worker {
             });
         };
         let opened = match input {
-            Input::File(bytes) => {
-                model::open_file(name, &bytes, &mut on_stage).map(|o| (Some(o.model), Some(o.case)))
+            Input::Files(files) => {
+                let named: Vec<NamedBytes> = (files.iter())
+                    .map(|f| NamedBytes {
+                        name: &f.name,
+                        bytes: &f.bytes,
+                    })
+                    .collect();
+                model::open_files(&named, &mut on_stage).map(|o| (Some(o.model), Some(o.case)))
             }
             Input::Addition(bytes) => {
                 model::open_case(name, &bytes, &mut on_stage).map(|case| (None, Some(case)))
@@ -275,7 +290,7 @@ impl Worker {
             }
             Err(e) => Reply::Failed {
                 job,
-                why: e.to_string(),
+                why: e.reason(),
             },
         }
     }

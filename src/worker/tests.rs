@@ -265,7 +265,13 @@ fn a_broken_worker_fails_its_job_instead_of_holding_it() {
 fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
     let (carrier, deliver) = Deferred::new(2);
     let mut pool = Pool::new(Box::new(carrier));
-    let job = pool.load("tube.ply", Input::File(SAMPLE.to_vec()));
+    let job = pool.load(
+        "tube.ply",
+        Input::Files(vec![NamedFile {
+            name: "tube.ply".into(),
+            bytes: SAMPLE.to_vec(),
+        }]),
+    );
     assert!(pool.take_loaded(job).is_none() && pool.load_stage(job).is_none());
     deliver.set(true);
     pool.pump();
@@ -336,8 +342,20 @@ fn a_file_to_add_comes_back_as_its_case_alone_after_its_reading_stage() {
 fn a_newer_opening_supersedes_an_older_and_a_bad_file_fails_its_job() {
     let (carrier, deliver) = Deferred::new(1);
     let mut pool = Pool::new(Box::new(carrier));
-    let first = pool.load("first.ply", Input::File(SAMPLE.to_vec()));
-    let second = pool.load("second.ply", Input::File(b"ply\nrubbish".to_vec()));
+    let first = pool.load(
+        "first.ply",
+        Input::Files(vec![NamedFile {
+            name: "first.ply".into(),
+            bytes: SAMPLE.to_vec(),
+        }]),
+    );
+    let second = pool.load(
+        "second.ply",
+        Input::Files(vec![NamedFile {
+            name: "second.ply".into(),
+            bytes: b"ply\nrubbish".to_vec(),
+        }]),
+    );
     deliver.set(true);
     let mut answers = Vec::new();
     for _ in 0..4 {

@@ -485,7 +485,7 @@ testIn(EVERY_RUN, "S9 files added to the case, and several dropped together, joi
         await app.metrics();
         await app.screenshot("S9-phantom-and-added-sphere");
 
-        // Dropped together: the first opens as the case, the others join it in order.
+        // Dropped together: they open as one case, in order.
         const ellipsoid = readFileSync(meshPath("synthetic/synthetic_ellipsoid_30_20_12.ply"));
         await app.dropFiles([
             { bytes: sphere, name: "synthetic_sphere_r20.stl" },
@@ -502,6 +502,41 @@ testIn(EVERY_RUN, "S9 files added to the case, and several dropped together, joi
         assert.notDeepEqual(dropped.structures.structures[0].color, dropped.structures.structures[1].color);
         await app.metrics();
         await app.screenshot("S9-two-meshes-dropped-as-one-case");
+    });
+});
+
+/** Drops `files` together and waits until they are open as the case `file`. */
+async function dropAsOneCase(app, files, file) {
+    await app.dropFiles(files);
+    return app.stateWhen((s) => s.structures?.file === file && s.loading === null && s.model !== null, `${file} to open`);
+}
+
+testIn(EVERY_RUN, "S9b a label map with its colour table, and four masks, dropped together open as the CLI opens them", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        // The table first, as a file manager may list it: it names the label map's labels.
+        const table = meshPath("labelmaps/case_phantom_shared_labels.txt");
+        let state = await dropAsOneCase(app, [
+            { bytes: readFileSync(table), name: "case_phantom_shared_labels.txt" },
+            { bytes: readFileSync(PHANTOM_NIFTI), name: "case_phantom_shared.nii.gz" },
+        ], "case_phantom_shared.nii.gz");
+        const named = await cli.cliJson("extract", PHANTOM_NIFTI, "--colors", table, "-o", join(E2E_OUT, `extract-table-${MODE}/`), "--json");
+        assertSameStructures(state.structures.structures, named.structures);
+        assert.ok(state.structures.structures.every((s) => !s.name.startsWith("label ")), "names from the table");
+        assert.equal(state.model, `case_phantom_shared.nii.gz: ${named.structures[0].name}`);
+        await app.metrics();
+        await app.screenshot("S9b-label-map-named-by-its-table");
+
+        // Four masks: one case of four structures, each named by its file, as `extract` of the four.
+        const masks = ["sphere_r20_mask.nii.gz", "ellipsoid_30_20_12_mask.nii.gz", "torus_R24_r8_mask.nii.gz", "bent_tube_r3.5_mask.nii.gz"];
+        const paths = masks.map((m) => meshPath(`synthetic/${m}`));
+        state = await dropAsOneCase(app, masks.map((name, i) => ({ bytes: readFileSync(paths[i]), name })), "sphere_r20_mask.nii.gz and 3 more files");
+        const native = await cli.cliJson("extract", ...paths, "-o", join(E2E_OUT, `extract-masks-${MODE}/`), "--json");
+        assertSameStructures(state.structures.structures, native.structures);
+        assert.deepEqual(state.structures.structures.map((s) => s.name), ["sphere r20 mask", "ellipsoid 30 20 12 mask", "torus R24 r8 mask", "bent tube r3.5 mask"]);
+        assert.deepEqual(state.structures.structures.map((s) => s.source), masks);
+        assert.equal(state.error, null);
+        await app.metrics();
+        await app.screenshot("S9b-four-masks-as-one-case");
     });
 });
 

@@ -8,7 +8,7 @@ use super::case_text::CaseText;
 use super::controls::{self, Controls};
 use super::document::{now_ms, Backend, Document, Opening, SharedDocument};
 use super::drag_params::DragParams;
-use super::file_input::{ArrivedFile, FileInput};
+use super::file_input::{Arrived, FileInput};
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
 use super::picture::Picture;
@@ -21,6 +21,7 @@ use crate::export::ExportFormat;
 use crate::session::ColorField;
 use crate::smooth::Filter;
 use crate::view::{CameraPose, ViewLink};
+use crate::worker::NamedFile;
 use eframe::egui;
 use eframe::egui_wgpu;
 use std::cell::RefCell;
@@ -85,15 +86,27 @@ pub struct Shell {
     first_paint: FirstPaint,
 }
 
-/// Opens the files that arrived (or adds them to the case).
-fn open_arrived(files: Vec<ArrivedFile>, doc: &mut Document) {
-    for file in files {
-        match file.bytes {
-            Ok(bytes) if file.add => doc.begin_add(&file.name, bytes, None),
-            Ok(bytes) => doc.begin_open(&file.name, bytes, None),
-            Err(reason) => {
-                doc.session.fail(&file.name, &reason);
+/// Opens the files that arrived, those that came together as one case (or adds each to it).
+fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
+    for group in arrived {
+        let mut files = Vec::with_capacity(group.files.len());
+        for file in group.files {
+            match file.bytes {
+                Ok(bytes) => files.push(NamedFile {
+                    name: file.name,
+                    bytes,
+                }),
+                Err(reason) => {
+                    doc.session.fail(&file.name, &reason);
+                }
             }
+        }
+        if group.add {
+            for f in files {
+                doc.begin_add(&f.name, f.bytes, None);
+            }
+        } else if !files.is_empty() {
+            doc.begin_open_files(files, None);
         }
     }
 }

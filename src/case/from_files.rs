@@ -1,5 +1,6 @@
-//! Opening files as a case: label maps (each label a structure, or several masks one
-//! structure each), surface meshes (one structure each, named by the file) and case glTFs
+//! Opening files as a case, the one way the CLI, the page's workers and the tests do: label
+//! maps (each label a structure, or several masks one structure each, named by a colour table
+//! given beside them), surface meshes (one structure each, named by the file) and case glTFs
 //! (their structures, records and all), in the order given.
 
 use super::{from_gltf_scene, Case, CaseRecordError, CaseStructure};
@@ -19,11 +20,28 @@ pub enum CaseOpenError {
         name: String,
         error: CaseRecordError,
     },
-    #[error("{name}: not a label map, mesh or glTF file (by its extension)")]
-    Unknown { name: String },
+    #[error("{first} and {second}: one colour table names a label map's labels, not two")]
+    Tables { first: String, second: String },
     #[error("no file given")]
     NoFiles,
 }
+
+impl CaseOpenError {
+    /// What is wrong, without the file's name: for a caller that names the one file itself.
+    pub fn detail(&self) -> String {
+        use segmentation::OpenError;
+        match self {
+            CaseOpenError::Segmentation(OpenError::Load { error, .. })
+            | CaseOpenError::Load { error, .. } => error.to_string(),
+            CaseOpenError::Segmentation(OpenError::Extract { error, .. }) => error.to_string(),
+            CaseOpenError::Record { error, .. } => error.to_string(),
+            other => other.to_string(),
+        }
+    }
+}
+
+/// Reading a surface or glTF file, one stage each.
+const READING_FILE: &str = "reading the file";
 
 /// Opens `files` as one case. Label maps go together to [`segmentation::open`] (one label map,
 /// or several masks) with `table` and `options`; every other file adds its structures after
@@ -33,21 +51,32 @@ pub fn open(
     table: Option<NamedBytes>,
     options: &OpenOptions,
 ) -> Result<Case, CaseOpenError> {
+    open_staged(files, table, options, &mut |_| {})
+}
+
+/// The stages [`open_staged`] announces for `files`, in order.
+pub fn reading_stages(files: &[NamedBytes]) -> Vec<&'static str> {
+    let maps = files.iter().filter(|f| io::is_label_map(f.name)).count();
+    let mut stages = segmentation::reading_stages(maps);
+    stages.extend(std::iter::repeat_n(READING_FILE, files.len() - maps));
+    stages
+}
+
+/// [`open`], telling `on_stage` each of [`reading_stages`] as it begins.
+pub fn open_staged(
+    files: &[NamedBytes],
+    table: Option<NamedBytes>,
+    options: &OpenOptions,
+    on_stage: &mut dyn FnMut(&'static str),
+) -> Result<Case, CaseOpenError> {
     if files.is_empty() {
         return Err(CaseOpenError::NoFiles);
     }
-    let (maps, others): (Vec<&NamedBytes>, Vec<&NamedBytes>) =
+    let (maps, others): (Vec<NamedBytes>, Vec<NamedBytes>) =
         files.iter().partition(|f| io::is_label_map(f.name));
     let mut case = Case::default();
     if !maps.is_empty() {
-        let maps: Vec<NamedBytes> = maps
-            .iter()
-            .map(|f| NamedBytes {
-                name: f.name,
-                bytes: f.bytes,
-            })
-            .collect();
-        let structures = segmentation::open(&maps, table, options)?;
+        let structures = segmentation::open_staged(&maps, table, options, on_stage)?;
         let source = match maps.as_slice() {
             [one] => Some(file_name(one.name)),
             _ => None,
@@ -61,6 +90,7 @@ pub fn open(
         case.add(opened);
     }
     for f in others {
+        on_stage(READING_FILE);
         let load = |error| CaseOpenError::Load {
             name: f.name.to_string(),
             error,
@@ -76,20 +106,37 @@ pub fn open(
                 })?;
                 case.add(opened);
             }
-            Some(Format::Stl | Format::Obj | Format::Ply) => {
+            // Surfaces, and whatever else: io::load says what it cannot read.
+            _ => {
                 let mesh = io::load(f.bytes, f.name).map_err(load)?;
                 let ordinal = case.structures.len();
                 case.structures
                     .push(surface_structure(f.name, mesh, ordinal));
             }
-            _ => {
-                return Err(CaseOpenError::Unknown {
-                    name: f.name.to_string(),
-                })
-            }
         }
     }
     Ok(case)
+}
+
+/// Files dropped or chosen together, with a colour table among them taken out to name the
+/// label maps' labels: a table is one only beside a label map (alone, a `.txt` is no file
+/// this opens). Two tables are refused.
+pub fn split_color_table<'a>(
+    files: &[NamedBytes<'a>],
+) -> Result<(Vec<NamedBytes<'a>>, Option<NamedBytes<'a>>), CaseOpenError> {
+    if !files.iter().any(|f| io::is_label_map(f.name)) {
+        return Ok((files.to_vec(), None));
+    }
+    let (tables, rest): (Vec<NamedBytes>, Vec<NamedBytes>) =
+        files.iter().partition(|f| io::is_color_table(f.name));
+    match tables.as_slice() {
+        [] => Ok((rest, None)),
+        [one] => Ok((rest, Some(*one))),
+        [first, second, ..] => Err(CaseOpenError::Tables {
+            first: first.name.to_string(),
+            second: second.name.to_string(),
+        }),
+    }
 }
 
 /// The structure a surface file (STL, OBJ, PLY) makes: named by its file, coloured by its

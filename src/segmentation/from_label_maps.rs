@@ -33,6 +33,20 @@ pub enum OpenError {
     LabelsWithMasks,
 }
 
+/// The stages of reading one label map.
+const ONE_MAP: [&str; 2] = ["reading the label map", "extracting the structures"];
+/// The stages of reading each of several masks, one after another.
+const EACH_MASK: [&str; 2] = ["reading a mask", "extracting its surface"];
+
+/// The stages [`open_staged`] announces for `maps` label-map files, in order.
+pub fn reading_stages(maps: usize) -> Vec<&'static str> {
+    match maps {
+        0 => Vec::new(),
+        1 => ONE_MAP.to_vec(),
+        n => EACH_MASK.repeat(n),
+    }
+}
+
 /// Reads the files and extracts their structures. One file: a label map, its labels named by
 /// the file, else by `table`, else `label N`. Several: each a mask (every non-zero voxel), one
 /// structure per file named by it; each keeps its own grid.
@@ -40,6 +54,17 @@ pub fn open(
     files: &[NamedBytes],
     table: Option<NamedBytes>,
     options: &OpenOptions,
+) -> Result<Vec<Structure>, OpenError> {
+    open_staged(files, table, options, &mut |_| {})
+}
+
+/// [`open`], telling `on_stage` each of [`reading_stages`] as it begins. Masks are read and
+/// extracted one at a time, so only one mask's voxels are in memory at once.
+pub fn open_staged(
+    files: &[NamedBytes],
+    table: Option<NamedBytes>,
+    options: &OpenOptions,
+    on_stage: &mut dyn FnMut(&'static str),
 ) -> Result<Vec<Structure>, OpenError> {
     let read_options = LabelMapOptions {
         level: options.level,
@@ -74,14 +99,21 @@ pub fn open(
     };
     match files {
         [] => Err(OpenError::NoFiles),
-        [one] => extract_from(one, &read(one)?, &options.extract),
+        [one] => {
+            on_stage(ONE_MAP[0]);
+            let map = read(one)?;
+            on_stage(ONE_MAP[1]);
+            extract_from(one, &map, &options.extract)
+        }
         several => {
             if !options.extract.labels.is_empty() {
                 return Err(OpenError::LabelsWithMasks);
             }
             let mut out = Vec::with_capacity(several.len());
             for (ordinal, f) in several.iter().enumerate() {
+                on_stage(EACH_MASK[0]);
                 let map = as_mask(read(f)?);
+                on_stage(EACH_MASK[1]);
                 for mut s in extract_from(f, &map, &options.extract)? {
                     s.label = ordinal as i64 + 1;
                     s.name = structure_name(f.name);
