@@ -108,30 +108,7 @@ fn structure(
         detail,
     };
     let matrix = if ours { IDENTITY } else { node.matrix };
-    let shown = place(&node.mesh, &matrix);
-    let finite = |m: &Mesh| m.positions.iter().flatten().all(|v| v.is_finite());
-    if !finite(&shown) {
-        return Err(fail(
-            "a position is not finite after the node's transform".into(),
-        ));
-    }
-    let original = match &node.morph_target {
-        Some(target) => {
-            let moved: Vec<[f32; 3]> = node
-                .mesh
-                .positions
-                .iter()
-                .zip(target)
-                .map(|(p, d)| [p[0] + d[0], p[1] + d[1], p[2] + d[2]])
-                .collect();
-            Some(place(
-                &Mesh::new(moved, node.mesh.triangles.clone()),
-                &matrix,
-            ))
-            .filter(finite)
-        }
-        None => None,
-    };
+    let (shown, original) = surfaces(&node, &matrix).map_err(|d| fail(d.into()))?;
     let color = node.base_color.map(|[r, g, b, a]| {
         [
             srgb::from_linear(r),
@@ -140,55 +117,17 @@ fn structure(
             a,
         ]
     });
-    let record = node.extras.as_ref().and_then(|e| e.get(CASE_KEY));
     let fallback = default_color(ordinal);
     let mut s = CaseStructure::from_mesh(&name, shown.clone(), fallback);
     s.source = Some(source.to_string());
     if let Some(c) = color {
         s.color = c;
     }
-    let Some(record) = record else {
+    let Some(record) = node.extras.as_ref().and_then(|e| e.get(CASE_KEY)) else {
         return Ok(s);
     };
-    if let Some(c) = floats::<4>(record.get("color")) {
-        s.color = c.map(|v| v as f32);
-    }
-    s.visible = record
-        .get("visible")
-        .and_then(Value::as_bool)
-        .unwrap_or(true);
-    s.group = record
-        .get("group")
-        .and_then(Value::as_str)
-        .map(str::to_string)
-        .or_else(|| (ours && node.ancestors.len() >= 2).then(|| node.ancestors[1].clone()));
-    s.description = (record.get("description").and_then(Value::as_str))
-        .unwrap_or_default()
-        .to_string();
-    s.source = record
-        .get("source")
-        .and_then(Value::as_str)
-        .map(str::to_string)
-        .or(s.source);
-    s.label = record.get("label").and_then(Value::as_i64);
-    s.voxel_size = floats::<3>(record.get("voxel_size_mm"));
-    s.voxels = record
-        .get("voxels")
-        .and_then(Value::as_u64)
-        .and_then(|v| usize::try_from(v).ok());
-    if let Some(tau) = record.get("tau").and_then(Value::as_f64) {
-        s.tau = tau;
-    }
-    let filter = record
-        .get("filter")
-        .and_then(Value::as_str)
-        .map(|f| Filter::from_name(f).ok_or_else(|| fail(format!("unknown filter '{f}'"))))
-        .transpose()?
-        .unwrap_or(s.params.filter);
-    s.params = match record.get("params") {
-        Some(p) => Params::defaults(filter).with_json(p).map_err(fail)?,
-        None => Params::defaults(filter),
-    };
+    read_looks(&mut s, record, &node, ours);
+    read_smoothing(&mut s, record).map_err(fail)?;
     let smoothed = record.get("smoothed").and_then(Value::as_bool) == Some(true);
     let metrics = record
         .get("metrics")
@@ -210,6 +149,75 @@ fn structure(
         _ => s.original = shown,
     }
     Ok(s)
+}
+
+/// The node's surface as shown and, where it has a morph target, its original, both placed
+/// by `matrix`; an original with a position that is not finite is dropped.
+fn surfaces(node: &GltfNode, matrix: &Mat4) -> Result<(Mesh, Option<Mesh>), &'static str> {
+    let shown = place(&node.mesh, matrix);
+    let finite = |m: &Mesh| m.positions.iter().flatten().all(|v| v.is_finite());
+    if !finite(&shown) {
+        return Err("a position is not finite after the node's transform");
+    }
+    let original = node.morph_target.as_ref().and_then(|target| {
+        let moved: Vec<[f32; 3]> = (node.mesh.positions.iter().zip(target))
+            .map(|(p, d)| [p[0] + d[0], p[1] + d[1], p[2] + d[2]])
+            .collect();
+        Some(place(
+            &Mesh::new(moved, node.mesh.triangles.clone()),
+            matrix,
+        ))
+        .filter(finite)
+    });
+    Ok((shown, original))
+}
+
+/// What the record says of how the structure is shown and where it came from.
+fn read_looks(s: &mut CaseStructure, record: &Value, node: &GltfNode, ours: bool) {
+    if let Some(c) = floats::<4>(record.get("color")) {
+        s.color = c.map(|v| v as f32);
+    }
+    s.visible = record
+        .get("visible")
+        .and_then(Value::as_bool)
+        .unwrap_or(true);
+    s.group = record
+        .get("group")
+        .and_then(Value::as_str)
+        .map(str::to_string)
+        .or_else(|| (ours && node.ancestors.len() >= 2).then(|| node.ancestors[1].clone()));
+    s.description = (record.get("description").and_then(Value::as_str))
+        .unwrap_or_default()
+        .to_string();
+    s.source = record
+        .get("source")
+        .and_then(Value::as_str)
+        .map(str::to_string)
+        .or(s.source.take());
+    s.label = record.get("label").and_then(Value::as_i64);
+    s.voxel_size = floats::<3>(record.get("voxel_size_mm"));
+    s.voxels = record
+        .get("voxels")
+        .and_then(Value::as_u64)
+        .and_then(|v| usize::try_from(v).ok());
+}
+
+/// The record's tau, filter and parameters.
+fn read_smoothing(s: &mut CaseStructure, record: &Value) -> Result<(), String> {
+    if let Some(tau) = record.get("tau").and_then(Value::as_f64) {
+        s.tau = tau;
+    }
+    let filter = record
+        .get("filter")
+        .and_then(Value::as_str)
+        .map(|f| Filter::from_name(f).ok_or_else(|| format!("unknown filter '{f}'")))
+        .transpose()?
+        .unwrap_or(s.params.filter);
+    s.params = match record.get("params") {
+        Some(p) => Params::defaults(filter).with_json(p)?,
+        None => Params::defaults(filter),
+    };
+    Ok(())
 }
 
 fn floats<const N: usize>(value: Option<&Value>) -> Option<[f64; N]> {
