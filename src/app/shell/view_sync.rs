@@ -3,9 +3,12 @@
 //! (the original, the CPU result or the GPU engine's buffers), its colours, and the case's other
 //! structures with their looks. Each is uploaded only when it changed.
 
+use eframe::egui_wgpu::RenderState;
+
 use super::Shell;
+use crate::app::gpu_engine::GpuEngine;
 use crate::app::viewer;
-use crate::session::{ColorField, Legend};
+use crate::session::{ColorField, Legend, Session};
 use crate::view;
 
 /// Where the view's positions come from.
@@ -40,170 +43,212 @@ pub(super) struct Shown {
 
 impl Shell {
     /// Brings the view's buffers up to date with the document: a new model, new positions
-    /// (the original, the CPU result or the GPU buffers), new colours.
+    /// (the original, the CPU result or the GPU buffers), new colours, the other structures
+    /// and the checks' marks.
     pub(super) fn sync_view(&mut self) {
         let Some((viewer, rs)) = &mut self.view else {
             return;
         };
         let doc = self.doc.borrow();
         let session = &doc.session;
-        let Some(model) = session.model() else {
+        if session.model().is_none() {
             return;
-        };
-        let mesh = model.mesh();
-        if self.shown.generation != doc.session.model_id() || self.shown.positions.is_none() {
-            let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
-            let kept_view = viewer.view_state();
-            viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
-            // A segmentation is framed whole once; another of its structures keeps the view.
-            let structures = session.case_structures();
-            let case =
-                (structures.len() > 1).then(|| (session.case_file().to_string(), structures.len()));
-            match (&case, case == self.framed_case) {
-                (Some(_), true) => viewer.set_view_state(kept_view),
-                (Some(_), false) => {
-                    let all: Vec<&[[f32; 3]]> =
-                        (structures.iter()).map(|s| s.positions()).collect();
-                    viewer.frame_all(&all);
-                }
-                (None, _) => {}
-            }
-            self.framed_case = case;
+        }
+        let shown = &mut self.shown;
+        if shown.generation != session.model_id() || shown.positions.is_none() {
+            sync_model(viewer, rs, session, &mut self.framed_case);
             // A link's camera, now that the view frames the case it was made for.
             if let Some(pose) = self.pending_pose.take() {
                 viewer.set_pose(pose);
             }
-            self.shown = Shown {
-                generation: doc.session.model_id(),
+            *shown = Shown {
+                generation: session.model_id(),
                 positions: Some(Positions::Original),
                 ..Shown::default()
             };
         }
-        let result = session.last_result();
         let toward = doc.view_asks.toward_segmentation;
-        let kept = session.kept_surface();
-        let before_result = if kept.is_some() {
-            Positions::Kept
-        } else {
-            Positions::Original
-        };
-        let wanted = if self.show_original {
-            Positions::Original
-        } else if toward > 0.0 {
-            result.map_or(Positions::Original, |r| {
-                Positions::Toward(r.revision, toward.to_bits())
-            })
-        } else if let Some(gpu) = &self.gpu {
-            (gpu.submitted(doc.session.model_id())).map_or(before_result, Positions::Gpu)
-        } else {
-            result.map_or(before_result, |r| Positions::Cpu(r.revision))
-        };
-        if self.shown.positions != Some(wanted) {
-            let shown = match wanted {
-                Positions::Original => {
-                    let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
-                    viewer.set_positions(rs, &mesh.positions, &normals);
-                    true
-                }
-                Positions::Toward(..) => {
-                    let moved = result
-                        .and_then(|r| view::toward_original(&mesh.positions, &r.positions, toward));
-                    if let Some(p) = moved {
-                        let normals = crate::mesh::vertex_normals(&p, &mesh.triangles);
-                        viewer.set_positions(rs, &p, &normals);
-                    }
-                    true
-                }
-                Positions::Kept => {
-                    if let Some(p) = kept {
-                        let normals = crate::mesh::vertex_normals(p, &mesh.triangles);
-                        viewer.set_positions(rs, p, &normals);
-                    }
-                    true
-                }
-                Positions::Cpu(_) => {
-                    // The engine recomputing the kept surface finds the same one: the view
-                    // need not draw it again.
-                    let unchanged = self.shown.positions == Some(Positions::Kept)
-                        && result.map(|r| &r.positions[..]) == kept;
-                    if let Some(r) = result.filter(|_| !unchanged) {
-                        let normals = crate::mesh::vertex_normals(&r.positions, &mesh.triangles);
-                        viewer.set_positions(rs, &r.positions, &normals);
-                    }
-                    true
-                }
-                // While a run is under way in the engine's buffers they hold none of its
-                // results: copy once it is done.
-                Positions::Gpu(_) => {
-                    match (self.gpu.as_ref()).and_then(|g| g.buffers(doc.session.model_id())) {
-                        Some((positions, normals)) => {
-                            viewer.copy_positions_from(rs, positions, normals);
-                            true
-                        }
-                        None => false,
-                    }
-                }
-            };
-            if shown {
-                self.shown.positions = Some(wanted);
-            }
+        let gpu = self.gpu.as_ref();
+        let wanted = wanted_positions(session, gpu, self.show_original, toward);
+        if shown.positions != Some(wanted)
+            && upload_positions(viewer, rs, session, gpu, wanted, shown.positions, toward)
+        {
+            shown.positions = Some(wanted);
         }
         // The brush shows what it paints; the weights' colours follow their own changes.
         let colors = if self.brush.active {
             Some((ColorField::Weights, session.weights_version()))
         } else {
-            self.coloring
-                .filter(|_| !self.show_original)
-                .zip(result.map(|r| r.revision))
+            (self.coloring.filter(|_| !self.show_original))
+                .zip(session.last_result().map(|r| r.revision))
         };
-        if self.shown.colors != colors {
+        if shown.colors != colors {
             let computed = colors.and_then(|(field, _)| session.colors(field));
             viewer.set_colors(rs, computed.as_ref().map(|(c, _)| c.as_slice()));
-            self.shown.legend = computed.map(|(_, l)| l);
-            self.shown.colors = colors;
+            shown.legend = computed.map(|(_, l)| l);
+            shown.colors = colors;
         }
         let looks = (session.case_version(), toward.to_bits());
-        if self.shown.looks != Some(looks) {
-            let others = session.other_structures();
-            let list = session.case_structures();
-            let moved: Vec<Option<Vec<[f32; 3]>>> = (others.iter())
-                .map(|o| {
-                    let original = &list[o.index].original.positions;
-                    (toward > 0.0)
-                        .then(|| view::toward_original(original, o.positions, toward))
-                        .flatten()
-                })
-                .collect();
-            let surfaces: Vec<viewer::ContextSurface<'_>> = (others.iter().zip(&moved))
-                .map(|(o, moved)| viewer::ContextSurface {
-                    positions: moved.as_deref().unwrap_or(o.positions),
-                    triangles: o.triangles,
-                    color: o.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
-                    closed: o.closed,
-                })
-                .collect();
-            viewer.set_context(rs, &surfaces);
-            let look = session.model_structure();
-            viewer.set_model_look(
-                look.map(|l| l.color),
-                look.is_none_or(|l| l.visible),
-                look.is_some_and(|l| l.closed_outward()),
-            );
-            self.shown.looks = Some(looks);
+        if shown.looks != Some(looks) {
+            upload_looks(viewer, rs, session, toward);
+            shown.looks = Some(looks);
         }
         let marks = (session.marks_key(), session.case_version());
-        if self.shown.marks != marks {
-            let patches = session.marked_surfaces();
-            let surfaces: Vec<viewer::ContextSurface<'_>> = (patches.iter())
-                .map(|p| viewer::ContextSurface {
-                    positions: &p.positions,
-                    triangles: &p.triangles,
-                    color: viewer::MARK_COLOR,
-                    closed: false,
-                })
-                .collect();
-            viewer.set_marks(rs, &surfaces);
-            self.shown.marks = marks;
+        if shown.marks != marks {
+            upload_marks(viewer, rs, session);
+            shown.marks = marks;
         }
     }
+}
+
+/// A new model in the view: framed when it is a new case's first, else where the view was.
+fn sync_model(
+    viewer: &mut viewer::Viewer,
+    rs: &RenderState,
+    session: &Session,
+    framed_case: &mut Option<(String, usize)>,
+) {
+    let Some(model) = session.model() else {
+        return;
+    };
+    let mesh = model.mesh();
+    let normals = crate::mesh::vertex_normals(&mesh.positions, &mesh.triangles);
+    let kept_view = viewer.view_state();
+    viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
+    // A segmentation is framed whole once; another of its structures keeps the view.
+    let structures = session.case_structures();
+    let case = (structures.len() > 1).then(|| (session.case_file().to_string(), structures.len()));
+    match (&case, case == *framed_case) {
+        (Some(_), true) => viewer.set_view_state(kept_view),
+        (Some(_), false) => {
+            let all: Vec<&[[f32; 3]]> = (structures.iter()).map(|s| s.positions()).collect();
+            viewer.frame_all(&all);
+        }
+        (None, _) => {}
+    }
+    *framed_case = case;
+}
+
+/// Where the view's positions should come from now.
+fn wanted_positions(
+    session: &Session,
+    gpu: Option<&GpuEngine>,
+    show_original: bool,
+    toward: f32,
+) -> Positions {
+    let result = session.last_result();
+    let before_result = if session.kept_surface().is_some() {
+        Positions::Kept
+    } else {
+        Positions::Original
+    };
+    if show_original {
+        Positions::Original
+    } else if toward > 0.0 {
+        result.map_or(Positions::Original, |r| {
+            Positions::Toward(r.revision, toward.to_bits())
+        })
+    } else if let Some(gpu) = gpu {
+        (gpu.submitted(session.model_id())).map_or(before_result, Positions::Gpu)
+    } else {
+        result.map_or(before_result, |r| Positions::Cpu(r.revision))
+    }
+}
+
+/// Uploads the `wanted` positions (`shown`: those the view has); false while the GPU engine's
+/// run is still under way.
+fn upload_positions(
+    viewer: &mut viewer::Viewer,
+    rs: &RenderState,
+    session: &Session,
+    gpu: Option<&GpuEngine>,
+    wanted: Positions,
+    shown: Option<Positions>,
+    toward: f32,
+) -> bool {
+    let Some(model) = session.model() else {
+        return false;
+    };
+    let mesh = model.mesh();
+    let result = session.last_result();
+    let kept = session.kept_surface();
+    let mut set = |positions: &[[f32; 3]]| {
+        let normals = crate::mesh::vertex_normals(positions, &mesh.triangles);
+        viewer.set_positions(rs, positions, &normals);
+    };
+    match wanted {
+        Positions::Original => set(&mesh.positions),
+        Positions::Toward(..) => {
+            let moved =
+                result.and_then(|r| view::toward_original(&mesh.positions, &r.positions, toward));
+            if let Some(p) = moved {
+                set(&p);
+            }
+        }
+        Positions::Kept => {
+            if let Some(p) = kept {
+                set(p);
+            }
+        }
+        Positions::Cpu(_) => {
+            // The engine recomputing the kept surface finds the same one: the view need not
+            // draw it again.
+            let unchanged =
+                shown == Some(Positions::Kept) && result.map(|r| &r.positions[..]) == kept;
+            if let Some(r) = result.filter(|_| !unchanged) {
+                set(&r.positions);
+            }
+        }
+        // While a run is under way in the engine's buffers they hold none of its results:
+        // copy once it is done.
+        Positions::Gpu(_) => match gpu.and_then(|g| g.buffers(session.model_id())) {
+            Some((positions, normals)) => viewer.copy_positions_from(rs, positions, normals),
+            None => return false,
+        },
+    }
+    true
+}
+
+/// The case's other structures with their looks (drawn back towards the segmentation by
+/// `toward`), and the model's look.
+fn upload_looks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session, toward: f32) {
+    let others = session.other_structures();
+    let list = session.case_structures();
+    let moved: Vec<Option<Vec<[f32; 3]>>> = (others.iter())
+        .map(|o| {
+            let original = &list[o.index].original.positions;
+            (toward > 0.0)
+                .then(|| view::toward_original(original, o.positions, toward))
+                .flatten()
+        })
+        .collect();
+    let surfaces: Vec<viewer::ContextSurface<'_>> = (others.iter().zip(&moved))
+        .map(|(o, moved)| viewer::ContextSurface {
+            positions: moved.as_deref().unwrap_or(o.positions),
+            triangles: o.triangles,
+            color: o.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
+            closed: o.closed,
+        })
+        .collect();
+    viewer.set_context(rs, &surfaces);
+    let look = session.model_structure();
+    viewer.set_model_look(
+        look.map(|l| l.color),
+        look.is_none_or(|l| l.visible),
+        look.is_some_and(|l| l.closed_outward()),
+    );
+}
+
+/// The checks' marks over the structures.
+fn upload_marks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session) {
+    let patches = session.marked_surfaces();
+    let surfaces: Vec<viewer::ContextSurface<'_>> = (patches.iter())
+        .map(|p| viewer::ContextSurface {
+            positions: &p.positions,
+            triangles: &p.triangles,
+            color: viewer::MARK_COLOR,
+            closed: false,
+        })
+        .collect();
+    viewer.set_marks(rs, &surfaces);
 }
