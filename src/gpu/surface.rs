@@ -65,6 +65,135 @@ pub(crate) struct SlotBuffers<'a> {
     pub aux: &'a wgpu::Buffer,
 }
 
+/// A mesh's neighbourhoods as the kernels read them: the 1-rings (CSR), the triangle fans
+/// (CSR), the boundary flags and each vertex's stay radius.
+struct Rings {
+    ring_offsets: wgpu::Buffer,
+    ring: wgpu::Buffer,
+    fan_offsets: wgpu::Buffer,
+    fan_corners: wgpu::Buffer,
+    boundary: wgpu::Buffer,
+    stay: wgpu::Buffer,
+}
+
+impl Rings {
+    fn upload(device: &wgpu::Device, original: &Original, fans: &[[u32; 2]]) -> Self {
+        let topology = original.topology();
+        let cast = bytemuck::cast_slice::<u32, u8>;
+        let boundary: Vec<u32> = topology.is_boundary.iter().map(|&b| b as u32).collect();
+        Self {
+            ring_offsets: storage_init(
+                device,
+                "meshsmooth 1-ring offsets",
+                cast(&topology.neighbor_offsets),
+            ),
+            ring: storage_init(device, "meshsmooth 1-ring", cast(&topology.neighbors)),
+            fan_offsets: storage_init(
+                device,
+                "meshsmooth fan offsets",
+                cast(&topology.triangle_offsets),
+            ),
+            fan_corners: storage_init(device, "meshsmooth fan corners", bytemuck::cast_slice(fans)),
+            boundary: storage_init(device, "meshsmooth boundary flags", cast(&boundary)),
+            stay: storage_init(
+                device,
+                "meshsmooth stay radii",
+                bytemuck::cast_slice(original.stay_radius2()),
+            ),
+        }
+    }
+}
+
+/// The measure pass's parts and partial count for `original` on a device with `limits`, after
+/// refusing a mesh that exceeds them.
+fn measure_plan(
+    limits: &wgpu::Limits,
+    original: &Original,
+) -> Result<(Vec<MeasurePart>, u32), GpuError> {
+    let n = original.mesh().vertex_count();
+    dispatch_size(n as u32, limits.max_compute_workgroups_per_dimension)
+        .ok_or_else(|| GpuError::Device("no workgroup grid covers the mesh".into()))?;
+    // The measure pass runs as 1-D parts: one partial per workgroup that holds vertices.
+    let parts = measure_parts(n as u32, limits.max_compute_workgroups_per_dimension);
+    let partial_count = (n as u32).div_ceil(super::layout::WORKGROUP_SIZE);
+    check_surface_fits(
+        limits,
+        n,
+        original.topology().neighbors.len(),
+        original.all_fan_corners().len(),
+        partial_count as usize,
+    )?;
+    Ok((parts, partial_count))
+}
+
+/// The buffers the kernels write for `n` vertices: the drifting reference (the identity until
+/// a run drifts it), the normals, the per-vertex measures and the measure pass's partials.
+fn working_buffers(device: &wgpu::Device, n: usize, partial_count: u32) -> [wgpu::Buffer; 4] {
+    let n64 = n as u64;
+    [
+        storage_init(
+            device,
+            "meshsmooth reference vertices",
+            bytemuck::cast_slice::<u32, u8>(&crate::metrics::identity(n)),
+        ),
+        written(device, "meshsmooth normals", n64 * POSITION_BYTES, true),
+        written(
+            device,
+            "meshsmooth vertex measures",
+            n64 * VERTEX_MEASURE_BYTES,
+            false,
+        ),
+        written(
+            device,
+            "meshsmooth measure partials",
+            u64::from(partial_count) * std::mem::size_of::<MeasurePartial>() as u64,
+            false,
+        ),
+    ]
+}
+
+/// The measure pass's part records, one per `stride` bytes (a dynamic uniform offset each).
+fn measure_part_records(device: &wgpu::Device, parts: &[MeasurePart], stride: u64) -> wgpu::Buffer {
+    let mut records = vec![0u8; (stride as usize * parts.len()).max(stride as usize)];
+    for (record, part) in records.chunks_mut(stride as usize).zip(parts) {
+        record[..std::mem::size_of::<MeasurePart>()].copy_from_slice(bytemuck::bytes_of(part));
+    }
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("meshsmooth measure parts"),
+        contents: &records,
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
+}
+
+/// The measure pass's bind group: `buffers` at bindings 0 to 7, one part record at 8.
+fn measure_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: [&wgpu::Buffer; 8],
+    part_records: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    let mut entries: Vec<_> = (0u32..)
+        .zip(buffers)
+        .map(|(binding, buffer)| wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        })
+        .collect();
+    entries.push(wgpu::BindGroupEntry {
+        binding: 8,
+        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: part_records,
+            offset: 0,
+            size: std::num::NonZeroU64::new(std::mem::size_of::<MeasurePart>() as u64),
+        }),
+    });
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("meshsmooth measures"),
+        layout,
+        entries: &entries,
+    })
+}
+
 impl SurfaceBuffers {
     /// Uploads `original`'s surface data for a mesh whose position buffers are `slots`, with
     /// `centre` as the volume's centre. Refuses, before uploading anything, what exceeds the
@@ -76,23 +205,9 @@ impl SurfaceBuffers {
         slots: SlotBuffers<'_>,
         centre: [f32; 3],
     ) -> Result<Self, GpuError> {
-        let mesh = original.mesh();
-        let topology = original.topology();
-        let n = mesh.vertex_count();
+        let n = original.mesh().vertex_count();
         let limits = device.limits();
-        dispatch_size(n as u32, limits.max_compute_workgroups_per_dimension)
-            .ok_or_else(|| GpuError::Device("no workgroup grid covers the mesh".into()))?;
-        // The measure pass runs as 1-D parts: one partial per workgroup that holds vertices.
-        let parts = measure_parts(n as u32, limits.max_compute_workgroups_per_dimension);
-        let partial_count = (n as u32).div_ceil(super::layout::WORKGROUP_SIZE);
-        let fans = original.all_fan_corners();
-        check_surface_fits(
-            &limits,
-            n,
-            topology.neighbors.len(),
-            fans.len(),
-            partial_count as usize,
-        )?;
+        let (parts, partial_count) = measure_plan(&limits, original)?;
 
         let params = SurfaceParams {
             vertex_count: n as u32,
@@ -104,99 +219,42 @@ impl SurfaceBuffers {
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let cast = bytemuck::cast_slice::<u32, u8>;
-        let ring_offsets = storage_init(
-            device,
-            "meshsmooth 1-ring offsets",
-            cast(&topology.neighbor_offsets),
-        );
-        let ring = storage_init(device, "meshsmooth 1-ring", cast(&topology.neighbors));
-        let fan_offsets = storage_init(
-            device,
-            "meshsmooth fan offsets",
-            cast(&topology.triangle_offsets),
-        );
-        let fan_corners =
-            storage_init(device, "meshsmooth fan corners", bytemuck::cast_slice(fans));
-        let boundary: Vec<u32> = topology.is_boundary.iter().map(|&b| b as u32).collect();
-        let boundary = storage_init(device, "meshsmooth boundary flags", cast(&boundary));
-        let stay = storage_init(
-            device,
-            "meshsmooth stay radii",
-            bytemuck::cast_slice(original.stay_radius2()),
-        );
-        let n64 = n as u64;
-        // The identity until a run drifts it.
-        let reference = storage_init(
-            device,
-            "meshsmooth reference vertices",
-            cast(&crate::metrics::identity(n)),
-        );
-        let normals = written(device, "meshsmooth normals", n64 * POSITION_BYTES, true);
-        let vertex_measures = written(
-            device,
-            "meshsmooth vertex measures",
-            n64 * VERTEX_MEASURE_BYTES,
-            false,
-        );
-        let partials = written(
-            device,
-            "meshsmooth measure partials",
-            u64::from(partial_count) * std::mem::size_of::<MeasurePartial>() as u64,
-            false,
-        );
+        let rings = Rings::upload(device, original, original.all_fan_corners());
+        let [reference, normals, vertex_measures, partials] =
+            working_buffers(device, n, partial_count);
 
         let stride = record_stride::<MeasurePart>(limits.min_uniform_buffer_offset_alignment);
-        let mut records = vec![0u8; (stride as usize * parts.len()).max(stride as usize)];
-        for (record, part) in records.chunks_mut(stride as usize).zip(&parts) {
-            record[..std::mem::size_of::<MeasurePart>()].copy_from_slice(bytemuck::bytes_of(part));
-        }
-        let part_records = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("meshsmooth measure parts"),
-            contents: &records,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let part_records = measure_part_records(device, &parts, stride);
 
         let group = |layout, buffers: &[&wgpu::Buffer]| {
             let mut all = vec![&params];
             all.extend_from_slice(buffers);
             bind_group(device, layout, &all)
         };
+        let Rings {
+            ring_offsets,
+            ring,
+            fan_offsets,
+            fan_corners,
+            boundary,
+            stay,
+        } = &rings;
         let drift_group = group(
             &layouts.drift,
-            &[slots.original, &ring_offsets, &ring, &stay, &reference],
+            &[slots.original, ring_offsets, ring, stay, &reference],
         );
-        let normals_group = group(&layouts.normals, &[&fan_offsets, &fan_corners, &normals]);
+        let normals_group = group(&layouts.normals, &[fan_offsets, fan_corners, &normals]);
         let measure_buffers = [
             &params,
             slots.original,
-            &fan_offsets,
-            &fan_corners,
-            &boundary,
+            fan_offsets,
+            fan_corners,
+            boundary,
             &reference,
             &vertex_measures,
             &partials,
         ];
-        let mut measure_entries: Vec<_> = (0u32..)
-            .zip(measure_buffers)
-            .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            })
-            .collect();
-        measure_entries.push(wgpu::BindGroupEntry {
-            binding: 8,
-            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: &part_records,
-                offset: 0,
-                size: std::num::NonZeroU64::new(std::mem::size_of::<MeasurePart>() as u64),
-            }),
-        });
-        let measure_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("meshsmooth measures"),
-            layout: &layouts.measure,
-            entries: &measure_entries,
-        });
+        let measure_group = measure_group(device, &layouts.measure, measure_buffers, &part_records);
         let looked_at = [slots.original, slots.a, slots.b, slots.aux]
             .map(|b| bind_group(device, &layouts.looked_at, &[b]));
         Ok(Self {
