@@ -442,27 +442,8 @@ impl Session {
         memo: &mut TermsMemo,
     ) -> bool {
         let key = self.search_key();
-        let params = *self.params();
-        // Jobs for another model, filter, weights or bound are dropped.
-        if self.guidance.search.as_ref().is_some_and(|j| j.key != key) {
-            self.guidance.search = None;
-        }
-        if self
-            .guidance
-            .gallery_job
-            .as_ref()
-            .is_some_and(|j| j.key != key)
-        {
-            self.guidance.gallery_job = None;
-        }
-        if self
-            .guidance
-            .sweep
-            .as_ref()
-            .is_some_and(|(k, p, _)| *k != key || *p != params)
-        {
-            self.guidance.sweep = None;
-        }
+        let (params, tau) = (*self.params(), self.tau);
+        self.guidance.drop_stale(key, &params);
         let Some(model) = self.model.as_ref() else {
             return false;
         };
@@ -479,83 +460,122 @@ impl Session {
             memo,
         };
         let guidance = &mut self.guidance;
-
-        if let Some(job) = guidance.search.as_mut() {
-            let (task, mut ev) = job.running.evaluator(&mut engine);
-            let finished = match task {
-                Search::Grid(t) => t.step(&mut ev),
-                Search::Local(t) => t.step(&mut ev),
-            };
-            if !finished {
-                return false;
-            }
-            let Some(job) = guidance.search.take() else {
-                return false;
-            };
-            let elapsed_ms = clock() - job.running.started_ms.unwrap_or_default();
-            let suggestion = match job.running.task {
-                Search::Grid(t) => t.into_output().and_then(|grid| {
-                    let best = grid.best(job.tau);
-                    guidance.grid = Some((key, grid));
-                    best
-                }),
-                Search::Local(t) => t.into_output().map(|o: LocalOutcome| o.suggestion),
-            };
-            if let Some(mut suggestion) = suggestion {
-                suggestion.params.max_displacement = key.bound;
-                guidance.suggested = Some(Suggested {
-                    suggestion,
-                    key,
-                    elapsed_ms,
-                });
-            }
-            return true;
+        if guidance.search.is_some() {
+            guidance.step_search(key, &mut engine)
+        } else if guidance.gallery_job.is_some() {
+            guidance.step_gallery(&mut engine)
+        } else {
+            guidance.step_graphs(key, &params, tau, &mut engine)
         }
+    }
+}
 
-        if let Some(job) = guidance.gallery_job.as_mut() {
-            let finished = step_gallery(job, &mut engine);
-            if finished {
-                if let Some(job) = guidance.gallery_job.take() {
-                    guidance.problem = job.problem;
-                    guidance.gallery = job.picks;
-                    guidance.gallery_key = Some(job.key);
-                    guidance.gallery_version += 1;
-                }
-            }
-            return finished;
+impl Guidance {
+    /// Drops the jobs for another model, filter, weights or bound (the graphs': or other
+    /// parameters).
+    fn drop_stale(&mut self, key: SearchKey, params: &Params) {
+        if self.search.as_ref().is_some_and(|j| j.key != key) {
+            self.search = None;
         }
+        if self.gallery_job.as_ref().is_some_and(|j| j.key != key) {
+            self.gallery_job = None;
+        }
+        if (self.sweep.as_ref()).is_some_and(|(k, p, _)| *k != key || p != params) {
+            self.sweep = None;
+        }
+    }
 
-        if !guidance.graphs_wanted {
-            guidance.sweep = None;
+    /// A step of the suggestion's search; once it finishes, the suggestion (and a grid's
+    /// answers) are kept. Whether it finished.
+    fn step_search(&mut self, key: SearchKey, engine: &mut Engine<'_, '_>) -> bool {
+        let Some(job) = self.search.as_mut() else {
+            return false;
+        };
+        let (task, mut ev) = job.running.evaluator(engine);
+        let finished = match task {
+            Search::Grid(t) => t.step(&mut ev),
+            Search::Local(t) => t.step(&mut ev),
+        };
+        if !finished {
             return false;
         }
-        let current = guidance
-            .graphs
-            .as_ref()
-            .is_some_and(|(k, g)| *k == key && g.current == params);
+        let Some(job) = self.search.take() else {
+            return false;
+        };
+        let elapsed_ms = (engine.clock)() - job.running.started_ms.unwrap_or_default();
+        let suggestion = match job.running.task {
+            Search::Grid(t) => t.into_output().and_then(|grid| {
+                let best = grid.best(job.tau);
+                self.grid = Some((key, grid));
+                best
+            }),
+            Search::Local(t) => t.into_output().map(|o: LocalOutcome| o.suggestion),
+        };
+        if let Some(mut suggestion) = suggestion {
+            suggestion.params.max_displacement = key.bound;
+            self.suggested = Some(Suggested {
+                suggestion,
+                key,
+                elapsed_ms,
+            });
+        }
+        true
+    }
+
+    /// A step of the gallery's job; once it finishes, its pictures are kept.
+    fn step_gallery(&mut self, engine: &mut Engine<'_, '_>) -> bool {
+        let Some(job) = self.gallery_job.as_mut() else {
+            return false;
+        };
+        let finished = step_gallery(job, engine);
+        if finished {
+            if let Some(job) = self.gallery_job.take() {
+                self.problem = job.problem;
+                self.gallery = job.picks;
+                self.gallery_key = Some(job.key);
+                self.gallery_version += 1;
+            }
+        }
+        finished
+    }
+
+    /// A step of the quality graphs around `params`, while they are wanted and not current.
+    fn step_graphs(
+        &mut self,
+        key: SearchKey,
+        params: &Params,
+        tau: f64,
+        engine: &mut Engine<'_, '_>,
+    ) -> bool {
+        if !self.graphs_wanted {
+            self.sweep = None;
+            return false;
+        }
+        let current =
+            (self.graphs.as_ref()).is_some_and(|(k, g)| *k == key && g.current == *params);
         if current {
             return false;
         }
-        if guidance.sweep.is_none() {
-            match QualitySweep::new(&params, self.tau) {
-                Ok(task) => guidance.sweep = Some((key, params, Running::new(task))),
+        if self.sweep.is_none() {
+            match QualitySweep::new(params, tau) {
+                Ok(task) => self.sweep = Some((key, *params, Running::new(task))),
                 Err(e) => {
-                    guidance.problem = Some(format!("No quality graphs: {e}"));
+                    self.problem = Some(format!("No quality graphs: {e}"));
                     return false;
                 }
             }
         }
-        let Some((_, _, running)) = guidance.sweep.as_mut() else {
+        let Some((_, _, running)) = self.sweep.as_mut() else {
             return false;
         };
-        let (task, mut ev) = running.evaluator(&mut engine);
+        let (task, mut ev) = running.evaluator(engine);
         if !task.step(&mut ev) {
             return false;
         }
-        if let Some((key, _, running)) = guidance.sweep.take() {
-            guidance.graphs_elapsed_ms = clock() - running.started_ms.unwrap_or_default();
+        if let Some((key, _, running)) = self.sweep.take() {
+            self.graphs_elapsed_ms = (engine.clock)() - running.started_ms.unwrap_or_default();
             if let Some(graphs) = running.task.into_output() {
-                guidance.graphs = Some((key, graphs));
+                self.graphs = Some((key, graphs));
             }
         }
         true
