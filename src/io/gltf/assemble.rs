@@ -121,60 +121,10 @@ fn assemble(
     let mut positions: Vec<[f32; 3]> = Vec::with_capacity(vertex_total);
     let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(triangle_total as usize);
     for job in jobs {
-        let mut points = read_vectors::<3>(&job.positions, data(&job.positions)?, format)?;
-        if let Some(v) = points.iter().flatten().find(|v| !v.is_finite()) {
-            return Err(LoadError::NonFinite {
-                format,
-                location: Location::Item("accessor", job.positions.accessor),
-                value: v.to_string(),
-            });
-        }
-        let m = &job.instance.matrix;
-        // The identity is skipped so that untransformed positions keep their exact bits (-0.0).
-        if *m != IDENTITY {
-            for p in &mut points {
-                *p = transform_point(m, *p);
-            }
-            if let Some(v) = points.iter().flatten().find(|v| !v.is_finite()) {
-                return Err(LoadError::NonFinite {
-                    format,
-                    location: Location::Item("node", job.instance.node),
-                    value: format!("{v} after the node's transform"),
-                });
-            }
-        }
-
-        let count = points.len();
-        let refs: Vec<u32> = match &job.indices {
-            Some(l) => {
-                let refs = read_indices(l, data(l)?, format)?;
-                if let Some(&bad) = refs.iter().find(|&&i| i as usize >= count) {
-                    return Err(LoadError::IndexOutOfRange {
-                        format,
-                        location: Location::Item("accessor", l.accessor),
-                        index: bad.into(),
-                        count,
-                    });
-                }
-                refs
-            }
-            // Counts are capped far below u32::MAX.
-            None => (0..count as u32).collect(),
-        };
-        if job.mode == Mode::Triangles && !refs.len().is_multiple_of(3) {
-            let accessor = job.indices.as_ref().unwrap_or(&job.positions).accessor;
-            return Err(LoadError::Syntax {
-                format,
-                location: Location::Item("accessor", accessor),
-                detail: format!(
-                    "{} vertex references do not make whole triangles",
-                    refs.len()
-                ),
-            });
-        }
-
+        let points = placed_points(job, data(&job.positions)?, format)?;
+        let refs = vertex_refs(job, points.len(), &data, format)?;
         let base = positions.len() as u32;
-        let mirrored = determinant3(m) < 0.0;
+        let mirrored = determinant3(&job.instance.matrix) < 0.0;
         let mut push = |t: [u32; 3]| {
             let [a, b, c] = t.map(|v| v + base);
             // A mirroring transform turns counter-clockwise into clockwise: swap to undo it.
@@ -206,6 +156,72 @@ fn assemble(
         return Err(LoadError::NoTriangles { format });
     }
     Ok(Mesh::new(positions, triangles))
+}
+
+/// A primitive's positions placed by its node's transform; refuses one that is not finite,
+/// before or after.
+fn placed_points(job: &Job, data: &[u8], format: Format) -> Result<Vec<[f32; 3]>, LoadError> {
+    let mut points = read_vectors::<3>(&job.positions, data, format)?;
+    if let Some(v) = points.iter().flatten().find(|v| !v.is_finite()) {
+        return Err(LoadError::NonFinite {
+            format,
+            location: Location::Item("accessor", job.positions.accessor),
+            value: v.to_string(),
+        });
+    }
+    let m = &job.instance.matrix;
+    // The identity is skipped so that untransformed positions keep their exact bits (-0.0).
+    if *m != IDENTITY {
+        for p in &mut points {
+            *p = transform_point(m, *p);
+        }
+        if let Some(v) = points.iter().flatten().find(|v| !v.is_finite()) {
+            return Err(LoadError::NonFinite {
+                format,
+                location: Location::Item("node", job.instance.node),
+                value: format!("{v} after the node's transform"),
+            });
+        }
+    }
+    Ok(points)
+}
+
+/// A primitive's vertex references (its indices, else every vertex in order), each checked
+/// against its `count` vertices, whole triangles for a triangle list.
+fn vertex_refs<'b>(
+    job: &Job,
+    count: usize,
+    data: &impl Fn(&Layout) -> Result<&'b [u8], LoadError>,
+    format: Format,
+) -> Result<Vec<u32>, LoadError> {
+    let refs: Vec<u32> = match &job.indices {
+        Some(l) => {
+            let refs = read_indices(l, data(l)?, format)?;
+            if let Some(&bad) = refs.iter().find(|&&i| i as usize >= count) {
+                return Err(LoadError::IndexOutOfRange {
+                    format,
+                    location: Location::Item("accessor", l.accessor),
+                    index: bad.into(),
+                    count,
+                });
+            }
+            refs
+        }
+        // Counts are capped far below u32::MAX.
+        None => (0..count as u32).collect(),
+    };
+    if job.mode == Mode::Triangles && !refs.len().is_multiple_of(3) {
+        let accessor = job.indices.as_ref().unwrap_or(&job.positions).accessor;
+        return Err(LoadError::Syntax {
+            format,
+            location: Location::Item("accessor", accessor),
+            detail: format!(
+                "{} vertex references do not make whole triangles",
+                refs.len()
+            ),
+        });
+    }
+    Ok(refs)
 }
 
 /// Strips and fans join runs with repeated indices; those are not triangles of the surface.
