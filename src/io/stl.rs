@@ -138,20 +138,62 @@ enum State {
 }
 
 fn parse_ascii(bytes: &[u8]) -> Result<Mesh, LoadError> {
-    let syntax = |line: usize, detail: String| LoadError::Syntax {
-        format: FORMAT,
-        location: Location::Line(line),
-        detail,
-    };
     // Each facet takes at least ~7 lines of ~15 bytes; a modest guess avoids regrowth.
-    let mut welder = Welder::with_expected_triangles(bytes.len() / 256);
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut corners = [0u32; 3];
+    let mut solid = AsciiSolid {
+        welder: Welder::with_expected_triangles(bytes.len() / 256),
+        triangles: Vec::new(),
+        corners: [0; 3],
+    };
     let mut state = State::Outside;
     for (line, content) in Lines::new(text::strip_bom(bytes)) {
         let mut tokens = text::tokens(content);
         let Some(word) = tokens.next() else { continue };
-        state = match state {
+        state = solid.next(state, word, &mut tokens, line)?;
+    }
+    let truncated = |detail: String| LoadError::Truncated {
+        format: FORMAT,
+        offset: bytes.len(),
+        detail,
+    };
+    match state {
+        State::Outside => {}
+        State::InSolid => return Err(truncated("missing 'endsolid'".into())),
+        State::InFacet { line, .. } => {
+            return Err(truncated(format!("inside the facet begun on line {line}")))
+        }
+    }
+    if solid.triangles.is_empty() {
+        return Err(LoadError::NoTriangles { format: FORMAT });
+    }
+    Ok(Mesh::new(solid.welder.into_positions(), solid.triangles))
+}
+
+fn syntax(line: usize, detail: String) -> LoadError {
+    LoadError::Syntax {
+        format: FORMAT,
+        location: Location::Line(line),
+        detail,
+    }
+}
+
+/// An ASCII solid as read so far: its welded vertices, its triangles and the corners of the
+/// facet under way.
+struct AsciiSolid {
+    welder: Welder,
+    triangles: Vec<[u32; 3]>,
+    corners: [u32; 3],
+}
+
+impl AsciiSolid {
+    /// The state after a line that begins with `word` (the rest in `tokens`) in `state`.
+    fn next<'a>(
+        &mut self,
+        state: State,
+        word: &[u8],
+        tokens: &mut impl Iterator<Item = &'a [u8]>,
+        line: usize,
+    ) -> Result<State, LoadError> {
+        Ok(match state {
             State::Outside if text::is_keyword(word, "solid") => State::InSolid,
             State::Outside => {
                 return Err(syntax(
@@ -174,69 +216,55 @@ fn parse_ascii(bytes: &[u8]) -> Result<Mesh, LoadError> {
             }
             State::InFacet {
                 line: start,
-                corners: n,
-            } if text::is_keyword(word, "vertex") => {
-                let Some(slot) = corners.get_mut(n) else {
-                    return Err(syntax(line, "a facet has more than 3 vertices".into()));
-                };
-                let p = read_xyz(&mut tokens, line)?;
-                if welder.len() >= u32::MAX as usize {
-                    return Err(too_many_vertices());
-                }
-                *slot = welder.insert(p);
-                State::InFacet {
-                    line: start,
-                    corners: n + 1,
-                }
+                corners,
+            } => self.in_facet(word, tokens, line, start, corners)?,
+        })
+    }
+
+    /// The state after a line of a facet begun on `start` with `n` corners read.
+    fn in_facet<'a>(
+        &mut self,
+        word: &[u8],
+        tokens: &mut impl Iterator<Item = &'a [u8]>,
+        line: usize,
+        start: usize,
+        n: usize,
+    ) -> Result<State, LoadError> {
+        if text::is_keyword(word, "vertex") {
+            let Some(slot) = self.corners.get_mut(n) else {
+                return Err(syntax(line, "a facet has more than 3 vertices".into()));
+            };
+            let p = read_xyz(tokens, line)?;
+            if self.welder.len() >= u32::MAX as usize {
+                return Err(too_many_vertices());
             }
-            State::InFacet {
+            *slot = self.welder.insert(p);
+            Ok(State::InFacet {
                 line: start,
-                corners: n,
-            } if text::is_keyword(word, "endfacet") => {
-                if n != 3 {
-                    return Err(syntax(
-                        line,
-                        format!("the facet begun on line {start} has {n} vertices, expected 3"),
-                    ));
-                }
-                triangles.push(corners);
-                State::InSolid
-            }
-            // The loop markers carry nothing the vertex count does not already check.
-            s @ State::InFacet { .. }
-                if text::is_keyword(word, "outer") || text::is_keyword(word, "endloop") =>
-            {
-                s
-            }
-            State::InFacet { .. } => {
+                corners: n + 1,
+            })
+        } else if text::is_keyword(word, "endfacet") {
+            if n != 3 {
                 return Err(syntax(
                     line,
-                    format!("unexpected '{}' inside a facet", text::show(word)),
-                ))
+                    format!("the facet begun on line {start} has {n} vertices, expected 3"),
+                ));
             }
-        };
-    }
-    match state {
-        State::Outside => {}
-        State::InSolid => {
-            return Err(LoadError::Truncated {
-                format: FORMAT,
-                offset: bytes.len(),
-                detail: "missing 'endsolid'".into(),
+            self.triangles.push(self.corners);
+            Ok(State::InSolid)
+        } else if text::is_keyword(word, "outer") || text::is_keyword(word, "endloop") {
+            // The loop markers carry nothing the vertex count does not already check.
+            Ok(State::InFacet {
+                line: start,
+                corners: n,
             })
-        }
-        State::InFacet { line, .. } => {
-            return Err(LoadError::Truncated {
-                format: FORMAT,
-                offset: bytes.len(),
-                detail: format!("inside the facet begun on line {line}"),
-            })
+        } else {
+            Err(syntax(
+                line,
+                format!("unexpected '{}' inside a facet", text::show(word)),
+            ))
         }
     }
-    if triangles.is_empty() {
-        return Err(LoadError::NoTriangles { format: FORMAT });
-    }
-    Ok(Mesh::new(welder.into_positions(), triangles))
 }
 
 fn read_xyz<'a>(
