@@ -140,6 +140,71 @@ pub(crate) fn bind_group(
     })
 }
 
+/// Positions of `n` vertices the kernels write and the view draws from.
+fn position_buffer(device: &wgpu::Device, label: &str, n: usize) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (n.max(1) as u64) * POSITION_BYTES,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::VERTEX,
+        mapped_at_creation: false,
+    })
+}
+
+/// The mesh's bind group: one step's parameters (a dynamic offset into `steps`), then the
+/// ring offsets, the ring, the original positions and the weights.
+fn mesh_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    steps: &wgpu::Buffer,
+    buffers: [&wgpu::Buffer; 4],
+) -> wgpu::BindGroup {
+    let mut entries = vec![wgpu::BindGroupEntry {
+        binding: 0,
+        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: steps,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<StepParams>() as u64),
+        }),
+    }];
+    entries.extend(
+        (1u32..)
+            .zip(buffers)
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+    );
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("meshsmooth mesh"),
+        layout,
+        entries: &entries,
+    })
+}
+
+impl PositionGroups {
+    /// Every pairing of the position buffers the filters read and write.
+    fn new(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        original: &wgpu::Buffer,
+        [a, b, aux]: [&wgpu::Buffer; 3],
+    ) -> Self {
+        let pair = |from, to| bind_group(device, &layouts.pair, &[from, to]);
+        Self {
+            a_to_b: pair(a, b),
+            b_to_a: pair(b, a),
+            a_to_aux: pair(a, aux),
+            aux_to_a: pair(aux, a),
+            sinc_first: bind_group(device, &layouts.sinc_first, &[original, b, aux, a]),
+            sinc_from_a: bind_group(device, &layouts.sinc_term, &[a, b, aux]),
+            sinc_from_b: bind_group(device, &layouts.sinc_term, &[b, a, aux]),
+        }
+    }
+}
+
 impl GpuMesh {
     pub(crate) fn upload(
         device: &wgpu::Device,
@@ -177,63 +242,18 @@ impl GpuMesh {
             "meshsmooth weights",
             bytemuck::cast_slice(&vec![1.0f32; n]),
         );
-        let positions = |label| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: (n.max(1) as u64) * POSITION_BYTES,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_SRC
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::VERTEX,
-                mapped_at_creation: false,
-            })
-        };
         let (a, b, aux) = (
-            positions("meshsmooth positions a"),
-            positions("meshsmooth positions b"),
-            positions("meshsmooth positions aux"),
+            position_buffer(device, "meshsmooth positions a", n),
+            position_buffer(device, "meshsmooth positions b", n),
+            position_buffer(device, "meshsmooth positions aux", n),
         );
-
-        let mesh_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("meshsmooth mesh"),
-            layout: &layouts.mesh,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &steps,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<StepParams>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: offsets.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: neighbors.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: original.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: weights.as_entire_binding(),
-                },
-            ],
-        });
-        let pair = |from, to| bind_group(device, &layouts.pair, &[from, to]);
-        let groups = PositionGroups {
-            a_to_b: pair(&a, &b),
-            b_to_a: pair(&b, &a),
-            a_to_aux: pair(&a, &aux),
-            aux_to_a: pair(&aux, &a),
-            sinc_first: bind_group(device, &layouts.sinc_first, &[&original, &b, &aux, &a]),
-            sinc_from_a: bind_group(device, &layouts.sinc_term, &[&a, &b, &aux]),
-            sinc_from_b: bind_group(device, &layouts.sinc_term, &[&b, &a, &aux]),
-        };
+        let mesh_group = mesh_group(
+            device,
+            &layouts.mesh,
+            &steps,
+            [&offsets, &neighbors, &original, &weights],
+        );
+        let groups = PositionGroups::new(device, layouts, &original, [&a, &b, &aux]);
         let centre = bounding_box(&mesh.positions).map_or([0.0; 3], |(lo, hi)| {
             std::array::from_fn(|k| ((f64::from(lo[k]) + f64::from(hi[k])) * 0.5) as f32)
         });
