@@ -81,20 +81,20 @@ pub const RAS_MM_TO_GLTF: [f64; 16] = [
     0.0, 0.0, 0.0, 1.0,
 ];
 
-/// Serialises the case.
-pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, ExportError> {
-    if case.structures.is_empty() {
-        return Err(ExportError::NoTriangles);
-    }
-    let estimate: u64 = case
-        .structures
-        .iter()
-        .map(|s| s.original.vertex_count() as u64 * 44 + s.original.triangle_count() as u64 * 12)
-        .sum();
-    if estimate > u64::from(u32::MAX) {
-        return Err(too_large());
-    }
-    let mut b = Builder::default();
+/// The scene's nodes (the root first, then each structure, with a node per group after its
+/// first structure), the structures' meshes and their materials.
+struct SceneParts {
+    nodes: Vec<Value>,
+    meshes: Vec<Value>,
+    materials: Vec<Value>,
+}
+
+fn scene_parts(
+    case: &Case,
+    title: &str,
+    options: &CaseGltfOptions,
+    b: &mut Builder,
+) -> Result<SceneParts, ExportError> {
     let mut nodes = vec![json!({})];
     let mut meshes = Vec::new();
     let mut materials = Vec::new();
@@ -102,7 +102,7 @@ pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, Exp
     let mut group_nodes: Vec<(&str, usize)> = Vec::new();
     for s in &case.structures {
         let index = meshes.len();
-        meshes.push(structure_mesh(&mut b, s, index, options)?);
+        meshes.push(structure_mesh(b, s, index, options)?);
         materials.push(material(s, options.unlit));
         let mut record = structure_record(s);
         if let Some(color) = s.color.get(..3) {
@@ -122,16 +122,42 @@ pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, Exp
             },
         }
     }
-    let title = if case.title.is_empty() {
-        "case"
-    } else {
-        &case.title
-    };
     let mut root = json!({ "name": title, "children": root_children });
     if options.frame == SceneFrame::Gltf {
         root["matrix"] = json!(RAS_MM_TO_GLTF);
     }
     nodes[0] = root;
+    Ok(SceneParts {
+        nodes,
+        meshes,
+        materials,
+    })
+}
+
+/// Serialises the case.
+pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, ExportError> {
+    if case.structures.is_empty() {
+        return Err(ExportError::NoTriangles);
+    }
+    let estimate: u64 = case
+        .structures
+        .iter()
+        .map(|s| s.original.vertex_count() as u64 * 44 + s.original.triangle_count() as u64 * 12)
+        .sum();
+    if estimate > u64::from(u32::MAX) {
+        return Err(too_large());
+    }
+    let title = if case.title.is_empty() {
+        "case"
+    } else {
+        &case.title
+    };
+    let mut b = Builder::default();
+    let SceneParts {
+        nodes,
+        meshes,
+        materials,
+    } = scene_parts(case, title, options, &mut b)?;
     let scene = json!({
         "name": title,
         "nodes": [0],
