@@ -7,7 +7,7 @@
 use super::backend::{Backend, GpuEngine};
 use super::params::filter;
 use crate::gpu;
-use crate::mesh::Topology;
+use crate::mesh::{Mesh, Topology};
 use crate::metrics::{self, DriftingReference, Original};
 use crate::smooth::{self, Filter, NoObserver, Params};
 use serde::Serialize;
@@ -70,49 +70,13 @@ pub(super) fn run(
     };
     let mut results = Vec::new();
     for f in filters {
-        let mut params = Params::defaults(f);
-        if let Some(n) = iterations {
-            params.iterations = n;
-        }
-        params.validate().map_err(|e| e.to_string())?;
-        let cpu_seconds = best_of(repeat, || {
-            smooth::smooth(&mesh, &topology, &params, None, &mut NoObserver);
-        });
-        let (seconds, gpu_figures) = match gpu.as_mut() {
-            None => (cpu_seconds, None),
-            Some(g) => {
-                let seconds = g.best_of(repeat, &params, false)?;
-                let with_drift = g.best_of(repeat, &params, true)?;
-                let measure = g.measure_best_of(repeat, &original)?;
-                (seconds, Some((measure, (with_drift - seconds).max(0.0))))
-            }
+        let case = BenchCase {
+            mesh: &mesh,
+            topology: &topology,
+            original: &original,
+            repeat,
         };
-        let mut positions = Vec::new();
-        let mut reference = Vec::new();
-        let with_drift = best_of(repeat, || {
-            let mut drift = DriftingReference::new(&original);
-            positions = smooth::smooth(&mesh, &topology, &params, None, &mut drift);
-            reference = drift.into_reference();
-        });
-        let measure_seconds = best_of(repeat, || {
-            metrics::measure(&original, &positions, &reference, 0.5);
-        });
-        let vertex_iterations = mesh.vertex_count() as f64 * params.iterations as f64;
-        results.push(BenchResult {
-            filter: f.name(),
-            vertices: mesh.vertex_count(),
-            iterations: params.iterations,
-            seconds,
-            vertex_iterations_per_second: vertex_iterations / seconds.max(1e-12),
-            measure_seconds,
-            drift_seconds: (with_drift - cpu_seconds).max(0.0),
-            laplace10_seconds: laplace10,
-            backend: if gpu.is_some() { "gpu" } else { "cpu" },
-            threads: rayon::current_num_threads(),
-            adapter: gpu.as_ref().map(|g| g.adapter.clone()),
-            gpu_measure_seconds: gpu_figures.map(|(m, _)| m),
-            gpu_drift_seconds: gpu_figures.map(|(_, d)| d),
-        });
+        results.push(bench_filter(&case, f, iterations, laplace10, gpu.as_mut())?);
     }
     if json {
         let text = if results.len() == 1 {
@@ -122,45 +86,125 @@ pub(super) fn run(
         };
         outln!("{text}");
     } else {
-        let engine = match &gpu {
-            Some(g) => format!(
-                "gpu backend on {} (measure and drift columns: the cpu's; gpu's below)",
-                g.adapter
-            ),
-            None => "cpu backend".to_string(),
-        };
-        outln!(
-            "{}: {} vertices, {engine}, {} threads, best of {repeat}",
-            file.display(),
-            mesh.vertex_count(),
-            rayon::current_num_threads()
-        );
-        outln!("filter   iter   smooth ms   M vertex-it/s   measure ms   drift ms   measure / 10 Laplace it");
-        for r in &results {
-            outln!(
-                "{:<8} {:>4} {:>11.2} {:>15.1} {:>12.2} {:>10.2} {:>25.2}",
-                r.filter,
-                r.iterations,
-                r.seconds * 1e3,
-                r.vertex_iterations_per_second / 1e6,
-                r.measure_seconds * 1e3,
-                r.drift_seconds * 1e3,
-                r.measure_seconds / r.laplace10_seconds.max(1e-12)
-            );
-        }
-        if gpu.is_some() {
-            outln!("filter   gpu measure ms   gpu drift ms");
-            for r in &results {
-                outln!(
-                    "{:<8} {:>15.2} {:>14.2}",
-                    r.filter,
-                    r.gpu_measure_seconds.unwrap_or(0.0) * 1e3,
-                    r.gpu_drift_seconds.unwrap_or(0.0) * 1e3
-                );
-            }
-        }
+        let adapter = gpu.as_ref().map(|g| g.adapter.as_str());
+        print_table(file, mesh.vertex_count(), adapter, repeat, &results);
     }
     Ok(())
+}
+
+/// The mesh a benchmark runs on, and how often each run is repeated (the best counts).
+struct BenchCase<'a> {
+    mesh: &'a Mesh,
+    topology: &'a Topology,
+    original: &'a Original,
+    repeat: usize,
+}
+
+/// One filter's figures: smoothing (on the GPU too, when given), the drift and the measures.
+fn bench_filter(
+    case: &BenchCase<'_>,
+    f: Filter,
+    iterations: Option<u32>,
+    laplace10: f64,
+    gpu: Option<&mut GpuBench>,
+) -> Result<BenchResult, String> {
+    let BenchCase {
+        mesh,
+        topology,
+        original,
+        repeat,
+    } = *case;
+    let adapter = gpu.as_ref().map(|g| g.adapter.clone());
+    let mut params = Params::defaults(f);
+    if let Some(n) = iterations {
+        params.iterations = n;
+    }
+    params.validate().map_err(|e| e.to_string())?;
+    let cpu_seconds = best_of(repeat, || {
+        smooth::smooth(mesh, topology, &params, None, &mut NoObserver);
+    });
+    let (seconds, gpu_figures) = match gpu {
+        None => (cpu_seconds, None),
+        Some(g) => {
+            let seconds = g.best_of(repeat, &params, false)?;
+            let with_drift = g.best_of(repeat, &params, true)?;
+            let measure = g.measure_best_of(repeat, original)?;
+            (seconds, Some((measure, (with_drift - seconds).max(0.0))))
+        }
+    };
+    let mut positions = Vec::new();
+    let mut reference = Vec::new();
+    let with_drift = best_of(repeat, || {
+        let mut drift = DriftingReference::new(original);
+        positions = smooth::smooth(mesh, topology, &params, None, &mut drift);
+        reference = drift.into_reference();
+    });
+    let measure_seconds = best_of(repeat, || {
+        metrics::measure(original, &positions, &reference, 0.5);
+    });
+    let vertex_iterations = mesh.vertex_count() as f64 * params.iterations as f64;
+    Ok(BenchResult {
+        filter: f.name(),
+        vertices: mesh.vertex_count(),
+        iterations: params.iterations,
+        seconds,
+        vertex_iterations_per_second: vertex_iterations / seconds.max(1e-12),
+        measure_seconds,
+        drift_seconds: (with_drift - cpu_seconds).max(0.0),
+        laplace10_seconds: laplace10,
+        backend: if adapter.is_some() { "gpu" } else { "cpu" },
+        threads: rayon::current_num_threads(),
+        adapter,
+        gpu_measure_seconds: gpu_figures.map(|(m, _)| m),
+        gpu_drift_seconds: gpu_figures.map(|(_, d)| d),
+    })
+}
+
+/// The results as a table, the GPU's own columns after it.
+fn print_table(
+    file: &Path,
+    vertices: usize,
+    adapter: Option<&str>,
+    repeat: usize,
+    results: &[BenchResult],
+) {
+    let engine = match adapter {
+        Some(adapter) => format!(
+            "gpu backend on {} (measure and drift columns: the cpu's; gpu's below)",
+            adapter
+        ),
+        None => "cpu backend".to_string(),
+    };
+    outln!(
+        "{}: {} vertices, {engine}, {} threads, best of {repeat}",
+        file.display(),
+        vertices,
+        rayon::current_num_threads()
+    );
+    outln!("filter   iter   smooth ms   M vertex-it/s   measure ms   drift ms   measure / 10 Laplace it");
+    for r in results {
+        outln!(
+            "{:<8} {:>4} {:>11.2} {:>15.1} {:>12.2} {:>10.2} {:>25.2}",
+            r.filter,
+            r.iterations,
+            r.seconds * 1e3,
+            r.vertex_iterations_per_second / 1e6,
+            r.measure_seconds * 1e3,
+            r.drift_seconds * 1e3,
+            r.measure_seconds / r.laplace10_seconds.max(1e-12)
+        );
+    }
+    if adapter.is_some() {
+        outln!("filter   gpu measure ms   gpu drift ms");
+        for r in results {
+            outln!(
+                "{:<8} {:>15.2} {:>14.2}",
+                r.filter,
+                r.gpu_measure_seconds.unwrap_or(0.0) * 1e3,
+                r.gpu_drift_seconds.unwrap_or(0.0) * 1e3
+            );
+        }
+    }
 }
 
 fn best_of(repeat: usize, mut f: impl FnMut()) -> f64 {
