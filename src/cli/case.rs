@@ -13,7 +13,7 @@ use crate::case::{self, Case, SuggestAllOptions, SuggestAllProgress};
 use crate::export::{self, CaseGltfOptions, Container, SceneFrame};
 use crate::segmentation::{ExtractOptions, OpenOptions};
 use crate::smooth::Filter;
-use crate::suggest::{Progress, SearchMethod};
+use crate::suggest::{Progress, SearchMethod, Suggestion};
 
 #[derive(clap::Subcommand)]
 pub(super) enum CaseCommand {
@@ -121,43 +121,14 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         method: args.search,
         max_volume_change: args.max_volume_change.0.map(|p| p / 100.0),
     };
-    let what = format!(
-        "suggesting and smoothing {} structures",
-        case.structures.len()
-    );
-    let line = Mutex::new(ProgressLine::on_terminal(&what, false));
     let suggest_started = Instant::now();
-    let report = |p: SuggestAllProgress| {
-        if let Ok(mut line) = line.lock() {
-            line.update(Progress {
-                done: p.structures_done,
-                total: p.structures,
-            });
-        }
-        true
-    };
-    let suggestions = case::suggest_all(&mut case, &options, &report);
-    if let Ok(line) = line.into_inner() {
-        line.finish();
-    }
-    let suggestions = suggestions.map_err(|e| e.to_string())?;
+    let suggestions = suggest_all_shown(&mut case, &options)?;
     let suggest_seconds = suggest_started.elapsed().as_secs_f64();
     let after = case::check(&case, true);
     let changes = case::relations::changes(&before, &after);
 
-    let gltf = CaseGltfOptions {
-        frame: if args.millimetres {
-            SceneFrame::Millimetres
-        } else {
-            SceneFrame::Gltf
-        },
-        container,
-        original_as_morph_target: !args.no_original,
-        local_error: args.local_error,
-        unlit: args.unlit,
-    };
-    let bytes =
-        export::write_case(&case, &gltf).map_err(|e| format!("{}: {e}", args.output.display()))?;
+    let bytes = export::write_case(&case, &gltf_options(args, container))
+        .map_err(|e| format!("{}: {e}", args.output.display()))?;
     super::write_file(&args.output, &bytes)?;
 
     let evaluations: usize = suggestions.iter().flatten().map(|s| s.evaluations).sum();
@@ -184,6 +155,47 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// [`case::suggest_all`] with a progress line on the terminal.
+fn suggest_all_shown(
+    case: &mut Case,
+    options: &SuggestAllOptions,
+) -> Result<Vec<Option<Suggestion>>, String> {
+    let what = format!(
+        "suggesting and smoothing {} structures",
+        case.structures.len()
+    );
+    let line = Mutex::new(ProgressLine::on_terminal(&what, false));
+    let report = |p: SuggestAllProgress| {
+        if let Ok(mut line) = line.lock() {
+            line.update(Progress {
+                done: p.structures_done,
+                total: p.structures,
+            });
+        }
+        true
+    };
+    let suggestions = case::suggest_all(case, options, &report);
+    if let Ok(line) = line.into_inner() {
+        line.finish();
+    }
+    suggestions.map_err(|e| e.to_string())
+}
+
+/// How `case build` writes the glTF.
+fn gltf_options(args: &BuildArgs, container: Container) -> CaseGltfOptions {
+    CaseGltfOptions {
+        frame: if args.millimetres {
+            SceneFrame::Millimetres
+        } else {
+            SceneFrame::Gltf
+        },
+        container,
+        original_as_morph_target: !args.no_original,
+        local_error: args.local_error,
+        unlit: args.unlit,
+    }
 }
 
 /// A percentage, or none.
