@@ -13,7 +13,9 @@ use crate::session::Session;
 use crate::smooth::Params;
 use crate::suggest::{Curve, Param};
 use eframe::egui;
-use egui_plot::{HLine, HoverPosition, Line, LineStyle, Plot, PlotPoints, Points, VLine};
+use egui_plot::{
+    HLine, HoverPosition, Line, LineStyle, Plot, PlotPoint, PlotPoints, PlotUi, Points, VLine,
+};
 
 const CURVATURE: egui::Color32 = egui::Color32::from_rgb(0x5d, 0xa5, 0xda);
 const ERROR: egui::Color32 = egui::Color32::from_rgb(0xfa, 0xa4, 0x3a);
@@ -102,6 +104,52 @@ fn column(
     drawn: &mut GraphColumn,
 ) -> Option<f64> {
     let param = curve.param;
+    let diverging: Vec<f64> = (curve.samples.iter())
+        .filter(|s| s.terms.roughens())
+        .map(|s| s.value)
+        .collect();
+    column_heading(ui, curve, stale, !diverging.is_empty());
+    let strip_height = ((ui.available_height() - 30.0) / STRIPS.len() as f32).clamp(56.0, 120.0);
+    let link = ui.scope_id().with(("graphs_x", format!("{param:?}")));
+    let mut picked = None;
+    for (k, strip) in STRIPS.iter().enumerate() {
+        let last = k + 1 == STRIPS.len();
+        let shown = StripShown {
+            curve,
+            strip,
+            k,
+            last,
+            diverging: &diverging,
+            half_vd,
+        };
+        let response = strip_plot(param, k, last, strip_height, link)
+            .show(ui, |plot_ui| draw_strip(plot_ui, &shown));
+        let bounds = response.transform.bounds();
+        drawn.strips.push((
+            (*response.transform.frame()).into(),
+            [bounds.min()[0], bounds.max()[0]],
+        ));
+        // The measure's name inside its strip, top left: every axis says what it is.
+        let rect = response.response.rect;
+        ui.painter().text(
+            egui::pos2(rect.left() + 46.0, rect.top() + 2.0),
+            egui::Align2::LEFT_TOP,
+            strip.title,
+            egui::FontId::proportional(12.0),
+            strip.color,
+        );
+        response.response.clone().on_hover_text(strip.help);
+        if let Some(at) = response.inner {
+            picked = nearest(curve, at.x);
+        }
+    }
+    picked
+}
+
+/// The column's heading (the parameter, its unit, where S is lowest) and its notes: that the
+/// curves are being updated, and what red bars mean where the filter diverges.
+fn column_heading(ui: &mut egui::Ui, curve: &Curve, stale: bool, diverges: bool) {
+    let param = curve.param;
     let unit = param.unit();
     let mut heading = format!(
         "{}{}",
@@ -123,114 +171,109 @@ fn column(
     if stale {
         ui.small("Updating for the new values…");
     }
-    let diverging: Vec<f64> = curve
-        .samples
-        .iter()
-        .filter(|s| s.terms.roughens())
-        .map(|s| s.value)
-        .collect();
-    if !diverging.is_empty() {
+    if diverges {
         ui.small(
             egui::RichText::new("Red: the filter diverges here (rougher than the original)")
                 .color(egui::Color32::from_rgb(0xe0, 0x60, 0x60)),
         )
         .on_hover_text(
-            "At these values the filter amplifies the mesh's finest ripples instead of damping              them, and repeating it blows the mesh up. They are never suggested.",
+            "At these values the filter amplifies the mesh's finest ripples instead of damping \
+             them, and repeating it blows the mesh up. They are never suggested.",
         );
     }
-    let strip_height = ((ui.available_height() - 30.0) / STRIPS.len() as f32).clamp(56.0, 120.0);
-    let link = ui.scope_id().with(("graphs_x", format!("{param:?}")));
-    let mut picked = None;
-    for (k, strip) in STRIPS.iter().enumerate() {
-        let runs = curve.runs(strip.value);
-        let last = k + 1 == STRIPS.len();
-        let plot = Plot::new(("graph", format!("{param:?}"), k))
-            .height(strip_height)
-            .link_axis(link, [true, false])
-            .link_cursor(link, [true, false])
-            .allow_zoom(false)
-            .allow_scroll(false)
-            .allow_drag(false)
-            .allow_boxed_zoom(false)
-            .allow_double_click_reset(false)
-            .show_x(true)
-            .show_y(true)
-            .y_axis_min_width(40.0)
-            .show_axes([last, true])
-            .x_axis_label(if last { label(param) } else { String::new() })
-            .label_formatter(move |hover| {
-                let (HoverPosition::NearDataPoint { position, .. }
-                | HoverPosition::Elsewhere { position }) = hover;
-                Some(format!(
-                    "{} = {}\n{:.4}",
-                    label(param),
-                    format_value(param, position.x),
-                    position.y
-                ))
-            });
-        let response = plot.show(ui, |plot_ui| {
-            if runs.is_empty() {
-                return None;
-            }
-            for &x in &diverging {
-                plot_ui.vline(VLine::new("filter diverges", x).color(DIVERGES).width(5.0));
-            }
-            for run in &runs {
-                plot_ui.line(
-                    Line::new(strip.title, PlotPoints::from(run.clone()))
-                        .color(strip.color)
-                        .width(2.0),
-                );
-            }
-            plot_ui.vline(
-                VLine::new("current value", curve.current)
-                    .color(CURRENT)
-                    .style(LineStyle::dashed_loose()),
-            );
-            if k == 1 {
-                if let Some(h) = half_vd {
-                    plot_ui.hline(
-                        HLine::new("half voxel diagonal", h)
-                            .color(REFERENCE)
-                            .style(LineStyle::dotted_dense()),
-                    );
-                }
-            }
-            if let Some(best) = curve.best.and_then(|i| curve.samples.get(i)) {
-                if let Some(v) = (strip.value)(best) {
-                    plot_ui.points(
-                        Points::new("lowest S", vec![[best.value, v]])
-                            .color(SCORE)
-                            .radius(if last { 5.0 } else { 3.5 })
-                            .shape(egui_plot::MarkerShape::Diamond),
-                    );
-                }
-            }
-            let r = plot_ui.response();
-            (r.clicked() || r.dragged())
-                .then(|| plot_ui.pointer_coordinate())
-                .flatten()
-        });
-        let bounds = response.transform.bounds();
-        drawn.strips.push((
-            (*response.transform.frame()).into(),
-            [bounds.min()[0], bounds.max()[0]],
-        ));
-        // The measure's name inside its strip, top left: every axis says what it is.
-        let rect = response.response.rect;
-        ui.painter().text(
-            egui::pos2(rect.left() + 46.0, rect.top() + 2.0),
-            egui::Align2::LEFT_TOP,
-            strip.title,
-            egui::FontId::proportional(12.0),
-            strip.color,
+}
+
+/// Strip `k` of `param`'s column: linked along x with the column's other strips, fixed (a
+/// click or drag sets the parameter), the x axis shown on the last strip only.
+fn strip_plot(param: Param, k: usize, last: bool, height: f32, link: egui::Id) -> Plot<'static> {
+    Plot::new(("graph", format!("{param:?}"), k))
+        .height(height)
+        .link_axis(link, [true, false])
+        .link_cursor(link, [true, false])
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .allow_drag(false)
+        .allow_boxed_zoom(false)
+        .allow_double_click_reset(false)
+        .show_x(true)
+        .show_y(true)
+        .y_axis_min_width(40.0)
+        .show_axes([last, true])
+        .x_axis_label(if last { label(param) } else { String::new() })
+        .label_formatter(move |hover| {
+            let (HoverPosition::NearDataPoint { position, .. }
+            | HoverPosition::Elsewhere { position }) = hover;
+            Some(format!(
+                "{} = {}\n{:.4}",
+                label(param),
+                format_value(param, position.x),
+                position.y
+            ))
+        })
+}
+
+/// What one strip draws.
+struct StripShown<'a> {
+    curve: &'a Curve,
+    strip: &'a Strip,
+    k: usize,
+    last: bool,
+    /// Sample values where the filter diverges.
+    diverging: &'a [f64],
+    /// Half the voxel diagonal (mm), the accuracy strip's reference, when known.
+    half_vd: Option<f64>,
+}
+
+/// Draws a strip's curves and marks; the point clicked or dragged at, if any.
+fn draw_strip(plot_ui: &mut PlotUi<'_>, shown: &StripShown<'_>) -> Option<PlotPoint> {
+    let StripShown {
+        curve,
+        strip,
+        k,
+        last,
+        diverging,
+        half_vd,
+    } = *shown;
+    let runs = curve.runs(strip.value);
+    if runs.is_empty() {
+        return None;
+    }
+    for &x in diverging {
+        plot_ui.vline(VLine::new("filter diverges", x).color(DIVERGES).width(5.0));
+    }
+    for run in &runs {
+        plot_ui.line(
+            Line::new(strip.title, PlotPoints::from(run.clone()))
+                .color(strip.color)
+                .width(2.0),
         );
-        response.response.clone().on_hover_text(strip.help);
-        if let Some(at) = response.inner {
-            picked = nearest(curve, at.x);
+    }
+    plot_ui.vline(
+        VLine::new("current value", curve.current)
+            .color(CURRENT)
+            .style(LineStyle::dashed_loose()),
+    );
+    if let Some(h) = half_vd.filter(|_| k == 1) {
+        plot_ui.hline(
+            HLine::new("half voxel diagonal", h)
+                .color(REFERENCE)
+                .style(LineStyle::dotted_dense()),
+        );
+    }
+    if let Some(best) = curve.best.and_then(|i| curve.samples.get(i)) {
+        if let Some(v) = (strip.value)(best) {
+            plot_ui.points(
+                Points::new("lowest S", vec![[best.value, v]])
+                    .color(SCORE)
+                    .radius(if last { 5.0 } else { 3.5 })
+                    .shape(egui_plot::MarkerShape::Diamond),
+            );
         }
     }
-    picked
+    let r = plot_ui.response();
+    (r.clicked() || r.dragged())
+        .then(|| plot_ui.pointer_coordinate())
+        .flatten()
 }
 
 /// The sample value nearest to `x` (samples are the values the sweep could set).
