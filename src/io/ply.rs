@@ -151,6 +151,40 @@ struct Pending {
     line: usize,
 }
 
+/// The encoding a `format` line names.
+fn parse_encoding(name: &[u8], line: usize) -> Result<Encoding, LoadError> {
+    Ok(match name {
+        b"ascii" => Encoding::Ascii,
+        b"binary_little_endian" => Encoding::BinaryLittleEndian,
+        b"binary_big_endian" => Encoding::BinaryBigEndian,
+        other => {
+            return Err(syntax(
+                line,
+                format!("unknown format '{}'", text::show(other)),
+            ))
+        }
+    })
+}
+
+impl Pending {
+    /// An element declared on `line` as `element NAME COUNT`, its properties to follow.
+    fn begin(name: &[u8], count: &[u8], line: usize) -> Result<Self, LoadError> {
+        let count = text::parse_int(count)
+            .and_then(|c| u64::try_from(c).ok())
+            .ok_or_else(|| syntax(line, format!("bad element count '{}'", text::show(count))))?;
+        Ok(Pending {
+            element: Element {
+                name: String::from_utf8_lossy(name).into_owned(),
+                count,
+                properties: Vec::new(),
+                role: Role::Skip,
+            },
+            names: Vec::new(),
+            line,
+        })
+    }
+}
+
 impl Header {
     fn parse(bytes: &[u8]) -> Result<Header, LoadError> {
         let mut lines = Lines::new(bytes);
@@ -182,38 +216,12 @@ impl Header {
             match words.as_slice() {
                 [] => {}
                 [b"comment" | b"obj_info", ..] => {}
-                [b"format", name, ..] => {
-                    encoding = Some(match *name {
-                        b"ascii" => Encoding::Ascii,
-                        b"binary_little_endian" => Encoding::BinaryLittleEndian,
-                        b"binary_big_endian" => Encoding::BinaryBigEndian,
-                        other => {
-                            return Err(syntax(
-                                line,
-                                format!("unknown format '{}'", text::show(other)),
-                            ))
-                        }
-                    })
-                }
+                [b"format", name, ..] => encoding = Some(parse_encoding(name, line)?),
                 [b"element", name, count] => {
                     if let Some(done) = pending.take() {
                         elements.push(finish(done)?);
                     }
-                    let count = text::parse_int(count)
-                        .and_then(|c| u64::try_from(c).ok())
-                        .ok_or_else(|| {
-                            syntax(line, format!("bad element count '{}'", text::show(count)))
-                        })?;
-                    pending = Some(Pending {
-                        element: Element {
-                            name: String::from_utf8_lossy(name).into_owned(),
-                            count,
-                            properties: Vec::new(),
-                            role: Role::Skip,
-                        },
-                        names: Vec::new(),
-                        line,
-                    });
+                    pending = Some(Pending::begin(name, count, line)?);
                 }
                 [b"property", rest @ ..] => {
                     let Some(current) = pending.as_mut() else {

@@ -51,6 +51,56 @@ fn syntax(format: Format, what: &'static str, index: usize, detail: String) -> L
     }
 }
 
+/// Where a buffer view lies in its buffer, and the stride of its elements.
+struct ViewSpan {
+    buffer_index: usize,
+    view_offset: u64,
+    view_len: u64,
+    stride: usize,
+}
+
+/// Checks buffer view `view_index` (read by accessor `index`, of `element`-byte elements): its
+/// buffer exists, it lies inside that buffer's declared length, its stride holds an element.
+fn view_span(
+    root: &Root,
+    view: &::gltf::json::buffer::View,
+    view_index: usize,
+    index: usize,
+    element: usize,
+    format: Format,
+) -> Result<ViewSpan, LoadError> {
+    let view_err = |detail: String| syntax(format, "buffer view", view_index, detail);
+    let buffer_index = view.buffer.value();
+    let buffer = (root.buffers.get(buffer_index))
+        .ok_or_else(|| view_err(format!("buffer {buffer_index} does not exist")))?;
+    let view_offset = view.byte_offset.map_or(0, |o| o.0);
+    let view_len = view.byte_length.0;
+    if view_offset
+        .checked_add(view_len)
+        .is_none_or(|end| end > buffer.byte_length.0)
+    {
+        return Err(view_err(format!(
+            "bytes {view_offset}..+{view_len} lie past the end of buffer {buffer_index} ({} bytes)",
+            buffer.byte_length.0
+        )));
+    }
+    let stride = match view.byte_stride {
+        Some(s) if s.0 != 0 => s.0,
+        _ => element,
+    };
+    if stride < element {
+        return Err(view_err(format!(
+            "byteStride {stride} is smaller than accessor {index}'s element size {element}"
+        )));
+    }
+    Ok(ViewSpan {
+        buffer_index,
+        view_offset,
+        view_len,
+        stride,
+    })
+}
+
 /// Resolves accessor `index` and checks that every element it reads lies inside its buffer view,
 /// and the view inside its buffer's declared `byteLength`.
 pub(super) fn layout(root: &Root, index: usize, format: Format) -> Result<Layout, LoadError> {
@@ -79,46 +129,12 @@ pub(super) fn layout(root: &Root, index: usize, format: Format) -> Result<Layout
         .buffer_views
         .get(view_index)
         .ok_or_else(|| err(format!("buffer view {view_index} does not exist")))?;
-    let buffer_index = view.buffer.value();
-    let buffer = root.buffers.get(buffer_index).ok_or_else(|| {
-        syntax(
-            format,
-            "buffer view",
-            view_index,
-            format!("buffer {buffer_index} does not exist"),
-        )
-    })?;
-
-    let view_offset = view.byte_offset.map_or(0, |o| o.0);
-    let view_len = view.byte_length.0;
-    if view_offset
-        .checked_add(view_len)
-        .is_none_or(|end| end > buffer.byte_length.0)
-    {
-        return Err(syntax(
-            format,
-            "buffer view",
-            view_index,
-            format!(
-                "bytes {view_offset}..+{view_len} lie past the end of buffer {buffer_index} ({} bytes)",
-                buffer.byte_length.0
-            ),
-        ));
-    }
-    let stride = match view.byte_stride {
-        Some(s) if s.0 != 0 => s.0,
-        _ => element,
-    };
-    if stride < element {
-        return Err(syntax(
-            format,
-            "buffer view",
-            view_index,
-            format!(
-                "byteStride {stride} is smaller than accessor {index}'s element size {element}"
-            ),
-        ));
-    }
+    let ViewSpan {
+        buffer_index,
+        view_offset,
+        view_len,
+        stride,
+    } = view_span(root, view, view_index, index, element, format)?;
 
     let offset = a.byte_offset.map_or(0, |o| o.0);
     let count = a.count.0;
