@@ -31,9 +31,9 @@ fn truncated(offset: usize, detail: String) -> LoadError {
     }
 }
 
-/// Splits a GLB file into its JSON and BIN chunks. Unknown chunk types are skipped, as the
-/// specification asks of readers.
-pub(super) fn split(bytes: &[u8]) -> Result<Glb<'_>, LoadError> {
+/// The file's length as its GLB header declares it, after checking the magic, the version
+/// and that the length fits the bytes and holds a JSON chunk's header.
+fn declared_length(bytes: &[u8]) -> Result<usize, LoadError> {
     if bytes.len() < HEADER_LEN {
         return Err(truncated(
             bytes.len(),
@@ -67,6 +67,13 @@ pub(super) fn split(bytes: &[u8]) -> Result<Glb<'_>, LoadError> {
             detail: format!("the header's length {declared} is too small to hold a JSON chunk"),
         });
     }
+    Ok(declared)
+}
+
+/// Splits a GLB file into its JSON and BIN chunks. Unknown chunk types are skipped, as the
+/// specification asks of readers.
+pub(super) fn split(bytes: &[u8]) -> Result<Glb<'_>, LoadError> {
+    let declared = declared_length(bytes)?;
     // Bytes past the declared length are not part of the file.
     let file = &bytes[..declared];
 

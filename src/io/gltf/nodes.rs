@@ -3,6 +3,8 @@
 //! and `extras`, its positions as stored (not transformed), so that a case written here reads
 //! back bit for bit. What a case is made of them is the case module's business.
 
+use std::borrow::Cow;
+
 use ::gltf::json::mesh::Semantic;
 use ::gltf::json::validation::Checked;
 use ::gltf::json::Root;
@@ -54,86 +56,97 @@ pub fn read_scene(bytes: &[u8], format: Format) -> Result<GltfScene, LoadError> 
     let placed = instances(&root, format)?;
     let buffers = load_buffers(&root, bin, &vec![true; root.buffers.len()], format)?;
     let parents = parents(&root);
-    let mut nodes = Vec::with_capacity(placed.len());
-    for instance in &placed {
-        let local = Instance {
-            matrix: IDENTITY,
-            ..instance.clone()
-        };
-        let mesh = merge_loaded(&root, std::slice::from_ref(&local), &buffers, format)?;
-        let gltf_mesh = &root.meshes[instance.mesh];
-        let node = &root.nodes[instance.node];
-        let single = match gltf_mesh.primitives.as_slice() {
-            [p] => Some(p),
-            _ => None,
-        };
-        let data = |l: &Layout| -> Result<&[u8], LoadError> {
-            buffers
-                .get(l.buffer)
-                .and_then(|b| b.as_deref())
-                .ok_or_else(|| bad(format, "buffer", l.buffer, "was not loaded".into()))
-        };
-        let per_vertex = |index: usize, what: &str| -> Result<Layout, LoadError> {
-            let l = layout(&root, index, format)?;
-            if l.count != mesh.vertex_count() {
-                return Err(bad(
-                    format,
-                    "accessor",
-                    index,
-                    format!(
-                        "{what} has {} entries for {} vertices",
-                        l.count,
-                        mesh.vertex_count()
-                    ),
-                ));
-            }
-            Ok(l)
-        };
-        let morph_target = match single.and_then(|p| p.targets.as_ref()?.first()?.positions) {
-            Some(a) => {
-                let l = per_vertex(a.value(), "the morph target")?;
-                Some(finite(
-                    read_vectors::<3>(&l, data(&l)?, format)?,
-                    &l,
-                    format,
-                )?)
-            }
-            None => None,
-        };
-        let error_key = Checked::Valid(Semantic::Extras("LOCAL_ERROR".into()));
-        let local_error = match single.and_then(|p| p.attributes.get(&error_key)) {
-            Some(a) => {
-                let l = per_vertex(a.value(), "_LOCAL_ERROR")?;
-                let values = read_vectors::<1>(&l, data(&l)?, format)?;
-                Some(values.into_iter().map(|[v]| v).collect())
-            }
-            None => None,
-        };
-        let base_color = single
-            .and_then(|p| p.material)
-            .and_then(|m| root.materials.get(m.value()))
-            .map(|m| m.pbr_metallic_roughness.base_color_factor.0);
-        nodes.push(GltfNode {
-            name: node
-                .name
-                .clone()
-                .or_else(|| gltf_mesh.name.clone())
-                .unwrap_or_default(),
-            ancestors: ancestor_names(&root, &parents, instance.node),
-            matrix: instance.matrix,
-            mesh,
-            morph_target,
-            local_error,
-            base_color,
-            extras: raw_json(node.extras.as_deref()),
-        });
-    }
+    let nodes = (placed.iter())
+        .map(|instance| read_node(&root, &parents, &buffers, instance, format))
+        .collect::<Result<_, _>>()?;
     let scene = root.scene.map_or(0, |s| s.value());
     let extras = root
         .scenes
         .get(scene)
         .and_then(|s| raw_json(s.extras.as_deref()));
     Ok(GltfScene { extras, nodes })
+}
+
+/// One placed mesh of the scene as a node: its mesh in its own frame, its morph target and
+/// local error where it has one primitive, its material's colour, names and extras.
+fn read_node(
+    root: &Root,
+    parents: &[Option<usize>],
+    buffers: &[Option<Cow<[u8]>>],
+    instance: &Instance,
+    format: Format,
+) -> Result<GltfNode, LoadError> {
+    let local = Instance {
+        matrix: IDENTITY,
+        ..instance.clone()
+    };
+    let mesh = merge_loaded(root, std::slice::from_ref(&local), buffers, format)?;
+    let gltf_mesh = &root.meshes[instance.mesh];
+    let node = &root.nodes[instance.node];
+    let single = match gltf_mesh.primitives.as_slice() {
+        [p] => Some(p),
+        _ => None,
+    };
+    let data = |l: &Layout| -> Result<&[u8], LoadError> {
+        buffers
+            .get(l.buffer)
+            .and_then(|b| b.as_deref())
+            .ok_or_else(|| bad(format, "buffer", l.buffer, "was not loaded".into()))
+    };
+    let per_vertex = |index: usize, what: &str| -> Result<Layout, LoadError> {
+        let l = layout(root, index, format)?;
+        if l.count != mesh.vertex_count() {
+            return Err(bad(
+                format,
+                "accessor",
+                index,
+                format!(
+                    "{what} has {} entries for {} vertices",
+                    l.count,
+                    mesh.vertex_count()
+                ),
+            ));
+        }
+        Ok(l)
+    };
+    let morph_target = match single.and_then(|p| p.targets.as_ref()?.first()?.positions) {
+        Some(a) => {
+            let l = per_vertex(a.value(), "the morph target")?;
+            Some(finite(
+                read_vectors::<3>(&l, data(&l)?, format)?,
+                &l,
+                format,
+            )?)
+        }
+        None => None,
+    };
+    let error_key = Checked::Valid(Semantic::Extras("LOCAL_ERROR".into()));
+    let local_error = match single.and_then(|p| p.attributes.get(&error_key)) {
+        Some(a) => {
+            let l = per_vertex(a.value(), "_LOCAL_ERROR")?;
+            let values = read_vectors::<1>(&l, data(&l)?, format)?;
+            Some(values.into_iter().map(|[v]| v).collect())
+        }
+        None => None,
+    };
+    let base_color = single
+        .and_then(|p| p.material)
+        .and_then(|m| root.materials.get(m.value()))
+        .map(|m| m.pbr_metallic_roughness.base_color_factor.0);
+    Ok(GltfNode {
+        name: node
+            .name
+            .clone()
+            .or_else(|| gltf_mesh.name.clone())
+            .unwrap_or_default(),
+        ancestors: ancestor_names(root, parents, instance.node),
+        matrix: instance.matrix,
+        mesh,
+        morph_target,
+        local_error,
+        base_color,
+        extras: raw_json(node.extras.as_deref()),
+    })
 }
 
 fn bad(format: Format, what: &'static str, index: usize, detail: String) -> LoadError {
