@@ -159,8 +159,6 @@ impl GpuSmoother {
         grid: (u32, u32),
         segment: &Segment<'_>,
     ) -> Slot {
-        let p = &self.pipelines;
-        let g = &mesh.groups;
         let fresh = segment.from == 0;
         if fresh && params.filter != Filter::Sinc {
             // Laplace, Taubin and HC iterate on `a`, starting from the original.
@@ -170,7 +168,7 @@ impl GpuSmoother {
             encoder,
             pass: None,
             mesh,
-            pipelines: p,
+            pipelines: &self.pipelines,
             grid,
             segment,
             measured: 0,
@@ -178,63 +176,10 @@ impl GpuSmoother {
         if fresh {
             run.reset_reference();
         }
-        let iterations = params.iterations;
         let result = match params.filter {
-            Filter::Laplace | Filter::Taubin => {
-                let factors = if params.filter == Filter::Laplace {
-                    1
-                } else {
-                    2
-                };
-                // A later segment goes on from where the previous one left the positions.
-                let mut in_a = fresh || mesh.result != Slot::B;
-                for iteration in segment.from + 1..=iterations {
-                    for slot in 0..factors {
-                        let group = if in_a { &g.a_to_b } else { &g.b_to_a };
-                        run.step(&p.umbrella_step, slot, group);
-                        in_a = !in_a;
-                        run.drift(if in_a { Slot::A } else { Slot::B });
-                    }
-                    run.after_iteration(iteration, if in_a { Slot::A } else { Slot::B });
-                }
-                if in_a {
-                    Slot::A
-                } else {
-                    Slot::B
-                }
-            }
-            Filter::Hc => {
-                for iteration in segment.from + 1..=iterations {
-                    run.step(&p.hc_differences, 0, &g.a_to_aux);
-                    run.step(&p.hc_correct, 0, &g.aux_to_a);
-                    run.drift(Slot::A);
-                    run.after_iteration(iteration, Slot::A);
-                }
-                Slot::A
-            }
-            Filter::Sinc => {
-                // T_0 in `b`, T_1 in `a`; each term overwrites T_{k-1} with T_{k+1}.
-                run.step(&p.sinc_first, 0, &g.sinc_first);
-                let mut current_in_a = true;
-                for slot in 1..iterations {
-                    let group = if current_in_a {
-                        &g.sinc_from_a
-                    } else {
-                        &g.sinc_from_b
-                    };
-                    run.step(&p.sinc_term, slot, group);
-                    current_in_a = !current_in_a;
-                }
-                if mesh.has_weights || bound(params).is_some() {
-                    run.step(&p.sinc_finish, 0, &g.sinc_from_a);
-                }
-                // As the CPU's observers see it: the result once per degree.
-                for _ in 0..iterations {
-                    run.drift(Slot::Aux);
-                }
-                run.after_iteration(iterations, Slot::Aux);
-                Slot::Aux
-            }
+            Filter::Laplace | Filter::Taubin => run.umbrella(params, fresh),
+            Filter::Hc => run.hc(params.iterations),
+            Filter::Sinc => run.sinc(params),
         };
         run.pass = None;
         result
@@ -268,6 +213,71 @@ struct Recorder<'e, 'm> {
 }
 
 impl Recorder<'_, '_> {
+    /// Laplace (one umbrella step an iteration) or Taubin (two), ping-ponging between `a` and
+    /// `b`; a later segment goes on from where the previous one left the positions.
+    fn umbrella(&mut self, params: &Params, fresh: bool) -> Slot {
+        let (p, g) = (self.pipelines, &self.mesh.groups);
+        let factors = if params.filter == Filter::Laplace {
+            1
+        } else {
+            2
+        };
+        let mut in_a = fresh || self.mesh.result != Slot::B;
+        for iteration in self.segment.from + 1..=params.iterations {
+            for slot in 0..factors {
+                let group = if in_a { &g.a_to_b } else { &g.b_to_a };
+                self.step(&p.umbrella_step, slot, group);
+                in_a = !in_a;
+                self.drift(if in_a { Slot::A } else { Slot::B });
+            }
+            self.after_iteration(iteration, if in_a { Slot::A } else { Slot::B });
+        }
+        if in_a {
+            Slot::A
+        } else {
+            Slot::B
+        }
+    }
+
+    /// Laplace+HC: the differences into `aux`, the corrected positions back into `a`.
+    fn hc(&mut self, iterations: u32) -> Slot {
+        let (p, g) = (self.pipelines, &self.mesh.groups);
+        for iteration in self.segment.from + 1..=iterations {
+            self.step(&p.hc_differences, 0, &g.a_to_aux);
+            self.step(&p.hc_correct, 0, &g.aux_to_a);
+            self.drift(Slot::A);
+            self.after_iteration(iteration, Slot::A);
+        }
+        Slot::A
+    }
+
+    /// Windowed sinc: the Chebyshev terms, the result accumulated in `aux`.
+    fn sinc(&mut self, params: &Params) -> Slot {
+        let (p, g) = (self.pipelines, &self.mesh.groups);
+        let iterations = params.iterations;
+        // T_0 in `b`, T_1 in `a`; each term overwrites T_{k-1} with T_{k+1}.
+        self.step(&p.sinc_first, 0, &g.sinc_first);
+        let mut current_in_a = true;
+        for slot in 1..iterations {
+            let group = if current_in_a {
+                &g.sinc_from_a
+            } else {
+                &g.sinc_from_b
+            };
+            self.step(&p.sinc_term, slot, group);
+            current_in_a = !current_in_a;
+        }
+        if self.mesh.has_weights || bound(params).is_some() {
+            self.step(&p.sinc_finish, 0, &g.sinc_from_a);
+        }
+        // As the CPU's observers see it: the result once per degree.
+        for _ in 0..iterations {
+            self.drift(Slot::Aux);
+        }
+        self.after_iteration(iterations, Slot::Aux);
+        Slot::Aux
+    }
+
     /// The open compute pass (a new one after a copy).
     fn pass(&mut self) -> &mut wgpu::ComputePass<'static> {
         let encoder = &mut *self.encoder;
