@@ -1,0 +1,135 @@
+//! Files opened together, in the page's session and in the CLI, through the one path from
+//! files to a case: a label map with its colour table, several masks, refusals.
+
+#[path = "common/label_maps.rs"]
+mod label_maps;
+
+use label_maps::read;
+use meshsmooth::session::Session;
+
+/// Files dropped together in the page open as the CLI opens them, through the one path: a
+/// colour table beside a label map names its labels; several masks are one structure each,
+/// named by their files; two colour tables are refused by name.
+#[test]
+fn files_opened_together_make_the_case_the_cli_makes() {
+    use meshsmooth::case;
+    use meshsmooth::segmentation::NamedBytes;
+    use meshsmooth::worker::NamedFile;
+
+    let opened = |files: &[(&str, Vec<u8>)]| {
+        let mut session = Session::default();
+        let named = (files.iter())
+            .map(|(name, bytes)| NamedFile {
+                name: name.to_string(),
+                bytes: bytes.clone(),
+            })
+            .collect();
+        session.begin_open_files(named);
+        let outcome = session.poll_opening().expect("done");
+        (session, outcome)
+    };
+    let same = |session: &Session, expected: &case::Case| {
+        let got = session.case_structures();
+        assert_eq!(got.len(), expected.structures.len());
+        for (g, e) in got.iter().zip(&expected.structures) {
+            assert_eq!(
+                (&g.name, g.label, g.color, &g.source),
+                (&e.name, e.label, e.color, &e.source)
+            );
+            assert_eq!(g.original, e.original, "{}", g.name);
+        }
+    };
+
+    // A label map with its colour table, the table first as a drop may list it.
+    let map = read("labelmaps/case_phantom_shared.nii.gz");
+    let table = read("labelmaps/case_phantom_shared_labels.txt");
+    let (session, outcome) = opened(&[
+        ("case_phantom_shared_labels.txt", table.clone()),
+        ("case_phantom_shared.nii.gz", map.clone()),
+    ]);
+    outcome.expect("opens");
+    let cli = case::open(
+        &[NamedBytes {
+            name: "case_phantom_shared.nii.gz",
+            bytes: &map,
+        }],
+        Some(NamedBytes {
+            name: "case_phantom_shared_labels.txt",
+            bytes: &table,
+        }),
+        &Default::default(),
+    )
+    .expect("the CLI's way");
+    same(&session, &cli);
+    let names: Vec<&str> = (session.case_structures().iter())
+        .map(|s| s.name.as_str())
+        .collect();
+    assert!(!names.iter().any(|n| n.starts_with("label ")), "{names:?}");
+    let model = session.model().expect("a model");
+    assert_eq!(
+        model.name,
+        format!("case_phantom_shared.nii.gz: {}", names[0])
+    );
+    assert!(
+        session.params().max_displacement.is_some(),
+        "a label map's own bound"
+    );
+
+    // Four masks: one structure each, read and extracted one after another.
+    let masks = [
+        "sphere_r20_mask.nii.gz",
+        "ellipsoid_30_20_12_mask.nii.gz",
+        "torus_R24_r8_mask.nii.gz",
+        "bent_tube_r3.5_mask.nii.gz",
+    ];
+    let bytes: Vec<Vec<u8>> = masks
+        .iter()
+        .map(|m| read(&format!("synthetic/{m}")))
+        .collect();
+    let files: Vec<(&str, Vec<u8>)> = masks.iter().copied().zip(bytes.iter().cloned()).collect();
+    let (session, outcome) = opened(&files);
+    outcome.expect("opens");
+    let named: Vec<NamedBytes> = (masks.iter().zip(&bytes))
+        .map(|(name, bytes)| NamedBytes { name, bytes })
+        .collect();
+    same(
+        &session,
+        &case::open(&named, None, &Default::default()).unwrap(),
+    );
+    let names: Vec<&str> = (session.case_structures().iter())
+        .map(|s| s.name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "sphere r20 mask",
+            "ellipsoid 30 20 12 mask",
+            "torus R24 r8 mask",
+            "bent tube r3.5 mask"
+        ]
+    );
+    let stages: Vec<&str> = (session.open_stages().iter())
+        .map(|(d, _)| d.as_str())
+        .collect();
+    let mut expected = ["reading a mask", "extracting its surface"].repeat(4);
+    expected.extend([
+        "building the topology",
+        "checking the mesh",
+        "measuring the original",
+    ]);
+    assert_eq!(stages, expected);
+    assert_eq!(
+        session.case_file(),
+        "sphere_r20_mask.nii.gz and 3 more files"
+    );
+
+    // Two tables: which one names the labels is not for the page to guess.
+    let (session, outcome) = opened(&[
+        ("case_phantom_shared.nii.gz", map),
+        ("a.txt", table.clone()),
+        ("b.txt", table),
+    ]);
+    let why = outcome.expect_err("refused");
+    assert!(why.contains("a.txt") && why.contains("b.txt"), "{why}");
+    assert!(session.model().is_none());
+}
