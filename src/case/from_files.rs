@@ -118,6 +118,13 @@ pub fn open_staged(
     Ok(case)
 }
 
+/// The file the case's first structure comes from: label maps open before the other files.
+pub fn first_structure_file<'a>(files: &[NamedBytes<'a>]) -> Option<&'a str> {
+    (files.iter().find(|f| io::is_label_map(f.name)))
+        .or(files.first())
+        .map(|f| f.name)
+}
+
 /// Files dropped or chosen together, with a colour table among them taken out to name the
 /// label maps' labels: a table is one only beside a label map (alone, a `.txt` is no file
 /// this opens). Two tables are refused.

@@ -13,8 +13,8 @@ pub mod relations;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
 pub use from_files::{
-    file_name, open, open_staged, reading_stages, split_color_table, surface_structure,
-    CaseOpenError,
+    file_name, first_structure_file, open, open_staged, reading_stages, split_color_table,
+    surface_structure, CaseOpenError,
 };
 pub use pipeline::{
     smooth_structure, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllProgress,

@@ -132,10 +132,7 @@ pub fn open_structure(name: &str, mesh: Mesh, on_stage: &mut dyn FnMut(Stage)) -
 /// The model's name: a surface file's own name, where its one structure is the model; else
 /// the file and the structure ("case.nii.gz: liver").
 fn model_name(files: &[NamedBytes], case: &Case) -> String {
-    // The first structure comes from the first label map, else from the first file.
-    let first = (files.iter().find(|f| io::is_label_map(f.name)))
-        .or(files.first())
-        .map_or("", |f| f.name);
+    let first = case::first_structure_file(files).unwrap_or_default();
     let alone = match files {
         [_] => case.structures.len() == 1 && !io::is_label_map(first),
         _ => matches!(

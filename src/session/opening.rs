@@ -4,9 +4,10 @@
 //! request is done on the calling thread as it is made.
 
 use super::{Model, Session};
-use crate::case::Case;
+use crate::case::{self, Case};
 use crate::io::{self, Format};
 use crate::model::Opened;
+use crate::segmentation::NamedBytes;
 use crate::worker::{Input, LoadJob, NamedFile, Reply};
 
 /// How far an opening got: the stage under way (0-based) of [`LoadProgress::total`].
@@ -67,14 +68,21 @@ impl Session {
     pub fn begin_open_files(&mut self, files: Vec<NamedFile>) -> Option<String> {
         // Files to add were meant for the case open or opening now, not this one.
         self.additions.clear();
-        let first_file = (files.iter().find(|f| io::is_label_map(&f.name)))
-            .or(files.first())
-            .map_or_else(String::new, |f| f.name.clone());
+        let named: Vec<NamedBytes> = (files.iter())
+            .map(|f| NamedBytes {
+                name: &f.name,
+                bytes: &f.bytes,
+            })
+            .collect();
         // A colour table beside a label map names its labels: the case is the label map's.
-        let table = |f: &&NamedFile| io::is_label_map(&first_file) && io::is_color_table(&f.name);
-        let shown: Vec<&NamedFile> = files.iter().filter(|f| !table(f)).collect();
+        // (Two tables are refused by the worker; the name then lists every file.)
+        let shown =
+            case::split_color_table(&named).map_or_else(|_| named.clone(), |(rest, _)| rest);
+        let first_file = case::first_structure_file(&shown)
+            .unwrap_or_default()
+            .to_string();
         let name = match shown.as_slice() {
-            [one] => one.name.clone(),
+            [one] => one.name.to_string(),
             [a, b] => format!("{} and {}", a.name, b.name),
             [a, rest @ ..] => format!("{} and {} more files", a.name, rest.len()),
             [] => String::new(),
