@@ -48,15 +48,14 @@ fn a_session_opens_a_label_map_as_its_structures() {
     assert_eq!(params.filter, meshsmooth::case::DEFAULT_FILTER);
     assert_eq!(params.max_displacement, Some((0.5 * vd) as f32));
 
-    session.begin_open_structure(2).expect("structure 2 exists");
-    session.poll_opening().expect("done").expect("opens");
+    session.select_structure(2).expect("structure 2 exists");
     assert_eq!(session.current_structure(), Some(2));
     assert_eq!(
         session.model().expect("a model").name,
         "case_phantom_shared.seg.nrrd: tumor"
     );
     assert!(session
-        .begin_open_structure(4)
+        .select_structure(4)
         .unwrap_err()
         .contains("4 does not exist"));
 
@@ -170,8 +169,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     session.set_params(liver_params).unwrap();
     session.smooth_cpu();
     let liver = session.result().expect("smoothed").clone();
-    session.begin_open_structure(1).unwrap();
-    session.poll_opening().expect("done").expect("opens");
+    session.select_structure(1).unwrap();
     let others = session.other_structures();
     let kept_liver = others
         .iter()
@@ -193,12 +191,21 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     assert!(json["structures"][3]["metrics"].is_null(), "never smoothed");
     assert_ne!(json["structures"][1]["metrics"], serde_json::Value::Null);
 
-    // Back to the liver: its parameters return, and with them the same result.
-    session.begin_open_structure(0).unwrap();
-    session.poll_opening().expect("done").expect("opens");
+    // Back to the liver: a pointer moves. Nothing is opened or smoothed again: its
+    // parameters and its result are where they were, in its structure.
+    let model_before = session.model_id();
+    session.select_structure(0).unwrap();
+    assert!(
+        session.loading().is_none(),
+        "no worker opens a selected structure"
+    );
+    assert!(session.model_id() > model_before);
     assert_eq!(*session.params(), liver_params);
-    session.smooth_cpu();
+    assert_eq!(session.case_structures()[0].params, liver_params);
+    assert!(!session.needs_smoothing(), "its result is there at once");
     assert_eq!(session.result().unwrap().positions, liver.positions);
+    assert_eq!(session.result().unwrap().metrics, liver.metrics);
+    assert!(session.smooth_cpu().is_none(), "nothing to smooth");
     assert_eq!(
         session.case_structures()[2].name,
         "tumour",
@@ -359,8 +366,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     session.set_structure(0, glassy).unwrap();
     session.smooth_cpu();
     let liver_params = *session.params();
-    session.begin_open_structure(3).unwrap();
-    session.poll_opening().expect("done").expect("opens");
+    session.select_structure(3).unwrap();
     let kidney_params = Params {
         iterations: 9,
         ..Params::defaults(Filter::Taubin)
@@ -440,8 +446,7 @@ fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
     let kept = again.case_structures()[0].smoothed.clone();
     assert!(kept.is_some(), "the case glTF holds the liver smoothed");
     assert!(again.last_result().is_none(), "nothing smoothed here yet");
-    again.begin_open_structure(2).unwrap();
-    again.poll_opening().expect("done").expect("opens");
+    again.select_structure(2).unwrap();
     assert_eq!(again.current_structure(), Some(2));
     assert_eq!(again.case_structures()[0].smoothed, kept);
 }
@@ -522,8 +527,7 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     assert_eq!(mask.params.max_displacement, mask.default_bound());
     let bound = mask.default_bound();
     // It smooths as the model with its own bound.
-    session.begin_open_structure(5).unwrap();
-    session.poll_opening().expect("done").expect("opens");
+    session.select_structure(5).unwrap();
     assert_eq!(session.params().max_displacement, bound);
     assert_eq!(session.to_case().unwrap().structures.len(), 6);
 

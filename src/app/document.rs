@@ -277,19 +277,14 @@ impl Document {
         self.waiting_for_load.extend(waiter);
     }
 
-    /// Starts opening structure `index` of the open segmentation as the model, as a file opens.
-    pub fn begin_open_structure(
-        &mut self,
-        index: usize,
-        waiter: Option<LoadWaiter>,
-    ) -> Result<(), String> {
-        if let Some(replaced) = self.session.begin_open_structure(index)? {
-            let why = format!("{replaced} was not opened: another structure was chosen first");
-            for w in std::mem::take(&mut self.waiting_for_load) {
-                w(Err(why.clone()));
-            }
+    /// Makes structure `index` of the open case the model, on this thread (its settings and
+    /// result are in the case; see [`Session::select_structure`]).
+    pub fn select_structure(&mut self, index: usize) -> Result<(), String> {
+        let before = self.session.model_id();
+        self.session.select_structure(index)?;
+        if self.session.model_id() != before {
+            self.opened();
         }
-        self.waiting_for_load.extend(waiter);
         Ok(())
     }
 

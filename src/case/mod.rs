@@ -66,8 +66,16 @@ pub struct CaseStructure {
     pub tau: f64,
     /// Per-vertex weights (0 locks a vertex); `None` = all 1.
     pub weights: Option<Vec<f32>>,
-    /// The result of smoothing with `params`; `None` until smoothed.
+    /// The latest smoothing; it is the result of the settings above while
+    /// [`Self::smoothed_now`] gives it, and shown until a newer one replaces it.
     pub smoothed: Option<Smoothed>,
+    /// Each other filter's parameters as last set, so choosing it again brings them back.
+    #[serde(skip)]
+    pub other_params: Vec<Params>,
+    /// Counts the changes of its filter, parameters, tau and weights; a smoothed surface
+    /// records the count it was made for.
+    #[serde(skip)]
+    pub revision: u64,
 }
 
 /// A structure's smoothed surface and its measures against the original.
@@ -79,6 +87,30 @@ pub struct Smoothed {
     pub metrics: Metrics,
     /// Per-vertex local error (mm), when measured here (a reopened case may lack it).
     pub local_error: Option<Vec<f32>>,
+    /// Per-vertex Gaussian curvature, when measured here (a case glTF does not keep it).
+    #[serde(skip)]
+    pub curvature: Option<Vec<f32>>,
+    /// The structure's [`CaseStructure::revision`] it was made for.
+    #[serde(skip)]
+    pub revision: u64,
+}
+
+impl Smoothed {
+    /// A smoothed surface and its measures; the per-vertex ones where they were measured.
+    pub fn new(positions: Vec<[f32; 3]>, metrics: Metrics, local_error: Option<Vec<f32>>) -> Self {
+        Self {
+            positions,
+            metrics,
+            local_error,
+            curvature: None,
+            revision: 0,
+        }
+    }
+
+    /// The per-vertex local error and curvature, when both were measured here.
+    pub fn vertex_measures(&self) -> Option<(&[f32], &[f32])> {
+        Some((self.local_error.as_deref()?, self.curvature.as_deref()?))
+    }
 }
 
 impl CaseStructure {
@@ -99,6 +131,8 @@ impl CaseStructure {
             tau: 0.5,
             weights: None,
             smoothed: None,
+            other_params: Vec::new(),
+            revision: 0,
         }
     }
 
@@ -126,25 +160,71 @@ impl CaseStructure {
             .map(|s| s.iter().map(|v| v * v).sum::<f64>().sqrt())
     }
 
-    /// Sets the filter, keeping the bound and taking the filter's default parameters.
+    /// Makes `filter` the active one: with the parameters it had when last active, else its
+    /// defaults with the bound kept.
     pub fn set_filter(&mut self, filter: Filter) {
-        let bound = self.params.max_displacement;
-        self.params = Params::defaults(filter);
-        self.params.max_displacement = bound;
-        self.smoothed = None;
+        if filter == self.params.filter {
+            return;
+        }
+        let remembered = self.other_params.iter().position(|p| p.filter == filter);
+        let params = remembered.map_or_else(
+            || Params {
+                max_displacement: self.params.max_displacement,
+                ..Params::defaults(filter)
+            },
+            |i| self.other_params[i],
+        );
+        self.set_params(params);
     }
 
-    /// The surface as shown: smoothed when it has been, else the original.
-    pub fn surface(&self) -> Mesh {
-        match &self.smoothed {
-            Some(s) => Mesh::new(s.positions.clone(), self.original.triangles.clone()),
-            None => self.original.clone(),
+    /// Sets the filter and parameters (checked by the caller); the filter left keeps its
+    /// parameters for when it is chosen again.
+    pub fn set_params(&mut self, params: Params) {
+        if params == self.params {
+            return;
+        }
+        if params.filter != self.params.filter {
+            self.other_params
+                .retain(|p| p.filter != params.filter && p.filter != self.params.filter);
+            self.other_params.push(self.params);
+        }
+        self.params = params;
+        self.revision += 1;
+    }
+
+    /// Sets the score's weight tau (checked by the caller).
+    pub fn set_tau(&mut self, tau: f64) {
+        if tau != self.tau {
+            self.tau = tau;
+            self.revision += 1;
         }
     }
 
-    /// Whether what it keeps as smoothed was smoothed with `params` and `weights`.
-    pub fn smoothed_with(&self, params: &Params, weights: Option<&[f32]>) -> bool {
-        self.smoothed.is_some() && self.params == *params && self.weights.as_deref() == weights
+    /// Sets the per-vertex weights (`None`: all 1).
+    pub fn set_weights(&mut self, weights: Option<Vec<f32>>) {
+        self.weights = weights;
+        self.revision += 1;
+    }
+
+    /// Keeps `smoothed` as the result of the structure's settings now.
+    pub fn keep(&mut self, smoothed: Smoothed) {
+        self.smoothed = Some(Smoothed {
+            revision: self.revision,
+            ..smoothed
+        });
+    }
+
+    /// The smoothed surface when it is the result of the structure's settings now.
+    pub fn smoothed_now(&self) -> Option<&Smoothed> {
+        (self.smoothed.as_ref()).filter(|m| m.revision == self.revision)
+    }
+
+    /// The surface as its settings make it: smoothed when it has been, else the original.
+    pub fn surface(&self) -> Mesh {
+        match self.smoothed_now() {
+            Some(s) => Mesh::new(s.positions.clone(), self.original.triangles.clone()),
+            None => self.original.clone(),
+        }
     }
 
     /// Whether its surface is closed and wound outward, so that from outside only its front
@@ -154,7 +234,7 @@ impl CaseStructure {
         self.label.is_some() && self.original.signed_volume() > 0.0
     }
 
-    /// The positions as shown.
+    /// The positions as shown: the latest smoothing until a newer one replaces it.
     pub fn positions(&self) -> &[[f32; 3]] {
         match &self.smoothed {
             Some(s) => &s.positions,

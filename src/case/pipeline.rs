@@ -19,7 +19,8 @@ use crate::suggest::{
 pub fn smooth_structure(structure: &mut CaseStructure) {
     let topology = Topology::build(&structure.original);
     let original = Original::new(&structure.original, &topology);
-    structure.smoothed = Some(smooth_on(structure, &original));
+    let smoothed = smooth_on(structure, &original);
+    structure.keep(smoothed);
 }
 
 fn smooth_on(structure: &CaseStructure, original: &Original) -> Smoothed {
@@ -27,9 +28,8 @@ fn smooth_on(structure: &CaseStructure, original: &Original) -> Smoothed {
     let (positions, reference) = smooth_drifting(original, &structure.params, weights);
     let (metrics, vertex) = measure_vertices(original, &positions, &reference, structure.tau);
     Smoothed {
-        positions,
-        metrics,
-        local_error: Some(vertex.local_error),
+        curvature: Some(vertex.gaussian_curvature),
+        ..Smoothed::new(positions, metrics, Some(vertex.local_error))
     }
 }
 
@@ -153,8 +153,9 @@ pub fn suggest_structure(
     };
     let suggestion =
         suggest_for_goal(&mut evaluator, &s.params, goal, options.method, on_progress)?;
-    s.params = suggestion.params;
-    s.tau = options.tau;
-    s.smoothed = Some(smooth_on(s, &original));
+    s.set_params(suggestion.params);
+    s.set_tau(options.tau);
+    let smoothed = smooth_on(s, &original);
+    s.keep(smoothed);
     Ok(Some(suggestion))
 }

@@ -41,11 +41,11 @@ pub fn structure_record(s: &CaseStructure) -> Value {
         "filter": s.params.filter,
         "params": s.params.to_json(),
         "tau": s.tau,
-        "smoothed": s.smoothed.is_some(),
+        "smoothed": s.smoothed_now().is_some(),
         "vertices": s.original.vertex_count(),
         "triangles": s.original.triangle_count(),
     });
-    if let Some(m) = s.smoothed.as_ref().map(|m| &m.metrics) {
+    if let Some(m) = s.smoothed_now().map(|m| &m.metrics) {
         let in_diagonals = |mm: f64| diagonal.map(|d| mm / d);
         r["volume_mm3"] = json!(m.volume);
         r["volume0_mm3"] = json!(m.volume0);
@@ -138,11 +138,7 @@ fn structure(
                 return Err(fail("the morph target does not match the surface".into()));
             }
             s.original = original;
-            s.smoothed = Some(Smoothed {
-                positions: shown.positions,
-                metrics,
-                local_error: node.local_error,
-            });
+            s.keep(Smoothed::new(shown.positions, metrics, node.local_error));
         }
         // Without its original (written without the morph target) the smoothed surface is
         // where the author goes on from.

@@ -63,7 +63,7 @@ fn a_label_maps_structure_wound_outward_is_closed_and_outward() {
 }
 
 #[test]
-fn changing_the_filter_keeps_the_bound_and_drops_the_result() {
+fn changing_the_filter_keeps_the_bound_and_outdates_the_result() {
     let mut s = CaseStructure::from_mesh("a", tetra(), [1.0, 0.0, 0.0]);
     s.params.max_displacement = Some(0.25);
     pipeline::smooth_structure(&mut s);
@@ -72,7 +72,21 @@ fn changing_the_filter_keeps_the_bound_and_drops_the_result() {
     assert_eq!(s.params.filter, Filter::Taubin);
     assert_eq!(s.params.max_displacement, Some(0.25));
     assert_eq!(s.params.lambda, Params::defaults(Filter::Taubin).lambda);
-    assert!(s.smoothed.is_none());
+    assert!(
+        s.smoothed_now().is_none(),
+        "no longer the result of its settings"
+    );
+    assert!(s.smoothed.is_some(), "shown until a newer one replaces it");
+    // Each filter keeps its own values: Taubin's lambda comes back with it.
+    s.set_params(Params {
+        lambda: 0.25,
+        ..s.params
+    });
+    s.set_filter(Filter::Hc);
+    assert_eq!(s.params.filter, Filter::Hc);
+    assert_eq!(s.params.max_displacement, Some(0.25));
+    s.set_filter(Filter::Taubin);
+    assert_eq!(s.params.lambda, 0.25);
 }
 
 #[test]

@@ -292,7 +292,7 @@ fn table(case: &Case) -> String {
             .params
             .max_displacement
             .map_or("-".into(), |b| format!("{b:.3}"));
-        let (volume, mean, max) = match &s.smoothed {
+        let (volume, mean, max) = match s.smoothed_now() {
             Some(m) => {
                 let vd = s.voxel_diagonal();
                 let both = |mm: f64| match vd {

@@ -235,7 +235,7 @@ fn structure_mesh(
     let n = shown.vertex_count();
     if let (true, Some(errors)) = (
         options.local_error,
-        s.smoothed.as_ref().and_then(|m| m.local_error.as_ref()),
+        s.smoothed_now().and_then(|m| m.local_error.as_ref()),
     ) {
         let bytes: Vec<u8> = errors.iter().flat_map(|v| v.to_le_bytes()).collect();
         attributes["_LOCAL_ERROR"] = json!(b.push(
@@ -253,7 +253,7 @@ fn structure_mesh(
         "attributes": attributes, "indices": indices, "material": material, "mode": TRIANGLES,
     });
     let mut mesh = json!({ "name": s.name });
-    if let (true, Some(_)) = (options.original_as_morph_target, &s.smoothed) {
+    if let (true, Some(_)) = (options.original_as_morph_target, s.smoothed_now()) {
         primitive["targets"] = json!([morph_target(b, &s.original, &shown, &normals)]);
         mesh["weights"] = json!([0.0]);
         mesh["extras"] = json!({ "targetNames": ["segmentation"] });

@@ -119,12 +119,13 @@ pub fn open_case(
     .map_err(|error| OpenFailure { error, files: 1 })
 }
 
-/// Opens a structure's `mesh` as a model named `name`.
-pub fn open_structure(name: &str, mesh: Mesh, on_stage: &mut dyn FnMut(Stage)) -> Model {
+/// Builds the model of a structure of the open case (its `mesh`), named `name`, on the
+/// calling thread.
+pub fn open_structure(name: &str, mesh: Mesh) -> Model {
     let mut stages = Stages {
         names: MESH_STAGES.to_vec(),
         next: 0,
-        on_stage,
+        on_stage: &mut |_| {},
     };
     build(name.to_string(), mesh, &mut stages)
 }

@@ -1,6 +1,7 @@
 //! The open model: a mesh with its topology, its report and its original's measures, as opening
-//! files (or one structure of a case) builds it (`build`). The engine workers build it and send it
-//! whole; the session holds it beside the case it is a structure of.
+//! files (or selecting one structure of a case) builds it (`build`). The engine workers build a
+//! file's and send it whole; the session builds a selected structure's and keeps each one built
+//! beside the case.
 
 mod build;
 

@@ -25,13 +25,16 @@ impl Session {
     }
 
     /// The case as it stands: each structure with its name, colour, opacity, visibility and
-    /// group, its filter and parameters, and its smoothed surface where it was smoothed (the
-    /// model's current result, the others' kept ones). `None` without a model.
+    /// group, its filter and parameters, and its smoothed surface where it has one for them
+    /// (the model's while its result is still to come: none). `None` without a model.
     pub fn to_case(&self) -> Option<Case> {
-        let current = self.current_structure()?;
+        self.current_structure()?;
         let mut case = self.case.clone();
-        let store = self.model_smoothing();
-        store(&mut case.structures[current]);
+        for s in &mut case.structures {
+            if s.smoothed_now().is_none() {
+                s.smoothed = None;
+            }
+        }
         Some(case)
     }
 

@@ -7,7 +7,7 @@
 //! Distances use a perceptually uniform sequential map (viridis, dark = small); curvature a
 //! diverging blue-grey-red map centred on 0 (saddle blue, flat grey, dome red).
 
-use super::Smoothed;
+use crate::case::Smoothed;
 
 /// What the colours show.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -196,9 +196,10 @@ pub fn colorize(
     voxel_diagonal: Option<f64>,
 ) -> (Vec<[u8; 4]>, Legend) {
     let displacement: Vec<f32>;
+    let (local_error, curvature) = result.vertex_measures().unwrap_or_default();
     let values: &[f32] = match field {
-        ColorField::LocalError => &result.vertex.local_error,
-        ColorField::Curvature => &result.vertex.gaussian_curvature,
+        ColorField::LocalError => local_error,
+        ColorField::Curvature => curvature,
         // The result does not hold the weights: see `weight_colors`.
         ColorField::Weights => return weight_colors(None, original.len()),
         ColorField::Displacement => {

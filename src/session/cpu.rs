@@ -1,7 +1,8 @@
 //! The session's CPU engine: asking its workers for the current revision's result and taking
 //! it back, and taking results measured elsewhere (the GPU engine's).
 
-use super::{Session, Smoothed, Timings};
+use super::{Session, Timings};
+use crate::case::Smoothed;
 use crate::evaluate::ModelRef;
 use crate::metrics::{Metrics, VertexMeasures};
 use crate::worker::{metrics_of, Pool, Reply};
@@ -63,12 +64,14 @@ impl Session {
         }
         let asked = self.cpu_job.is_some_and(|(r, _)| r == self.revision);
         if self.needs_smoothing() && !asked {
-            let (params, tau) = (*self.params(), self.tau);
-            if let Some(m) = &self.model {
+            let (params, tau) = (*self.params(), self.tau());
+            // Field by field: the CPU engine is borrowed to change.
+            if let Some(m) = self.models.get(self.current) {
+                let structure = self.case.structures.get(self.current);
                 let model = ModelRef {
                     original: &m.original,
                     id: self.model_id,
-                    weights: self.weights.as_deref(),
+                    weights: structure.and_then(|s| s.weights.as_deref()),
                     weights_version: self.weights_version,
                 };
                 let job = self.cpu.smooth(&model, &params, tau, true);
@@ -128,7 +131,7 @@ impl Session {
         metrics: Metrics,
         vertex: VertexMeasures,
     ) -> bool {
-        let Some(model) = &self.model else {
+        let Some(model) = self.model() else {
             return false;
         };
         let n = model.mesh().vertex_count();
@@ -138,12 +141,10 @@ impl Session {
         if revision != self.revision || !fits {
             return false;
         }
-        self.result = Some(Smoothed {
-            revision,
-            params: *self.params(),
-            positions,
-            metrics,
-            vertex,
+        let s = &mut self.case.structures[self.current];
+        s.keep(Smoothed {
+            curvature: Some(vertex.gaussian_curvature),
+            ..Smoothed::new(positions, metrics, Some(vertex.local_error))
         });
         true
     }

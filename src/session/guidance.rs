@@ -137,7 +137,7 @@ impl Session {
         SearchKey {
             model: self.model_id,
             weights: self.weights_version,
-            filter: self.filter,
+            filter: self.filter(),
             bound: self.params().max_displacement,
         }
     }
@@ -155,8 +155,8 @@ impl Session {
     /// than the current ones while new ones are computed), rescored at the current tau.
     pub fn graphs(&self) -> Option<QualityGraphs> {
         let (key, graphs) = self.guidance.graphs.as_ref()?;
-        (key.model == self.model_id && key.filter == self.filter)
-            .then(|| graphs.clone().rescored(self.tau))
+        (key.model == self.model_id && key.filter == self.filter())
+            .then(|| graphs.clone().rescored(self.tau()))
     }
 
     /// What `sweep --json` prints for the current graphs, once they are current.
@@ -182,7 +182,8 @@ impl Session {
         let key = self.search_key();
         if let Some((k, grid)) = &self.guidance.grid {
             if *k == key {
-                if let (Some(mut s), Some(last)) = (grid.best(self.tau), &self.guidance.suggested) {
+                if let (Some(mut s), Some(last)) = (grid.best(self.tau()), &self.guidance.suggested)
+                {
                     s.params.max_displacement = key.bound;
                     return Some(Suggested {
                         suggestion: s,
@@ -201,7 +202,7 @@ impl Session {
     /// at once.
     pub fn start_suggest(&mut self, method: SearchMethod) {
         self.guidance.search = None;
-        if self.model.is_some() {
+        if self.model().is_some() {
             self.queue_suggest(method);
         }
     }
@@ -213,14 +214,14 @@ impl Session {
         let search = match method {
             SearchMethod::Grid => GridSearch::new(base.filter, &base).map(Search::Grid),
             SearchMethod::Local => {
-                LocalSearch::new(base.filter, &base, self.tau).map(Search::Local)
+                LocalSearch::new(base.filter, &base, self.tau()).map(Search::Local)
             }
         };
         match search {
             Ok(task) => {
                 self.guidance.search = Some(SearchJob {
                     key,
-                    tau: self.tau,
+                    tau: self.tau(),
                     method,
                     running: Running::new(task),
                 })
@@ -276,7 +277,7 @@ impl Session {
 
     /// Starts the gallery of [`GALLERY_TAUS`] for the active filter.
     pub fn start_gallery(&mut self) {
-        if self.model.is_none() {
+        if self.model().is_none() {
             self.guidance.gallery_job = None;
             return;
         }
@@ -376,7 +377,7 @@ impl Session {
     }
 
     fn graphs_due(&self) -> bool {
-        self.guidance.graphs_wanted && self.model.is_some() && !self.graphs_current()
+        self.guidance.graphs_wanted && self.model().is_some() && !self.graphs_current()
     }
 
     /// Works on the background jobs on the CPU engine's workers: the suggestion first (the
@@ -442,16 +443,18 @@ impl Session {
         memo: &mut TermsMemo,
     ) -> bool {
         let key = self.search_key();
-        let (params, tau) = (*self.params(), self.tau);
+        let (params, tau) = (*self.params(), self.tau());
         self.guidance.drop_stale(key, &params);
-        let Some(model) = self.model.as_ref() else {
+        // Field by field: the guidance below is borrowed to change.
+        let Some(model) = self.models.get(self.current) else {
             return false;
         };
+        let structure = self.case.structures.get(self.current);
         let mut engine = Engine {
             model: ModelRef {
                 original: &model.original,
                 id: self.model_id,
-                weights: self.weights.as_deref(),
+                weights: structure.and_then(|s| s.weights.as_deref()),
                 weights_version: self.weights_version,
             },
             clock,

@@ -1,14 +1,14 @@
 //! The document the app and its embedding API edit, free of any UI, so the browser app, its
 //! JavaScript API and the native tests drive the same state the same way: the open case and
-//! which structure is the model (`structures`, `case`), the model's filter, parameters, tau,
-//! weights and latest result (here and `weights`), the files being opened by the workers
-//! (`opening`), the CPU engine's runs (`cpu`), the background work that guides the author
-//! (`guidance`: graphs, suggestion, gallery; `suggest_all`; `checks`), and the colours and
-//! pointing the view asks for (`colors`, `pointing`).
+//! which of its structures is the model (`structures`, `case`, `models`), the files being
+//! opened by the workers (`opening`), the CPU engine's runs (`cpu`), the background work that
+//! guides the author (`guidance`: graphs, suggestion, gallery; `suggest_all`; `checks`), and
+//! the colours and pointing the view asks for (`colors`, `pointing`).
 //!
-//! While a structure is the model, its filter, parameters, tau and weights are the session's
-//! and its entry in the case catches up when another structure is selected (see
-//! `structures`).
+//! Each structure's filter, parameters, tau, weights and result live in the case, and only
+//! there: the getters and setters here read and write the structure that is the model.
+//! Selecting another structure moves a pointer; the session caches each structure's model
+//! (topology and the original's measures) so coming back finds it built.
 //!
 //! Every change (a new model, filter or parameter) bumps `revision`; a result belongs to the
 //! revision it was computed for, so a result that arrives late (from the GPU) for an older
@@ -19,6 +19,7 @@ mod checks;
 mod colors;
 mod cpu;
 mod guidance;
+mod models;
 mod opening;
 mod pointing;
 mod structures;
@@ -32,26 +33,14 @@ pub use opening::LoadProgress;
 pub use structures::{OtherStructure, StructureChange};
 pub use weights::WeightsSummary;
 
-use crate::case::Case;
+use crate::case::{Case, CaseStructure, Smoothed, DEFAULT_FILTER};
 use crate::export::{self, ExportFormat, ExportOptions};
 use crate::mesh::{vertex_normals, Mesh};
-use crate::metrics::{Metrics, VertexMeasures};
 use crate::smooth::{Filter, Params};
 use crate::worker::{Pool, SmoothJob};
 
 /// The score's default weight (ALGORITHMS.md: `tau` in [0, 1], default 0.5).
 pub const DEFAULT_TAU: f64 = 0.5;
-
-/// A smoothing run's result and its measures.
-#[derive(Clone, Debug)]
-pub struct Smoothed {
-    /// The session revision these positions were computed for.
-    pub revision: u64,
-    pub params: Params,
-    pub positions: Vec<[f32; 3]>,
-    pub metrics: Metrics,
-    pub vertex: VertexMeasures,
-}
 
 /// How long a result took, in milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -62,42 +51,37 @@ pub struct Timings {
     pub measure_ms: f64,
 }
 
-/// The open model, the filter settings and the latest result.
+/// Nothing open: the parameters the controls show.
+const NO_PARAMS: Params = Params::defaults(DEFAULT_FILTER);
+
+/// The open case, which structure is the model, and the engines and background work on it.
 pub struct Session {
-    model: Option<Model>,
-    filter: Filter,
-    /// Each filter keeps its own values while another is active.
-    params: [Params; 4],
-    tau: f64,
-    /// Edge length of a voxel of the segmentation the mesh came from (mm), when the user gave
-    /// it: error legends then also read in voxel diagonals.
-    voxel_size: Option<[f64; 3]>,
-    revision: u64,
-    result: Option<Smoothed>,
-    /// The CPU engine: its workers, and the smoothing of the revision asked of them.
-    cpu: Pool,
-    cpu_job: Option<(u64, SmoothJob)>,
-    /// Why the last file could not be opened; cleared by the next successful open.
-    error: Option<String>,
-    /// Counts the models opened, so background results of another model are told apart.
-    model_id: u64,
-    /// Per-vertex smoothing weights of the open model (0 locks a vertex), `None` for all 1.
-    weights: Option<Vec<f32>>,
-    /// Counts changes of `weights`.
-    weights_version: u64,
-    guidance: guidance::Guidance,
-    /// A file (or structure) the CPU engine's workers are opening.
-    opening: Option<opening::Opening>,
-    /// How long each stage of the latest opening took (ms), in order.
-    open_stages: Vec<(String, f64)>,
-    /// The open case: every structure opened, as the author arranges them; the model is
-    /// structure `current`'s surface (empty with nothing open).
+    /// The open case: every structure opened, as the author arranges them, each with its
+    /// settings and result; the model is structure `current`'s surface (empty: nothing open).
     case: Case,
     /// The file the case was opened from.
     case_file: String,
     current: usize,
     /// Counts changes of the case's structures, for the view.
     case_version: u64,
+    /// The models of the structures selected so far (the current one always among them).
+    models: models::Models,
+    /// Counts what the model is smoothed with and which structure it is; see the module docs.
+    revision: u64,
+    /// Counts the models opened, so background results of another model are told apart.
+    model_id: u64,
+    /// Counts changes of the model's weights (the GPU engine uploads them once per change).
+    weights_version: u64,
+    /// The CPU engine: its workers, and the smoothing of the revision asked of them.
+    cpu: Pool,
+    cpu_job: Option<(u64, SmoothJob)>,
+    /// Why the last file could not be opened; cleared by the next successful open.
+    error: Option<String>,
+    guidance: guidance::Guidance,
+    /// A file the CPU engine's workers are opening.
+    opening: Option<opening::Opening>,
+    /// How long each stage of the latest opening took (ms), in order.
+    open_stages: Vec<(String, f64)>,
     /// Files to add to the case once the one opening now is open.
     additions: std::collections::VecDeque<(String, Vec<u8>)>,
     suggest_all: suggest_all::SuggestAll,
@@ -110,26 +94,20 @@ pub struct Session {
 impl Default for Session {
     fn default() -> Self {
         Self {
-            model: None,
-            filter: Filter::Hc,
-            params: Filter::ALL.map(Params::defaults),
-            tau: DEFAULT_TAU,
-            voxel_size: None,
-            revision: 0,
-            result: None,
-            cpu: Pool::in_thread(1),
-            cpu_job: None,
-            error: None,
-            model_id: 0,
-            weights: None,
-            weights_version: 0,
-            guidance: guidance::Guidance::default(),
-            opening: None,
-            open_stages: Vec::new(),
             case: Case::default(),
             case_file: String::new(),
             current: 0,
             case_version: 0,
+            models: Default::default(),
+            revision: 0,
+            model_id: 0,
+            weights_version: 0,
+            cpu: Pool::in_thread(1),
+            cpu_job: None,
+            error: None,
+            guidance: guidance::Guidance::default(),
+            opening: None,
+            open_stages: Vec::new(),
             additions: Default::default(),
             suggest_all: Default::default(),
             checks: Default::default(),
@@ -138,16 +116,22 @@ impl Default for Session {
     }
 }
 
-fn slot(filter: Filter) -> usize {
-    Filter::ALL
-        .iter()
-        .position(|&f| f == filter)
-        .unwrap_or_default()
-}
-
 impl Session {
     pub fn model(&self) -> Option<&Model> {
-        self.model.as_ref()
+        self.models.get(self.current)
+    }
+
+    /// The structure that is the model, where its settings and result live.
+    fn structure(&self) -> Option<&CaseStructure> {
+        self.model()?;
+        self.case.structures.get(self.current)
+    }
+
+    /// [`Self::structure`] to change: what it is smoothed with changes, so the revision does.
+    fn structure_mut(&mut self) -> Option<&mut CaseStructure> {
+        self.model()?;
+        self.revision += 1;
+        self.case.structures.get_mut(self.current)
     }
 
     /// Counts the models opened: it changes when another model (file or structure) opens.
@@ -160,66 +144,65 @@ impl Session {
     }
 
     pub fn filter(&self) -> Filter {
-        self.filter
+        self.params().filter
     }
 
-    /// The active filter's parameters.
+    /// The model's filter and parameters (the defaults with nothing open).
     pub fn params(&self) -> &Params {
-        &self.params[slot(self.filter)]
+        self.structure().map_or(&NO_PARAMS, |s| &s.params)
     }
 
     pub fn tau(&self) -> f64 {
-        self.tau
+        self.structure().map_or(DEFAULT_TAU, |s| s.tau)
     }
 
     pub fn revision(&self) -> u64 {
         self.revision
     }
 
+    /// The voxel size of the segmentation the model came from (mm), when known.
     pub fn voxel_size(&self) -> Option<[f64; 3]> {
-        self.voxel_size
+        self.structure()?.voxel_size
     }
 
     /// The voxel diagonal (mm) when the voxel size is known.
     pub fn voxel_diagonal(&self) -> Option<f64> {
-        self.voxel_size
-            .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
+        self.structure()?.voxel_diagonal()
     }
 
-    /// The latest result, if it matches the current model and parameters.
+    /// The model's result with its per-vertex measures, if it is for the current parameters.
     pub fn result(&self) -> Option<&Smoothed> {
-        self.result.as_ref().filter(|r| r.revision == self.revision)
+        let s = self.structure()?;
+        s.smoothed_now().filter(|r| r.vertex_measures().is_some())
     }
 
-    /// The latest result even if the parameters changed since (shown until the new one lands).
+    /// The model's latest result with its per-vertex measures even if the parameters changed
+    /// since (shown until the new one lands).
     pub fn last_result(&self) -> Option<&Smoothed> {
-        self.result.as_ref()
+        let s = self.structure()?;
+        s.smoothed
+            .as_ref()
+            .filter(|r| r.vertex_measures().is_some())
     }
 
     /// Whether a model is open whose result for the current parameters is still to compute.
     pub fn needs_smoothing(&self) -> bool {
-        self.model.is_some() && self.result().is_none()
+        self.model().is_some() && self.result().is_none()
     }
 
-    fn changed(&mut self) {
-        self.revision += 1;
-    }
-
-    /// Makes `model` the open model (the previous result is dropped).
-    fn set_model(&mut self, model: Model) -> &Model {
+    /// Structure `current` (its model built) became the model: what was asked or found for
+    /// the one before is dropped.
+    fn became_model(&mut self) {
         self.error = None;
-        self.result = None;
-        self.changed();
+        self.revision += 1;
         self.model_id += 1;
         self.cpu_job = None;
-        self.weights = None;
         self.weights_version += 1;
         self.reset_guidance();
         // A suggestion for the new model, ready to apply with one click.
         if self.suggest_on_open {
             self.queue_suggest(crate::suggest::SearchMethod::Local);
         }
-        self.model.insert(model)
     }
 
     /// Whether each model opened from now on gets a suggestion search at once.
@@ -236,9 +219,10 @@ impl Session {
 
     /// Makes `filter` active (with the values it had when last active).
     pub fn set_filter(&mut self, filter: Filter) {
-        if filter != self.filter {
-            self.filter = filter;
-            self.changed();
+        if filter != self.filter() {
+            if let Some(s) = self.structure_mut() {
+                s.set_filter(filter);
+            }
         }
     }
 
@@ -253,11 +237,10 @@ impl Session {
     /// Sets the parameters of `params.filter` (and makes it active), if they are valid.
     pub fn set_params(&mut self, params: Params) -> Result<(), String> {
         params.validate().map_err(|e| e.to_string())?;
-        let changed = params != *self.params() || params.filter != self.filter;
-        self.params[slot(params.filter)] = params;
-        self.filter = params.filter;
-        if changed {
-            self.changed();
+        if params != *self.params() {
+            self.structure_mut()
+                .ok_or("no mesh is open")?
+                .set_params(params);
         }
         Ok(())
     }
@@ -274,28 +257,32 @@ impl Session {
         if !(0.0..=1.0).contains(&tau) {
             return Err(format!("tau = {tau} is out of range: [0, 1]"));
         }
-        if tau != self.tau {
-            self.tau = tau;
-            self.changed();
+        if tau != self.tau() {
+            self.structure_mut().ok_or("no mesh is open")?.set_tau(tau);
         }
         Ok(())
     }
 
-    /// The voxel size (mm per voxel along x, y, z), or `None` when unknown.
+    /// The voxel size (mm per voxel along x, y, z) of the segmentation the model came from,
+    /// or `None` when unknown.
     pub fn set_voxel_size(&mut self, size: Option<[f64; 3]>) -> Result<(), String> {
         if let Some(v) = size {
             if !v.iter().all(|s| s.is_finite() && *s > 0.0) {
                 return Err(format!("voxel size {v:?} must be three lengths > 0 mm"));
             }
         }
-        self.voxel_size = size;
+        self.model().ok_or("no mesh is open")?;
+        let s = &mut self.case.structures[self.current];
+        if s.voxel_size != size {
+            s.voxel_size = size;
+            self.case_version += 1;
+        }
         Ok(())
     }
 
     /// The mesh report of the open model as the CLI's `info --json` prints it.
     pub fn info_json(&self) -> Option<serde_json::Value> {
-        self.model
-            .as_ref()
+        self.model()
             .and_then(|m| serde_json::to_value(&m.report).ok())
     }
 
@@ -308,7 +295,7 @@ impl Session {
     /// Per-vertex colours of `field` on the latest result (the weights: as painted now), with
     /// the legend that explains them.
     pub fn colors(&self, field: ColorField) -> Option<(Vec<[u8; 4]>, Legend)> {
-        let model = self.model.as_ref()?;
+        let model = self.model()?;
         if field == ColorField::Weights {
             let n = model.mesh().vertex_count();
             return Some(colors::weight_colors(self.weights(), n));
@@ -330,12 +317,12 @@ impl Session {
         format: ExportFormat,
         colors: Option<&[[u8; 4]]>,
     ) -> Result<Vec<u8>, String> {
-        let model = self.model.as_ref().ok_or("no mesh is open")?;
+        let model = self.model().ok_or("no mesh is open")?;
         let triangles = model.mesh().triangles.clone();
         let (mesh, extras) = match self.last_result() {
             Some(r) => (
                 Mesh::new(r.positions.clone(), triangles),
-                Some(export::smoothing_extras(&r.params, &r.metrics)),
+                Some(export::smoothing_extras(self.params(), &r.metrics)),
             ),
             None => (model.mesh().clone(), None),
         };
@@ -351,15 +338,15 @@ impl Session {
 
     /// What the embedding API's `state()` reports.
     pub fn state_json(&self, busy: bool) -> serde_json::Value {
-        let model = self.model.as_ref();
+        let model = self.model();
         serde_json::json!({
             "model": model.map(|m| m.name.as_str()),
             "vertices": model.map(|m| m.report.vertices),
             "faces": model.map(|m| m.report.faces),
             "error": self.error,
-            "filter": self.filter.name(),
+            "filter": self.filter().name(),
             "params": self.params().to_json(),
-            "tau": self.tau,
+            "tau": self.tau(),
             "busy": busy,
             "cpu_engine": self.cpu.to_json(),
             "weights": self.weights_summary(),

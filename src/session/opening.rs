@@ -1,5 +1,5 @@
-//! Opening files and structures: handed to the CPU engine's workers (which read the file as a
-//! case, build the model's topology, check the mesh and measure the original, then send them
+//! Opening files: handed to the CPU engine's workers (which read the files as a case, build
+//! its first structure's topology, check the mesh and measure the original, then send them
 //! whole), while the open model stays until the new one is there. Without threads the same
 //! request is done on the calling thread as it is made.
 
@@ -27,8 +27,6 @@ pub struct LoadProgress {
 enum Purpose {
     /// A file becomes the open case, its first structure the model.
     File,
-    /// Structure `index` of the open case becomes the model.
-    Structure(usize),
     /// A file's structures join the open case.
     Addition,
 }
@@ -49,7 +47,7 @@ impl Session {
         match Model::load(name, bytes) {
             Ok(Opened { case, model }) => {
                 self.take_file(name, name, case, model);
-                Ok(self.model.as_ref().expect("just set"))
+                Ok(self.model().expect("just set"))
             }
             Err(e) => Err(self.fail(name, &e.reason())),
         }
@@ -96,7 +94,7 @@ impl Session {
     pub fn begin_add(&mut self, name: &str, bytes: Vec<u8>) {
         if self.opening.is_some() || !self.additions.is_empty() {
             self.additions.push_back((name.to_string(), bytes));
-        } else if self.model.is_none() {
+        } else if self.model().is_none() {
             self.begin_open(name, bytes);
         } else {
             let first_file = name.to_string();
@@ -116,24 +114,6 @@ impl Session {
                 self.begin_add(&name, bytes);
             }
         }
-    }
-
-    /// Starts opening structure `index` of the open case as the model, as a file opens.
-    /// Errors when no case is open or it has no such structure.
-    pub fn begin_open_structure(&mut self, index: usize) -> Result<Option<String>, String> {
-        if self.model.is_none() {
-            return Err("nothing is open".to_string());
-        }
-        let count = self.case.structures.len();
-        let Some(structure) = self.case.structures.get(index) else {
-            return Err(format!(
-                "structure {index} does not exist: the case has {count}"
-            ));
-        };
-        let name = format!("{}: {}", self.case_file, structure.name);
-        let input = Input::Structure(structure.original.clone());
-        let first_file = self.case_file.clone();
-        Ok(self.begin(name, first_file, input, Purpose::Structure(index)))
     }
 
     fn begin(
@@ -195,18 +175,8 @@ impl Session {
         };
         self.open_stages = stages;
         match (purpose, model, case) {
-            (Purpose::File, Some(model), Some(case)) => {
-                self.take_file(name, first_file, *case, *model)
-            }
-            (Purpose::Structure(index), Some(model), _) => {
-                // The structure leaving keeps its smoothing, the one coming gets back what it
-                // kept.
-                self.keep_model_structure();
-                self.set_model(*model);
-                self.current = index;
-                self.restore_model_structure();
-            }
-            (Purpose::Addition, _, Some(case)) => {
+            (Purpose::File, Some(model), case) => self.take_file(name, first_file, *case, *model),
+            (Purpose::Addition, _, case) => {
                 self.error = None;
                 self.add_to_case(*case);
             }
@@ -218,18 +188,25 @@ impl Session {
     /// Makes the case of files opened as `name` the open one and `model` (its first structure,
     /// from `first_file`) the model. A label map's or a case glTF's structure brings its own
     /// filter and parameters (a label map's with the bound at half its voxel diagonal); a
-    /// surface takes the session's.
+    /// surface takes those of the model before it, so files opened one after another smooth
+    /// alike.
     fn take_file(&mut self, name: &str, first_file: &str, case: Case, model: Model) {
-        self.adopt_case(case, name);
-        self.set_model(model);
         let own_params = io::is_label_map(first_file)
             || matches!(
                 Format::from_name(first_file),
                 Some(Format::Glb | Format::Gltf)
             );
-        if own_params {
-            self.restore_model_structure();
+        let before = (self.structure())
+            .filter(|_| !own_params)
+            .map(|s| (s.params, s.other_params.clone(), s.tau));
+        self.adopt_case(case, name);
+        self.models.keep(0, model);
+        if let (Some((params, others, tau)), Some(s)) = (before, self.case.structures.first_mut()) {
+            s.set_params(params);
+            s.other_params = others;
+            s.set_tau(tau);
         }
+        self.became_model();
     }
 
     /// How long each stage of the latest opening took (ms), in order.

@@ -1,14 +1,11 @@
 //! The open case's structures as the author arranges them: each one's name, colour, opacity,
-//! visibility and group, and its smoothing kept while another structure is the model, so the
-//! view shows every structure smoothed its own way and coming back to one restores it.
-//!
-//! The session's case holds them; the model is structure `current`'s surface, and while it
-//! is, that structure's parameters and result are the session's own (its entry catches up
-//! when another structure is selected, and in [`Session::to_case`]).
+//! visibility and group, and which one is the model. Each keeps its own smoothing, so the view
+//! shows every structure smoothed its own way and selecting one again finds it as it was.
 
 use super::Session;
-use crate::case::{Case, CaseStructure, Smoothed};
+use crate::case::{Case, CaseStructure};
 use crate::metrics::Metrics;
+use crate::model;
 use crate::segmentation::default_color;
 use crate::smooth::Params;
 
@@ -45,7 +42,7 @@ impl Session {
 
     /// Which structure the model is, while one is open.
     pub fn current_structure(&self) -> Option<usize> {
-        self.model.as_ref().map(|_| self.current)
+        self.model().map(|_| self.current)
     }
 
     /// The name of the file the case was opened from.
@@ -64,13 +61,39 @@ impl Session {
         self.case.structures.get(self.current_structure()?)
     }
 
-    /// The surface the model's structure keeps for the current parameters (a case glTF's
-    /// smoothed surface, or its own from before), shown while the engine recomputes it.
+    /// The surface the model's structure has for the current parameters without the
+    /// per-vertex measures (a case glTF's, a "Suggest all" result), shown while the engine
+    /// measures it.
     pub fn kept_surface(&self) -> Option<&[[f32; 3]]> {
-        let s = self.model_structure()?;
-        let same = s.smoothed_with(self.params(), self.weights());
-        let kept = s.smoothed.as_ref().filter(|_| same)?;
+        let s = self.structure()?;
+        let kept = s.smoothed_now()?;
         (kept.positions.len() == s.original.positions.len()).then_some(&kept.positions[..])
+    }
+
+    /// Makes structure `index` the model: its model is built here the first time (then kept),
+    /// and its settings and result are where they were. Errors when nothing is open or the
+    /// case has no such structure.
+    pub fn select_structure(&mut self, index: usize) -> Result<(), String> {
+        if self.model().is_none() {
+            return Err("nothing is open".to_string());
+        }
+        let count = self.case.structures.len();
+        let Some(structure) = self.case.structures.get(index) else {
+            return Err(format!(
+                "structure {index} does not exist: the case has {count}"
+            ));
+        };
+        if index == self.current {
+            return Ok(());
+        }
+        if !self.models.touch(index) {
+            let name = format!("{}: {}", self.case_file, structure.name);
+            let built = model::open_structure(&name, structure.original.clone());
+            self.models.keep(index, built);
+        }
+        self.current = index;
+        self.became_model();
+        Ok(())
     }
 
     /// Changes structure `index`'s name, colour, opacity, visibility, group or description;
@@ -162,6 +185,7 @@ impl Session {
         self.case = case;
         self.case_file = file.to_string();
         self.current = 0;
+        self.models.clear();
         self.case_version += 1;
     }
 
@@ -180,53 +204,6 @@ impl Session {
         self.case_version += 1;
     }
 
-    /// The model's smoothing, to write into a structure as it keeps it.
-    pub(super) fn model_smoothing(&self) -> impl FnOnce(&mut CaseStructure) + 'static {
-        let (params, tau, weights) = (*self.params(), self.tau, self.weights.clone());
-        let smoothed = self.result().map(|r| Smoothed {
-            positions: r.positions.clone(),
-            metrics: r.metrics.clone(),
-            local_error: Some(r.vertex.local_error.clone()),
-        });
-        move |s: &mut CaseStructure| {
-            // Left before its result came, it keeps the surface it had for these parameters
-            // (a case glTF's, or its own from before).
-            let same = s.smoothed_with(&params, weights.as_deref());
-            let smoothed = smoothed.or_else(|| s.smoothed.take().filter(|_| same));
-            (s.params, s.tau, s.weights, s.smoothed) = (params, tau, weights, smoothed);
-        }
-    }
-
-    /// Keeps the model's smoothing in its structure, before another structure opens.
-    pub(super) fn keep_model_structure(&mut self) {
-        let Some(current) = self.current_structure() else {
-            return;
-        };
-        let store = self.model_smoothing();
-        store(&mut self.case.structures[current]);
-        self.case_version += 1;
-    }
-
-    /// Takes up what the structure that is the model keeps: its filter and parameters (a
-    /// label map's with the bound at half its voxel diagonal), tau, weights and voxel size.
-    pub(super) fn restore_model_structure(&mut self) {
-        let Some(s) = self.model_structure() else {
-            return;
-        };
-        let (params, tau, weights, voxel_size) = (s.params, s.tau, s.weights.clone(), s.voxel_size);
-        // Values it was smoothed with (or read back with) were checked then; a refusal keeps
-        // the session's.
-        let _ = self.set_params(params);
-        let _ = self.set_tau(tau);
-        if weights.is_some() {
-            self.weights = weights;
-            self.weights_version += 1;
-        }
-        if voxel_size.is_some() {
-            self.voxel_size = voxel_size;
-        }
-    }
-
     /// Structure `index`'s measures as shown: the model's current result's, another's kept
     /// ones; `None` where it is not smoothed (or the model's result is still to come).
     pub fn structure_metrics(&self, index: usize) -> Option<&Metrics> {
@@ -234,17 +211,13 @@ impl Session {
             self.result().map(|r| &r.metrics)
         } else {
             let s = self.case.structures.get(index)?;
-            s.smoothed.as_ref().map(|k| &k.metrics)
+            s.smoothed_now().map(|k| &k.metrics)
         }
     }
 
-    /// Structure `index`'s filter and parameters: the session's for the model.
+    /// Structure `index`'s filter and parameters.
     pub fn structure_params(&self, index: usize) -> Option<Params> {
-        if Some(index) == self.current_structure() {
-            Some(*self.params())
-        } else {
-            self.case.structures.get(index).map(|s| s.params)
-        }
+        self.case.structures.get(index).map(|s| s.params)
     }
 
     /// The open case's structures for `state()` and the page's API: what each is, how it is

@@ -28,7 +28,7 @@ impl Session {
             return Err(format!("tau = {tau} is out of range: [0, 1]"));
         }
         self.cancel_suggest_all();
-        let model = self.model.as_ref().ok_or("no mesh is open")?;
+        self.model().ok_or("no mesh is open")?;
         let options = SuggestAllOptions {
             tau,
             filter: None,
@@ -37,17 +37,8 @@ impl Session {
             // score weighs it.
             max_volume_change: Some(0.05),
         };
-        let current = self.current;
         let work: Vec<_> = (self.case.structures.iter().enumerate())
-            .map(|(i, s)| match i == current {
-                true => (
-                    i,
-                    model.mesh().clone(),
-                    *self.params(),
-                    self.weights.clone(),
-                ),
-                false => (i, s.original.clone(), s.params, s.weights.clone()),
-            })
+            .map(|(i, s)| (i, s.original.clone(), s.params, s.weights.clone()))
             .collect();
         let mut work = work;
         // The largest first, so no worker is left with one big structure at the end.
@@ -151,13 +142,13 @@ impl Session {
             let _ = self.set_params(suggested.params);
             let _ = self.set_tau(tau);
         } else if let Some(s) = self.case.structures.get_mut(i) {
-            s.params = suggested.params;
-            s.tau = tau;
-            s.smoothed = Some(Smoothed {
-                positions: suggested.positions,
+            s.set_params(suggested.params);
+            s.set_tau(tau);
+            s.keep(Smoothed::new(
+                suggested.positions,
                 metrics,
-                local_error: Some(suggested.local_error),
-            });
+                Some(suggested.local_error),
+            ));
             self.case_version += 1;
         }
         summary

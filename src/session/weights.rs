@@ -1,7 +1,7 @@
 //! Per-vertex smoothing weights painted by the user (ALGORITHMS.md: each step moves a vertex by
-//! `w_i` times its filter displacement; 0 locks it). The session keeps them for the open model;
-//! every change bumps the session's revision (the result is recomputed) and the weights'
-//! own version (the GPU engine uploads them once per change).
+//! `w_i` times its filter displacement; 0 locks it). The model's structure keeps them; every
+//! change bumps the session's revision (the result is recomputed) and the weights' own
+//! version (the GPU engine uploads them once per change).
 //!
 //! Painting takes the minimum with the brush's profile and erasing the maximum, so dabbing the
 //! same spot again in one stroke changes nothing: a stroke never "builds up" with the frame rate.
@@ -33,7 +33,7 @@ fn summarize(weights: Option<&[f32]>) -> Option<WeightsSummary> {
 impl Session {
     /// The painted weights (one per vertex in [0, 1]), or `None` while every vertex is free.
     pub fn weights(&self) -> Option<&[f32]> {
-        self.weights.as_deref()
+        self.structure()?.weights.as_deref()
     }
 
     /// How many vertices are painted and locked, and the lowest weight; `None` when nothing is.
@@ -62,21 +62,20 @@ impl Session {
 
     /// Every vertex free again. Returns whether anything was painted.
     pub fn clear_weights(&mut self) -> bool {
-        if self.weights.is_none() {
+        if self.weights().is_none() {
             return false;
         }
-        self.weights = None;
-        self.weights_version += 1;
-        self.changed();
+        self.set_weights(None);
         true
     }
 
     fn edit_weights(&mut self, footprint: &[(u32, f32)], rule: impl Fn(f32, f32) -> f32) -> bool {
-        let Some(model) = &self.model else {
+        let Some(model) = self.model() else {
             return false;
         };
         let n = model.mesh().vertex_count();
-        let mut values = self.weights.take().unwrap_or_else(|| vec![1.0; n]);
+        let kept = &mut self.case.structures[self.current].weights;
+        let mut values = kept.take().unwrap_or_else(|| vec![1.0; n]);
         let mut changed = false;
         for &(i, f) in footprint {
             let Some(w) = values.get_mut(i as usize) else {
@@ -94,12 +93,20 @@ impl Session {
             }
         }
         // All free again: no weights at all, so the result is exactly the unweighted one.
-        self.weights = values.iter().any(|&w| w < 1.0).then_some(values);
+        let values = values.iter().any(|&w| w < 1.0).then_some(values);
         if changed {
-            self.weights_version += 1;
-            self.changed();
+            self.set_weights(values);
+        } else {
+            self.case.structures[self.current].weights = values;
         }
         changed
+    }
+
+    fn set_weights(&mut self, weights: Option<Vec<f32>>) {
+        if let Some(s) = self.structure_mut() {
+            s.set_weights(weights);
+            self.weights_version += 1;
+        }
     }
 }
 

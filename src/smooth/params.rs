@@ -74,7 +74,7 @@ impl Params {
     }
 
     /// ALGORITHMS.md's defaults for `filter` (sinc runs 20 iterations, the others 10).
-    pub fn defaults(filter: Filter) -> Self {
+    pub const fn defaults(filter: Filter) -> Self {
         Self {
             filter,
             lambda: 0.5,
@@ -82,7 +82,11 @@ impl Params {
             alpha: 0.1,
             beta: 0.5,
             passband: 0.1,
-            iterations: if filter == Filter::Sinc { 20 } else { 10 },
+            iterations: if matches!(filter, Filter::Sinc) {
+                20
+            } else {
+                10
+            },
             max_displacement: None,
         }
     }

@@ -36,8 +36,6 @@ pub enum Input {
     Files(Vec<NamedFile>),
     /// A file's bytes read as a case only, to add its structures to the open one.
     Addition(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
-    /// A structure of the open case, by its mesh: the model only.
-    Structure(Mesh),
 }
 
 /// A message to a worker.
@@ -94,8 +92,8 @@ pub enum Reply {
         job: u64,
         /// The model (none for an [`Input::Addition`]).
         model: Option<Box<Model>>,
-        /// The case the file makes (none for an [`Input::Structure`]).
-        case: Option<Box<Case>>,
+        /// The case the files make.
+        case: Box<Case>,
         /// Each stage with the milliseconds it took, in order.
         stages: Vec<(String, f64)>,
     },
@@ -263,13 +261,10 @@ impl Worker {
                         bytes: &f.bytes,
                     })
                     .collect();
-                model::open_files(&named, &mut on_stage).map(|o| (Some(o.model), Some(o.case)))
+                model::open_files(&named, &mut on_stage).map(|o| (Some(o.model), o.case))
             }
             Input::Addition(bytes) => {
-                model::open_case(name, &bytes, &mut on_stage).map(|case| (None, Some(case)))
-            }
-            Input::Structure(mesh) => {
-                Ok((Some(model::open_structure(name, mesh, &mut on_stage)), None))
+                model::open_case(name, &bytes, &mut on_stage).map(|case| (None, case))
             }
         };
         let ended = clock();
@@ -284,7 +279,7 @@ impl Worker {
                 Reply::Loaded {
                     job,
                     model: model.map(Box::new),
-                    case: case.map(Box::new),
+                    case: Box::new(case),
                     stages,
                 }
             }
@@ -344,8 +339,8 @@ fn suggest_structure(
     options: &SuggestAllOptions,
 ) -> Reply {
     let mut structure = CaseStructure::from_mesh("", mesh, [1.0; 3]);
-    structure.params = params;
-    structure.weights = weights;
+    structure.set_params(params);
+    structure.set_weights(weights);
     match case::suggest_structure(&mut structure, options, &mut |_| true) {
         Ok(suggestion) => {
             let suggested = suggestion.zip(structure.smoothed).map(|(s, smoothed)| {

@@ -120,6 +120,8 @@ pub struct Pool {
     next_job: u64,
     /// An opening not handed out yet.
     load: Option<(u64, Request)>,
+    /// How many openings were asked for.
+    openings: u64,
     loaded: HashMap<u64, Reply>,
     load_stages: HashMap<u64, LoadStage>,
     smooths: VecDeque<QueuedSmooth>,
@@ -156,6 +158,7 @@ impl Pool {
             sent: None,
             next_job: 0,
             load: None,
+            openings: 0,
             loaded: HashMap::new(),
             load_stages: HashMap::new(),
             smooths: VecDeque::new(),
@@ -197,12 +200,14 @@ impl Pool {
         self.carrier.threaded()
     }
 
-    /// What `state()` says of the CPU engine: its workers and whether they are threads.
+    /// What `state()` says of the CPU engine: its workers, whether they are threads, and how
+    /// many openings were asked of them.
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
             "workers": self.workers(),
             "view_worker": self.view_worker.is_some(),
             "threaded": self.carrier.threaded(),
+            "openings": self.openings,
         })
     }
 
@@ -283,6 +288,7 @@ impl Pool {
         let job = self.new_job();
         let name = name.to_string();
         self.load = Some((job, Request::Load { job, name, input }));
+        self.openings += 1;
         self.pump();
         LoadJob(job)
     }

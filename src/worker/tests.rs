@@ -280,7 +280,7 @@ fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
     assert_eq!(stage.doing, "measuring the original");
     let Some(Reply::Loaded {
         model: Some(model),
-        case: Some(case),
+        case,
         stages,
         ..
     }) = pool.take_loaded(job)
@@ -330,10 +330,7 @@ fn a_file_to_add_comes_back_as_its_case_alone_after_its_reading_stage() {
         model.is_none(),
         "no model is built for a file added to a case"
     );
-    assert_eq!(
-        *case.expect("a case"),
-        Model::load("tube.ply", SAMPLE).unwrap().case
-    );
+    assert_eq!(*case, Model::load("tube.ply", SAMPLE).unwrap().case);
     let names: Vec<&str> = stages.iter().map(|(doing, _)| doing.as_str()).collect();
     assert_eq!(names, ["reading the file"]);
 }

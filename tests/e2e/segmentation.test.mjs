@@ -306,9 +306,15 @@ testIn(EVERY_RUN, "S6 every structure is drawn in its colour: opacity, hiding, s
         assert.deepEqual(list.structures[0].metrics, liver);
         assert.equal(list.structures[1].metrics, null, "never smoothed");
         assert.equal(list.structures[2].metrics, null, "never smoothed");
-        // Back to the kidney: its filter and parameters return, and its result with them.
+        // Back to the kidney: its filter and parameters return, and its result with them. A
+        // pointer moves: no worker opens it and nothing is smoothed again.
+        const openings = (await app.state()).cpu_engine.openings;
         await app.call("selectStructure", 3);
         const state = await app.state();
+        assert.equal(state.structures.current, 3);
+        assert.equal(state.cpu_engine.openings, openings, "selecting asked the workers to open nothing");
+        assert.equal(state.loading, null);
+        assert.equal(state.busy, false, "its result is there at once");
         assert.equal(state.filter, "taubin");
         assert.equal(state.params.iterations, 12);
         assert.deepEqual(await app.metrics(), kidney);

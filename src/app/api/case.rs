@@ -2,11 +2,10 @@
 //! `setStructure`, `soloStructure` and `setCase`.
 
 use eframe::egui;
-use js_sys::{Function, Promise};
+use js_sys::Promise;
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsValue;
 
-use super::files::info_waiter;
 use super::{from_js, setter, settled, to_js, Api};
 use crate::app::document::SharedDocument;
 use crate::session::Session;
@@ -57,7 +56,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
     Ok(())
 }
 
-/// `selectStructure(index)`: opens that structure as the model; settles as `loadMesh` does.
+/// `selectStructure(index)`: makes that structure the model; resolves with its info.
 fn select_structure(
     doc: &SharedDocument,
     ctx: &egui::Context,
@@ -69,20 +68,14 @@ fn select_structure(
                 "selectStructure(index): index must be a whole number >= 0".into(),
             ));
         };
-        let (d, c) = (d.clone(), c.clone());
-        let mut result = None;
-        let promise = Promise::new(&mut |resolve: Function, reject: Function| {
-            let waiter = info_waiter(resolve, reject);
-            result = Some(
-                d.borrow_mut()
-                    .begin_open_structure(index as usize, Some(waiter)),
-            );
-            crate::app::wake(&c);
+        let mut doc = d.borrow_mut();
+        let selected = doc.select_structure(index as usize).and_then(|()| {
+            (doc.session.info_json())
+                .map(|v| to_js(&v))
+                .ok_or_else(|| "nothing is open".to_string())
         });
-        match result {
-            Some(Err(e)) => settled(Err(e)),
-            _ => promise,
-        }
+        crate::app::wake(&c);
+        settled(selected)
     })
 }
 

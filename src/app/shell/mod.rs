@@ -362,7 +362,7 @@ impl Shell {
                     add_files = true;
                     Ok(())
                 }
-                StructureAction::Select(i) => doc.begin_open_structure(i, None),
+                StructureAction::Select(i) => doc.select_structure(i),
                 StructureAction::Change(i, change) => doc.session.set_structure(i, change),
                 StructureAction::Solo(i) => doc.session.solo_structure(i),
                 StructureAction::CaseText(title, description) => {

@@ -64,7 +64,7 @@ impl Shell {
                 }
                 for action in actions {
                     let done = match action {
-                        StructureAction::Select(i) => doc.begin_open_structure(i, None),
+                        StructureAction::Select(i) => doc.select_structure(i),
                         StructureAction::Change(i, change) => doc.session.set_structure(i, change),
                         StructureAction::Solo(i) => doc.session.solo_structure(i),
                         _ => Ok(()),

@@ -104,7 +104,7 @@ impl Shell {
         doc.view_asks.clip = link.clip;
         doc.view_asks.toward_segmentation = link.toward_segmentation;
         if let Some(i) = link.selected {
-            if let Err(e) = doc.begin_open_structure(i, None) {
+            if let Err(e) = doc.select_structure(i) {
                 problems.push(e);
             }
         }

@@ -43,7 +43,7 @@ impl Shell {
                     let current = doc.session.current_structure();
                     if let (true, Some(i)) = (self.reading, clicked.filter(|&i| Some(i) != current))
                     {
-                        if let Err(e) = doc.begin_open_structure(i, None) {
+                        if let Err(e) = doc.select_structure(i) {
                             log::warn!("{e}");
                         }
                     }
