@@ -29,7 +29,7 @@ fn files_opened_together_make_the_case_the_cli_makes() {
         (session, outcome)
     };
     let same = |session: &Session, expected: &case::Case| {
-        let got = session.case_structures();
+        let got = session.case().case_structures();
         assert_eq!(got.len(), expected.structures.len());
         for (g, e) in got.iter().zip(&expected.structures) {
             assert_eq!(
@@ -61,17 +61,17 @@ fn files_opened_together_make_the_case_the_cli_makes() {
     )
     .expect("the CLI's way");
     same(&session, &cli);
-    let names: Vec<&str> = (session.case_structures().iter())
+    let names: Vec<&str> = (session.case().case_structures().iter())
         .map(|s| s.name.as_str())
         .collect();
     assert!(!names.iter().any(|n| n.starts_with("label ")), "{names:?}");
-    let model = session.model().expect("a model");
+    let model = session.case().model().expect("a model");
     assert_eq!(
         model.name,
         format!("case_phantom_shared.nii.gz: {}", names[0])
     );
     assert!(
-        session.params().max_displacement.is_some(),
+        session.case().params().max_displacement.is_some(),
         "a label map's own bound"
     );
 
@@ -96,7 +96,7 @@ fn files_opened_together_make_the_case_the_cli_makes() {
         &session,
         &case::open(&named, None, &Default::default()).unwrap(),
     );
-    let names: Vec<&str> = (session.case_structures().iter())
+    let names: Vec<&str> = (session.case().case_structures().iter())
         .map(|s| s.name.as_str())
         .collect();
     assert_eq!(
@@ -119,7 +119,7 @@ fn files_opened_together_make_the_case_the_cli_makes() {
     ]);
     assert_eq!(stages, expected);
     assert_eq!(
-        session.case_file(),
+        session.case().case_file(),
         "sphere_r20_mask.nii.gz and 3 more files"
     );
 
@@ -131,5 +131,5 @@ fn files_opened_together_make_the_case_the_cli_makes() {
     ]);
     let why = outcome.expect_err("refused");
     assert!(why.contains("a.txt") && why.contains("b.txt"), "{why}");
-    assert!(session.model().is_none());
+    assert!(session.case().model().is_none());
 }

@@ -33,25 +33,26 @@ fn a_session_opens_a_label_map_as_its_structures() {
             "measuring the original"
         ]
     );
-    let structures = session.case_structures();
+    let structures = session.case().case_structures();
     assert_eq!(structures.len(), 4);
-    assert_eq!(session.current_structure(), Some(0));
-    let model = session.model().expect("a model");
+    assert_eq!(session.case().current_structure(), Some(0));
+    let model = session.case().model().expect("a model");
     assert_eq!(model.name, "case_phantom_shared.seg.nrrd: liver");
     assert_eq!(model.mesh(), &structures[0].original);
     let vd = session
+        .case()
         .voxel_diagonal()
         .expect("the voxel size comes with the structure");
     assert!((vd - (0.78f64 * 0.78 * 2.0 + 2.5 * 2.5).sqrt()).abs() < 1e-6);
     // Gibson's bound by default: half the voxel diagonal, with the case's filter.
-    let params = session.params();
+    let params = session.case().params();
     assert_eq!(params.filter, meshsmooth::case::DEFAULT_FILTER);
     assert_eq!(params.max_displacement, Some((0.5 * vd) as f32));
 
     session.select_structure(2).expect("structure 2 exists");
-    assert_eq!(session.current_structure(), Some(2));
+    assert_eq!(session.case().current_structure(), Some(2));
     assert_eq!(
-        session.model().expect("a model").name,
+        session.case().model().expect("a model").name,
         "case_phantom_shared.seg.nrrd: tumor"
     );
     assert!(session
@@ -66,7 +67,7 @@ fn a_session_opens_a_label_map_as_its_structures() {
     let e = session.poll_opening().expect("finished").unwrap_err();
     assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
     assert_eq!(
-        session.model().expect("kept").name,
+        session.case().model().expect("kept").name,
         "case_phantom_shared.seg.nrrd: tumor"
     );
 }
@@ -83,23 +84,32 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         read("labelmaps/case_phantom_shared.seg.nrrd"),
     );
     session.poll_opening().expect("done").expect("opens");
-    assert_eq!(session.case_structures().len(), 4);
+    assert_eq!(session.case().case_structures().len(), 4);
     assert!(session
+        .case()
         .case_structures()
         .iter()
         .all(|l| l.visible && l.color[3] == 1.0));
     // Three others around the liver, as extracted.
-    let others: Vec<usize> = session.other_structures().iter().map(|o| o.index).collect();
+    let others: Vec<usize> = session
+        .case()
+        .other_structures()
+        .iter()
+        .map(|o| o.index)
+        .collect();
     assert_eq!(others, [1, 2, 3]);
 
     let (index, change) = StructureChange::from_json(&serde_json::json!({
         "index": 2, "name": " tumour ", "color": [0.0, 1.0, 0.0], "opacity": 0.4
     }))
     .unwrap();
-    let version = session.case_version();
-    session.set_structure(index.unwrap(), change).unwrap();
-    assert!(session.case_version() > version);
-    let tumour = &session.case_structures()[2];
+    let version = session.case().case_version();
+    session
+        .case_mut()
+        .set_structure(index.unwrap(), change)
+        .unwrap();
+    assert!(session.case().case_version() > version);
+    let tumour = &session.case().case_structures()[2];
     assert_eq!(
         (tumour.name.as_str(), tumour.color),
         ("tumour", [0.0, 1.0, 0.0, 0.4])
@@ -112,15 +122,16 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         serde_json::json!({"visible": "yes"}),
         serde_json::json!([1]),
     ] {
-        let refused =
-            StructureChange::from_json(&bad).and_then(|(_, c)| session.set_structure(2, c));
+        let refused = StructureChange::from_json(&bad)
+            .and_then(|(_, c)| session.case_mut().set_structure(2, c));
         assert!(refused.is_err(), "{bad}");
     }
     assert!(session
+        .case_mut()
         .set_structure(9, StructureChange::default())
         .is_err());
     assert_eq!(
-        session.case_structures()[2].name,
+        session.case().case_structures()[2].name,
         "tumour",
         "a refusal changes nothing"
     );
@@ -131,56 +142,61 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
             .1
     };
     session
+        .case_mut()
         .set_structure(1, group(serde_json::json!(" Vessels ")))
         .unwrap();
     assert_eq!(
-        session.case_structures()[1].group.as_deref(),
+        session.case().case_structures()[1].group.as_deref(),
         Some("Vessels")
     );
     assert_eq!(
-        session.structures_json().unwrap()["structures"][1]["group"],
+        session.case().structures_json().unwrap()["structures"][1]["group"],
         "Vessels"
     );
     session
+        .case_mut()
         .set_structure(1, group(serde_json::Value::Null))
         .unwrap();
-    assert_eq!(session.case_structures()[1].group, None);
+    assert_eq!(session.case().case_structures()[1].group, None);
     session
+        .case_mut()
         .set_structure(1, group(serde_json::json!("Vessels")))
         .unwrap();
 
     // Solo shows one alone; again, every one.
-    session.solo_structure(3).unwrap();
+    session.case_mut().solo_structure(3).unwrap();
     let visible: Vec<bool> = session
+        .case()
         .case_structures()
         .iter()
         .map(|l| l.visible)
         .collect();
     assert_eq!(visible, [false, false, false, true]);
-    assert_eq!(session.other_structures().len(), 1);
-    session.solo_structure(3).unwrap();
-    assert!(session.case_structures().iter().all(|l| l.visible));
+    assert_eq!(session.case().other_structures().len(), 1);
+    session.case_mut().solo_structure(3).unwrap();
+    assert!(session.case().case_structures().iter().all(|l| l.visible));
 
     // Smooth the liver, then work on the portal vein: the liver keeps its smoothing.
     let liver_params = Params {
         iterations: 7,
         ..Params::defaults(Filter::Taubin)
     };
-    session.set_params(liver_params).unwrap();
+    session.case_mut().set_params(liver_params).unwrap();
     session.smooth_cpu();
-    let liver = session.result().expect("smoothed").clone();
+    let liver = session.case().result().expect("smoothed").clone();
     session.select_structure(1).unwrap();
-    let others = session.other_structures();
+    let others = session.case().other_structures();
     let kept_liver = others
         .iter()
         .find(|o| o.index == 0)
         .expect("the liver is drawn");
     assert_eq!(kept_liver.positions, &liver.positions[..]);
     session
+        .case_mut()
         .set_params(Params::defaults(Filter::Laplace))
         .unwrap();
     session.smooth_cpu();
-    let json = session.structures_json().unwrap();
+    let json = session.case().structures_json().unwrap();
     assert_eq!(json["current"], 1);
     assert_eq!(json["structures"][2]["name"], "tumour");
     assert_eq!(json["structures"][2]["opacity"], 0.4f32 as f64);
@@ -193,29 +209,35 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
 
     // Back to the liver: a pointer moves. Nothing is opened or smoothed again: its
     // parameters and its result are where they were, in its structure.
-    let model_before = session.model_id();
+    let model_before = session.case().model_id();
     session.select_structure(0).unwrap();
     assert!(
         session.loading().is_none(),
         "no worker opens a selected structure"
     );
-    assert!(session.model_id() > model_before);
-    assert_eq!(*session.params(), liver_params);
-    assert_eq!(session.case_structures()[0].params, liver_params);
-    assert!(!session.needs_smoothing(), "its result is there at once");
-    assert_eq!(session.result().unwrap().positions, liver.positions);
-    assert_eq!(session.result().unwrap().metrics, liver.metrics);
+    assert!(session.case().model_id() > model_before);
+    assert_eq!(*session.case().params(), liver_params);
+    assert_eq!(session.case().case_structures()[0].params, liver_params);
+    assert!(
+        !session.case().needs_smoothing(),
+        "its result is there at once"
+    );
+    assert_eq!(session.case().result().unwrap().positions, liver.positions);
+    assert_eq!(session.case().result().unwrap().metrics, liver.metrics);
     assert!(session.smooth_cpu().is_none(), "nothing to smooth");
     assert_eq!(
-        session.case_structures()[2].name,
+        session.case().case_structures()[2].name,
         "tumour",
         "looks stay across switches"
     );
 
     // The case as arranged: the page's case glTF reads back with the same names, looks,
     // parameters and smoothed surfaces (the portal vein's kept, the liver's current).
-    session.set_case_text(Some(" Abdomen "), Some("Liver with a tumour"));
+    session
+        .case_mut()
+        .set_case_text(Some(" Abdomen "), Some("Liver with a tumour"));
     let glb = session
+        .case()
         .export_case(meshsmooth::export::Container::Glb)
         .expect("the case exports");
     let files = [meshsmooth::segmentation::NamedBytes {
@@ -254,7 +276,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         read("labelmaps/case_phantom_shared.seg.nrrd"),
     );
     session.poll_opening().expect("done").expect("opens");
-    assert_eq!(session.case_structures()[2].name, "tumor");
+    assert_eq!(session.case().case_structures()[2].name, "tumor");
 }
 
 /// "Suggest all" in the page's session: each structure gets what the CLI's pipeline suggests for
@@ -271,16 +293,16 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     session.poll_opening().expect("done").expect("opens");
     // Each structure starts from its own filter and bound, the model's as the session has it.
     let mut expected = Case {
-        structures: session.case_structures().to_vec(),
+        structures: session.case().case_structures().to_vec(),
         ..Case::default()
     };
-    assert_eq!(expected.structures[0].params, *session.params());
+    assert_eq!(expected.structures[0].params, *session.case().params());
     assert!(session.start_suggest_all(1.5, SearchMethod::Local).is_err());
     session.start_suggest_all(0.5, SearchMethod::Local).unwrap();
     // Workers on this thread answer at once.
     assert!(session.step_suggest_all());
-    assert!(!session.suggesting_all());
-    let outcome = session.suggest_all_json().unwrap();
+    assert!(!session.background().suggesting_all());
+    let outcome = session.background().suggest_all_json().unwrap();
     assert_eq!(
         (outcome["done"].as_u64(), outcome["total"].as_u64()),
         (Some(4), Some(4))
@@ -298,17 +320,17 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
         .unwrap();
     case::suggest_all(&mut expected, &options, &|_| true).unwrap();
     assert_eq!(
-        *session.params(),
+        *session.case().params(),
         first.params,
         "the model takes its suggestion"
     );
     session.smooth_cpu();
     assert_eq!(
-        session.result().unwrap().positions,
+        session.case().result().unwrap().positions,
         liver.smoothed.as_ref().unwrap().positions
     );
     for i in 1..4 {
-        let kept = &session.case_structures()[i];
+        let kept = &session.case().case_structures()[i];
         let want = &expected.structures[i];
         assert_eq!(kept.params, want.params, "structure {i}");
         let smoothed = kept.smoothed.as_ref().unwrap();
@@ -320,7 +342,7 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
         assert_eq!(outcome["structures"][i]["params"], want.params.to_json());
     }
     // Drawn as suggested.
-    let others = session.other_structures();
+    let others = session.case().other_structures();
     assert_eq!(
         others[0].positions,
         &expected.structures[1].smoothed.as_ref().unwrap().positions[..]
@@ -329,7 +351,7 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     session.begin_open("case_phantom_shared.seg.nrrd", bytes);
     session.poll_opening().expect("done").expect("opens");
     assert!(
-        session.suggest_all_json().is_none(),
+        session.background().suggest_all_json().is_none(),
         "a new file starts over"
     );
 }
@@ -352,42 +374,54 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
-    session.set_case_text(Some("Abdomen"), Some("Liver, tumour, vessels"));
+    session
+        .case_mut()
+        .set_case_text(Some("Abdomen"), Some("Liver, tumour, vessels"));
     let vessels = StructureChange {
         group: Some(Some("Vessels".into())),
         description: Some("  Carries blood from the gut to the liver. ".into()),
         ..Default::default()
     };
-    session.set_structure(1, vessels).unwrap();
+    session.case_mut().set_structure(1, vessels).unwrap();
     let glassy = StructureChange {
         opacity: Some(0.3),
         ..Default::default()
     };
-    session.set_structure(0, glassy).unwrap();
+    session.case_mut().set_structure(0, glassy).unwrap();
     session.smooth_cpu();
-    let liver_params = *session.params();
+    let liver_params = *session.case().params();
     session.select_structure(3).unwrap();
     let kidney_params = Params {
         iterations: 9,
         ..Params::defaults(Filter::Taubin)
     };
-    session.set_params(kidney_params).unwrap();
+    session.case_mut().set_params(kidney_params).unwrap();
     session.smooth_cpu();
-    let first = session.export_case(Container::Glb).unwrap();
+    let first = session.case().export_case(Container::Glb).unwrap();
 
     let mut again = Session::default();
     open_in_session(&mut again, "abdomen_case.glb", first.clone());
-    assert_eq!(again.current_structure(), Some(0));
-    assert_eq!(again.model().unwrap().name, "abdomen_case.glb: liver");
-    assert_eq!(*again.params(), liver_params, "the liver's own parameters");
-    assert!(again.voxel_diagonal().is_some(), "its voxel size too");
+    assert_eq!(again.case().current_structure(), Some(0));
     assert_eq!(
-        (again.case_title(), again.case_description()),
+        again.case().model().unwrap().name,
+        "abdomen_case.glb: liver"
+    );
+    assert_eq!(
+        *again.case().params(),
+        liver_params,
+        "the liver's own parameters"
+    );
+    assert!(
+        again.case().voxel_diagonal().is_some(),
+        "its voxel size too"
+    );
+    assert_eq!(
+        (again.case().case_title(), again.case().case_description()),
         ("Abdomen", "Liver, tumour, vessels")
     );
-    assert_eq!(again.case_structures()[3].params, kidney_params);
+    assert_eq!(again.case().case_structures()[3].params, kidney_params);
     again.smooth_cpu();
-    let second = again.export_case(Container::Glb).unwrap();
+    let second = again.case().export_case(Container::Glb).unwrap();
 
     let read_case = |bytes: &[u8]| {
         let files = [meshsmooth::segmentation::NamedBytes {
@@ -439,16 +473,19 @@ fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
     session.smooth_cpu();
-    let case = session.export_case(Container::Glb).unwrap();
+    let case = session.case().export_case(Container::Glb).unwrap();
 
     let mut again = Session::default();
     open_in_session(&mut again, "case.glb", case);
-    let kept = again.case_structures()[0].smoothed.clone();
+    let kept = again.case().case_structures()[0].smoothed.clone();
     assert!(kept.is_some(), "the case glTF holds the liver smoothed");
-    assert!(again.last_result().is_none(), "nothing smoothed here yet");
+    assert!(
+        again.case().last_result().is_none(),
+        "nothing smoothed here yet"
+    );
     again.select_structure(2).unwrap();
-    assert_eq!(again.current_structure(), Some(2));
-    assert_eq!(again.case_structures()[0].smoothed, kept);
+    assert_eq!(again.case().current_structure(), Some(2));
+    assert_eq!(again.case().case_structures()[0].smoothed, kept);
 }
 
 /// While the engine recomputes a case glTF's structure, the page shows the surface the case
@@ -459,33 +496,37 @@ fn a_case_glb_structure_shows_its_kept_surface_until_the_engine_recomputes_it() 
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
     assert!(
-        session.kept_surface().is_none(),
+        session.case().kept_surface().is_none(),
         "a label map holds no surfaces"
     );
     session.smooth_cpu();
-    let case = session.export_case(Container::Glb).unwrap();
+    let case = session.case().export_case(Container::Glb).unwrap();
 
     let mut again = Session::default();
     open_in_session(&mut again, "case.glb", case);
     let kept = again
+        .case()
         .kept_surface()
         .expect("the liver's smoothed surface")
         .to_vec();
-    let segmentation = &again.model().unwrap().mesh().positions;
+    let segmentation = &again.case().model().unwrap().mesh().positions;
     assert!(
         farthest(&kept, segmentation) > 0.1,
         "smoothed, not the segmentation"
     );
     again.smooth_cpu();
     assert_eq!(
-        again.result().unwrap().positions,
+        again.case().result().unwrap().positions,
         kept,
         "the engine's surface is the case's"
     );
-    let mut other = *again.params();
+    let mut other = *again.case().params();
     other.iterations += 1;
-    again.set_params(other).unwrap();
-    assert!(again.kept_surface().is_none(), "none for other parameters");
+    again.case_mut().set_params(other).unwrap();
+    assert!(
+        again.case().kept_surface().is_none(),
+        "none for other parameters"
+    );
 }
 
 /// Files added to an open case join it as structures (a surface coloured by its place, a label
@@ -501,11 +542,11 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
         "case_phantom_shared.seg.nrrd",
         phantom.clone(),
     );
-    let model = session.model_id();
+    let model = session.case().model_id();
     session.begin_add("synthetic_sphere_r20.stl", sphere.clone());
     session.poll_opening().expect("done").expect("added");
-    assert_eq!(session.model_id(), model, "the model stays");
-    let list = session.case_structures();
+    assert_eq!(session.case().model_id(), model, "the model stays");
+    let list = session.case().case_structures();
     assert_eq!(list.len(), 5);
     let added = &list[4];
     assert_eq!(added.name, "synthetic sphere r20");
@@ -522,23 +563,23 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
         read("synthetic/sphere_r20_mask.nii.gz"),
     );
     session.poll_opening().expect("done").expect("added");
-    let mask = &session.case_structures()[5];
+    let mask = &session.case().case_structures()[5];
     assert!(mask.voxel_size.is_some() && mask.label.is_some());
     assert_eq!(mask.params.max_displacement, mask.default_bound());
     let bound = mask.default_bound();
     // It smooths as the model with its own bound.
     session.select_structure(5).unwrap();
-    assert_eq!(session.params().max_displacement, bound);
-    assert_eq!(session.to_case().unwrap().structures.len(), 6);
+    assert_eq!(session.case().params().max_displacement, bound);
+    assert_eq!(session.case().to_case().unwrap().structures.len(), 6);
 
     // Dropped together: the second waits for the first, then joins its case.
     session.begin_open("case_phantom_shared.seg.nrrd", phantom);
     session.begin_add("synthetic_sphere_r20.stl", sphere.clone());
     session.poll_opening().expect("done").expect("opens");
     assert!(session.loading().is_some(), "the addition follows");
-    assert_eq!(session.case_structures().len(), 4);
+    assert_eq!(session.case().case_structures().len(), 4);
     session.poll_opening().expect("done").expect("added");
-    assert_eq!(session.case_structures().len(), 5);
+    assert_eq!(session.case().case_structures().len(), 5);
     assert!(session.loading().is_none());
 
     // A file that fails to open takes the files meant for its case with it.
@@ -549,5 +590,5 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     let e = session.poll_opening().expect("finished").unwrap_err();
     assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
     assert!(session.loading().is_none(), "nothing left to add");
-    assert_eq!(session.case_structures().len(), 5, "the case stays");
+    assert_eq!(session.case().case_structures().len(), 5, "the case stays");
 }

@@ -22,8 +22,8 @@ fn the_session_checks_its_structures_as_they_stand() {
         session.step_checks(),
         "a worker on this thread answers at once"
     );
-    assert!(!session.checking());
-    let report = session.checks_json().unwrap();
+    assert!(!session.background().checking());
+    let report = session.background().checks_json().unwrap();
     assert!(
         report["text"]
             .as_str()
@@ -33,9 +33,9 @@ fn the_session_checks_its_structures_as_they_stand() {
     );
     assert_eq!(report["left_inside"], serde_json::json!([]));
     assert_eq!(report["current"], true);
-    assert!(session.flagged_structures().is_empty());
+    assert!(session.background().flagged_structures().is_empty());
     // The same as the CLI's pipeline says of the same case.
-    let case = session.to_case().unwrap();
+    let case = session.case().to_case().unwrap();
     let before = meshsmooth::case::check(&case, false);
     let after = meshsmooth::case::check(&case, true);
     let changes = meshsmooth::case::relations::changes(&before, &after);
@@ -49,12 +49,15 @@ fn the_session_checks_its_structures_as_they_stand() {
         max_displacement: None,
         ..Params::defaults(Filter::Laplace)
     };
-    session.set_params(shrink).unwrap();
-    assert_eq!(session.checks_json().unwrap()["current"], false);
+    session.case_mut().set_params(shrink).unwrap();
+    assert_eq!(
+        session.background().checks_json().unwrap()["current"],
+        false
+    );
     session.smooth_cpu();
     session.start_checks().unwrap();
     session.step_checks();
-    let report = session.checks_json().unwrap();
+    let report = session.background().checks_json().unwrap();
     assert_eq!(
         report["left_inside"],
         serde_json::json!([["tumor", "liver"]]),
@@ -71,7 +74,7 @@ fn the_session_checks_its_structures_as_they_stand() {
         crossings,
         &serde_json::json!([["liver", "portal_vein"], ["liver", "tumor"]])
     );
-    assert_eq!(session.flagged_structures(), [0, 1, 2]);
+    assert_eq!(session.background().flagged_structures(), [0, 1, 2]);
 
     // The view marks where: the tumour's vertices out of the liver, the liver's in the vein and
     // the tumour, the vein's and the tumour's in the liver; nothing of the kidney.
@@ -79,10 +82,10 @@ fn the_session_checks_its_structures_as_they_stand() {
     let counts: Vec<u64> = marked.iter().map(|n| n.as_u64().unwrap()).collect();
     assert!(counts[..3].iter().all(|&n| n > 0), "{counts:?}");
     assert_eq!(counts[3], 0, "{counts:?}");
-    let key = session.marks_key().expect("marks to show");
-    let patches = session.marked_surfaces();
+    let key = session.background().marks_key().expect("marks to show");
+    let patches = session.background().marked_surfaces();
     assert_eq!(patches.len(), 3);
-    let liver = &session.case_structures()[0];
+    let liver = &session.case().case_structures()[0];
     assert!(patches[0].triangle_count() < liver.original.triangle_count() / 2);
     // Hiding or recolouring a structure leaves the surfaces as checked; a hidden one's marks
     // are not drawn.
@@ -91,20 +94,26 @@ fn the_session_checks_its_structures_as_they_stand() {
         color: Some([0.2, 0.3, 0.4]),
         ..Default::default()
     };
-    session.set_structure(1, hide).unwrap();
-    assert_eq!(session.checks_json().unwrap()["current"], true);
-    assert_eq!(session.marks_key(), Some(key));
-    assert_eq!(session.marked_surfaces().len(), 2);
+    session.case_mut().set_structure(1, hide).unwrap();
+    assert_eq!(session.background().checks_json().unwrap()["current"], true);
+    assert_eq!(session.background().marks_key(), Some(key));
+    assert_eq!(session.background().marked_surfaces().len(), 2);
     // Smoothing anew does not: the marks go.
-    session.set_params(Params::defaults(Filter::Hc)).unwrap();
+    session
+        .case_mut()
+        .set_params(Params::defaults(Filter::Hc))
+        .unwrap();
     session.smooth_cpu();
-    assert_eq!(session.checks_json().unwrap()["current"], false);
-    assert_eq!(session.marks_key(), None);
-    assert!(session.marked_surfaces().is_empty());
+    assert_eq!(
+        session.background().checks_json().unwrap()["current"],
+        false
+    );
+    assert_eq!(session.background().marks_key(), None);
+    assert!(session.background().marked_surfaces().is_empty());
     // Back to the checked parameters, the same surface again: the marks are current again.
-    session.set_params(shrink).unwrap();
+    session.case_mut().set_params(shrink).unwrap();
     session.smooth_cpu();
-    assert_eq!(session.marks_key(), Some(key));
+    assert_eq!(session.background().marks_key(), Some(key));
 }
 
 /// The structure under the pointer, as drawn: the nearest visible one along the ray, looking
@@ -115,7 +124,7 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
-    let tumour = &session.case_structures()[2].original.positions;
+    let tumour = &session.case().case_structures()[2].original.positions;
     let centre = tumour
         .iter()
         .fold(glam::Vec3::ZERO, |sum, &p| sum + glam::Vec3::from(p))
@@ -127,6 +136,7 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
     };
     let none = [0.0; 4];
     let (first, hit) = session
+        .case()
         .structure_at(&ray, none)
         .expect("the case in the way");
     assert_eq!(first, 0, "the liver first");
@@ -134,31 +144,34 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
         opacity: Some(0.0),
         ..Default::default()
     };
-    session.set_structure(0, clear).unwrap();
-    let (seen, deeper) = session.structure_at(&ray, none).unwrap();
+    session.case_mut().set_structure(0, clear).unwrap();
+    let (seen, deeper) = session.case().structure_at(&ray, none).unwrap();
     assert_eq!(seen, 2, "through the transparent liver, the tumour");
     assert!(deeper.distance > hit.distance);
-    session.solo_structure(2).unwrap();
-    let (alone, near) = session.structure_at(&ray, none).unwrap();
+    session.case_mut().solo_structure(2).unwrap();
+    let (alone, near) = session.case().structure_at(&ray, none).unwrap();
     assert_eq!(alone, 2);
     // A plane through the tumour's centre cutting away its near half (x below the centre):
     // the pointer meets its far half.
     let cut_near = [-1.0, 0.0, 0.0, -centre.x];
-    let (_, far) = session.structure_at(&ray, cut_near).unwrap();
+    let (_, far) = session.case().structure_at(&ray, cut_near).unwrap();
     assert!(
         far.point.x > centre.x && far.distance > near.distance,
         "{far:?}"
     );
     // Cutting everything away leaves nothing to name.
-    assert!(session.structure_at(&ray, [0.0, 0.0, 0.0, -1.0]).is_none());
-    session.solo_structure(2).unwrap();
+    assert!(session
+        .case()
+        .structure_at(&ray, [0.0, 0.0, 0.0, -1.0])
+        .is_none());
+    session.case_mut().solo_structure(2).unwrap();
     let hide = StructureChange {
         visible: Some(false),
         ..Default::default()
     };
-    session.set_structure(2, hide).unwrap();
+    session.case_mut().set_structure(2, hide).unwrap();
     assert_ne!(
-        session.structure_at(&ray, none).map(|(i, _)| i),
+        session.case().structure_at(&ray, none).map(|(i, _)| i),
         Some(2),
         "hidden"
     );

@@ -58,8 +58,8 @@ impl BottomPanel {
             let picked = self.gallery.show(ui, session, &mut cards);
             layout.gallery = cards.into_iter().map(Into::into).collect();
             if let Some((tau, params)) = picked {
-                let _ = session.set_tau(tau);
-                let _ = session.set_params(params);
+                let _ = session.case_mut().set_tau(tau);
+                let _ = session.case_mut().set_params(params);
             }
         } else {
             graphs_tab(ui, session, &mut layout.graphs);
@@ -69,9 +69,9 @@ impl BottomPanel {
 
 fn graphs_tab(ui: &mut egui::Ui, session: &mut Session, layout: &mut Vec<GraphColumn>) {
     ui.horizontal(|ui| {
-        let filter = session.filter();
+        let filter = session.case().filter();
         ui.label(format!("{filter} filter: each column varies one parameter"));
-        for a in session.activities() {
+        for a in session.background().activities() {
             if let Activity::Graphs(_) = a {
                 ui.add(
                     egui::ProgressBar::new(a.fraction())
@@ -82,6 +82,6 @@ fn graphs_tab(ui: &mut egui::Ui, session: &mut Session, layout: &mut Vec<GraphCo
         }
     });
     if let Some(p) = graphs::show(ui, session, layout) {
-        let _ = session.set_params(p);
+        let _ = session.case_mut().set_params(p);
     }
 }

@@ -75,16 +75,16 @@ impl Brush {
                     "P: left drag paints where smoothing may act; Ctrl/⌘ + left drag or the \
                      middle button orbits meanwhile",
                 );
-            let painted = session.weights().is_some();
+            let painted = session.case().weights().is_some();
             if ui
                 .add_enabled(painted, egui::Button::new("Clear"))
                 .on_hover_text("Every vertex free again")
                 .clicked()
             {
-                session.clear_weights();
+                session.case_mut().clear_weights();
             }
         });
-        if !self.active && session.weights().is_none() {
+        if !self.active && session.case().weights().is_none() {
             return;
         }
         ui.horizontal(|ui| {
@@ -120,7 +120,7 @@ impl Brush {
                     .suffix(" mm"),
             );
         });
-        if let Some(w) = session.weights_summary() {
+        if let Some(w) = session.case().weights_summary() {
             ui.small(format!(
                 "{} vertices painted, {} locked (lowest weight {:.2})",
                 w.painted, w.locked, w.min
@@ -165,11 +165,12 @@ impl Brush {
 
         let mut footprints = Vec::new();
         {
-            let Some(model) = session.model() else {
+            let Some(model) = session.case().model() else {
                 return;
             };
             let positions = match surface.1 {
                 Some(_) => session
+                    .case()
                     .last_result()
                     .map_or(&model.mesh().positions, |r| &r.positions),
                 None => &model.mesh().positions,
@@ -240,9 +241,11 @@ impl Brush {
         }
         for footprint in footprints {
             match self.mode {
-                BrushMode::Lock => session.paint_weights(&footprint, 0.0),
-                BrushMode::Weaken => session.paint_weights(&footprint, 1.0 - self.strength),
-                BrushMode::Erase => session.erase_weights(&footprint),
+                BrushMode::Lock => session.case_mut().paint_weights(&footprint, 0.0),
+                BrushMode::Weaken => session
+                    .case_mut()
+                    .paint_weights(&footprint, 1.0 - self.strength),
+                BrushMode::Erase => session.case_mut().erase_weights(&footprint),
             };
         }
         self.draw_circle(ui, camera, rect, size);

@@ -21,18 +21,18 @@ pub fn show(
     layout.structures.clear();
     layout.structure_name = None;
     let mut actions = Vec::new();
-    let Some(current) = session.current_structure() else {
+    let Some(current) = session.case().current_structure() else {
         return actions;
     };
-    let list = session.case_structures();
-    let title = session.case_title();
+    let list = session.case().case_structures();
+    let title = session.case().case_title();
     ui.heading(if title.is_empty() {
-        session.case_file()
+        session.case().case_file()
     } else {
         title
     });
-    if !session.case_description().is_empty() {
-        ui.label(session.case_description());
+    if !session.case().case_description().is_empty() {
+        ui.label(session.case().case_description());
     }
     ui.separator();
     ui.horizontal(|ui| {

@@ -17,8 +17,11 @@ pub struct CaseText {
 impl CaseText {
     /// Rewrites the canvas's label and the structures' list where the case changed.
     pub fn update(&mut self, session: &Session) {
-        let (version, current) = (session.case_version(), session.current_structure());
-        let (file, title) = (session.case_file(), session.case_title());
+        let (version, current) = (
+            session.case().case_version(),
+            session.case().current_structure(),
+        );
+        let (file, title) = (session.case().case_file(), session.case().case_title());
         if let Some((v, c, f, t)) = &self.written {
             if (*v, *c, f.as_str(), t.as_str()) == (version, current, file, title) {
                 return;
@@ -46,11 +49,11 @@ impl CaseText {
 
 /// The canvas's label: what the view shows.
 fn label(session: &Session) -> String {
-    let structures = session.case_structures();
+    let structures = session.case().case_structures();
     let shown = structures.iter().filter(|s| s.visible).count();
-    let title = session.case_title();
+    let title = session.case().case_title();
     let what = if title.is_empty() {
-        session.case_file()
+        session.case().case_file()
     } else {
         title
     };
@@ -58,7 +61,7 @@ fn label(session: &Session) -> String {
         "3D view of {what}: {} structures, {shown} shown",
         structures.len()
     );
-    if let Some(s) = session.model_structure() {
+    if let Some(s) = session.case().model_structure() {
         text.push_str(&format!("; selected: {}", s.name));
     }
     text
@@ -67,8 +70,8 @@ fn label(session: &Session) -> String {
 /// One line per structure: its name, group, whether it is shown and how opaque, whether it is
 /// selected, and its description.
 fn lines(session: &Session) -> Vec<String> {
-    let current = session.current_structure();
-    (session.case_structures().iter().enumerate())
+    let current = session.case().current_structure();
+    (session.case().case_structures().iter().enumerate())
         .map(|(i, s)| {
             let mut line = s.name.clone();
             if let Some(group) = &s.group {

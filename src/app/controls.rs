@@ -49,15 +49,15 @@ fn slider(
 impl Controls {
     /// The filter and its parameters.
     pub fn filter(&mut self, ui: &mut egui::Ui, session: &mut Session) {
-        let mut p: Params = *session.params();
+        let mut p: Params = *session.case().params();
         ui.horizontal_wrapped(|ui| {
             for f in Filter::ALL {
                 if ui
-                    .selectable_label(session.filter() == f, filter_label(f))
+                    .selectable_label(session.case().filter() == f, filter_label(f))
                     .clicked()
                 {
-                    session.set_filter(f);
-                    p = *session.params();
+                    session.case_mut().set_filter(f);
+                    p = *session.case().params();
                 }
             }
         });
@@ -121,7 +121,7 @@ impl Controls {
             ui.label("iterations");
             ui.add(egui::Slider::new(&mut p.iterations, min_it..=max_it));
         });
-        let voxel = session.voxel_diagonal().map(|d| d as f32);
+        let voxel = session.case().voxel_diagonal().map(|d| d as f32);
         ui.horizontal(|ui| {
             let mut bounded = p.max_displacement.is_some();
             ui.checkbox(&mut bounded, "max displacement")
@@ -139,8 +139,8 @@ impl Controls {
         if ui.small_button("Defaults").clicked() {
             p = Params::defaults(p.filter);
         }
-        if p != *session.params() {
-            self.refused = session.set_params(p).err();
+        if p != *session.case().params() {
+            self.refused = session.case_mut().set_params(p).err();
         }
         if let Some(why) = &self.refused {
             ui.colored_label(ui.visuals().warn_fg_color, why);
@@ -188,12 +188,12 @@ fn percent(v: f64) -> String {
 
 /// The measures of the latest result, as a table.
 pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<EngineTimings>) {
-    let Some(result) = session.last_result() else {
+    let Some(result) = session.case().last_result() else {
         ui.label("Not smoothed yet.");
         return;
     };
     let m = &result.metrics;
-    let vd = session.voxel_diagonal();
+    let vd = session.case().voxel_diagonal();
     let mm = |v: f64| match vd {
         Some(d) => format!("{v:.3} mm ({:.2} vd)", v / d),
         None => format!("{v:.3} mm"),
@@ -234,7 +234,7 @@ pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<EngineTimi
                 format!("{:.4}", m.score),
             );
         });
-    if session.result().is_none() {
+    if session.case().result().is_none() {
         ui.small("Updating…");
     } else if let Some(t) = timings {
         ui.small(t.describe());
@@ -249,8 +249,8 @@ pub fn coloring(ui: &mut egui::Ui, field: &mut Option<ColorField>, session: &mut
             ui.selectable_value(field, Some(f), f.name());
         }
     });
-    let mut known = session.voxel_size().is_some();
-    let mut size = session.voxel_size().unwrap_or([1.0; 3]);
+    let mut known = session.case().voxel_size().is_some();
+    let mut size = session.case().voxel_size().unwrap_or([1.0; 3]);
     ui.horizontal(|ui| {
         ui.checkbox(&mut known, "voxel size").on_hover_text(
             "The segmentation's voxel spacing: distances then also read in voxel diagonals (vd)",
@@ -268,8 +268,8 @@ pub fn coloring(ui: &mut egui::Ui, field: &mut Option<ColorField>, session: &mut
         }
     });
     let wanted = known.then_some(size);
-    if wanted != session.voxel_size() {
+    if wanted != session.case().voxel_size() {
         // The drag values' range keeps the sizes valid.
-        let _ = session.set_voxel_size(wanted);
+        let _ = session.case_mut().set_voxel_size(wanted);
     }
 }

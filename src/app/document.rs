@@ -280,9 +280,9 @@ impl Document {
     /// Makes structure `index` of the open case the model, on this thread (its settings and
     /// result are in the case; see [`Session::select_structure`]).
     pub fn select_structure(&mut self, index: usize) -> Result<(), String> {
-        let before = self.session.model_id();
+        let before = self.session.case().model_id();
         self.session.select_structure(index)?;
-        if self.session.model_id() != before {
+        if self.session.case().model_id() != before {
             self.opened();
         }
         Ok(())
@@ -303,13 +303,13 @@ impl Document {
         if self.session.loading().is_none() {
             return Opening::Idle;
         }
-        let model_before = self.session.model_id();
+        let model_before = self.session.case().model_id();
         let Some(outcome) = self.session.poll_opening() else {
             return Opening::Working;
         };
         match &outcome {
             // A file added to the case leaves the model as it was.
-            Ok(()) if self.session.model_id() != model_before => self.opened(),
+            Ok(()) if self.session.case().model_id() != model_before => self.opened(),
             Ok(()) => {}
             Err(message) => log::warn!("{message}"),
         }
@@ -328,7 +328,7 @@ impl Document {
 
     /// What a newly opened model needs.
     fn opened(&mut self) {
-        if let Some(model) = self.session.model() {
+        if let Some(model) = self.session.case().model() {
             log::info!(
                 "opened {}: {} vertices, {} faces",
                 model.name,
@@ -341,7 +341,7 @@ impl Document {
 
     /// Whether work for the current parameters is still to do.
     pub fn busy(&self) -> bool {
-        self.session.needs_smoothing()
+        self.session.case().needs_smoothing()
     }
 
     /// Runs `waiter` once the current parameters' result is there (at once if it is).
@@ -387,10 +387,10 @@ impl Document {
     /// keeps drawing frames.
     pub fn working(&self) -> bool {
         self.busy()
-            || self.session.guidance_busy()
+            || self.session.background().guidance_busy()
             || self.session.loading().is_some()
-            || self.session.suggesting_all()
-            || self.session.checking()
+            || self.session.background().suggesting_all()
+            || self.session.background().checking()
     }
 
     /// The CPU engine's share of this frame: asks its workers for the current parameters'
@@ -432,7 +432,7 @@ impl Document {
     /// What the API's `state()` returns.
     pub fn state_json(&self) -> serde_json::Value {
         let mut state = self.session.state_json(self.busy());
-        state["guidance"] = self.session.guidance_json();
+        state["guidance"] = self.session.background().guidance_json();
         state["backend"] = serde_json::json!(self.backend.name());
         state["mode"] = serde_json::json!(if self.reading { "viewer" } else { "author" });
         state["shortcuts"] = serde_json::json!(self.shortcuts);
@@ -462,7 +462,7 @@ impl Document {
             None => serde_json::Value::Null,
         };
         state["layout"] = self.panel.to_json();
-        state["checks"] = self.session.checks_json().unwrap_or_default();
+        state["checks"] = self.session.background().checks_json().unwrap_or_default();
         // WebAssembly memory only grows: its size is the page's peak.
         state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state
@@ -473,7 +473,7 @@ impl Document {
     /// The view as it stands: camera, hidden and see-through structures, the selected one,
     /// the clipping plane and the slide towards the segmentation.
     pub fn view_link(&self) -> ViewLink {
-        let listed = self.session.case_structures().iter().enumerate();
+        let listed = self.session.case().case_structures().iter().enumerate();
         ViewLink {
             camera: self.view.pose,
             hidden: (listed.clone().filter(|(_, s)| !s.visible))
@@ -482,7 +482,7 @@ impl Document {
             opacity: (listed.filter(|(_, s)| s.color[3] < 1.0))
                 .map(|(i, s)| (i, s.color[3]))
                 .collect(),
-            selected: self.session.current_structure().filter(|&i| i > 0),
+            selected: self.session.case().current_structure().filter(|&i| i > 0),
             clip: self.view_asks.clip,
             toward_segmentation: self.view_asks.toward_segmentation,
         }
@@ -521,11 +521,11 @@ mod tests {
         let mut doc = Document::new(Backend::Cpu);
         doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
             .unwrap();
-        let generation = doc.session.model_id();
+        let generation = doc.session.case().model_id();
         let error = doc.open("notes.txt", b"not a mesh").unwrap_err();
         assert!(error.starts_with("Cannot open notes.txt: "), "{error}");
         assert!(error.contains(".stl .obj .ply"), "{error}");
-        assert_eq!(doc.session.model_id(), generation);
+        assert_eq!(doc.session.case().model_id(), generation);
         let state = doc.state_json();
         assert_eq!(state["model"], crate::app::SAMPLE_NAME);
         assert_eq!(state["error"], error.as_str());
@@ -553,10 +553,12 @@ mod tests {
         deliver.set(false);
         doc.session.set_graphs_wanted(true);
         assert!(!doc.step_cpu_engine(), "the graphs' runs are asked");
-        assert!(doc.session.guidance_busy());
+        assert!(doc.session.background().guidance_busy());
         deliver.set(true);
         assert!(doc.step_cpu_engine(), "the graphs are done, between frames");
-        assert!(!doc.session.guidance_busy() && doc.session.graphs_current());
+        assert!(
+            !doc.session.background().guidance_busy() && doc.session.background().graphs_current()
+        );
     }
 
     #[wasm_bindgen_test]
@@ -567,7 +569,7 @@ mod tests {
         let answered = Rc::new(Cell::new(0));
         let seen = answered.clone();
         doc.when_current(Box::new(move |s| {
-            assert!(s.result().is_some());
+            assert!(s.case().result().is_some());
             seen.set(seen.get() + 1);
         }));
         doc.answer_waiting();
@@ -579,7 +581,7 @@ mod tests {
         assert_eq!(answered.get(), 1);
         assert!(doc.timings.is_some());
         assert_eq!(doc.state_json()["busy"], false);
-        let model = doc.session.model().unwrap();
+        let model = doc.session.case().model().unwrap();
         assert_eq!(
             (model.report.vertices, model.report.faces),
             (2296, 4588),

@@ -93,29 +93,29 @@ impl DragParams {
             )
         });
         if pressed && response.is_pointer_button_down_on() {
-            self.start = origin.map(|o| (*session.params(), o));
+            self.start = origin.map(|o| (*session.case().params(), o));
         }
         let (Some((start, origin)), Some(pointer)) = (self.start, pointer) else {
             self.start = None;
             return;
         };
-        if start.filter != session.filter() {
+        if start.filter != session.case().filter() {
             // The filter changed under the drag (a key): carry on from its values.
-            self.start = Some((*session.params(), pointer));
+            self.start = Some((*session.case().params(), pointer));
             return;
         }
         let axes = self.axes[slot(start.filter)];
         let delta = pointer - origin;
         let p = dragged_params(&start, axes, Vec2::new(delta.x, delta.y));
-        if p != *session.params() {
+        if p != *session.case().params() {
             // dragged_params keeps the parameters valid.
-            let _ = session.set_params(p);
+            let _ = session.case_mut().set_params(p);
         }
         if !held {
             self.start = None;
             return;
         }
-        let p = session.params();
+        let p = session.case().params();
         let text = if axes[0] == axes[1] {
             format!("{} {}", label(axes[0]), value_text(axes[0], p))
         } else {

@@ -21,9 +21,9 @@ pub struct GalleryView {
 impl GalleryView {
     /// Draws the next picture of a newly finished gallery (one per frame).
     pub fn update(&mut self, ctx: &egui::Context, session: &Session) {
-        let picks = session.gallery();
-        if session.gallery_version() != self.version {
-            self.version = session.gallery_version();
+        let picks = session.background().gallery();
+        if session.background().gallery_version() != self.version {
+            self.version = session.background().gallery_version();
             self.items.clear();
             let sets: Vec<&[f32]> = picks
                 .iter()
@@ -35,7 +35,9 @@ impl GalleryView {
             self.items.clear();
             return;
         }
-        let Some(model) = session.model() else { return };
+        let Some(model) = session.case().model() else {
+            return;
+        };
         let k = self.items.len();
         let (Some(pick), Some(colors)) = (picks.get(k), self.colors.get(k)) else {
             return;
@@ -68,12 +70,12 @@ impl GalleryView {
         cards: &mut Vec<egui::Rect>,
     ) -> Option<(f64, Params)> {
         ui.horizontal(|ui| {
-            if session.making_gallery() {
+            if session.background().making_gallery() {
                 if ui.button("Cancel").clicked() {
                     session.cancel_gallery();
                 }
             } else if ui
-                .button(if session.gallery().is_empty() { "Make gallery" } else { "Make again" })
+                .button(if session.background().gallery().is_empty() { "Make gallery" } else { "Make again" })
                 .on_hover_text(format!(
                     "Smooth the model as suggested for τ = {} with the active filter",
                     GALLERY_TAUS.map(|t| t.to_string()).join(", ")
@@ -82,7 +84,7 @@ impl GalleryView {
             {
                 session.start_gallery();
             }
-            for a in session.activities() {
+            for a in session.background().activities() {
                 if let Activity::Gallery { .. } = a {
                     ui.add(
                         egui::ProgressBar::new(a.fraction())
@@ -98,15 +100,15 @@ impl GalleryView {
                 ));
             }
         });
-        if session.gallery().is_empty() && !session.making_gallery() {
+        if session.background().gallery().is_empty() && !session.background().making_gallery() {
             ui.label(
                 "The gallery shows the model smoothed as suggested at several target smoothness \
                  values, from accurate (τ 0.1) to smooth (τ 0.9), to choose from by eye.",
             );
             return None;
         }
-        let current = *session.params();
-        let picks = session.gallery();
+        let current = *session.case().params();
+        let picks = session.background().gallery();
         for (item, pick) in self.items.iter_mut().zip(picks) {
             item.selected = pick.params == current;
         }

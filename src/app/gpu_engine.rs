@@ -237,7 +237,7 @@ impl GpuEngine {
         if self.in_flight.is_some() || self.device_work.waiting {
             return Ok(Sent::Nothing);
         }
-        let generation = doc.session.model_id();
+        let generation = doc.session.case().model_id();
         if self
             .running
             .as_ref()
@@ -246,10 +246,10 @@ impl GpuEngine {
             self.running = None;
         }
         if self.running.is_none() {
-            if !doc.session.needs_smoothing() {
+            if !doc.session.case().needs_smoothing() {
                 return Ok(Sent::Nothing);
             }
-            let Some(model) = doc.session.model() else {
+            let Some(model) = doc.session.case().model() else {
                 return Ok(Sent::Nothing);
             };
             if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
@@ -266,18 +266,18 @@ impl GpuEngine {
             }
             self.running = Some(Running {
                 generation,
-                revision: doc.session.revision(),
+                revision: doc.session.case().revision(),
                 started_ms: now_ms(),
-                pieces: RunPieces::new(doc.session.params()),
+                pieces: RunPieces::new(doc.session.case().params()),
             });
         }
         let (Some((_, mesh)), Some(run)) = (self.mesh.as_mut(), self.running.as_mut()) else {
             return Ok(Sent::Nothing);
         };
         let e = |e: crate::gpu::GpuError| e.to_string();
-        let weights_version = doc.session.weights_version();
+        let weights_version = doc.session.case().weights_version();
         if self.weights_uploaded != Some(weights_version) {
-            mesh.set_weights(&self.queue, doc.session.weights())
+            mesh.set_weights(&self.queue, doc.session.case().weights())
                 .map_err(e)?;
             self.weights_uploaded = Some(weights_version);
         }
@@ -299,7 +299,7 @@ impl GpuEngine {
             .map_err(e)?;
         self.frame_work.sent(advance.spent, advance.full);
         self.device_work.sent = true;
-        let stale = run.revision != doc.session.revision();
+        let stale = run.revision != doc.session.case().revision();
         if run.pieces.smoothed() && stale {
             // The parameters moved on: show where these took the mesh, skip its measures.
             self.submitted = Some(run.revision);
@@ -329,7 +329,7 @@ impl GpuEngine {
         let Some(run) = self.in_flight.as_mut() else {
             return Ok(());
         };
-        if run.generation != doc.session.model_id() {
+        if run.generation != doc.session.case().model_id() {
             // A run for a model that is no longer open: its measures belong to another
             // original. Dropping it drops its pending mappings.
             self.in_flight = None;
@@ -341,11 +341,14 @@ impl GpuEngine {
                 Some(r) => run.result = Some(r.map_err(|e| e.to_string())?.positions),
             }
         }
-        let Some(model) = doc.session.model() else {
+        let Some(model) = doc.session.case().model() else {
             self.in_flight = None;
             return Ok(());
         };
-        let measured = match run.measures.try_take(&model.original, doc.session.tau()) {
+        let measured = match run
+            .measures
+            .try_take(&model.original, doc.session.case().tau())
+        {
             None => return Ok(()),
             Some(m) => m.map_err(|e| e.to_string())?,
         };

@@ -68,12 +68,12 @@ const STRIPS: [Strip; 4] = [
 /// Shows the graphs; returns new parameters when the user clicked or dragged in a strip.
 /// `layout` gets where each column's strips were drawn.
 pub fn show(ui: &mut egui::Ui, session: &Session, layout: &mut Vec<GraphColumn>) -> Option<Params> {
-    let Some(graphs) = session.graphs() else {
+    let Some(graphs) = session.background().graphs() else {
         ui.label("The quality graphs are being computed…");
         return None;
     };
-    let stale = !session.graphs_current();
-    let half_vd = session.voxel_diagonal().map(|d| d / 2.0);
+    let stale = !session.background().graphs_current();
+    let half_vd = session.case().voxel_diagonal().map(|d| d / 2.0);
     let mut picked = None;
     let columns = graphs.curves.len().max(1);
     ui.columns(columns, |cols| {
@@ -85,13 +85,13 @@ pub fn show(ui: &mut egui::Ui, session: &Session, layout: &mut Vec<GraphColumn>)
             let value = column(ui, curve, half_vd, stale, &mut drawn);
             layout.push(drawn);
             if let Some(value) = value {
-                let mut p = *session.params();
+                let mut p = *session.case().params();
                 curve.param.set(&mut p, value);
                 picked = Some(p);
             }
         }
     });
-    picked.filter(|p| p.validate().is_ok() && p != session.params())
+    picked.filter(|p| p.validate().is_ok() && p != session.case().params())
 }
 
 /// One parameter's strips; returns the sample value picked. Each strip's plot area goes into

@@ -24,7 +24,7 @@ impl Default for Guide {
 
 impl Guide {
     pub fn show(&mut self, ui: &mut egui::Ui, session: &mut Session) {
-        let mut tau = session.tau();
+        let mut tau = session.case().tau();
         ui.horizontal(|ui| {
             ui.label("accuracy");
             let r = ui
@@ -39,7 +39,7 @@ impl Guide {
                 );
             ui.label("smoothness");
             if r.changed() {
-                let _ = session.set_tau(tau);
+                let _ = session.case_mut().set_tau(tau);
             }
         });
         ui.horizontal(|ui| {
@@ -59,7 +59,7 @@ impl Guide {
                             "Every grid point: slower, but then the suggestion follows τ at once",
                         );
                 });
-            if session.suggesting() {
+            if session.background().suggesting() {
                 if ui.button("Cancel").clicked() {
                     session.cancel_suggest();
                 }
@@ -71,26 +71,26 @@ impl Guide {
                 session.start_suggest(self.method);
             }
         });
-        for a in session.activities() {
+        for a in session.background().activities() {
             if let Activity::Suggest { .. } = a {
                 ui.add(egui::ProgressBar::new(a.fraction()).text(a.describe()));
             }
         }
-        let Some(suggested) = session.suggestion() else {
-            if !session.suggesting() {
+        let Some(suggested) = session.background().suggestion() else {
+            if !session.background().suggesting() {
                 ui.small("No suggestion for this filter yet.");
             }
             return;
         };
         let s = &suggested.suggestion;
-        let current = *session.params();
+        let current = *session.case().params();
         let applied = s.params == current;
         egui::Frame::group(ui.style()).show(ui, |ui| {
-            let for_tau = if (s.tau - session.tau()).abs() > 1e-9 {
+            let for_tau = if (s.tau - session.case().tau()).abs() > 1e-9 {
                 format!(
                     " (for τ {:.2}: suggest again for {:.2})",
                     s.tau,
-                    session.tau()
+                    session.case().tau()
                 )
             } else {
                 String::new()
@@ -120,7 +120,7 @@ impl Guide {
                     )
                     .clicked()
                 {
-                    let _ = session.set_params(s.params);
+                    let _ = session.case_mut().set_params(s.params);
                 }
                 if s.search == SearchMethod::Grid {
                     ui.checkbox(&mut self.follow_tau, "Apply as τ moves");
@@ -128,7 +128,7 @@ impl Guide {
             });
         });
         if self.follow_tau && s.search == SearchMethod::Grid && !applied {
-            let _ = session.set_params(s.params);
+            let _ = session.case_mut().set_params(s.params);
         }
     }
 }

@@ -45,9 +45,9 @@ impl Pointing {
             camera: *camera,
             plane,
             case: (
-                session.case_version(),
-                session.revision(),
-                session.case_structures().len(),
+                session.case().case_version(),
+                session.case().revision(),
+                session.case().case_structures().len(),
             ),
         };
         if self.asked != Some(asked) {
@@ -55,8 +55,10 @@ impl Pointing {
             let at = Vec2::new(pointer.x - rect.left(), pointer.y - rect.top());
             let ray = camera.ray_through(at, Vec2::new(rect.width(), rect.height()));
             self.named = ray
-                .and_then(|ray| session.structure_at(&ray, plane))
-                .and_then(|(i, _)| Some((i, session.case_structures().get(i)?.name.clone())));
+                .and_then(|ray| session.case().structure_at(&ray, plane))
+                .and_then(|(i, _)| {
+                    Some((i, session.case().case_structures().get(i)?.name.clone()))
+                });
             self.asked = Some(asked);
         }
         let (index, name) = self.named.as_ref()?;

@@ -62,10 +62,10 @@ impl StructureList {
         layout.structures.clear();
         layout.structure_name = None;
         let mut actions = Vec::new();
-        let Some(current) = session.current_structure() else {
+        let Some(current) = session.case().current_structure() else {
             return actions;
         };
-        let list = session.case_structures();
+        let list = session.case().case_structures();
         ui.horizontal(|ui| {
             ui.heading("Structures");
             let tip = "Open more files (meshes, a label map, a case glTF) into this case";
@@ -74,7 +74,7 @@ impl StructureList {
             }
         });
         let groups = listed_groups(list);
-        let flagged = session.flagged_structures();
+        let flagged = session.background().flagged_structures();
         egui::ScrollArea::vertical()
             .max_height(220.0)
             .id_salt("structure list")
@@ -95,7 +95,7 @@ impl StructureList {
                 }
             });
         if let Some(s) = list.get(current) {
-            let key = (session.model_id(), current);
+            let key = (session.case().model_id(), current);
             let group = s.group.clone().unwrap_or_default();
             let stored = (s.name.clone(), group, s.description.clone());
             let editing = match &mut self.editing {
@@ -162,8 +162,8 @@ impl StructureList {
         actions: &mut Vec<StructureAction>,
     ) {
         let stored = (
-            session.case_title().to_string(),
-            session.case_description().to_string(),
+            session.case().case_title().to_string(),
+            session.case().case_description().to_string(),
         );
         if self.case_text.1 != stored {
             self.case_text = (stored.clone(), stored);
@@ -190,7 +190,7 @@ impl StructureList {
                 description.clone(),
             ));
         }
-        ui.horizontal(|ui| match session.suggest_all_progress() {
+        ui.horizontal(|ui| match session.background().suggest_all_progress() {
             Some((done, total)) => {
                 let bar = egui::ProgressBar::new(done as f32 / total.max(1) as f32)
                     .desired_width(160.0)
@@ -216,7 +216,7 @@ impl StructureList {
             {
                 actions.push(StructureAction::ExportCase);
             }
-            if session.checking() {
+            if session.background().checking() {
                 // No spinner: it would draw frames for as long as a worker checks.
                 ui.label("checking…");
             } else if ui
@@ -233,7 +233,7 @@ impl StructureList {
 
 /// The last checks' lines, warnings in the warning colour.
 fn checks_report(ui: &mut egui::Ui, session: &Session) {
-    let Some(report) = session.checks_json() else {
+    let Some(report) = session.background().checks_json() else {
         return;
     };
     if let Some(error) = report["error"].as_str() {
@@ -251,7 +251,7 @@ fn checks_report(ui: &mut egui::Ui, session: &Session) {
     }
     if report["current"] == false {
         ui.small("(the case changed since: check again)");
-    } else if session.marks_key().is_some() {
+    } else if session.background().marks_key().is_some() {
         ui.small("Where: marked in magenta in the view, seen through what lies in front.");
     }
 }
@@ -260,11 +260,13 @@ fn checks_report(ui: &mut egui::Ui, session: &Session) {
 /// the volume change and the local error, mean and maximum (mm, and in voxel diagonals where
 /// the voxel size is known).
 pub fn measures(s: &CaseStructure, session: &Session, i: usize) -> [String; 2] {
-    let params = session.structure_params(i).unwrap_or(s.params);
+    let params = session.case().structure_params(i).unwrap_or(s.params);
     let how = format!("{}: {}", params.filter.name(), params.describe());
-    let what = match session.structure_metrics(i) {
+    let what = match session.case().structure_metrics(i) {
         Some(m) => measured(m, s.voxel_diagonal()),
-        None if i == session.current_structure().unwrap_or(usize::MAX) => "smoothing…".into(),
+        None if i == session.case().current_structure().unwrap_or(usize::MAX) => {
+            "smoothing…".into()
+        }
         None => "not smoothed".into(),
     };
     [how, what]

@@ -1,11 +1,11 @@
 //! The open case as a document: its title and description, and its case glTF of every
 //! structure as the author arranged and smoothed it (a mesh alone is a case of one).
 
-use super::Session;
+use super::CaseDocument;
 use crate::case::Case;
 use crate::export::{self, CaseGltfOptions, Container};
 
-impl Session {
+impl CaseDocument {
     pub fn case_title(&self) -> &str {
         &self.case.title
     }

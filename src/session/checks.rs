@@ -6,7 +6,7 @@
 
 use std::cell::Cell;
 
-use super::Session;
+use super::{Background, Session};
 use crate::worker::{Reply, StructureJob};
 
 /// The checks asked last, and their report once it came.
@@ -32,7 +32,7 @@ type SessionState = (u64, u64, bool);
 impl Session {
     /// Starts checking the case as it stands (replacing checks under way).
     pub fn start_checks(&mut self) -> Result<(), String> {
-        let case = self.to_case().ok_or("nothing is open")?;
+        let case = self.doc.to_case().ok_or("nothing is open")?;
         let checked = (case.structures.iter())
             .map(|s| s.positions().to_vec())
             .collect();
@@ -46,11 +46,6 @@ impl Session {
             reports: self.checks.reports,
         };
         Ok(())
-    }
-
-    /// Whether checks are under way.
-    pub fn checking(&self) -> bool {
-        self.checks.job.is_some()
     }
 
     /// Takes the checks' report if it came; returns whether it did.
@@ -75,6 +70,13 @@ impl Session {
         self.checks.report = Some(report);
         true
     }
+}
+
+impl Background<'_> {
+    /// Whether checks are under way.
+    pub fn checking(&self) -> bool {
+        self.checks.job.is_some()
+    }
 
     /// The last checks: `{pairs, left_inside, new_crossings, text, flagged, ms, current}`
     /// (`current`: the case is as it was checked), or `{error}`.
@@ -90,17 +92,21 @@ impl Session {
         if self.checks.report.is_none() {
             return false;
         }
-        let state = (self.revision, self.case_version, self.result().is_some());
+        let state = (
+            self.doc.revision,
+            self.doc.case_version,
+            self.doc.result().is_some(),
+        );
         if let Some((when, same)) = self.checks.same.get() {
             if when == state {
                 return same;
             }
         }
-        let current = self.current_structure();
-        let list = &self.case.structures;
+        let current = self.doc.current_structure();
+        let list = &self.doc.case.structures;
         let same = list.len() == self.checks.checked.len()
             && (list.iter().zip(&self.checks.checked).enumerate()).all(|(i, (s, checked))| {
-                let shown = match self.result() {
+                let shown = match self.doc.result() {
                     Some(r) if Some(i) == current => &r.positions,
                     _ if Some(i) == current => &s.original.positions,
                     _ => s.positions(),
@@ -125,7 +131,7 @@ impl Session {
         if self.marks_key().is_none() {
             return Vec::new();
         }
-        let Some(case) = self.to_case() else {
+        let Some(case) = self.doc.to_case() else {
             return Vec::new();
         };
         (case.structures.iter().zip(&self.checks.marks))

@@ -58,24 +58,24 @@ impl Session {
                     done = self.accept_reply(revision, reply);
                 }
                 // Superseded below.
-                None if revision != self.revision => {}
+                None if revision != self.doc.revision => {}
                 None => return None,
             }
         }
-        let asked = self.cpu_job.is_some_and(|(r, _)| r == self.revision);
-        if self.needs_smoothing() && !asked {
-            let (params, tau) = (*self.params(), self.tau());
+        let asked = self.cpu_job.is_some_and(|(r, _)| r == self.doc.revision);
+        if self.doc.needs_smoothing() && !asked {
+            let (params, tau) = (*self.doc.params(), self.doc.tau());
             // Field by field: the CPU engine is borrowed to change.
-            if let Some(m) = self.models.get(self.current) {
-                let structure = self.case.structures.get(self.current);
+            if let Some(m) = self.doc.models.get(self.doc.current) {
+                let structure = self.doc.case.structures.get(self.doc.current);
                 let model = ModelRef {
                     original: &m.original,
-                    id: self.model_id,
+                    id: self.doc.model_id,
                     weights: structure.and_then(|s| s.weights.as_deref()),
-                    weights_version: self.weights_version,
+                    weights_version: self.doc.weights_version,
                 };
                 let job = self.cpu.smooth(&model, &params, tau, true);
-                if let Some((_, old)) = self.cpu_job.replace((self.revision, job)) {
+                if let Some((_, old)) = self.cpu_job.replace((self.doc.revision, job)) {
                     self.cpu.forget(old);
                 }
             }
@@ -118,7 +118,7 @@ impl Session {
     /// Whether the CPU engine is working on the current revision's result.
     pub fn smoothing_on_cpu(&self) -> bool {
         self.cpu_job
-            .is_some_and(|(r, job)| r == self.revision && self.cpu.pending(job))
+            .is_some_and(|(r, job)| r == self.doc.revision && self.cpu.pending(job))
     }
 
     /// Accepts a result measured elsewhere (the GPU engine's smoothing and measure pass) for
@@ -131,21 +131,10 @@ impl Session {
         metrics: Metrics,
         vertex: VertexMeasures,
     ) -> bool {
-        let Some(model) = self.model() else {
-            return false;
-        };
-        let n = model.mesh().vertex_count();
-        let fits = positions.len() == n
-            && vertex.local_error.len() == n
-            && vertex.gaussian_curvature.len() == n;
-        if revision != self.revision || !fits {
-            return false;
-        }
-        let s = &mut self.case.structures[self.current];
-        s.keep(Smoothed {
+        let result = Smoothed {
             curvature: Some(vertex.gaussian_curvature),
             ..Smoothed::new(positions, metrics, Some(vertex.local_error))
-        });
-        true
+        };
+        self.doc.keep_result(revision, result)
     }
 }

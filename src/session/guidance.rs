@@ -10,7 +10,7 @@
 //! them changes it is dropped (the graphs also when any parameter changes) and its result no
 //! longer shown as current.
 
-use super::Session;
+use super::{Background, CaseDocument, Session};
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
     EvaluatedGrid, GridSearch, LocalOutcome, LocalSearch, ModelRef, Offload, Progress,
@@ -132,8 +132,8 @@ pub struct Guidance {
     memo_for: Option<(u64, u64, bool)>,
 }
 
-impl Session {
-    fn search_key(&self) -> SearchKey {
+impl CaseDocument {
+    pub(super) fn search_key(&self) -> SearchKey {
         SearchKey {
             model: self.model_id,
             weights: self.weights_version,
@@ -141,22 +141,15 @@ impl Session {
             bound: self.params().max_displacement,
         }
     }
+}
 
-    /// Drops jobs and results of another model.
-    pub(super) fn reset_guidance(&mut self) {
-        let wanted = self.guidance.graphs_wanted;
-        self.guidance = Guidance {
-            graphs_wanted: wanted,
-            ..Guidance::default()
-        };
-    }
-
+impl<'a> Background<'a> {
     /// The latest finished quality graphs of the active filter (maybe for other parameters
     /// than the current ones while new ones are computed), rescored at the current tau.
     pub fn graphs(&self) -> Option<QualityGraphs> {
         let (key, graphs) = self.guidance.graphs.as_ref()?;
-        (key.model == self.model_id && key.filter == self.filter())
-            .then(|| graphs.clone().rescored(self.tau()))
+        (key.model == self.doc.model_id && key.filter == self.doc.filter())
+            .then(|| graphs.clone().rescored(self.doc.tau()))
     }
 
     /// What `sweep --json` prints for the current graphs, once they are current.
@@ -170,19 +163,19 @@ impl Session {
 
     /// Whether [`Self::graphs`] are for exactly the current parameters, weights and model.
     pub fn graphs_current(&self) -> bool {
-        self.guidance
-            .graphs
-            .as_ref()
-            .is_some_and(|(key, g)| *key == self.search_key() && g.current == *self.params())
+        self.guidance.graphs.as_ref().is_some_and(|(key, g)| {
+            *key == self.doc.search_key() && g.current == *self.doc.params()
+        })
     }
 
     /// The last suggestion, if it is for the current model, filter, weights and bound; from
     /// an evaluated grid it follows tau.
     pub fn suggestion(&self) -> Option<Suggested> {
-        let key = self.search_key();
+        let key = self.doc.search_key();
         if let Some((k, grid)) = &self.guidance.grid {
             if *k == key {
-                if let (Some(mut s), Some(last)) = (grid.best(self.tau()), &self.guidance.suggested)
+                if let (Some(mut s), Some(last)) =
+                    (grid.best(self.doc.tau()), &self.guidance.suggested)
                 {
                     s.params.max_displacement = key.bound;
                     return Some(Suggested {
@@ -197,49 +190,8 @@ impl Session {
         self.guidance.suggested.clone().filter(|s| s.key == key)
     }
 
-    /// Starts a suggestion search for the active filter at the current tau (replacing one
-    /// under way). A grid already evaluated for this model, filter, weights and bound answers
-    /// at once.
-    pub fn start_suggest(&mut self, method: SearchMethod) {
-        self.guidance.search = None;
-        if self.model().is_some() {
-            self.queue_suggest(method);
-        }
-    }
-
-    /// Sets up a search for the current key (the model may be about to be set).
-    pub(super) fn queue_suggest(&mut self, method: SearchMethod) {
-        let key = self.search_key();
-        let base = *self.params();
-        let search = match method {
-            SearchMethod::Grid => GridSearch::new(base.filter, &base).map(Search::Grid),
-            SearchMethod::Local => {
-                LocalSearch::new(base.filter, &base, self.tau()).map(Search::Local)
-            }
-        };
-        match search {
-            Ok(task) => {
-                self.guidance.search = Some(SearchJob {
-                    key,
-                    tau: self.tau(),
-                    method,
-                    running: Running::new(task),
-                })
-            }
-            Err(e) => self.guidance.problem = Some(format!("No suggestion: {e}")),
-        }
-    }
-
-    /// Keeps the quality graphs of the active filter up to date in the background (or stops).
-    pub fn set_graphs_wanted(&mut self, wanted: bool) {
-        self.guidance.graphs_wanted = wanted;
-        if !wanted {
-            self.guidance.sweep = None;
-        }
-    }
-
     /// Why the last background job gave no result.
-    pub fn guidance_problem(&self) -> Option<&str> {
+    pub fn guidance_problem(&self) -> Option<&'a str> {
         self.guidance.problem.as_deref()
     }
 
@@ -270,37 +222,6 @@ impl Session {
         self.guidance.search.is_some()
     }
 
-    /// Stops the suggestion search under way.
-    pub fn cancel_suggest(&mut self) {
-        self.guidance.search = None;
-    }
-
-    /// Starts the gallery of [`GALLERY_TAUS`] for the active filter.
-    pub fn start_gallery(&mut self) {
-        if self.model().is_none() {
-            self.guidance.gallery_job = None;
-            return;
-        }
-        let key = self.search_key();
-        // With an evaluated grid the suggestions are known already.
-        let suggested = match &self.guidance.grid {
-            Some((k, grid)) if *k == key => GALLERY_TAUS
-                .iter()
-                .filter_map(|&tau| grid.best(tau))
-                .map(|s| (with_bound(s.params, key.bound), s.terms))
-                .collect(),
-            _ => Vec::new(),
-        };
-        self.guidance.gallery_job = Some(GalleryJob {
-            key,
-            suggested,
-            search: None,
-            smoothing: None,
-            picks: Vec::new(),
-            problem: None,
-        });
-    }
-
     /// Changes when a gallery is finished.
     pub fn gallery_version(&self) -> u64 {
         self.guidance.gallery_version
@@ -311,13 +232,9 @@ impl Session {
         self.guidance.gallery_job.is_some()
     }
 
-    pub fn cancel_gallery(&mut self) {
-        self.guidance.gallery_job = None;
-    }
-
     /// The last finished gallery, if it is for the current model, filter, weights and bound.
-    pub fn gallery(&self) -> &[GalleryPick] {
-        if self.guidance.gallery_key == Some(self.search_key()) {
+    pub fn gallery(&self) -> &'a [GalleryPick] {
+        if self.guidance.gallery_key == Some(self.doc.search_key()) {
             &self.guidance.gallery
         } else {
             &[]
@@ -350,6 +267,105 @@ impl Session {
         out
     }
 
+    /// Whether any background job is under way or due.
+    pub fn guidance_busy(&self) -> bool {
+        self.guidance.search.is_some()
+            || self.guidance.gallery_job.is_some()
+            || self.guidance.sweep.is_some()
+            || self.graphs_due()
+    }
+
+    fn graphs_due(&self) -> bool {
+        self.guidance.graphs_wanted && self.doc.model().is_some() && !self.graphs_current()
+    }
+}
+
+impl Session {
+    /// Drops jobs and results of another model.
+    pub(super) fn reset_guidance(&mut self) {
+        let wanted = self.guidance.graphs_wanted;
+        self.guidance = Guidance {
+            graphs_wanted: wanted,
+            ..Guidance::default()
+        };
+    }
+
+    /// Starts a suggestion search for the active filter at the current tau (replacing one
+    /// under way). A grid already evaluated for this model, filter, weights and bound answers
+    /// at once.
+    pub fn start_suggest(&mut self, method: SearchMethod) {
+        self.guidance.search = None;
+        if self.doc.model().is_some() {
+            self.queue_suggest(method);
+        }
+    }
+
+    /// Sets up a search for the current key (the model may be about to be set).
+    pub(super) fn queue_suggest(&mut self, method: SearchMethod) {
+        let key = self.doc.search_key();
+        let base = *self.doc.params();
+        let search = match method {
+            SearchMethod::Grid => GridSearch::new(base.filter, &base).map(Search::Grid),
+            SearchMethod::Local => {
+                LocalSearch::new(base.filter, &base, self.doc.tau()).map(Search::Local)
+            }
+        };
+        match search {
+            Ok(task) => {
+                self.guidance.search = Some(SearchJob {
+                    key,
+                    tau: self.doc.tau(),
+                    method,
+                    running: Running::new(task),
+                })
+            }
+            Err(e) => self.guidance.problem = Some(format!("No suggestion: {e}")),
+        }
+    }
+
+    /// Keeps the quality graphs of the active filter up to date in the background (or stops).
+    pub fn set_graphs_wanted(&mut self, wanted: bool) {
+        self.guidance.graphs_wanted = wanted;
+        if !wanted {
+            self.guidance.sweep = None;
+        }
+    }
+
+    /// Stops the suggestion search under way.
+    pub fn cancel_suggest(&mut self) {
+        self.guidance.search = None;
+    }
+
+    /// Starts the gallery of [`GALLERY_TAUS`] for the active filter.
+    pub fn start_gallery(&mut self) {
+        if self.doc.model().is_none() {
+            self.guidance.gallery_job = None;
+            return;
+        }
+        let key = self.doc.search_key();
+        // With an evaluated grid the suggestions are known already.
+        let suggested = match &self.guidance.grid {
+            Some((k, grid)) if *k == key => GALLERY_TAUS
+                .iter()
+                .filter_map(|&tau| grid.best(tau))
+                .map(|s| (with_bound(s.params, key.bound), s.terms))
+                .collect(),
+            _ => Vec::new(),
+        };
+        self.guidance.gallery_job = Some(GalleryJob {
+            key,
+            suggested,
+            search: None,
+            smoothing: None,
+            picks: Vec::new(),
+            problem: None,
+        });
+    }
+
+    pub fn cancel_gallery(&mut self) {
+        self.guidance.gallery_job = None;
+    }
+
     /// The engine the background ran on failed (`why`): the jobs under way start again (on the
     /// CPU engine, which the caller turns to) and the problem is shown.
     pub fn guidance_engine_failed(&mut self, why: &str) {
@@ -366,18 +382,6 @@ impl Session {
         self.guidance.problem = Some(format!(
             "The GPU engine failed ({why}); guidance goes on on the CPU"
         ));
-    }
-
-    /// Whether any background job is under way or due.
-    pub fn guidance_busy(&self) -> bool {
-        self.guidance.search.is_some()
-            || self.guidance.gallery_job.is_some()
-            || self.guidance.sweep.is_some()
-            || self.graphs_due()
-    }
-
-    fn graphs_due(&self) -> bool {
-        self.guidance.graphs_wanted && self.model().is_some() && !self.graphs_current()
     }
 
     /// Works on the background jobs on the CPU engine's workers: the suggestion first (the
@@ -405,11 +409,11 @@ impl Session {
             let lent = offload.as_mut().map(|o| &mut **o as &mut dyn Offload);
             finished |= self.step_guidance_once(clock, &mut cpu, lent);
             let waiting = cpu.waiting() || offload.as_deref().is_some_and(|o| o.waiting());
-            if waiting || !self.guidance_busy() {
+            if waiting || !self.background().guidance_busy() {
                 break;
             }
         }
-        if !self.guidance_busy() || offload.is_some() {
+        if !self.background().guidance_busy() || offload.is_some() {
             cpu.clear_guidance();
         }
         self.cpu = cpu;
@@ -423,7 +427,11 @@ impl Session {
         cpu: &mut Pool,
         offload: Option<&mut dyn Offload>,
     ) -> bool {
-        let memo_for = Some((self.model_id, self.weights_version, offload.is_some()));
+        let memo_for = Some((
+            self.doc.model_id,
+            self.doc.weights_version,
+            offload.is_some(),
+        ));
         if self.guidance.memo_for != memo_for {
             self.guidance.memo = TermsMemo::default();
             self.guidance.memo_for = memo_for;
@@ -442,20 +450,20 @@ impl Session {
         offload: Option<&mut dyn Offload>,
         memo: &mut TermsMemo,
     ) -> bool {
-        let key = self.search_key();
-        let (params, tau) = (*self.params(), self.tau());
+        let key = self.doc.search_key();
+        let (params, tau) = (*self.doc.params(), self.doc.tau());
         self.guidance.drop_stale(key, &params);
         // Field by field: the guidance below is borrowed to change.
-        let Some(model) = self.models.get(self.current) else {
+        let Some(model) = self.doc.models.get(self.doc.current) else {
             return false;
         };
-        let structure = self.case.structures.get(self.current);
+        let structure = self.doc.case.structures.get(self.doc.current);
         let mut engine = Engine {
             model: ModelRef {
                 original: &model.original,
-                id: self.model_id,
+                id: self.doc.model_id,
                 weights: structure.and_then(|s| s.weights.as_deref()),
-                weights_version: self.weights_version,
+                weights_version: self.doc.weights_version,
             },
             clock,
             cpu,

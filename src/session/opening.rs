@@ -47,7 +47,7 @@ impl Session {
         match Model::load(name, bytes) {
             Ok(Opened { case, model }) => {
                 self.take_file(name, name, case, model);
-                Ok(self.model().expect("just set"))
+                Ok(self.doc.model().expect("just set"))
             }
             Err(e) => Err(self.fail(name, &e.reason())),
         }
@@ -94,7 +94,7 @@ impl Session {
     pub fn begin_add(&mut self, name: &str, bytes: Vec<u8>) {
         if self.opening.is_some() || !self.additions.is_empty() {
             self.additions.push_back((name.to_string(), bytes));
-        } else if self.model().is_none() {
+        } else if self.doc.model().is_none() {
             self.begin_open(name, bytes);
         } else {
             let first_file = name.to_string();
@@ -178,7 +178,7 @@ impl Session {
             (Purpose::File, Some(model), case) => self.take_file(name, first_file, *case, *model),
             (Purpose::Addition, _, case) => {
                 self.error = None;
-                self.add_to_case(*case);
+                self.doc.add(*case);
             }
             _ => return Err(self.fail(name, "a worker answered something else")),
         }
@@ -196,12 +196,16 @@ impl Session {
                 Format::from_name(first_file),
                 Some(Format::Glb | Format::Gltf)
             );
-        let before = (self.structure())
+        let before = (self.doc.structure())
             .filter(|_| !own_params)
             .map(|s| (s.params, s.other_params.clone(), s.tau));
-        self.adopt_case(case, name);
-        self.models.keep(0, model);
-        if let (Some((params, others, tau)), Some(s)) = (before, self.case.structures.first_mut()) {
+        // A "Suggest all" or checks of the structures before are of no use now.
+        self.cancel_suggest_all();
+        self.suggest_all = Default::default();
+        self.checks = Default::default();
+        self.doc.adopt(case, name, model);
+        let first = self.doc.case.structures.first_mut();
+        if let (Some((params, others, tau)), Some(s)) = (before, first) {
             s.set_params(params);
             s.other_params = others;
             s.set_tau(tau);

@@ -2,14 +2,14 @@
 //! names it. Hidden structures, those drawn all but transparent and what the clipping plane
 //! cuts away are passed through.
 
-use super::Session;
+use super::CaseDocument;
 use crate::view::{pick_triangle_where, Hit, Ray};
 use glam::Vec3;
 
 /// Below this opacity a structure is looked through, not at.
 const SEEN_THROUGH: f32 = 0.05;
 
-impl Session {
+impl CaseDocument {
     /// The structure `ray` meets first, and where, of those drawn; `plane` is the view's
     /// clipping plane `(n, d)` (`n . p > d` is cut away; zero cuts nothing).
     pub fn structure_at(&self, ray: &Ray, plane: [f32; 4]) -> Option<(usize, Hit)> {

@@ -2,7 +2,7 @@
 //! visibility and group, and which one is the model. Each keeps its own smoothing, so the view
 //! shows every structure smoothed its own way and selecting one again finds it as it was.
 
-use super::Session;
+use super::{CaseDocument, Model};
 use crate::case::{Case, CaseStructure};
 use crate::metrics::Metrics;
 use crate::model;
@@ -33,7 +33,7 @@ pub struct OtherStructure<'a> {
     pub closed: bool,
 }
 
-impl Session {
+impl CaseDocument {
     /// The open case's structures (empty with nothing open); the model's entry holds what it
     /// had when it became the model.
     pub fn case_structures(&self) -> &[CaseStructure] {
@@ -71,9 +71,9 @@ impl Session {
     }
 
     /// Makes structure `index` the model: its model is built here the first time (then kept),
-    /// and its settings and result are where they were. Errors when nothing is open or the
-    /// case has no such structure.
-    pub fn select_structure(&mut self, index: usize) -> Result<(), String> {
+    /// and its settings and result are where they were. Whether it changed the model; errors
+    /// when nothing is open or the case has no such structure.
+    pub(super) fn select(&mut self, index: usize) -> Result<bool, String> {
         if self.model().is_none() {
             return Err("nothing is open".to_string());
         }
@@ -84,7 +84,7 @@ impl Session {
             ));
         };
         if index == self.current {
-            return Ok(());
+            return Ok(false);
         }
         if !self.models.touch(index) {
             let name = format!("{}: {}", self.case_file, structure.name);
@@ -93,7 +93,7 @@ impl Session {
         }
         self.current = index;
         self.became_model();
-        Ok(())
+        Ok(true)
     }
 
     /// Changes structure `index`'s name, colour, opacity, visibility, group or description;
@@ -176,22 +176,21 @@ impl Session {
             .collect()
     }
 
-    /// Makes `case` (opened from `file`) the open case, its first structure to be the model.
-    pub(super) fn adopt_case(&mut self, case: Case, file: &str) {
-        // A "Suggest all" of the structures before is of no use now.
-        self.cancel_suggest_all();
-        self.suggest_all = Default::default();
-        self.checks = Default::default();
+    /// Makes `case` (opened from `file`) the open case, its first structure (with `model`
+    /// built) the model.
+    pub(super) fn adopt(&mut self, case: Case, file: &str, model: Model) {
         self.case = case;
         self.case_file = file.to_string();
         self.current = 0;
         self.models.clear();
+        self.models.keep(0, model);
         self.case_version += 1;
+        self.became_model();
     }
 
     /// Adds the structures of `other` (another file) to the open case. Surfaces, which carry
     /// no colour of their own, get the palette's colour of their place in the case.
-    pub(super) fn add_to_case(&mut self, other: Case) {
+    pub(super) fn add(&mut self, other: Case) {
         let start = self.case.structures.len();
         let mut other = other;
         for (i, s) in other.structures.iter_mut().enumerate() {

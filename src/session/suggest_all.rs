@@ -3,7 +3,7 @@
 //! structure per engine worker (the CLI's `case build` does the same on its threads). Progress
 //! and cancel; the structure that is the model takes its suggestion as new parameters.
 
-use super::Session;
+use super::{Background, Session};
 use crate::case::{Smoothed, SuggestAllOptions};
 use crate::suggest::SearchMethod;
 use crate::worker::{metrics_of, Reply, StructureJob};
@@ -28,7 +28,7 @@ impl Session {
             return Err(format!("tau = {tau} is out of range: [0, 1]"));
         }
         self.cancel_suggest_all();
-        self.model().ok_or("no mesh is open")?;
+        self.doc.model().ok_or("no mesh is open")?;
         let options = SuggestAllOptions {
             tau,
             filter: None,
@@ -37,7 +37,7 @@ impl Session {
             // score weighs it.
             max_volume_change: Some(0.05),
         };
-        let work: Vec<_> = (self.case.structures.iter().enumerate())
+        let work: Vec<_> = (self.doc.case.structures.iter().enumerate())
             .map(|(i, s)| (i, s.original.clone(), s.params, s.weights.clone()))
             .collect();
         let mut work = work;
@@ -61,18 +61,6 @@ impl Session {
             cancelled: false,
         };
         Ok(())
-    }
-
-    /// Whether "Suggest all" is under way.
-    pub fn suggesting_all(&self) -> bool {
-        !self.suggest_all.waiting.is_empty()
-    }
-
-    /// Structures done and in all, while "Suggest all" is under way.
-    pub fn suggest_all_progress(&self) -> Option<(usize, usize)> {
-        let s = &self.suggest_all;
-        self.suggesting_all()
-            .then(|| (s.total - s.waiting.len(), s.total))
     }
 
     /// Stops "Suggest all": structures already done keep what they got.
@@ -113,6 +101,7 @@ impl Session {
     /// follows), another keeps them with its smoothed surface.
     fn take_structure_suggestion(&mut self, i: usize, reply: Reply, tau: f64) -> serde_json::Value {
         let name = self
+            .doc
             .case
             .structures
             .get(i)
@@ -137,11 +126,11 @@ impl Session {
             "evaluations": suggested.evaluations,
             "metrics": metrics,
         });
-        if self.current_structure() == Some(i) {
+        if self.doc.current_structure() == Some(i) {
             // The engines smooth it again for the view, to the same surface.
-            let _ = self.set_params(suggested.params);
-            let _ = self.set_tau(tau);
-        } else if let Some(s) = self.case.structures.get_mut(i) {
+            let _ = self.doc.set_params(suggested.params);
+            let _ = self.doc.set_tau(tau);
+        } else if let Some(s) = self.doc.case.structures.get_mut(i) {
             s.set_params(suggested.params);
             s.set_tau(tau);
             s.keep(Smoothed::new(
@@ -149,9 +138,23 @@ impl Session {
                 metrics,
                 Some(suggested.local_error),
             ));
-            self.case_version += 1;
+            self.doc.case_version += 1;
         }
         summary
+    }
+}
+
+impl Background<'_> {
+    /// Whether "Suggest all" is under way.
+    pub fn suggesting_all(&self) -> bool {
+        !self.suggest_all.waiting.is_empty()
+    }
+
+    /// Structures done and in all, while "Suggest all" is under way.
+    pub fn suggest_all_progress(&self) -> Option<(usize, usize)> {
+        let s = &self.suggest_all;
+        self.suggesting_all()
+            .then(|| (s.total - s.waiting.len(), s.total))
     }
 
     /// The last "Suggest all": `{tau, search, structures: [...], cancelled, done, total}`.

@@ -1,6 +1,9 @@
 use super::*;
+use crate::case::Smoothed;
+use crate::export::ExportFormat;
 use crate::io;
 use crate::metrics::{self, DriftingReference, VertexMeasures};
+use crate::smooth::{Filter, Params};
 
 const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
 
@@ -23,15 +26,15 @@ fn sample_session() -> Session {
 #[test]
 fn a_bad_file_keeps_the_model_and_names_the_problem() {
     let mut s = sample_session();
-    let before = s.revision();
+    let before = s.case().revision();
     let e = s.open("notes.txt", b"not a mesh").unwrap_err();
     assert!(e.starts_with("Cannot open notes.txt: "), "{e}");
     assert_eq!(s.error(), Some(e.as_str()));
     assert_eq!(
-        s.model().map(|m| m.name.as_str()),
+        s.case().model().map(|m| m.name.as_str()),
         Some("bent_tube_staircase.ply")
     );
-    assert_eq!(s.revision(), before, "a failed open changes nothing");
+    assert_eq!(s.case().revision(), before, "a failed open changes nothing");
     s.open("again.ply", SAMPLE).unwrap();
     assert_eq!(s.error(), None);
 }
@@ -39,15 +42,19 @@ fn a_bad_file_keeps_the_model_and_names_the_problem() {
 #[test]
 fn cpu_result_equals_smoothing_then_measuring_directly() {
     let mut s = sample_session();
-    s.set_filter_name("taubin").unwrap();
-    s.set_params_json(&serde_json::json!({"lambda": 0.6, "mu": -0.65, "iterations": 12}))
+    s.case_mut().set_filter_name("taubin").unwrap();
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"lambda": 0.6, "mu": -0.65, "iterations": 12}))
         .unwrap();
-    assert!(s.needs_smoothing());
+    assert!(s.case().needs_smoothing());
     s.smooth_cpu();
-    let r = s.result().expect("a result for the current revision");
+    let r = s
+        .case()
+        .result()
+        .expect("a result for the current revision");
 
-    let model = s.model().unwrap();
-    let params = *s.params();
+    let model = s.case().model().unwrap();
+    let params = *s.case().params();
     let mut drift = DriftingReference::new(&model.original);
     let positions =
         crate::smooth::smooth(model.mesh(), model.topology(), &params, None, &mut drift);
@@ -55,7 +62,7 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
     assert_eq!(r.positions, positions);
     assert_eq!(r.metrics, direct);
     assert_eq!(
-        s.metrics_json().unwrap(),
+        s.case().metrics_json().unwrap(),
         serde_json::to_value(&direct).unwrap()
     );
     assert!(
@@ -68,67 +75,73 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
 fn every_change_makes_the_result_stale_and_late_results_are_refused() {
     let mut s = sample_session();
     s.smooth_cpu();
-    assert!(!s.needs_smoothing());
-    let old = s.revision();
-    let r = s.result().unwrap().clone();
+    assert!(!s.case().needs_smoothing());
+    let old = s.case().revision();
+    let r = s.case().result().unwrap().clone();
     let n = r.positions.len();
 
-    s.set_params_json(&serde_json::json!({"iterations": 3}))
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 3}))
         .unwrap();
-    assert!(s.needs_smoothing());
+    assert!(s.case().needs_smoothing());
     assert!(
-        s.last_result().is_some(),
+        s.case().last_result().is_some(),
         "the old result is shown meanwhile"
     );
     let take = |s: &mut Session, revision, positions: Vec<[f32; 3]>| {
         s.accept_measured(revision, positions, r.metrics.clone(), vertex(&r))
     };
     assert!(!take(&mut s, old, r.positions.clone()));
-    let current = s.revision();
+    let current = s.case().revision();
     assert!(!take(&mut s, current, r.positions[1..].to_vec()));
-    assert_eq!(n, s.model().unwrap().mesh().vertex_count());
+    assert_eq!(n, s.case().model().unwrap().mesh().vertex_count());
     assert!(take(&mut s, current, r.positions.clone()));
-    assert!(!s.needs_smoothing());
+    assert!(!s.case().needs_smoothing());
 
     // Setting the same values again is not a change.
-    let r = s.revision();
-    s.set_params_json(&serde_json::json!({"iterations": 3}))
+    let r = s.case().revision();
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 3}))
         .unwrap();
-    s.set_filter_name("hc").unwrap();
-    assert_eq!(s.revision(), r);
+    s.case_mut().set_filter_name("hc").unwrap();
+    assert_eq!(s.case().revision(), r);
 }
 
 #[test]
 fn refused_parameters_change_nothing_and_each_filter_keeps_its_values() {
     let mut s = sample_session();
     let e = s
+        .case_mut()
         .set_params_json(&serde_json::json!({"iterations": 1000}))
         .unwrap_err();
     assert!(e.contains("iterations") && e.contains("[0, 50]"), "{e}");
     assert!(s
+        .case_mut()
         .set_filter_name("gaussian")
         .unwrap_err()
         .contains("unknown filter"));
-    assert_eq!(*s.params(), Params::defaults(Filter::Hc));
+    assert_eq!(*s.case().params(), Params::defaults(Filter::Hc));
 
-    s.set_filter_name("laplace").unwrap();
-    s.set_params_json(&serde_json::json!({"lambda": 0.3}))
+    s.case_mut().set_filter_name("laplace").unwrap();
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"lambda": 0.3}))
         .unwrap();
-    s.set_filter_name("sinc").unwrap();
-    assert_eq!(s.params().iterations, 20);
-    s.set_filter_name("laplace").unwrap();
-    assert_eq!(s.params().lambda, 0.3);
-    assert!(s.set_tau(1.5).is_err());
-    assert!(s.set_voxel_size(Some([1.0, 0.0, 1.0])).is_err());
+    s.case_mut().set_filter_name("sinc").unwrap();
+    assert_eq!(s.case().params().iterations, 20);
+    s.case_mut().set_filter_name("laplace").unwrap();
+    assert_eq!(s.case().params().lambda, 0.3);
+    assert!(s.case_mut().set_tau(1.5).is_err());
+    assert!(s.case_mut().set_voxel_size(Some([1.0, 0.0, 1.0])).is_err());
 }
 
 #[test]
 fn exports_carry_the_smoothing_and_read_back() {
     let mut s = sample_session();
-    s.set_params_json(&serde_json::json!({"iterations": 5}))
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 5}))
         .unwrap();
     s.smooth_cpu();
-    let r = s.result().unwrap().clone();
+    let r = s.case().result().unwrap().clone();
     for format in [
         ExportFormat::Ply,
         ExportFormat::Stl,
@@ -136,18 +149,18 @@ fn exports_carry_the_smoothing_and_read_back() {
         ExportFormat::Glb,
     ] {
         let name = format!("out.{}", format!("{format:?}").to_lowercase());
-        let bytes = s.export(format, None).unwrap();
+        let bytes = s.case().export(format, None).unwrap();
         let back = io::load(&bytes, &name).unwrap();
         assert_eq!(back.vertex_count(), r.positions.len(), "{name}");
         assert_eq!(
             back.triangle_count(),
-            s.model().unwrap().mesh().triangle_count()
+            s.case().model().unwrap().mesh().triangle_count()
         );
         if format != ExportFormat::Stl {
             assert_eq!(back.positions, r.positions, "{name}");
         }
     }
-    let glb = s.export(ExportFormat::Glb, None).unwrap();
+    let glb = s.case().export(ExportFormat::Glb, None).unwrap();
     let text = String::from_utf8_lossy(&glb);
     assert!(text.contains("\"filter\":\"hc\""), "extras name the filter");
     assert!(text.contains("\"mean_error\""), "extras carry the measures");
@@ -156,24 +169,29 @@ fn exports_carry_the_smoothing_and_read_back() {
 #[test]
 fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     let mut s = sample_session();
-    s.set_params_json(&serde_json::json!({"iterations": 0}))
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 0}))
         .unwrap();
     s.smooth_cpu();
-    let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
-    assert_eq!(colors.len(), s.model().unwrap().mesh().vertex_count());
+    let (colors, legend) = s.case().colors(ColorField::LocalError).unwrap();
+    assert_eq!(
+        colors.len(),
+        s.case().model().unwrap().mesh().vertex_count()
+    );
     assert!(
         colors.iter().all(|c| *c == legend.bar[0]),
         "no error: all at the bottom"
     );
 
-    s.set_voxel_size(Some([1.0, 1.0, 1.0])).unwrap();
-    s.set_params_json(&serde_json::json!({"iterations": 10}))
+    s.case_mut().set_voxel_size(Some([1.0, 1.0, 1.0])).unwrap();
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 10}))
         .unwrap();
     s.smooth_cpu();
-    let (colors, legend) = s.colors(ColorField::LocalError).unwrap();
+    let (colors, legend) = s.case().colors(ColorField::LocalError).unwrap();
     assert!(colors.iter().any(|c| *c != legend.bar[0]));
     assert_eq!(legend.min, 0.0);
-    let max = s.result().unwrap().metrics.max_error;
+    let max = s.case().result().unwrap().metrics.max_error;
     assert!(
         legend.max > 0.0 && legend.max <= 2.5 * max.max(1e-9),
         "{legend:?} max {max}"
@@ -184,10 +202,10 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
         legend.ticks
     );
 
-    let (_, k) = s.colors(ColorField::Curvature).unwrap();
+    let (_, k) = s.case().colors(ColorField::Curvature).unwrap();
     assert_eq!(k.min, -k.max);
     assert!(!k.ticks[0].label.contains("vd"));
-    let (d, _) = s.colors(ColorField::Displacement).unwrap();
+    let (d, _) = s.case().colors(ColorField::Displacement).unwrap();
     assert_eq!(d.len(), colors.len());
 }
 
@@ -195,13 +213,14 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
 fn every_filter_gives_what_the_cli_computes() {
     for filter in ["laplace", "taubin", "hc", "sinc"] {
         let mut s = sample_session();
-        s.set_filter_name(filter).unwrap();
+        s.case_mut().set_filter_name(filter).unwrap();
         let timings = s.smooth_cpu().expect("smoothed");
         assert!(timings.smooth_ms >= 0.0 && timings.measure_ms >= 0.0);
-        let original = &s.model().unwrap().original;
-        let (positions, reference) = crate::metrics::smooth_drifting(original, s.params(), None);
-        let expected = crate::metrics::measure(original, &positions, &reference, s.tau());
-        let result = s.result().unwrap();
+        let original = &s.case().model().unwrap().original;
+        let (positions, reference) =
+            crate::metrics::smooth_drifting(original, s.case().params(), None);
+        let expected = crate::metrics::measure(original, &positions, &reference, s.case().tau());
+        let result = s.case().result().unwrap();
         assert_eq!(result.positions, positions, "{filter}");
         assert_eq!(result.metrics, expected, "{filter}");
         assert!(!s.smoothing_on_cpu());
@@ -213,38 +232,45 @@ fn a_change_while_a_run_is_out_takes_only_the_newer_result() {
     let mut s = sample_session();
     assert!(s.compute_cpu().is_none(), "asked, not back yet");
     assert!(s.smoothing_on_cpu());
-    s.set_params_json(&serde_json::json!({"iterations": 4}))
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 4}))
         .unwrap();
     assert!(!s.smoothing_on_cpu(), "the run out is for other parameters");
     assert!(s.compute_cpu().is_none(), "the old result is refused");
-    assert!(s.result().is_none() && s.last_result().is_none());
+    assert!(s.case().result().is_none() && s.case().last_result().is_none());
     assert!(s.compute_cpu().is_some());
-    assert!(s.result().is_some());
-    assert_eq!(s.params().iterations, 4);
+    assert!(s.case().result().is_some());
+    assert_eq!(s.case().params().iterations, 4);
 }
 
 #[test]
 fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
     let mut s = sample_session();
     s.smooth_cpu();
-    let r = s.result().unwrap().clone();
-    let old = s.revision();
-    s.set_params_json(&serde_json::json!({"iterations": 2}))
+    let r = s.case().result().unwrap().clone();
+    let old = s.case().revision();
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 2}))
         .unwrap();
     assert!(!s.accept_measured(old, r.positions.clone(), r.metrics.clone(), vertex(&r)));
     let mut short = vertex(&r);
     short.local_error.pop();
-    assert!(!s.accept_measured(s.revision(), r.positions.clone(), r.metrics.clone(), short));
+    assert!(!s.accept_measured(
+        s.case().revision(),
+        r.positions.clone(),
+        r.metrics.clone(),
+        short
+    ));
     assert!(s.accept_measured(
-        s.revision(),
+        s.case().revision(),
         r.positions.clone(),
         r.metrics.clone(),
         vertex(&r)
     ));
-    assert!(s.result().is_some());
-    assert_eq!(s.params().iterations, 2);
+    assert!(s.case().result().is_some());
+    assert_eq!(s.case().params().iterations, 2);
     assert_eq!(
-        s.metrics_json().unwrap(),
+        s.case().metrics_json().unwrap(),
         serde_json::to_value(&r.metrics).unwrap()
     );
 }
@@ -272,7 +298,11 @@ fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
         assert_eq!((p.name.as_str(), p.stage), ("second.ply", 0));
         assert_eq!(s.state_json(false)["loading"]["doing"], p.doing);
         assert_eq!(s.poll_opening(), None, "the worker is busy");
-        assert_eq!(s.model().unwrap().name, "first.ply", "the model stays");
+        assert_eq!(
+            s.case().model().unwrap().name,
+            "first.ply",
+            "the model stays"
+        );
     }
     deliver.set(true);
     s.pump_cpu_engine();
@@ -294,7 +324,7 @@ fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
         assert_eq!(s.state_json(false)["open_stages"][k]["doing"], *doing);
     }
     assert!(s.loading().is_none() && s.state_json(false)["loading"].is_null());
-    let model = s.model().unwrap();
+    let model = s.case().model().unwrap();
     assert_eq!(model.name, "second.ply");
     assert_eq!(model.report, at_once.report);
     assert_eq!(model.edges, at_once.edges);
@@ -302,13 +332,13 @@ fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
     assert_eq!(model.original.volume(), at_once.original.volume());
     assert_eq!(s.poll_opening(), None, "nothing left to open");
     // The workers hold the new model: the view's result comes from them.
-    assert!(s.smooth_cpu().is_some() && s.result().is_some());
+    assert!(s.smooth_cpu().is_some() && s.case().result().is_some());
 }
 
 #[test]
 fn a_bad_file_opened_in_a_worker_keeps_the_model_and_a_later_file_replaces_an_earlier() {
     let mut s = sample_session();
-    let revision = s.revision();
+    let revision = s.case().revision();
     s.begin_open(
         "broken.ply",
         b"ply\nformat ascii 1.0\nelement vertex 99\n".to_vec(),
@@ -316,8 +346,8 @@ fn a_bad_file_opened_in_a_worker_keeps_the_model_and_a_later_file_replaces_an_ea
     let e = s.poll_opening().unwrap().unwrap_err();
     assert!(e.starts_with("Cannot open broken.ply: "), "{e}");
     assert_eq!(s.error(), Some(e.as_str()));
-    assert_eq!(s.model().unwrap().name, "bent_tube_staircase.ply");
-    assert_eq!(s.revision(), revision, "nothing changed");
+    assert_eq!(s.case().model().unwrap().name, "bent_tube_staircase.ply");
+    assert_eq!(s.case().revision(), revision, "nothing changed");
 
     let (mut s, deliver) = deferred_session();
     s.begin_open("first.ply", SAMPLE.to_vec());
@@ -326,6 +356,6 @@ fn a_bad_file_opened_in_a_worker_keeps_the_model_and_a_later_file_replaces_an_ea
     assert_eq!(replaced.as_deref(), Some("first.ply"));
     deliver.set(true);
     assert_eq!(s.poll_opening(), Some(Ok(())));
-    assert_eq!(s.model().unwrap().name, "second.ply");
+    assert_eq!(s.case().model().unwrap().name, "second.ply");
     assert_eq!(s.error(), None);
 }

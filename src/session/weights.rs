@@ -6,7 +6,7 @@
 //! Painting takes the minimum with the brush's profile and erasing the maximum, so dabbing the
 //! same spot again in one stroke changes nothing: a stroke never "builds up" with the frame rate.
 
-use super::Session;
+use super::CaseDocument;
 
 /// What `state()` reports about the weights.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -30,7 +30,7 @@ fn summarize(weights: Option<&[f32]>) -> Option<WeightsSummary> {
     })
 }
 
-impl Session {
+impl CaseDocument {
     /// The painted weights (one per vertex in [0, 1]), or `None` while every vertex is free.
     pub fn weights(&self) -> Option<&[f32]> {
         self.structure()?.weights.as_deref()
@@ -114,6 +114,7 @@ impl Session {
 mod tests {
     use super::*;
     use crate::session::ColorField;
+    use crate::session::Session;
     use crate::smooth::Filter;
 
     const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
@@ -127,7 +128,7 @@ mod tests {
 
     fn smoothed(s: &mut Session) -> Vec<[f32; 3]> {
         s.smooth_cpu();
-        s.result().expect("a result").positions.clone()
+        s.case().result().expect("a result").positions.clone()
     }
 
     /// The first `k` vertices at full strength.
@@ -138,12 +139,12 @@ mod tests {
     #[test]
     fn locked_vertices_do_not_move_with_any_filter() {
         let mut s = sample_session();
-        assert!(s.paint_weights(&dab(50), 0.0));
+        assert!(s.case_mut().paint_weights(&dab(50), 0.0));
         // A half weight on the next ones: they move, but less than unweighted.
-        assert!(s.paint_weights(&[(60, 1.0), (61, 1.0)], 0.5));
-        let original = s.model().unwrap().mesh().positions.clone();
+        assert!(s.case_mut().paint_weights(&[(60, 1.0), (61, 1.0)], 0.5));
+        let original = s.case().model().unwrap().mesh().positions.clone();
         for filter in Filter::ALL {
-            s.set_filter(filter);
+            s.case_mut().set_filter(filter);
             let weighted = smoothed(&mut s);
             for i in 0..50 {
                 assert_eq!(weighted[i], original[i], "{filter}: vertex {i} moved");
@@ -153,41 +154,45 @@ mod tests {
                 "{filter}: half-weighted vertices move"
             );
             // In frame-sized chunks too (the browser's CPU engine).
-            let w = s.weights().unwrap().to_vec();
-            s.clear_weights();
-            assert!(s.paint_weights(
+            let w = s.case().weights().unwrap().to_vec();
+            s.case_mut().clear_weights();
+            assert!(s.case_mut().paint_weights(
                 &w.iter()
                     .enumerate()
                     .map(|(i, &w)| (i as u32, 1.0 - w))
                     .collect::<Vec<_>>(),
                 0.0
             ));
-            assert_eq!(s.weights().unwrap(), w.as_slice());
+            assert_eq!(s.case().weights().unwrap(), w.as_slice());
             s.smooth_cpu();
-            assert_eq!(s.result().unwrap().positions, weighted, "{filter}: again");
+            assert_eq!(
+                s.case().result().unwrap().positions,
+                weighted,
+                "{filter}: again"
+            );
         }
     }
 
     #[test]
     fn clearing_restores_the_unweighted_result_exactly() {
         let mut s = sample_session();
-        s.set_filter(Filter::Taubin);
+        s.case_mut().set_filter(Filter::Taubin);
         let free = smoothed(&mut s);
-        let free_metrics = s.result().unwrap().metrics.clone();
-        let revision = s.revision();
-        assert!(s.paint_weights(&dab(400), 0.2));
-        assert!(s.revision() > revision, "painting recomputes");
+        let free_metrics = s.case().result().unwrap().metrics.clone();
+        let revision = s.case().revision();
+        assert!(s.case_mut().paint_weights(&dab(400), 0.2));
+        assert!(s.case().revision() > revision, "painting recomputes");
         let painted = smoothed(&mut s);
         assert_ne!(painted, free);
-        assert!(s.clear_weights());
-        assert_eq!(s.weights(), None);
-        assert!(!s.clear_weights(), "nothing left to clear");
+        assert!(s.case_mut().clear_weights());
+        assert_eq!(s.case().weights(), None);
+        assert!(!s.case_mut().clear_weights(), "nothing left to clear");
         assert_eq!(smoothed(&mut s), free);
-        assert_eq!(s.result().unwrap().metrics, free_metrics);
+        assert_eq!(s.case().result().unwrap().metrics, free_metrics);
         // Erasing everything painted is the same as clearing.
-        assert!(s.paint_weights(&dab(400), 0.0));
-        assert!(s.erase_weights(&dab(400)));
-        assert_eq!(s.weights(), None);
+        assert!(s.case_mut().paint_weights(&dab(400), 0.0));
+        assert!(s.case_mut().erase_weights(&dab(400)));
+        assert_eq!(s.case().weights(), None);
         assert_eq!(smoothed(&mut s), free);
     }
 
@@ -195,23 +200,26 @@ mod tests {
     fn a_dab_repeated_changes_nothing_and_keeps_the_results() {
         let mut s = sample_session();
         let footprint = [(3, 1.0), (4, 0.5), (5, 0.0), (6, f32::NAN), (99_999, 1.0)];
-        let generation = s.weights_version();
-        assert!(s.paint_weights(&footprint, 0.0));
-        assert_eq!(s.weights_version(), generation + 1);
-        let w = s.weights().unwrap();
+        let generation = s.case().weights_version();
+        assert!(s.case_mut().paint_weights(&footprint, 0.0));
+        assert_eq!(s.case().weights_version(), generation + 1);
+        let w = s.case().weights().unwrap();
         assert_eq!((w[3], w[4], w[5], w[6]), (0.0, 0.5, 1.0, 1.0));
         s.smooth_cpu();
-        let revision = s.revision();
-        assert!(!s.paint_weights(&footprint, 0.0), "the same dab again");
+        let revision = s.case().revision();
+        assert!(
+            !s.case_mut().paint_weights(&footprint, 0.0),
+            "the same dab again"
+        );
         // A weaker brush does not unlock what is locked.
-        assert!(!s.paint_weights(&footprint, 0.7));
-        assert_eq!(s.revision(), revision);
-        assert!(s.result().is_some(), "nothing to recompute");
+        assert!(!s.case_mut().paint_weights(&footprint, 0.7));
+        assert_eq!(s.case().revision(), revision);
+        assert!(s.case().result().is_some(), "nothing to recompute");
         // Erasing at half strength raises to at least the falloff.
-        assert!(s.erase_weights(&[(3, 0.25)]));
-        assert_eq!(s.weights().unwrap()[3], 0.25);
+        assert!(s.case_mut().erase_weights(&[(3, 0.25)]));
+        assert_eq!(s.case().weights().unwrap()[3], 0.25);
 
-        let summary = summarize(s.weights()).unwrap();
+        let summary = summarize(s.case().weights()).unwrap();
         assert_eq!((summary.painted, summary.locked), (2, 0));
         assert_eq!(summary.min, 0.25);
         let state = s.state_json(false);
@@ -220,23 +228,26 @@ mod tests {
 
         // A new model starts free.
         s.open("again.ply", SAMPLE).unwrap();
-        assert_eq!(s.weights(), None);
+        assert_eq!(s.case().weights(), None);
         assert_eq!(s.state_json(false)["weights"], serde_json::Value::Null);
-        assert!(s.weights_version() > generation + 1);
+        assert!(s.case().weights_version() > generation + 1);
         // Nothing open, nothing to paint.
-        assert!(!Session::default().paint_weights(&footprint, 0.0));
+        assert!(!Session::default().case_mut().paint_weights(&footprint, 0.0));
     }
 
     #[test]
     fn weights_colour_locked_apart_from_free() {
         let mut s = sample_session();
-        let (free, legend) = s.colors(ColorField::Weights).expect("before any result");
-        assert_eq!(free.len(), s.model().unwrap().mesh().vertex_count());
+        let (free, legend) = s
+            .case()
+            .colors(ColorField::Weights)
+            .expect("before any result");
+        assert_eq!(free.len(), s.case().model().unwrap().mesh().vertex_count());
         assert!(free.iter().all(|c| *c == free[0]));
         assert_eq!((legend.min, legend.max), (0.0, 1.0));
         assert_eq!(legend.ticks[0].label, "0");
-        s.paint_weights(&dab(1), 0.0);
-        let (painted, _) = s.colors(ColorField::Weights).unwrap();
+        s.case_mut().paint_weights(&dab(1), 0.0);
+        let (painted, _) = s.case().colors(ColorField::Weights).unwrap();
         assert_ne!(painted[0], painted[1]);
         assert_eq!(painted[1], free[1]);
     }

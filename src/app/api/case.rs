@@ -16,7 +16,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
         "structures",
         Closure::<dyn FnMut() -> JsValue>::new(move || {
             let doc = d.borrow();
-            match doc.session.structures_json() {
+            match doc.session.case().structures_json() {
                 Some(s) => to_js(&s),
                 None => JsValue::NULL,
             }
@@ -37,8 +37,8 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
                     (visible, opacity, color), not its name, group or description"
                     .into());
             }
-            let index = (index.or(session.current_structure())).ok_or("nothing is open")?;
-            session.set_structure(index, change)
+            let index = (index.or(session.case().current_structure())).ok_or("nothing is open")?;
+            session.case_mut().set_structure(index, change)
         }),
     )?;
 
@@ -48,7 +48,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
             let index = (index.as_f64())
                 .filter(|i| *i >= 0.0 && i.fract() == 0.0)
                 .ok_or("soloStructure(index): index must be a whole number >= 0")?;
-            session.solo_structure(index as usize)
+            session.case_mut().solo_structure(index as usize)
         }),
     )?;
 
@@ -70,7 +70,7 @@ fn select_structure(
         };
         let mut doc = d.borrow_mut();
         let selected = doc.select_structure(index as usize).and_then(|()| {
-            (doc.session.info_json())
+            (doc.session.case().info_json())
                 .map(|v| to_js(&v))
                 .ok_or_else(|| "nothing is open".to_string())
         });
@@ -97,6 +97,8 @@ fn set_case(session: &mut Session, values: JsValue) -> Result<(), String> {
     {
         return Err(format!("setCase: unknown key {key} (title, description)"));
     }
-    session.set_case_text(text("title")?, text("description")?);
+    session
+        .case_mut()
+        .set_case_text(text("title")?, text("description")?);
     Ok(())
 }

@@ -27,12 +27,13 @@ fn suggest(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut(JsVal
         Ok((tau, method)) => when_ready(
             &d,
             &c,
-            |s| !s.suggesting(),
-            move |s| match s.suggestion() {
+            |s| !s.background().suggesting(),
+            move |s| match s.background().suggestion() {
                 Some(x) if x.suggestion.tau == tau && x.suggestion.search == method => {
                     Ok(to_js(&x.suggestion.to_json(x.elapsed_ms / 1000.0)))
                 }
                 _ => Err(s
+                    .background()
                     .guidance_problem()
                     .unwrap_or("the suggestion was cancelled or replaced")
                     .to_string()),
@@ -46,16 +47,17 @@ fn suggest(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut(JsVal
 fn sweep(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Promise> {
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move || {
-        if d.borrow().session.model().is_none() {
+        if d.borrow().session.case().model().is_none() {
             return settled(Err("no mesh is open: call loadMesh first".into()));
         }
         d.borrow_mut().session.set_graphs_wanted(true);
         when_ready(
             &d,
             &c,
-            |s| s.graphs_current(),
+            |s| s.background().graphs_current(),
             |s| {
-                s.graphs_json()
+                s.background()
+                    .graphs_json()
                     .map(|v| to_js(&v))
                     .ok_or_else(|| "no quality graphs".to_string())
             },
@@ -79,8 +81,8 @@ fn suggest_all(
             &d,
             &c,
             started,
-            |s| !s.suggesting_all(),
-            |s| s.suggest_all_json(),
+            |s| !s.background().suggesting_all(),
+            |s| s.background().suggest_all_json(),
         )
     })
 }
@@ -90,7 +92,13 @@ fn check_structures(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn Fn
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move || {
         let started = d.borrow_mut().session.start_checks();
-        started_work(&d, &c, started, |s| !s.checking(), |s| s.checks_json())
+        started_work(
+            &d,
+            &c,
+            started,
+            |s| !s.background().checking(),
+            |s| s.background().checks_json(),
+        )
     })
 }
 
@@ -100,7 +108,7 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
     Closure::new(move || {
         {
             let mut doc = d.borrow_mut();
-            if doc.session.model().is_none() {
+            if doc.session.case().model().is_none() {
                 return settled(Err("no mesh is open: call loadMesh first".into()));
             }
             doc.session.start_gallery();
@@ -109,15 +117,16 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
         when_ready(
             &d,
             &c,
-            |s| !s.making_gallery(),
+            |s| !s.background().making_gallery(),
             |s| {
-                if s.gallery().is_empty() {
+                if s.background().gallery().is_empty() {
                     return Err(s
+                        .background()
                         .guidance_problem()
                         .unwrap_or("the gallery was cancelled")
                         .to_string());
                 }
-                Ok(to_js(&s.guidance_json()["gallery"]))
+                Ok(to_js(&s.background().guidance_json()["gallery"]))
             },
         )
     })
@@ -129,7 +138,7 @@ fn start_suggest(doc: &SharedDocument, options: &JsValue) -> Result<(f64, Search
     let mut doc = doc.borrow_mut();
     let session = &mut doc.session;
     let (tau, method) = tau_and_search(session, options, "suggest")?;
-    session.set_tau(tau)?;
+    session.case_mut().set_tau(tau)?;
     session.start_suggest(method);
     Ok((tau, method))
 }
@@ -145,11 +154,11 @@ fn tau_and_search(
     } else {
         from_js(options)?
     };
-    if session.model().is_none() {
+    if session.case().model().is_none() {
         return Err("no mesh is open: call loadMesh first".into());
     }
     let tau = match options.get("tau") {
-        None | Some(serde_json::Value::Null) => session.tau(),
+        None | Some(serde_json::Value::Null) => session.case().tau(),
         Some(v) => v
             .as_f64()
             .ok_or_else(|| format!("{what}: tau must be a number in [0, 1], got {v}"))?,

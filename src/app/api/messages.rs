@@ -84,7 +84,7 @@ impl Embedding {
     }
 
     fn post_structures(&self, event: &str, doc: &Document) {
-        let detail = doc.session.structures_json().unwrap_or_default();
+        let detail = doc.session.case().structures_json().unwrap_or_default();
         self.post_event(event, &detail);
     }
 
@@ -120,7 +120,7 @@ fn parent_origin(value: &str) -> Result<String, String> {
 type CaseKey = (u64, Option<usize>, u64);
 
 fn case_key(doc: &Document) -> CaseKey {
-    let s = &doc.session;
+    let s = doc.session.case();
     (s.case_version(), s.current_structure(), s.revision())
 }
 

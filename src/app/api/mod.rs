@@ -131,7 +131,7 @@ fn when_current(
     ctx: &egui::Context,
     answer: impl Fn(&crate::session::Session) -> Result<JsValue, String> + 'static,
 ) -> Promise {
-    if doc.borrow().session.model().is_none() {
+    if doc.borrow().session.case().model().is_none() {
         return Promise::reject(&error("no mesh is open: call loadMesh first"));
     }
     let doc = doc.clone();
@@ -287,13 +287,15 @@ fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Res
     api.define(
         "setFilter",
         setter(doc, ctx, |session, name| {
-            session.set_filter_name(&name.as_string().unwrap_or_default())
+            session
+                .case_mut()
+                .set_filter_name(&name.as_string().unwrap_or_default())
         }),
     )?;
     api.define(
         "setParams",
         setter(doc, ctx, |session, values| {
-            session.set_params_json(&from_js(&values)?)
+            session.case_mut().set_params_json(&from_js(&values)?)
         }),
     )?;
 
@@ -303,6 +305,7 @@ fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Res
         Closure::<dyn FnMut() -> Promise>::new(move || {
             when_current(&d, &c, |session| {
                 session
+                    .case()
                     .metrics_json()
                     .map(|v| to_js(&v))
                     .ok_or_else(|| "no measures".to_string())
@@ -314,7 +317,7 @@ fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Res
     api.define(
         "clearWeights",
         Closure::<dyn FnMut()>::new(move || {
-            d.borrow_mut().session.clear_weights();
+            d.borrow_mut().session.case_mut().clear_weights();
             crate::app::wake(&c);
         }),
     )
@@ -333,7 +336,7 @@ fn define_export(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result
                 )));
             };
             when_current(&d, &c, move |session| {
-                let bytes = session.export(format, None)?;
+                let bytes = session.case().export(format, None)?;
                 Ok(Uint8Array::from(bytes.as_slice()).into())
             })
         }),
@@ -354,7 +357,7 @@ fn define_export(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result
                 }
             };
             when_current(&d, &c, move |session| {
-                let bytes = session.export_case(container)?;
+                let bytes = session.case().export_case(container)?;
                 Ok(Uint8Array::from(bytes.as_slice()).into())
             })
         }),

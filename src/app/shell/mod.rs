@@ -231,11 +231,13 @@ impl Shell {
     fn export(&mut self, format: ExportFormat) {
         let doc = self.doc.borrow();
         let session = &doc.session;
-        let Some(model) = session.model() else { return };
+        let Some(model) = session.case().model() else {
+            return;
+        };
         let colors = self
             .coloring
             .filter(|_| self.bake_colors)
-            .and_then(|f| session.colors(f))
+            .and_then(|f| session.case().colors(f))
             .map(|(c, _)| c);
         let stem = model
             .name
@@ -243,6 +245,7 @@ impl Shell {
             .map_or(model.name.as_str(), |s| s.0);
         let name = format!("{stem}_smoothed.{}", format.extension());
         self.export_error = session
+            .case()
             .export(format, colors.as_deref())
             .and_then(|bytes| download::save(&name, &bytes, format.mime()))
             .err();
@@ -273,13 +276,18 @@ impl Shell {
                         .copied(),
                 };
             }
-            Action::Filter(k) => self.doc.borrow_mut().session.set_filter(Filter::ALL[k]),
+            Action::Filter(k) => self
+                .doc
+                .borrow_mut()
+                .session
+                .case_mut()
+                .set_filter(Filter::ALL[k]),
             Action::ExportGlb => self.export(ExportFormat::Glb),
             Action::ToggleHelp => self.help_open = !self.help_open,
             Action::ApplySuggestion => {
                 let mut doc = self.doc.borrow_mut();
-                if let Some(s) = doc.session.suggestion() {
-                    let _ = doc.session.set_params(s.suggestion.params);
+                if let Some(s) = doc.session.background().suggestion() {
+                    let _ = doc.session.case_mut().set_params(s.suggestion.params);
                 }
             }
             Action::ToggleGraphs => {
@@ -363,14 +371,18 @@ impl Shell {
                     Ok(())
                 }
                 StructureAction::Select(i) => doc.select_structure(i),
-                StructureAction::Change(i, change) => doc.session.set_structure(i, change),
-                StructureAction::Solo(i) => doc.session.solo_structure(i),
+                StructureAction::Change(i, change) => {
+                    doc.session.case_mut().set_structure(i, change)
+                }
+                StructureAction::Solo(i) => doc.session.case_mut().solo_structure(i),
                 StructureAction::CaseText(title, description) => {
-                    doc.session.set_case_text(Some(&title), Some(&description));
+                    doc.session
+                        .case_mut()
+                        .set_case_text(Some(&title), Some(&description));
                     Ok(())
                 }
                 StructureAction::SuggestAll => {
-                    let tau = doc.session.tau();
+                    let tau = doc.session.case().tau();
                     let method = self.guide.method;
                     doc.session.start_suggest_all(tau, method)
                 }
@@ -380,10 +392,11 @@ impl Shell {
                     Ok(())
                 }
                 StructureAction::ExportCase => {
-                    let file = doc.session.case_file();
+                    let file = doc.session.case().case_file();
                     let stem = file.split('.').next().filter(|s| !s.is_empty());
                     let name = format!("{}_case.glb", stem.unwrap_or("case"));
                     doc.session
+                        .case()
                         .export_case(crate::export::Container::Glb)
                         .and_then(|bytes| download::save(&name, &bytes, "model/gltf-binary"))
                 }
@@ -394,7 +407,7 @@ impl Shell {
         }
         ui.heading("Smoothing");
         self.controls.filter(ui, &mut doc.session);
-        self.drag_params.panel(ui, doc.session.filter());
+        self.drag_params.panel(ui, doc.session.case().filter());
         ui.separator();
         self.brush.panel(ui, &mut doc.session);
         ui.separator();
@@ -415,7 +428,7 @@ impl Shell {
     fn status_bar(&self, ui: &mut egui::Ui) {
         let doc = self.doc.borrow();
         ui.horizontal(|ui| {
-            if let Some(model) = doc.session.model() {
+            if let Some(model) = doc.session.case().model() {
                 ui.label(format!(
                     "{}: {} vertices, {} faces",
                     model.name, model.report.vertices, model.report.faces
@@ -488,7 +501,11 @@ impl eframe::App for Shell {
         let uploading = !arrived && self.compute();
         if !arrived && !uploading {
             let mut doc = self.doc.borrow_mut();
-            let vertices = doc.session.model().map_or(0, |m| m.mesh().vertex_count());
+            let vertices = doc
+                .session
+                .case()
+                .model()
+                .map_or(0, |m| m.mesh().vertex_count());
             let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
             doc.guidance_on_gpu = offload.is_some();
             doc.compute_guidance(offload);
@@ -565,7 +582,7 @@ impl Shell {
             .default_size(260.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
-                    if let Some(model) = self.doc.borrow().session.model() {
+                    if let Some(model) = self.doc.borrow().session.case().model() {
                         report_view::show(ui, model);
                     }
                 });

@@ -65,8 +65,10 @@ impl Shell {
                 for action in actions {
                     let done = match action {
                         StructureAction::Select(i) => doc.select_structure(i),
-                        StructureAction::Change(i, change) => doc.session.set_structure(i, change),
-                        StructureAction::Solo(i) => doc.session.solo_structure(i),
+                        StructureAction::Change(i, change) => {
+                            doc.session.case_mut().set_structure(i, change)
+                        }
+                        StructureAction::Solo(i) => doc.session.case_mut().solo_structure(i),
                         _ => Ok(()),
                     };
                     if let Err(e) = done {

@@ -40,7 +40,7 @@ impl Shell {
                 if !self.brush.active && !self.picture.pending {
                     let at = (viewer.camera(), viewer.clip_plane());
                     let clicked = self.pointing.update(ui, &response, at, &doc.session);
-                    let current = doc.session.current_structure();
+                    let current = doc.session.case().current_structure();
                     if let (true, Some(i)) = (self.reading, clicked.filter(|&i| Some(i) != current))
                     {
                         if let Err(e) = doc.select_structure(i) {
@@ -64,7 +64,7 @@ impl Shell {
                     Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
                     _ => None,
                 };
-                let surface = (doc.session.model_id(), shown);
+                let surface = (doc.session.case().model_id(), shown);
                 let camera = viewer.camera();
                 self.brush
                     .interact(ui, &response, camera, &mut doc.session, surface);

@@ -51,18 +51,18 @@ impl Shell {
         };
         let doc = self.doc.borrow();
         let session = &doc.session;
-        if session.model().is_none() {
+        if session.case().model().is_none() {
             return;
         }
         let shown = &mut self.shown;
-        if shown.generation != session.model_id() || shown.positions.is_none() {
+        if shown.generation != session.case().model_id() || shown.positions.is_none() {
             sync_model(viewer, rs, session, &mut self.framed_case);
             // A link's camera, now that the view frames the case it was made for.
             if let Some(pose) = self.pending_pose.take() {
                 viewer.set_pose(pose);
             }
             *shown = Shown {
-                generation: session.model_id(),
+                generation: session.case().model_id(),
                 positions: Some(Positions::Original),
                 ..Shown::default()
             };
@@ -77,23 +77,26 @@ impl Shell {
         }
         // The brush shows what it paints; the weights' colours follow their own changes.
         let colors = if self.brush.active {
-            Some((ColorField::Weights, session.weights_version()))
+            Some((ColorField::Weights, session.case().weights_version()))
         } else {
             (self.coloring.filter(|_| !self.show_original))
-                .zip(session.last_result().map(|r| r.revision))
+                .zip(session.case().last_result().map(|r| r.revision))
         };
         if shown.colors != colors {
-            let computed = colors.and_then(|(field, _)| session.colors(field));
+            let computed = colors.and_then(|(field, _)| session.case().colors(field));
             viewer.set_colors(rs, computed.as_ref().map(|(c, _)| c.as_slice()));
             shown.legend = computed.map(|(_, l)| l);
             shown.colors = colors;
         }
-        let looks = (session.case_version(), toward.to_bits());
+        let looks = (session.case().case_version(), toward.to_bits());
         if shown.looks != Some(looks) {
             upload_looks(viewer, rs, session, toward);
             shown.looks = Some(looks);
         }
-        let marks = (session.marks_key(), session.case_version());
+        let marks = (
+            session.background().marks_key(),
+            session.case().case_version(),
+        );
         if shown.marks != marks {
             upload_marks(viewer, rs, session);
             shown.marks = marks;
@@ -108,7 +111,7 @@ fn sync_model(
     session: &Session,
     framed_case: &mut Option<(String, usize)>,
 ) {
-    let Some(model) = session.model() else {
+    let Some(model) = session.case().model() else {
         return;
     };
     let mesh = model.mesh();
@@ -116,8 +119,9 @@ fn sync_model(
     let kept_view = viewer.view_state();
     viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
     // A segmentation is framed whole once; another of its structures keeps the view.
-    let structures = session.case_structures();
-    let case = (structures.len() > 1).then(|| (session.case_file().to_string(), structures.len()));
+    let structures = session.case().case_structures();
+    let case =
+        (structures.len() > 1).then(|| (session.case().case_file().to_string(), structures.len()));
     match (&case, case == *framed_case) {
         (Some(_), true) => viewer.set_view_state(kept_view),
         (Some(_), false) => {
@@ -136,8 +140,8 @@ fn wanted_positions(
     show_original: bool,
     toward: f32,
 ) -> Positions {
-    let result = session.last_result();
-    let before_result = if session.kept_surface().is_some() {
+    let result = session.case().last_result();
+    let before_result = if session.case().kept_surface().is_some() {
         Positions::Kept
     } else {
         Positions::Original
@@ -149,7 +153,7 @@ fn wanted_positions(
             Positions::Toward(r.revision, toward.to_bits())
         })
     } else if let Some(gpu) = gpu {
-        (gpu.submitted(session.model_id())).map_or(before_result, Positions::Gpu)
+        (gpu.submitted(session.case().model_id())).map_or(before_result, Positions::Gpu)
     } else {
         result.map_or(before_result, |r| Positions::Cpu(r.revision))
     }
@@ -166,12 +170,12 @@ fn upload_positions(
     shown: Option<Positions>,
     toward: f32,
 ) -> bool {
-    let Some(model) = session.model() else {
+    let Some(model) = session.case().model() else {
         return false;
     };
     let mesh = model.mesh();
-    let result = session.last_result();
-    let kept = session.kept_surface();
+    let result = session.case().last_result();
+    let kept = session.case().kept_surface();
     let mut set = |positions: &[[f32; 3]]| {
         let normals = crate::mesh::vertex_normals(positions, &mesh.triangles);
         viewer.set_positions(rs, positions, &normals);
@@ -201,7 +205,7 @@ fn upload_positions(
         }
         // While a run is under way in the engine's buffers they hold none of its results:
         // copy once it is done.
-        Positions::Gpu(_) => match gpu.and_then(|g| g.buffers(session.model_id())) {
+        Positions::Gpu(_) => match gpu.and_then(|g| g.buffers(session.case().model_id())) {
             Some((positions, normals)) => viewer.copy_positions_from(rs, positions, normals),
             None => return false,
         },
@@ -212,8 +216,8 @@ fn upload_positions(
 /// The case's other structures with their looks (drawn back towards the segmentation by
 /// `toward`), and the model's look.
 fn upload_looks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session, toward: f32) {
-    let others = session.other_structures();
-    let list = session.case_structures();
+    let others = session.case().other_structures();
+    let list = session.case().case_structures();
     let moved: Vec<Option<Vec<[f32; 3]>>> = (others.iter())
         .map(|o| {
             let original = &list[o.index].original.positions;
@@ -231,7 +235,7 @@ fn upload_looks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session
         })
         .collect();
     viewer.set_context(rs, &surfaces);
-    let look = session.model_structure();
+    let look = session.case().model_structure();
     viewer.set_model_look(
         look.map(|l| l.color),
         look.is_none_or(|l| l.visible),
@@ -241,7 +245,7 @@ fn upload_looks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session
 
 /// The checks' marks over the structures.
 fn upload_marks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session) {
-    let patches = session.marked_surfaces();
+    let patches = session.background().marked_surfaces();
     let surfaces: Vec<viewer::ContextSurface<'_>> = (patches.iter())
         .map(|p| viewer::ContextSurface {
             positions: &p.positions,

@@ -8,7 +8,7 @@ const SAMPLE: &[u8] = include_bytes!("../../../web/sample/bent_tube_staircase.pl
 fn session(filter: &str) -> Session {
     let mut s = Session::default();
     s.open("sample.ply", SAMPLE).unwrap();
-    s.set_filter_name(filter).unwrap();
+    s.case_mut().set_filter_name(filter).unwrap();
     s
 }
 
@@ -26,7 +26,7 @@ fn settle_on(s: &mut Session, mut offload: Option<&mut dyn Offload>) -> usize {
         ticks.get()
     };
     let mut calls = 0;
-    while s.guidance_busy() {
+    while s.background().guidance_busy() {
         let lent = offload.as_mut().map(|o| &mut **o as &mut dyn Offload);
         s.step_guidance_on(&clock, lent);
         calls += 1;
@@ -39,10 +39,20 @@ fn settle_on(s: &mut Session, mut offload: Option<&mut dyn Offload>) -> usize {
 fn a_loaded_model_gets_the_local_search_suggestion() {
     let mut s = Session::default();
     s.open("sample.ply", SAMPLE).unwrap();
-    assert!(s.suggesting(), "a search starts with the model");
+    assert!(
+        s.background().suggesting(),
+        "a search starts with the model"
+    );
     settle(&mut s);
-    let got = s.suggestion().expect("a suggestion").suggestion;
-    assert_eq!(got, local_suggestion(&s.model().unwrap().original, &s));
+    let got = s
+        .background()
+        .suggestion()
+        .expect("a suggestion")
+        .suggestion;
+    assert_eq!(
+        got,
+        local_suggestion(&s.case().model().unwrap().original, &s)
+    );
 }
 
 #[test]
@@ -50,26 +60,33 @@ fn a_session_that_only_shows_starts_no_search_for_a_model() {
     let mut s = Session::default();
     s.set_suggest_on_open(false);
     s.open("sample.ply", SAMPLE).unwrap();
-    assert!(!s.suggesting(), "no search starts with the model");
-    assert!(!s.guidance_busy(), "nothing runs in the background");
-    assert!(s.suggestion().is_none());
+    assert!(
+        !s.background().suggesting(),
+        "no search starts with the model"
+    );
+    assert!(
+        !s.background().guidance_busy(),
+        "nothing runs in the background"
+    );
+    assert!(s.background().suggestion().is_none());
 }
 
 #[test]
 fn a_grid_suggestion_follows_tau_without_smoothing_again() {
     let mut s = session("laplace");
-    s.set_params_json(&serde_json::json!({"max_displacement": 0.4}))
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"max_displacement": 0.4}))
         .unwrap();
     s.start_suggest(SearchMethod::Grid);
     settle(&mut s);
     for tau in [0.5, 0.2, 0.9] {
-        s.set_tau(tau).unwrap();
-        assert!(!s.guidance_busy());
-        let got = s.suggestion().unwrap().suggestion;
+        s.case_mut().set_tau(tau).unwrap();
+        assert!(!s.background().guidance_busy());
+        let got = s.background().suggestion().unwrap().suggestion;
         let expected = suggest(
             &model_original(&s),
             None,
-            s.params(),
+            s.case().params(),
             tau,
             SearchMethod::Grid,
             &mut |_| true,
@@ -79,49 +96,69 @@ fn a_grid_suggestion_follows_tau_without_smoothing_again() {
         assert_eq!(got.params.max_displacement, Some(0.4));
     }
     // Another filter: the grid is not for it.
-    s.set_filter_name("hc").unwrap();
-    assert!(s.suggestion().is_none());
+    s.case_mut().set_filter_name("hc").unwrap();
+    assert!(s.background().suggestion().is_none());
 }
 
 /// The one-shot engine's local-search suggestion for `original` at the session's parameters
 /// and tau, unweighted: what the background must arrive at.
 fn local_suggestion(original: &metrics::Original, s: &Session) -> crate::suggest::Suggestion {
     let method = SearchMethod::Local;
-    suggest(original, None, s.params(), s.tau(), method, &mut |_| true).unwrap()
+    suggest(
+        original,
+        None,
+        s.case().params(),
+        s.case().tau(),
+        method,
+        &mut |_| true,
+    )
+    .unwrap()
 }
 
 fn model_original(s: &Session) -> metrics::Original {
-    s.model().unwrap().original.clone()
+    s.case().model().unwrap().original.clone()
 }
 
 #[test]
 fn graphs_follow_the_parameters_in_the_background() {
     let mut s = session("taubin");
     s.cancel_suggest();
-    s.set_params_json(&serde_json::json!({"iterations": 8}))
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 8}))
         .unwrap();
-    assert!(!s.guidance_busy(), "graphs are only made when wanted");
+    assert!(
+        !s.background().guidance_busy(),
+        "graphs are only made when wanted"
+    );
     s.set_graphs_wanted(true);
     settle(&mut s);
-    assert!(s.graphs_current());
+    assert!(s.background().graphs_current());
     let original = model_original(&s);
-    let expected = quality_graphs(&original, None, s.params(), s.tau(), &mut |_| true).unwrap();
-    assert_eq!(s.graphs().unwrap(), expected);
+    let expected = quality_graphs(
+        &original,
+        None,
+        s.case().params(),
+        s.case().tau(),
+        &mut |_| true,
+    )
+    .unwrap();
+    assert_eq!(s.background().graphs().unwrap(), expected);
 
     // A new value: the old graphs stay on show, marked stale, until new ones are made.
-    s.set_params_json(&serde_json::json!({"lambda": 0.4}))
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"lambda": 0.4}))
         .unwrap();
-    assert!(!s.graphs_current());
-    assert_eq!(s.graphs().unwrap(), expected);
-    assert!(s.guidance_busy());
+    assert!(!s.background().graphs_current());
+    assert_eq!(s.background().graphs().unwrap(), expected);
+    assert!(s.background().guidance_busy());
     settle(&mut s);
-    assert!(s.graphs_current());
-    assert_eq!(s.graphs().unwrap().current, *s.params());
+    assert!(s.background().graphs_current());
+    assert_eq!(s.background().graphs().unwrap().current, *s.case().params());
 
     // tau rescored without smoothing.
-    s.set_tau(0.9).unwrap();
-    assert!(!s.guidance_busy());
-    assert_eq!(s.graphs().unwrap().tau, 0.9);
+    s.case_mut().set_tau(0.9).unwrap();
+    assert!(!s.background().guidance_busy());
+    assert_eq!(s.background().graphs().unwrap().tau, 0.9);
 }
 
 #[test]
@@ -130,14 +167,14 @@ fn the_gallery_holds_the_local_suggestion_of_each_tau() {
     s.cancel_suggest();
     s.start_gallery();
     settle(&mut s);
-    let picks = s.gallery();
+    let picks = s.background().gallery();
     assert_eq!(picks.len(), GALLERY_TAUS.len());
     let original = model_original(&s);
     for (pick, &tau) in picks.iter().zip(&GALLERY_TAUS) {
         let expected = suggest(
             &original,
             None,
-            s.params(),
+            s.case().params(),
             tau,
             SearchMethod::Local,
             &mut |_| true,
@@ -165,19 +202,19 @@ fn a_search_for_another_filter_or_model_is_dropped() {
         ticks.get()
     };
     s.start_suggest(SearchMethod::Local);
-    assert!(s.suggesting());
-    s.set_filter_name("sinc").unwrap();
+    assert!(s.background().suggesting());
+    s.case_mut().set_filter_name("sinc").unwrap();
     s.step_guidance(&clock);
-    assert!(!s.suggesting());
-    s.set_filter_name("hc").unwrap();
+    assert!(!s.background().suggesting());
+    s.case_mut().set_filter_name("hc").unwrap();
     s.start_gallery();
     s.open("again.ply", SAMPLE).unwrap();
-    assert!(s.gallery().is_empty());
+    assert!(s.background().gallery().is_empty());
     assert_eq!(
-        s.activities().len(),
+        s.background().activities().len(),
         1,
         "only the new model's suggestion: {:?}",
-        s.activities()
+        s.background().activities()
     );
 }
 
@@ -222,10 +259,17 @@ fn an_offload_runs_the_searches_and_graphs_with_the_same_results() {
     assert!(calls >= offload.requests.len(), "{calls} calls");
     let original = model_original(&s);
     let expected = local_suggestion(&original, &s);
-    assert_eq!(s.suggestion().unwrap().suggestion, expected);
-    let graphs = quality_graphs(&original, None, s.params(), s.tau(), &mut |_| true).unwrap();
-    assert_eq!(s.graphs().unwrap(), graphs);
-    assert!(offload.requests.iter().all(|&id| id == s.model_id));
+    assert_eq!(s.background().suggestion().unwrap().suggestion, expected);
+    let graphs = quality_graphs(
+        &original,
+        None,
+        s.case().params(),
+        s.case().tau(),
+        &mut |_| true,
+    )
+    .unwrap();
+    assert_eq!(s.background().graphs().unwrap(), graphs);
+    assert!(offload.requests.iter().all(|&id| id == s.doc.model_id));
 }
 
 #[test]
@@ -238,12 +282,22 @@ fn searches_reuse_the_terms_measured_before_until_the_weights_change() {
     s.start_gallery();
     settle_on(&mut s, Some(&mut offload));
     let gallery = offload.requests.len() - suggestion;
-    let picks: Vec<_> = s.gallery().iter().map(|p| (p.params, p.terms)).collect();
+    let picks: Vec<_> = s
+        .background()
+        .gallery()
+        .iter()
+        .map(|p| (p.params, p.terms))
+        .collect();
     // Made again: every search is answered from what was measured, with the same picks.
     s.start_gallery();
     settle_on(&mut s, Some(&mut offload));
     assert_eq!(offload.requests.len(), suggestion + gallery);
-    let again: Vec<_> = s.gallery().iter().map(|p| (p.params, p.terms)).collect();
+    let again: Vec<_> = s
+        .background()
+        .gallery()
+        .iter()
+        .map(|p| (p.params, p.terms))
+        .collect();
     assert_eq!(again, picks);
     // The gallery's tau 0.5 search is the opening suggestion's: it measured nothing new, so
     // the gallery asked for fewer runs than five searches alone would.
@@ -258,7 +312,7 @@ fn searches_reuse_the_terms_measured_before_until_the_weights_change() {
         alone.requests.len()
     );
     // Other weights: measured afresh.
-    assert!(s.paint_weights(&[(0, 1.0), (1, 1.0)], 0.0));
+    assert!(s.case_mut().paint_weights(&[(0, 1.0), (1, 1.0)], 0.0));
     s.start_gallery();
     settle_on(&mut s, Some(&mut offload));
     assert!(offload.requests.len() > suggestion + gallery);
