@@ -99,15 +99,14 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .collect();
     assert_eq!(others, [1, 2, 3]);
 
-    let (index, change) = StructureChange::from_json(&serde_json::json!({
-        "index": 2, "name": " tumour ", "color": [0.0, 1.0, 0.0], "opacity": 0.4
-    }))
-    .unwrap();
+    let change = StructureChange {
+        name: Some(" tumour ".into()),
+        color: Some([0.0, 1.0, 0.0]),
+        opacity: Some(0.4),
+        ..Default::default()
+    };
     let version = session.case().case_version();
-    session
-        .case_mut()
-        .set_structure(index.unwrap(), change)
-        .unwrap();
+    session.case_mut().set_structure(2, change).unwrap();
     assert!(session.case().case_version() > version);
     let tumour = &session.case().case_structures()[2];
     assert_eq!(
@@ -115,16 +114,21 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         ("tumour", [0.0, 1.0, 0.0, 0.4])
     );
     for bad in [
-        serde_json::json!({"opacity": 1.5}),
-        serde_json::json!({"color": [0, 2, 0]}),
-        serde_json::json!({"name": "  "}),
-        serde_json::json!({"group": 3}),
-        serde_json::json!({"visible": "yes"}),
-        serde_json::json!([1]),
+        StructureChange {
+            opacity: Some(1.5),
+            ..Default::default()
+        },
+        StructureChange {
+            color: Some([0.0, 2.0, 0.0]),
+            ..Default::default()
+        },
+        StructureChange {
+            name: Some("  ".into()),
+            ..Default::default()
+        },
     ] {
-        let refused = StructureChange::from_json(&bad)
-            .and_then(|(_, c)| session.case_mut().set_structure(2, c));
-        assert!(refused.is_err(), "{bad}");
+        let refused = session.case_mut().set_structure(2, bad.clone());
+        assert!(refused.is_err(), "{bad:?}");
     }
     assert!(session
         .case_mut()
@@ -136,31 +140,23 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         "a refusal changes nothing"
     );
     // Groups: set, trimmed, and taken away by null.
-    let group = |v| {
-        StructureChange::from_json(&serde_json::json!({ "group": v }))
-            .unwrap()
-            .1
+    let group = |g: Option<&str>| StructureChange {
+        group: Some(g.map(str::to_string)),
+        ..Default::default()
     };
     session
         .case_mut()
-        .set_structure(1, group(serde_json::json!(" Vessels ")))
+        .set_structure(1, group(Some(" Vessels ")))
         .unwrap();
     assert_eq!(
         session.case().case_structures()[1].group.as_deref(),
         Some("Vessels")
     );
-    assert_eq!(
-        session.case().structures_json().unwrap()["structures"][1]["group"],
-        "Vessels"
-    );
-    session
-        .case_mut()
-        .set_structure(1, group(serde_json::Value::Null))
-        .unwrap();
+    session.case_mut().set_structure(1, group(None)).unwrap();
     assert_eq!(session.case().case_structures()[1].group, None);
     session
         .case_mut()
-        .set_structure(1, group(serde_json::json!("Vessels")))
+        .set_structure(1, group(Some("Vessels")))
         .unwrap();
 
     // Solo shows one alone; again, every one.
@@ -196,16 +192,13 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .set_params(Params::defaults(Filter::Laplace))
         .unwrap();
     session.smooth_cpu();
-    let json = session.case().structures_json().unwrap();
-    assert_eq!(json["current"], 1);
-    assert_eq!(json["structures"][2]["name"], "tumour");
-    assert_eq!(json["structures"][2]["opacity"], 0.4f32 as f64);
-    assert_eq!(
-        json["structures"][0]["metrics"],
-        serde_json::to_value(&liver.metrics).unwrap()
-    );
-    assert!(json["structures"][3]["metrics"].is_null(), "never smoothed");
-    assert_ne!(json["structures"][1]["metrics"], serde_json::Value::Null);
+    let case = session.case();
+    assert_eq!(case.current_structure(), Some(1));
+    assert_eq!(case.case_structures()[2].name, "tumour");
+    assert_eq!(case.case_structures()[2].color[3], 0.4);
+    assert_eq!(case.structure_metrics(0), Some(&liver.metrics));
+    assert!(case.structure_metrics(3).is_none(), "never smoothed");
+    assert!(case.structure_metrics(1).is_some());
 
     // Back to the liver: a pointer moves. Nothing is opened or smoothed again: its
     // parameters and its result are where they were, in its structure.

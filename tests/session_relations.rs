@@ -23,7 +23,7 @@ fn the_session_checks_its_structures_as_they_stand() {
         "a worker on this thread answers at once"
     );
     assert!(!session.background().checking());
-    let report = session.background().checks_json().unwrap();
+    let report = session.background().checks_report().unwrap();
     assert!(
         report["text"]
             .as_str()
@@ -32,7 +32,7 @@ fn the_session_checks_its_structures_as_they_stand() {
         "{report}"
     );
     assert_eq!(report["left_inside"], serde_json::json!([]));
-    assert_eq!(report["current"], true);
+    assert!(session.background().checks_current());
     assert!(session.background().flagged_structures().is_empty());
     // The same as the CLI's pipeline says of the same case.
     let case = session.case().to_case().unwrap();
@@ -50,14 +50,11 @@ fn the_session_checks_its_structures_as_they_stand() {
         ..Params::defaults(Filter::Laplace)
     };
     session.case_mut().set_params(shrink).unwrap();
-    assert_eq!(
-        session.background().checks_json().unwrap()["current"],
-        false
-    );
+    assert!(!session.background().checks_current());
     session.smooth_cpu();
     session.start_checks().unwrap();
     session.step_checks();
-    let report = session.background().checks_json().unwrap();
+    let report = session.background().checks_report().unwrap();
     assert_eq!(
         report["left_inside"],
         serde_json::json!([["tumor", "liver"]]),
@@ -95,7 +92,7 @@ fn the_session_checks_its_structures_as_they_stand() {
         ..Default::default()
     };
     session.case_mut().set_structure(1, hide).unwrap();
-    assert_eq!(session.background().checks_json().unwrap()["current"], true);
+    assert!(session.background().checks_current());
     assert_eq!(session.background().marks_key(), Some(key));
     assert_eq!(session.background().marked_surfaces().len(), 2);
     // Smoothing anew does not: the marks go.
@@ -104,10 +101,7 @@ fn the_session_checks_its_structures_as_they_stand() {
         .set_params(Params::defaults(Filter::Hc))
         .unwrap();
     session.smooth_cpu();
-    assert_eq!(
-        session.background().checks_json().unwrap()["current"],
-        false
-    );
+    assert!(!session.background().checks_current());
     assert_eq!(session.background().marks_key(), None);
     assert!(session.background().marked_surfaces().is_empty());
     // Back to the checked parameters, the same surface again: the marks are current again.

@@ -380,7 +380,9 @@ impl Document {
     /// Whether all the work under way runs in the CPU engine's workers, whose replies wake
     /// the page: then frames are needed only when one lands, not continuously.
     pub fn working_elsewhere(&self) -> bool {
-        self.backend == Backend::Cpu && !self.guidance_on_gpu && self.session.cpu_engine_threaded()
+        self.backend == Backend::Cpu
+            && !self.guidance_on_gpu
+            && self.session.cpu_engine().threaded()
     }
 
     /// Whether anything is computing (the current result or background work), so the page
@@ -409,7 +411,7 @@ impl Document {
     /// what the page shows changed (a result taken, a search or graph finished): a frame is due.
     pub fn step_cpu_engine(&mut self) -> bool {
         self.session.pump_cpu_engine();
-        if self.backend != Backend::Cpu || !self.session.cpu_engine_threaded() {
+        if self.backend != Backend::Cpu || !self.session.cpu_engine().threaded() {
             return false;
         }
         let took = self.compute_on_cpu();
@@ -431,8 +433,7 @@ impl Document {
 
     /// What the API's `state()` returns.
     pub fn state_json(&self) -> serde_json::Value {
-        let mut state = self.session.state_json(self.busy());
-        state["guidance"] = self.session.background().guidance_json();
+        let mut state = super::api::json::session_state(&self.session, self.busy());
         state["backend"] = serde_json::json!(self.backend.name());
         state["mode"] = serde_json::json!(if self.reading { "viewer" } else { "author" });
         state["shortcuts"] = serde_json::json!(self.shortcuts);
@@ -462,7 +463,6 @@ impl Document {
             None => serde_json::Value::Null,
         };
         state["layout"] = self.panel.to_json();
-        state["checks"] = self.session.background().checks_json().unwrap_or_default();
         // WebAssembly memory only grows: its size is the page's peak.
         state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state

@@ -233,7 +233,7 @@ impl StructureList {
 
 /// The last checks' lines, warnings in the warning colour.
 fn checks_report(ui: &mut egui::Ui, session: &Session) {
-    let Some(report) = session.background().checks_json() else {
+    let Some(report) = session.background().checks_report() else {
         return;
     };
     if let Some(error) = report["error"].as_str() {

@@ -72,23 +72,21 @@ impl Session {
     }
 }
 
-impl Background<'_> {
+impl<'a> Background<'a> {
+    /// The last checks' report as `case check --json` prints it (see
+    /// [`Self::checks_current`]); `None` before any.
+    pub fn checks_report(&self) -> Option<&'a serde_json::Value> {
+        self.checks.report.as_ref()
+    }
+
     /// Whether checks are under way.
     pub fn checking(&self) -> bool {
         self.checks.job.is_some()
     }
 
-    /// The last checks: `{pairs, left_inside, new_crossings, text, flagged, ms, current}`
-    /// (`current`: the case is as it was checked), or `{error}`.
-    pub fn checks_json(&self) -> Option<serde_json::Value> {
-        let mut report = self.checks.report.clone()?;
-        report["current"] = self.checks_current().into();
-        Some(report)
-    }
-
     /// Whether every structure shows the surface the last checks found (as [`Session::to_case`]
     /// gives it: the model's current result, or its original while that is computed).
-    fn checks_current(&self) -> bool {
+    pub fn checks_current(&self) -> bool {
         if self.checks.report.is_none() {
             return false;
         }

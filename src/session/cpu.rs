@@ -22,9 +22,9 @@ impl Session {
         self.cpu_job = None;
     }
 
-    /// Whether the CPU engine's workers run beside this thread.
-    pub fn cpu_engine_threaded(&self) -> bool {
-        self.cpu.threaded()
+    /// The CPU engine: its workers, what it was asked.
+    pub fn cpu_engine(&self) -> &Pool {
+        &self.cpu
     }
 
     /// Takes the CPU engine's replies and hands its idle workers their next jobs (the ones

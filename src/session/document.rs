@@ -168,18 +168,6 @@ impl CaseDocument {
         Ok(())
     }
 
-    /// The mesh report of the open model as the CLI's `info --json` prints it.
-    pub fn info_json(&self) -> Option<serde_json::Value> {
-        self.model()
-            .and_then(|m| serde_json::to_value(&m.report).ok())
-    }
-
-    /// The current result's measures as the CLI's `measure --json` prints them.
-    pub fn metrics_json(&self) -> Option<serde_json::Value> {
-        self.result()
-            .and_then(|r| serde_json::to_value(&r.metrics).ok())
-    }
-
     /// Per-vertex colours of `field` on the latest result (the weights: as painted now), with
     /// the legend that explains them.
     pub fn colors(&self, field: ColorField) -> Option<(Vec<[u8; 4]>, Legend)> {

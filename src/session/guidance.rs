@@ -144,21 +144,17 @@ impl CaseDocument {
 }
 
 impl<'a> Background<'a> {
+    /// How long the sweep of [`Self::graphs`] took, in seconds of wall time spread over frames.
+    pub fn graphs_seconds(&self) -> f64 {
+        self.guidance.graphs_elapsed_ms / 1000.0
+    }
+
     /// The latest finished quality graphs of the active filter (maybe for other parameters
     /// than the current ones while new ones are computed), rescored at the current tau.
     pub fn graphs(&self) -> Option<QualityGraphs> {
         let (key, graphs) = self.guidance.graphs.as_ref()?;
         (key.model == self.doc.model_id && key.filter == self.doc.filter())
             .then(|| graphs.clone().rescored(self.doc.tau()))
-    }
-
-    /// What `sweep --json` prints for the current graphs, once they are current.
-    pub fn graphs_json(&self) -> Option<serde_json::Value> {
-        if !self.graphs_current() {
-            return None;
-        }
-        let graphs = self.graphs()?;
-        Some(graphs.to_json(self.guidance.graphs_elapsed_ms / 1000.0))
     }
 
     /// Whether [`Self::graphs`] are for exactly the current parameters, weights and model.
@@ -193,28 +189,6 @@ impl<'a> Background<'a> {
     /// Why the last background job gave no result.
     pub fn guidance_problem(&self) -> Option<&'a str> {
         self.guidance.problem.as_deref()
-    }
-
-    /// What the embedding API's `state().guidance` holds: the background work under way and
-    /// whether the graphs are current.
-    pub fn guidance_json(&self) -> serde_json::Value {
-        let activities: Vec<serde_json::Value> = self
-            .activities()
-            .iter()
-            .map(|a| serde_json::json!({"what": a.describe(), "fraction": a.fraction()}))
-            .collect();
-        serde_json::json!({
-            "activities": activities,
-            "graphs_current": self.graphs_current(),
-            "suggestion": self.suggestion().map(|s| s.suggestion.to_json(s.elapsed_ms / 1000.0)),
-            "gallery": self.gallery().iter().map(|p| serde_json::json!({
-                "tau": p.tau,
-                "params": p.params.to_json(),
-                "terms": p.terms,
-                "volume_change": p.volume_change,
-            })).collect::<Vec<_>>(),
-            "problem": self.guidance_problem(),
-        })
     }
 
     /// Whether a suggestion search is under way.

@@ -157,30 +157,6 @@ impl Session {
         self.error = Some(message.clone());
         message
     }
-
-    /// What the embedding API's `state()` reports.
-    pub fn state_json(&self, busy: bool) -> serde_json::Value {
-        let model = self.doc.model();
-        serde_json::json!({
-            "model": model.map(|m| m.name.as_str()),
-            "vertices": model.map(|m| m.report.vertices),
-            "faces": model.map(|m| m.report.faces),
-            "error": self.error,
-            "filter": self.doc.filter().name(),
-            "params": self.doc.params().to_json(),
-            "tau": self.doc.tau(),
-            "busy": busy,
-            "cpu_engine": self.cpu.to_json(),
-            "weights": self.doc.weights_summary(),
-            "structures": self.doc.structures_json(),
-            "loading": self.loading().map(|l| serde_json::json!({
-                "name": l.name, "stage": l.stage, "stages": l.total, "doing": l.doing,
-            })),
-            "open_stages": self.open_stages().iter()
-                .map(|(doing, ms)| serde_json::json!({"doing": doing, "ms": ms}))
-                .collect::<Vec<_>>(),
-        })
-    }
 }
 
 #[cfg(test)]

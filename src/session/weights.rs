@@ -222,14 +222,12 @@ mod tests {
         let summary = summarize(s.case().weights()).unwrap();
         assert_eq!((summary.painted, summary.locked), (2, 0));
         assert_eq!(summary.min, 0.25);
-        let state = s.state_json(false);
-        assert_eq!(state["weights"]["painted"], 2);
-        assert_eq!(state["weights"]["min"], 0.25);
+        assert_eq!(s.case().weights_summary(), Some(summary));
 
         // A new model starts free.
         s.open("again.ply", SAMPLE).unwrap();
         assert_eq!(s.case().weights(), None);
-        assert_eq!(s.state_json(false)["weights"], serde_json::Value::Null);
+        assert_eq!(s.case().weights_summary(), None);
         assert!(s.case().weights_version() > generation + 1);
         // Nothing open, nothing to paint.
         assert!(!Session::default().case_mut().paint_weights(&footprint, 0.0));

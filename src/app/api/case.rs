@@ -16,7 +16,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
         "structures",
         Closure::<dyn FnMut() -> JsValue>::new(move || {
             let doc = d.borrow();
-            match doc.session.case().structures_json() {
+            match super::json::structures(doc.session.case()) {
                 Some(s) => to_js(&s),
                 None => JsValue::NULL,
             }
@@ -29,7 +29,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
     api.define(
         "setStructure",
         setter(doc, ctx, move |session, values| {
-            let (index, change) = crate::session::StructureChange::from_json(&from_js(&values)?)?;
+            let (index, change) = super::json::structure_change(&from_js(&values)?)?;
             if reading
                 && (change.name.is_some() || change.group.is_some() || change.description.is_some())
             {
@@ -70,7 +70,7 @@ fn select_structure(
         };
         let mut doc = d.borrow_mut();
         let selected = doc.select_structure(index as usize).and_then(|()| {
-            (doc.session.case().info_json())
+            super::json::info(doc.session.case())
                 .map(|v| to_js(&v))
                 .ok_or_else(|| "nothing is open".to_string())
         });

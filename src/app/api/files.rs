@@ -29,7 +29,7 @@ fn load_waiter(
 }
 
 pub(super) fn info_waiter(resolve: Function, reject: Function) -> LoadWaiter {
-    load_waiter(resolve, reject, |s| s.case().info_json())
+    load_waiter(resolve, reject, |s| super::json::info(s.case()))
 }
 
 /// How a file handed to the API opens.
@@ -74,7 +74,7 @@ pub(super) fn file_call(
         let (d, c) = (d.clone(), c.clone());
         Promise::new(&mut |resolve: Function, reject: Function| {
             let Some(bytes) = bytes.take() else { return };
-            let structures = |s: &crate::session::Session| s.case().structures_json();
+            let structures = |s: &crate::session::Session| super::json::structures(s.case());
             let mut doc = d.borrow_mut();
             match call {
                 FileCall::Mesh => doc.begin_open(&name, bytes, Some(info_waiter(resolve, reject))),

@@ -56,8 +56,7 @@ fn sweep(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Pr
             &c,
             |s| s.background().graphs_current(),
             |s| {
-                s.background()
-                    .graphs_json()
+                super::json::graphs(&s.background())
                     .map(|v| to_js(&v))
                     .ok_or_else(|| "no quality graphs".to_string())
             },
@@ -97,7 +96,7 @@ fn check_structures(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn Fn
             &c,
             started,
             |s| !s.background().checking(),
-            |s| s.background().checks_json(),
+            |s| Some(super::json::checks(&s.background())),
         )
     })
 }
@@ -126,7 +125,7 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
                         .unwrap_or("the gallery was cancelled")
                         .to_string());
                 }
-                Ok(to_js(&s.background().guidance_json()["gallery"]))
+                Ok(to_js(&super::json::guidance(&s.background())["gallery"]))
             },
         )
     })

@@ -84,7 +84,7 @@ impl Embedding {
     }
 
     fn post_structures(&self, event: &str, doc: &Document) {
-        let detail = doc.session.case().structures_json().unwrap_or_default();
+        let detail = super::json::structures(doc.session.case()).unwrap_or_default();
         self.post_event(event, &detail);
     }
 

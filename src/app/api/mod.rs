@@ -85,6 +85,7 @@
 mod case;
 mod files;
 mod guidance;
+pub(crate) mod json;
 mod messages;
 mod view;
 
@@ -304,9 +305,7 @@ fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Res
         "metrics",
         Closure::<dyn FnMut() -> Promise>::new(move || {
             when_current(&d, &c, |session| {
-                session
-                    .case()
-                    .metrics_json()
+                json::metrics(session.case())
                     .map(|v| to_js(&v))
                     .ok_or_else(|| "no measures".to_string())
             })

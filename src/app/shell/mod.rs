@@ -194,7 +194,7 @@ impl Shell {
         };
         let session = &doc.session;
         self.files.reading().is_empty()
-            && (!session.opening_unanswered() || !session.cpu_engine_threaded())
+            && (!session.opening_unanswered() || !session.cpu_engine().threaded())
     }
 
     /// This frame's engine work: the GPU engine where there is one, else the CPU engine.
