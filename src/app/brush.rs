@@ -149,19 +149,7 @@ impl Brush {
         }
         let rect = response.rect;
         let size = Vec2::new(rect.width(), rect.height());
-        let (down, released, moving_camera, latest) = ui.input(|i| {
-            (
-                i.pointer.primary_down(),
-                i.pointer.primary_released(),
-                i.modifiers.shift || i.modifiers.command,
-                i.pointer.latest_pos(),
-            )
-        });
-        let pointer = response.hover_pos().or(latest.filter(|_| down || released));
-        // A stroke also takes the travel of the frame its button is released in.
-        let painting = !moving_camera
-            && ((down && response.is_pointer_button_down_on())
-                || (released && self.last_dab.is_some()));
+        let (pointer, painting) = stroke_input(ui, response, self.last_dab.is_some());
 
         let mut footprints = Vec::new();
         {
@@ -190,48 +178,18 @@ impl Brush {
                 self.last_dab = None;
                 return;
             };
-            let fresh = self.hover.as_ref().is_none_or(|h| {
-                h.pointer != pointer || h.camera != *camera || h.surface != surface
-            });
-            if fresh {
-                let hit = pick(pointer);
-                self.hover = Some(Hover {
-                    pointer,
-                    camera: *camera,
-                    surface,
-                    hit,
-                });
-            }
-            let hover_hit = self.hover.as_ref().and_then(|h| h.hit);
+            let hover_hit = self.hover_at(pointer, camera, surface, &mut pick);
 
             if painting {
                 let screen_radius = hover_hit.map_or(20.0, |h| {
                     self.radius_mm * camera.points_per_unit_at(h.point, size)
                 });
                 let spacing = (0.5 * screen_radius).max(2.0);
-                let dabs: Vec<egui::Pos2> = match self.last_dab {
-                    None => vec![pointer],
-                    Some(last) => {
-                        let steps = ((pointer - last).length() / spacing).floor() as usize;
-                        let steps = steps.min(MAX_DABS_PER_FRAME);
-                        (1..=steps)
-                            .map(|k| last + (pointer - last) * (k as f32 / steps as f32))
-                            .collect()
-                    }
-                };
-                for at in dabs {
-                    let hit = if at == pointer { hover_hit } else { pick(at) };
-                    if let Some(hit) = hit {
-                        footprints.push(brush_footprint(
-                            positions,
-                            triangles,
-                            model.topology(),
-                            &hit,
-                            self.radius_mm,
-                        ));
-                    }
-                    self.last_dab = Some(at);
-                }
+                let radius = self.radius_mm;
+                let topology = model.topology();
+                let under =
+                    |hit: &Hit| brush_footprint(positions, triangles, topology, hit, radius);
+                footprints = self.stroke_to((pointer, hover_hit), spacing, &mut pick, under);
             } else {
                 self.last_dab = None;
             }
@@ -240,15 +198,57 @@ impl Brush {
             }
         }
         for footprint in footprints {
+            let weights = session.case_mut();
             match self.mode {
-                BrushMode::Lock => session.case_mut().paint_weights(&footprint, 0.0),
-                BrushMode::Weaken => session
-                    .case_mut()
-                    .paint_weights(&footprint, 1.0 - self.strength),
-                BrushMode::Erase => session.case_mut().erase_weights(&footprint),
+                BrushMode::Lock => weights.paint_weights(&footprint, 0.0),
+                BrushMode::Weaken => weights.paint_weights(&footprint, 1.0 - self.strength),
+                BrushMode::Erase => weights.erase_weights(&footprint),
             };
         }
         self.draw_circle(ui, camera, rect, size);
+    }
+
+    /// What lies under the pointer, picked again only when the pointer, the camera or the
+    /// surface moved since.
+    fn hover_at(
+        &mut self,
+        pointer: egui::Pos2,
+        camera: &OrbitCamera,
+        surface: SurfaceKey,
+        pick: &mut impl FnMut(egui::Pos2) -> Option<Hit>,
+    ) -> Option<Hit> {
+        let fresh = self
+            .hover
+            .as_ref()
+            .is_none_or(|h| h.pointer != pointer || h.camera != *camera || h.surface != surface);
+        if fresh {
+            let hit = pick(pointer);
+            self.hover = Some(Hover {
+                pointer,
+                camera: *camera,
+                surface,
+                hit,
+            });
+        }
+        self.hover.as_ref().and_then(|h| h.hit)
+    }
+
+    /// The stroke's dabs from the last one to the pointer (its hit known, `hover`), each
+    /// picked on the surface and taken as the footprint `under` gives.
+    fn stroke_to(
+        &mut self,
+        (pointer, hover): (egui::Pos2, Option<Hit>),
+        spacing: f32,
+        pick: &mut impl FnMut(egui::Pos2) -> Option<Hit>,
+        under: impl Fn(&Hit) -> Vec<(u32, f32)>,
+    ) -> Vec<Vec<(u32, f32)>> {
+        let mut footprints = Vec::new();
+        for at in dab_points(self.last_dab, pointer, spacing) {
+            let hit = if at == pointer { hover } else { pick(at) };
+            footprints.extend(hit.as_ref().map(&under));
+            self.last_dab = Some(at);
+        }
+        footprints
     }
 
     /// The brush's footprint under the pointer: a circle of the brush's radius at the hit's
@@ -286,4 +286,39 @@ impl Brush {
         );
         ui.ctx().set_cursor_icon(egui::CursorIcon::Crosshair);
     }
+}
+
+/// Where the pointer is over the view (or was, in the frame its button went up), and whether
+/// it paints: the left button down on the view without Shift or Ctrl/⌘ (which move the camera).
+/// A stroke (`stroking`) also takes the travel of the frame its button is released in.
+fn stroke_input(
+    ui: &egui::Ui,
+    response: &egui::Response,
+    stroking: bool,
+) -> (Option<egui::Pos2>, bool) {
+    let (down, released, moving_camera, latest) = ui.input(|i| {
+        (
+            i.pointer.primary_down(),
+            i.pointer.primary_released(),
+            i.modifiers.shift || i.modifiers.command,
+            i.pointer.latest_pos(),
+        )
+    });
+    let pointer = response.hover_pos().or(latest.filter(|_| down || released));
+    let painting = !moving_camera
+        && ((down && response.is_pointer_button_down_on()) || (released && stroking));
+    (pointer, painting)
+}
+
+/// The dabs of a stroke from the last one to `pointer`, `spacing` points apart (the pointer
+/// alone for a stroke's first); at most [`MAX_DABS_PER_FRAME`].
+fn dab_points(last: Option<egui::Pos2>, pointer: egui::Pos2, spacing: f32) -> Vec<egui::Pos2> {
+    let Some(last) = last else {
+        return vec![pointer];
+    };
+    let steps = ((pointer - last).length() / spacing).floor() as usize;
+    let steps = steps.min(MAX_DABS_PER_FRAME);
+    (1..=steps)
+        .map(|k| last + (pointer - last) * (k as f32 / steps as f32))
+        .collect()
 }

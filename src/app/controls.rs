@@ -46,6 +46,63 @@ fn slider(
     });
 }
 
+/// The sliders of the active filter's own parameters.
+fn filter_sliders(ui: &mut egui::Ui, p: &mut Params) {
+    match p.filter {
+        Filter::Laplace => slider(
+            ui,
+            "λ",
+            "Step towards the neighbours' mean per iteration",
+            &mut p.lambda,
+            0.0..=1.0,
+        ),
+        Filter::Taubin => {
+            slider(
+                ui,
+                "λ",
+                "Shrinking step per iteration",
+                &mut p.lambda,
+                0.01..=1.0,
+            );
+            slider(
+                ui,
+                "μ",
+                "Inflating step per iteration; needs μ < −λ",
+                &mut p.mu,
+                -1.0..=-0.01,
+            );
+        }
+        Filter::Hc => {
+            slider(
+                ui,
+                "α",
+                "Pull back towards the original positions",
+                &mut p.alpha,
+                0.0..=1.0,
+            );
+            slider(
+                ui,
+                "β",
+                "Pull back towards the previous iteration",
+                &mut p.beta,
+                0.0..=1.0,
+            );
+        }
+        Filter::Sinc => {
+            ui.horizontal(|ui| {
+                let help = "Pass band: lower removes more detail";
+                ui.label("pass band").on_hover_text(help);
+                ui.add(
+                    egui::Slider::new(&mut p.passband, 0.001..=1.999)
+                        .logarithmic(true)
+                        .max_decimals(4),
+                )
+                .on_hover_text(help);
+            });
+        }
+    }
+}
+
 impl Controls {
     /// The filter and its parameters.
     pub fn filter(&mut self, ui: &mut egui::Ui, session: &mut Session) {
@@ -62,59 +119,7 @@ impl Controls {
             }
         });
         ui.add_space(4.0);
-        match p.filter {
-            Filter::Laplace => slider(
-                ui,
-                "λ",
-                "Step towards the neighbours' mean per iteration",
-                &mut p.lambda,
-                0.0..=1.0,
-            ),
-            Filter::Taubin => {
-                slider(
-                    ui,
-                    "λ",
-                    "Shrinking step per iteration",
-                    &mut p.lambda,
-                    0.01..=1.0,
-                );
-                slider(
-                    ui,
-                    "μ",
-                    "Inflating step per iteration; needs μ < −λ",
-                    &mut p.mu,
-                    -1.0..=-0.01,
-                );
-            }
-            Filter::Hc => {
-                slider(
-                    ui,
-                    "α",
-                    "Pull back towards the original positions",
-                    &mut p.alpha,
-                    0.0..=1.0,
-                );
-                slider(
-                    ui,
-                    "β",
-                    "Pull back towards the previous iteration",
-                    &mut p.beta,
-                    0.0..=1.0,
-                );
-            }
-            Filter::Sinc => {
-                ui.horizontal(|ui| {
-                    let help = "Pass band: lower removes more detail";
-                    ui.label("pass band").on_hover_text(help);
-                    ui.add(
-                        egui::Slider::new(&mut p.passband, 0.001..=1.999)
-                            .logarithmic(true)
-                            .max_decimals(4),
-                    )
-                    .on_hover_text(help);
-                });
-            }
-        }
+        filter_sliders(ui, &mut p);
         let max_it = if p.filter == Filter::Sinc { 100 } else { 50 };
         let min_it = if p.filter == Filter::Sinc { 1 } else { 0 };
         ui.horizontal(|ui| {

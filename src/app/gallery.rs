@@ -113,27 +113,7 @@ fn show_card(
     if ui.is_rect_visible(rect) {
         let visuals = ui.visuals();
         let hovered = response.hovered();
-        let (fill, stroke) = if item.selected {
-            (
-                visuals.widgets.hovered.weak_bg_fill,
-                egui::Stroke::new(2.0, visuals.selection.bg_fill),
-            )
-        } else if hovered {
-            (
-                visuals.widgets.hovered.weak_bg_fill,
-                visuals.widgets.hovered.bg_stroke,
-            )
-        } else {
-            (
-                visuals.faint_bg_color,
-                visuals.widgets.noninteractive.bg_stroke,
-            )
-        };
-        let stroke = if response.has_focus() {
-            visuals.selection.stroke
-        } else {
-            stroke
-        };
+        let (fill, stroke) = card_frame(visuals, item.selected, hovered, response.has_focus());
         let painter = ui.painter();
         painter.rect(rect, CORNER_RADIUS, fill, stroke, egui::StrokeKind::Inside);
 
@@ -150,38 +130,7 @@ fn show_card(
             badge(painter, picture, visuals);
         }
 
-        let text = visuals.text_color();
-        let weak = visuals.weak_text_color();
-        let top = picture.bottom() + CAPTION_GAP;
-        let (left, right) = (picture.left(), picture.right());
-        let (left_top, right_top) = (egui::Align2::LEFT_TOP, egui::Align2::RIGHT_TOP);
-        let captions = [
-            (left, top, left_top, tau, visuals.strong_text_color()),
-            (
-                right,
-                top,
-                right_top,
-                format!("K/K0 {:.3}", item.curvature_ratio),
-                text,
-            ),
-            (
-                left,
-                top + line,
-                left_top,
-                format!("{:.3} mm", item.mean_error),
-                text,
-            ),
-            (
-                right,
-                top + line,
-                right_top,
-                format!("ΔV {}", format_volume(item.volume_change)),
-                weak,
-            ),
-        ];
-        for (x, y, align, caption, color) in captions {
-            painter.text(egui::pos2(x, y), align, caption, font.clone(), color);
-        }
+        paint_captions(painter, visuals, item, picture, (font, line), tau);
     }
     response
         .on_hover_cursor(egui::CursorIcon::PointingHand)
@@ -198,6 +147,82 @@ fn show_card(
                 "Click to apply this result."
             },
         ))
+}
+
+/// A card's fill and outline: selected, hovered or neither, and focused.
+fn card_frame(
+    visuals: &egui::Visuals,
+    selected: bool,
+    hovered: bool,
+    focused: bool,
+) -> (egui::Color32, egui::Stroke) {
+    let (fill, stroke) = if selected {
+        (
+            visuals.widgets.hovered.weak_bg_fill,
+            egui::Stroke::new(2.0, visuals.selection.bg_fill),
+        )
+    } else if hovered {
+        (
+            visuals.widgets.hovered.weak_bg_fill,
+            visuals.widgets.hovered.bg_stroke,
+        )
+    } else {
+        (
+            visuals.faint_bg_color,
+            visuals.widgets.noninteractive.bg_stroke,
+        )
+    };
+    (
+        fill,
+        if focused {
+            visuals.selection.stroke
+        } else {
+            stroke
+        },
+    )
+}
+
+/// The two caption lines under a card's picture: tau and K/K0, mean error and volume change.
+fn paint_captions(
+    painter: &egui::Painter,
+    visuals: &egui::Visuals,
+    item: &GalleryItem,
+    picture: egui::Rect,
+    (font, line): (&egui::FontId, f32),
+    tau: String,
+) {
+    let text = visuals.text_color();
+    let weak = visuals.weak_text_color();
+    let top = picture.bottom() + CAPTION_GAP;
+    let (left, right) = (picture.left(), picture.right());
+    let (left_top, right_top) = (egui::Align2::LEFT_TOP, egui::Align2::RIGHT_TOP);
+    let captions = [
+        (left, top, left_top, tau, visuals.strong_text_color()),
+        (
+            right,
+            top,
+            right_top,
+            format!("K/K0 {:.3}", item.curvature_ratio),
+            text,
+        ),
+        (
+            left,
+            top + line,
+            left_top,
+            format!("{:.3} mm", item.mean_error),
+            text,
+        ),
+        (
+            right,
+            top + line,
+            right_top,
+            format!("ΔV {}", format_volume(item.volume_change)),
+            weak,
+        ),
+    ];
+    for (x, y, align, caption, color) in captions {
+        painter.text(egui::pos2(x, y), align, caption, font.clone(), color);
+    }
 }
 
 /// "applied" in the picture's top-left corner.

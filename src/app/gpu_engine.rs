@@ -203,6 +203,47 @@ impl GpuEngine {
         Some(why)
     }
 
+    /// Starts a run for the current revision when the document needs one and none is under
+    /// way; a new model is uploaded first, in a frame of its own. `Some` is what the frame
+    /// sent when it goes no further.
+    fn start_run(&mut self, doc: &Document) -> Result<Option<Sent>, String> {
+        let generation = doc.session.case().model_id();
+        if self
+            .running
+            .as_ref()
+            .is_some_and(|r| r.generation != generation)
+        {
+            self.running = None;
+        }
+        if self.running.is_none() {
+            if !doc.session.case().needs_smoothing() {
+                return Ok(Some(Sent::Nothing));
+            }
+            let Some(model) = doc.session.case().model() else {
+                return Ok(Some(Sent::Nothing));
+            };
+            if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
+                self.mesh = None;
+                self.submitted = None;
+                self.weights_uploaded = None;
+                let uploaded = self
+                    .smoother
+                    .upload_with_measures(&self.device, &model.original)
+                    .map_err(|e| e.to_string())?;
+                self.mesh = Some((generation, uploaded));
+                // A large model's upload fills a frame: its first run goes out with the next one.
+                return Ok(Some(Sent::Model));
+            }
+            self.running = Some(Running {
+                generation,
+                revision: doc.session.case().revision(),
+                started_ms: now_ms(),
+                pieces: RunPieces::new(doc.session.case().params()),
+            });
+        }
+        Ok(None)
+    }
+
     /// The revision whose run the buffers hold for the document's model `generation`
     /// (submitted; maybe not finished yet). `None` while the engine still holds the model
     /// before: a new model can reach the view before the engine takes it up.
@@ -237,39 +278,8 @@ impl GpuEngine {
         if self.in_flight.is_some() || self.device_work.waiting {
             return Ok(Sent::Nothing);
         }
-        let generation = doc.session.case().model_id();
-        if self
-            .running
-            .as_ref()
-            .is_some_and(|r| r.generation != generation)
-        {
-            self.running = None;
-        }
-        if self.running.is_none() {
-            if !doc.session.case().needs_smoothing() {
-                return Ok(Sent::Nothing);
-            }
-            let Some(model) = doc.session.case().model() else {
-                return Ok(Sent::Nothing);
-            };
-            if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
-                self.mesh = None;
-                self.submitted = None;
-                self.weights_uploaded = None;
-                let uploaded = self
-                    .smoother
-                    .upload_with_measures(&self.device, &model.original)
-                    .map_err(|e| e.to_string())?;
-                self.mesh = Some((generation, uploaded));
-                // A large model's upload fills a frame: its first run goes out with the next one.
-                return Ok(Sent::Model);
-            }
-            self.running = Some(Running {
-                generation,
-                revision: doc.session.case().revision(),
-                started_ms: now_ms(),
-                pieces: RunPieces::new(doc.session.case().params()),
-            });
+        if let Some(sent) = self.start_run(doc)? {
+            return Ok(sent);
         }
         let (Some((_, mesh)), Some(run)) = (self.mesh.as_mut(), self.running.as_mut()) else {
             return Ok(Sent::Nothing);

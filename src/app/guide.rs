@@ -42,35 +42,7 @@ impl Guide {
                 let _ = session.case_mut().set_tau(tau);
             }
         });
-        ui.horizontal(|ui| {
-            ui.label("search");
-            egui::ComboBox::from_id_salt("search_method")
-                .selected_text(match self.method {
-                    SearchMethod::Local => "local (fast)",
-                    SearchMethod::Grid => "grid (all points)",
-                })
-                .show_ui(ui, |ui| {
-                    ui.selectable_value(&mut self.method, SearchMethod::Local, "local (fast)")
-                        .on_hover_text(
-                            "The paper's local search from opposite corners of the grid",
-                        );
-                    ui.selectable_value(&mut self.method, SearchMethod::Grid, "grid (all points)")
-                        .on_hover_text(
-                            "Every grid point: slower, but then the suggestion follows τ at once",
-                        );
-                });
-            if session.background().suggesting() {
-                if ui.button("Cancel").clicked() {
-                    session.cancel_suggest();
-                }
-            } else if ui
-                .button("Suggest")
-                .on_hover_text("Search the parameters with the lowest score S for this τ")
-                .clicked()
-            {
-                session.start_suggest(self.method);
-            }
-        });
+        self.search_row(ui, session);
         for a in session.background().activities() {
             if let Activity::Suggest { .. } = a {
                 ui.add(egui::ProgressBar::new(a.fraction()).text(a.describe()));
@@ -130,5 +102,38 @@ impl Guide {
         if self.follow_tau && s.search == SearchMethod::Grid && !applied {
             let _ = session.case_mut().set_params(s.params);
         }
+    }
+
+    /// The search method, and Suggest (or Cancel while a search is under way).
+    fn search_row(&mut self, ui: &mut egui::Ui, session: &mut Session) {
+        ui.horizontal(|ui| {
+            ui.label("search");
+            egui::ComboBox::from_id_salt("search_method")
+                .selected_text(match self.method {
+                    SearchMethod::Local => "local (fast)",
+                    SearchMethod::Grid => "grid (all points)",
+                })
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(&mut self.method, SearchMethod::Local, "local (fast)")
+                        .on_hover_text(
+                            "The paper's local search from opposite corners of the grid",
+                        );
+                    ui.selectable_value(&mut self.method, SearchMethod::Grid, "grid (all points)")
+                        .on_hover_text(
+                            "Every grid point: slower, but then the suggestion follows τ at once",
+                        );
+                });
+            if session.background().suggesting() {
+                if ui.button("Cancel").clicked() {
+                    session.cancel_suggest();
+                }
+            } else if ui
+                .button("Suggest")
+                .on_hover_text("Search the parameters with the lowest score S for this τ")
+                .clicked()
+            {
+                session.start_suggest(self.method);
+            }
+        });
     }
 }

@@ -95,63 +95,75 @@ impl StructureList {
                 }
             });
         if let Some(s) = list.get(current) {
-            let key = (session.case().model_id(), current);
-            let group = s.group.clone().unwrap_or_default();
-            let stored = (s.name.clone(), group, s.description.clone());
-            let editing = match &mut self.editing {
-                Some(e) if e.key == key && e.taken == stored => e,
-                editing => editing.insert(Editing {
-                    key,
-                    taken: stored.clone(),
-                    text: stored,
-                }),
-            };
-            let (name, group, description) = &mut editing.text;
-            ui.horizontal(|ui| {
-                ui.label("Name");
-                let edit = ui.add(egui::TextEdit::singleline(name).desired_width(110.0));
-                layout.structure_name = Some(edit.rect.into());
-                if edit.lost_focus() && name.trim() != s.name {
-                    let change = StructureChange {
-                        name: Some(name.clone()),
-                        ..Default::default()
-                    };
-                    actions.push(StructureAction::Change(current, change));
-                }
-                ui.label("Group");
-                let edit = ui.add(
-                    egui::TextEdit::singleline(group)
-                        .hint_text("none")
-                        .desired_width(80.0),
-                );
-                if edit.lost_focus() && Some(group.trim()) != s.group.as_deref() {
-                    let change = StructureChange {
-                        group: Some(Some(group.clone())),
-                        ..Default::default()
-                    };
-                    actions.push(StructureAction::Change(current, change));
-                }
-            });
-            let edit = ui.add(
-                egui::TextEdit::multiline(description)
-                    .hint_text("description for readers")
-                    .desired_rows(2)
-                    .desired_width(f32::INFINITY),
-            );
-            if edit.lost_focus() && description.trim() != s.description {
-                let change = StructureChange {
-                    description: Some(description.clone()),
-                    ..Default::default()
-                };
-                actions.push(StructureAction::Change(current, change));
-            }
-            let [how, what] = measures(s, session, current);
-            ui.small(how);
-            ui.small(what);
+            self.selected_fields(ui, session, (current, s), layout, &mut actions);
         }
         self.case_fields(ui, session, &mut actions);
         ui.separator();
         actions
+    }
+
+    /// The selected structure's name, group and description to edit, and how it is smoothed.
+    fn selected_fields(
+        &mut self,
+        ui: &mut egui::Ui,
+        session: &Session,
+        (current, s): (usize, &CaseStructure),
+        layout: &mut PanelLayout,
+        actions: &mut Vec<StructureAction>,
+    ) {
+        let key = (session.case().model_id(), current);
+        let group = s.group.clone().unwrap_or_default();
+        let stored = (s.name.clone(), group, s.description.clone());
+        let editing = match &mut self.editing {
+            Some(e) if e.key == key && e.taken == stored => e,
+            editing => editing.insert(Editing {
+                key,
+                taken: stored.clone(),
+                text: stored,
+            }),
+        };
+        let (name, group, description) = &mut editing.text;
+        ui.horizontal(|ui| {
+            ui.label("Name");
+            let edit = ui.add(egui::TextEdit::singleline(name).desired_width(110.0));
+            layout.structure_name = Some(edit.rect.into());
+            if edit.lost_focus() && name.trim() != s.name {
+                let change = StructureChange {
+                    name: Some(name.clone()),
+                    ..Default::default()
+                };
+                actions.push(StructureAction::Change(current, change));
+            }
+            ui.label("Group");
+            let edit = ui.add(
+                egui::TextEdit::singleline(group)
+                    .hint_text("none")
+                    .desired_width(80.0),
+            );
+            if edit.lost_focus() && Some(group.trim()) != s.group.as_deref() {
+                let change = StructureChange {
+                    group: Some(Some(group.clone())),
+                    ..Default::default()
+                };
+                actions.push(StructureAction::Change(current, change));
+            }
+        });
+        let edit = ui.add(
+            egui::TextEdit::multiline(description)
+                .hint_text("description for readers")
+                .desired_rows(2)
+                .desired_width(f32::INFINITY),
+        );
+        if edit.lost_focus() && description.trim() != s.description {
+            let change = StructureChange {
+                description: Some(description.clone()),
+                ..Default::default()
+            };
+            actions.push(StructureAction::Change(current, change));
+        }
+        let [how, what] = measures(s, session, current);
+        ui.small(how);
+        ui.small(what);
     }
 
     /// The case's title and description, and its export.

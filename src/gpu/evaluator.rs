@@ -263,34 +263,8 @@ impl GpuEvaluator {
         let bytes = mesh.surface()?.partial_bytes();
         let parts = GpuSmoother::measure_part_count(mesh)?;
         if let Some(next) = job.measuring {
-            // Parts of the measure after `done` iterations, its sums read back after the last.
-            let part_cost = measure_part_cost(vertices, parts);
-            let count = budget.map_or(parts, |b| (b / part_cost).max(1) as usize);
-            let end = (next + count).min(parts);
-            self.smoother
-                .measure_parts(&self.device, &self.queue, mesh, next..end)?;
-            let finished = end == parts;
-            let sizes: &[u64] = if finished { &[bytes] } else { &[] };
-            let staging = Staging::create(&self.device, "meshsmooth evaluator readback", sizes);
-            if finished {
-                let mut encoder = self.device.create_command_encoder(&Default::default());
-                let (buffer, offset) = staging.region(0);
-                encoder.copy_buffer_to_buffer(&mesh.surface()?.partials, 0, buffer, offset, bytes);
-                self.queue.submit([encoder.finish()]);
-            }
-            staging.request_map();
-            job.measuring = (!finished).then_some(end);
-            let full = count < parts - next;
-            job.in_flight = Some(InFlight {
-                staging,
-                to: job.done,
-                submitted_ms: (self.clock)(),
-                full,
-            });
-            return Ok(Advance {
-                spent: (end - next) as u64 * part_cost,
-                full,
-            });
+            let gpu = (&self.device, &self.queue, &self.smoother);
+            return measure_parts(gpu, self.clock, job, mesh, next, budget);
         }
         let iteration = iteration_cost(params.filter, vertices);
         let measure = measure_part_cost(vertices, parts) * parts as u64;
@@ -513,4 +487,46 @@ impl Offload for GpuEvaluator {
     fn failure(&self) -> Option<String> {
         self.failure.as_ref().map(|e| e.to_string())
     }
+}
+
+/// Sends the next parts of `job`'s measure pass after its smoothing reached `job.done`, from
+/// part `next`, within `budget`; its sums are read back after the last part.
+fn measure_parts(
+    (device, queue, smoother): (&wgpu::Device, &wgpu::Queue, &GpuSmoother),
+    clock: fn() -> f64,
+    job: &mut Job,
+    mesh: &mut GpuMesh,
+    next: usize,
+    budget: Option<u64>,
+) -> Result<Advance, GpuError> {
+    let vertices = mesh.vertex_count() as u64;
+    let bytes = mesh.surface()?.partial_bytes();
+    let parts = GpuSmoother::measure_part_count(mesh)?;
+    // Parts of the measure after `done` iterations, its sums read back after the last.
+    let part_cost = measure_part_cost(vertices, parts);
+    let count = budget.map_or(parts, |b| (b / part_cost).max(1) as usize);
+    let end = (next + count).min(parts);
+    smoother.measure_parts(device, queue, mesh, next..end)?;
+    let finished = end == parts;
+    let sizes: &[u64] = if finished { &[bytes] } else { &[] };
+    let staging = Staging::create(device, "meshsmooth evaluator readback", sizes);
+    if finished {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let (buffer, offset) = staging.region(0);
+        encoder.copy_buffer_to_buffer(&mesh.surface()?.partials, 0, buffer, offset, bytes);
+        queue.submit([encoder.finish()]);
+    }
+    staging.request_map();
+    job.measuring = (!finished).then_some(end);
+    let full = count < parts - next;
+    job.in_flight = Some(InFlight {
+        staging,
+        to: job.done,
+        submitted_ms: clock(),
+        full,
+    });
+    Ok(Advance {
+        spent: (end - next) as u64 * part_cost,
+        full,
+    })
 }

@@ -500,21 +500,7 @@ impl eframe::App for Shell {
         }
         let uploading = !arrived && self.compute();
         if !arrived && !uploading {
-            let mut doc = self.doc.borrow_mut();
-            let vertices = doc
-                .session
-                .case()
-                .model()
-                .map_or(0, |m| m.mesh().vertex_count());
-            let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
-            doc.guidance_on_gpu = offload.is_some();
-            doc.compute_guidance(offload);
-            if let Some(gpu) = self.gpu.as_mut() {
-                gpu.guidance_sent();
-            }
-            if let Some(why) = self.gpu.as_mut().and_then(|g| g.take_evaluator_failure()) {
-                doc.session.guidance_engine_failed(&why);
-            }
+            self.step_guidance();
         }
         self.bottom.update(&ctx, &mut self.doc.borrow_mut());
         // The view takes up a new model once the GPU engine has (a frame later); the CPU
@@ -556,6 +542,21 @@ impl eframe::App for Shell {
 }
 
 impl Shell {
+    /// The background's guidance steps on, its runs on the GPU engine when it takes them.
+    fn step_guidance(&mut self) {
+        let mut doc = self.doc.borrow_mut();
+        let vertices = (doc.session.case().model()).map_or(0, |m| m.mesh().vertex_count());
+        let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
+        doc.guidance_on_gpu = offload.is_some();
+        doc.compute_guidance(offload);
+        if let Some(gpu) = self.gpu.as_mut() {
+            gpu.guidance_sent();
+        }
+        if let Some(why) = self.gpu.as_mut().and_then(|g| g.take_evaluator_failure()) {
+            doc.session.guidance_engine_failed(&why);
+        }
+    }
+
     /// The author's panels: smoothing on the left, graphs below, the mesh report on the right.
     fn authoring_panels(&mut self, ui: &mut egui::Ui) {
         egui::Panel::left("smoothing")

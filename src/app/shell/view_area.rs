@@ -5,7 +5,8 @@ use eframe::egui;
 
 use super::view_sync::Positions;
 use super::Shell;
-use crate::app::document::ViewReport;
+use crate::app::document::{Document, ViewReport};
+use crate::app::pointing::Pointing;
 use crate::app::{legend, orientation_marker, status, view_tools, viewer};
 
 impl Shell {
@@ -39,14 +40,7 @@ impl Shell {
                     .inner;
                 if !self.brush.active && !self.picture.pending {
                     let at = (viewer.camera(), viewer.clip_plane());
-                    let clicked = self.pointing.update(ui, &response, at, &doc.session);
-                    let current = doc.session.case().current_structure();
-                    if let (true, Some(i)) = (self.reading, clicked.filter(|&i| Some(i) != current))
-                    {
-                        if let Err(e) = doc.select_structure(i) {
-                            log::warn!("{e}");
-                        }
-                    }
+                    point(&mut self.pointing, self.reading, ui, &response, at, doc);
                 } else {
                     self.pointing = Default::default();
                 }
@@ -91,5 +85,23 @@ impl Shell {
         let error = self.export_error.as_deref();
         let lines = status::view_messages(ui, &doc, error, &reading, self.show_original);
         status::paint_messages(ui, rect, lines);
+    }
+}
+
+/// Names the structure under the pointer; in the viewer (`reading`) a click selects it.
+fn point(
+    pointing: &mut Pointing,
+    reading: bool,
+    ui: &egui::Ui,
+    response: &egui::Response,
+    at: (&crate::view::OrbitCamera, [f32; 4]),
+    doc: &mut Document,
+) {
+    let clicked = pointing.update(ui, response, at, &doc.session);
+    let current = doc.session.case().current_structure();
+    if let (true, Some(i)) = (reading, clicked.filter(|&i| Some(i) != current)) {
+        if let Err(e) = doc.select_structure(i) {
+            log::warn!("{e}");
+        }
     }
 }

@@ -332,31 +332,25 @@ fn smoothness_panel(area: &Area, curve: &Curve) -> Result<(), String> {
     Ok(())
 }
 
-fn accuracy_panel(area: &Area, curve: &Curve, voxel_size: Option<f64>) -> Result<(), String> {
-    let (x0, x1) = x_range(curve);
-    let param = curve.param;
-    let half_diagonal = voxel_size.map(|v| 0.5 * v * 3f64.sqrt());
+/// The accuracy panel's top error (mm) and volume change (%), and whether there is a volume.
+fn accuracy_ranges(curve: &Curve, half_diagonal: Option<f64>) -> (f64, f64, bool) {
     let e1 = upper(
-        curve
-            .samples
-            .iter()
+        (curve.samples.iter())
             .map(|s| s.terms.mean_error)
             .chain(half_diagonal.map(|h| 1.06 * h)),
         0.01,
     );
-    let has_volume = curve
-        .samples
-        .iter()
-        .any(|s| s.terms.volume_change.is_some());
+    let has_volume = (curve.samples.iter()).any(|s| s.terms.volume_change.is_some());
     // Headroom above the volume curve keeps it below the reference line's label.
-    let v1 = 1.2
-        * upper(
-            curve
-                .samples
-                .iter()
-                .filter_map(|s| s.terms.volume_change.map(|v| 100.0 * v)),
-            0.1,
-        );
+    let volumes = (curve.samples.iter()).filter_map(|s| s.terms.volume_change.map(|v| 100.0 * v));
+    (e1, 1.2 * upper(volumes, 0.1), has_volume)
+}
+
+fn accuracy_panel(area: &Area, curve: &Curve, voxel_size: Option<f64>) -> Result<(), String> {
+    let (x0, x1) = x_range(curve);
+    let param = curve.param;
+    let half_diagonal = voxel_size.map(|v| 0.5 * v * 3f64.sqrt());
+    let (e1, v1, has_volume) = accuracy_ranges(curve, half_diagonal);
     let what = if has_volume {
         format!("{}: accuracy", symbol(param))
     } else {
