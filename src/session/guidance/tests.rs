@@ -12,6 +12,13 @@ fn session(filter: &str) -> Session {
     s
 }
 
+/// The quality graphs of the session's model and parameters, computed here.
+fn graphs_here(s: &Session) -> QualityGraphs {
+    let original = model_original(s);
+    let (params, tau) = (s.case().params(), s.case().tau());
+    quality_graphs(&original, None, params, tau, &mut |_| true).unwrap()
+}
+
 /// Steps the background until nothing is left, on a clock that ticks 1 ms per reading;
 /// returns the calls it took.
 fn settle(s: &mut Session) -> usize {
@@ -133,15 +140,7 @@ fn graphs_follow_the_parameters_in_the_background() {
     s.set_graphs_wanted(true);
     settle(&mut s);
     assert!(s.background().graphs_current());
-    let original = model_original(&s);
-    let expected = quality_graphs(
-        &original,
-        None,
-        s.case().params(),
-        s.case().tau(),
-        &mut |_| true,
-    )
-    .unwrap();
+    let expected = graphs_here(&s);
     assert_eq!(s.background().graphs().unwrap(), expected);
 
     // A new value: the old graphs stay on show, marked stale, until new ones are made.
@@ -260,15 +259,7 @@ fn an_offload_runs_the_searches_and_graphs_with_the_same_results() {
     let original = model_original(&s);
     let expected = local_suggestion(&original, &s);
     assert_eq!(s.background().suggestion().unwrap().suggestion, expected);
-    let graphs = quality_graphs(
-        &original,
-        None,
-        s.case().params(),
-        s.case().tau(),
-        &mut |_| true,
-    )
-    .unwrap();
-    assert_eq!(s.background().graphs().unwrap(), graphs);
+    assert_eq!(s.background().graphs().unwrap(), graphs_here(&s));
     assert!(offload.requests.iter().all(|&id| id == s.doc.model_id));
 }
 
