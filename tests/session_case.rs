@@ -91,12 +91,8 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .iter()
         .all(|l| l.visible && l.color[3] == 1.0));
     // Three others around the liver, as extracted.
-    let others: Vec<usize> = session
-        .case()
-        .other_structures()
-        .iter()
-        .map(|o| o.index)
-        .collect();
+    let drawn = session.case().other_structures();
+    let others: Vec<usize> = drawn.iter().map(|o| o.index).collect();
     assert_eq!(others, [1, 2, 3]);
 
     let change = StructureChange {

@@ -273,23 +273,16 @@ fn searches_reuse_the_terms_measured_before_until_the_weights_change() {
     s.start_gallery();
     settle_on(&mut s, Some(&mut offload));
     let gallery = offload.requests.len() - suggestion;
-    let picks: Vec<_> = s
-        .background()
-        .gallery()
-        .iter()
-        .map(|p| (p.params, p.terms))
-        .collect();
+    let picks_of = |s: &Session| -> Vec<_> {
+        let gallery = s.background().gallery();
+        gallery.iter().map(|p| (p.params, p.terms)).collect()
+    };
+    let picks = picks_of(&s);
     // Made again: every search is answered from what was measured, with the same picks.
     s.start_gallery();
     settle_on(&mut s, Some(&mut offload));
     assert_eq!(offload.requests.len(), suggestion + gallery);
-    let again: Vec<_> = s
-        .background()
-        .gallery()
-        .iter()
-        .map(|p| (p.params, p.terms))
-        .collect();
-    assert_eq!(again, picks);
+    assert_eq!(picks_of(&s), picks);
     // The gallery's tau 0.5 search is the opening suggestion's: it measured nothing new, so
     // the gallery asked for fewer runs than five searches alone would.
     let mut alone = Deferred::default();
