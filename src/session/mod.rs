@@ -70,7 +70,7 @@ pub struct Session {
     error: Option<String>,
     guidance: guidance::Guidance,
     /// A file the CPU engine's workers are opening.
-    opening: Option<opening::Opening>,
+    opening: Option<opening::WorkerOpening>,
     /// How long each stage of the latest opening took (ms), in order.
     open_stages: Vec<(String, f64)>,
     /// Files to add to the case once the one opening now is open.

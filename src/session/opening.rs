@@ -32,7 +32,7 @@ enum Purpose {
 }
 
 /// An opening asked of the workers.
-pub(super) struct Opening {
+pub(super) struct WorkerOpening {
     name: String,
     job: LoadJob,
     purpose: Purpose,
@@ -126,7 +126,7 @@ impl Session {
         let replaced = self.opening.take().map(|o| o.name);
         self.open_stages.clear();
         let job = self.cpu.load(&name, input);
-        self.opening = Some(Opening {
+        self.opening = Some(WorkerOpening {
             name,
             job,
             purpose,
@@ -141,7 +141,7 @@ impl Session {
     pub fn poll_opening(&mut self) -> Option<Result<(), String>> {
         let opening = self.opening.as_ref()?;
         let reply = self.cpu.take_loaded(opening.job)?;
-        let Opening {
+        let WorkerOpening {
             name,
             purpose,
             first_file,

@@ -22,7 +22,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz, xyz0, Field, Fields, Ring, Rings, CHUNK};
+use super::rings::{xyz, xyz0, Field, Fields, KernelRings, Ring, CHUNK};
 use super::{follow_parts, FollowPart, StepObserver};
 
 /// How an iteration runs (see the module's documentation).
@@ -40,7 +40,7 @@ enum Plan {
 impl Plan {
     /// The sweep with `threads` runs when the pass-1 work done twice (the `lead` chunks on
     /// either side of each run's edge) stays under an eighth of an iteration's; else two passes.
-    fn choose(rings: Rings, threads: usize) -> Plan {
+    fn choose(rings: KernelRings, threads: usize) -> Plan {
         let chunks = rings.vertex_count().div_ceil(CHUNK);
         let lead = (rings.span() as usize).div_ceil(CHUNK).max(1);
         let threads = threads.clamp(1, chunks.max(1));
@@ -67,7 +67,7 @@ impl Plan {
 /// in `points`. Returns whether `points` holds the last iteration's positions.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn advance<C: Constrain>(
-    rings: Rings,
+    rings: KernelRings,
     original: &[[f32; 3]],
     fields: &mut Fields,
     points: &mut Vec<[f32; 3]>,
@@ -84,7 +84,7 @@ pub(crate) fn advance<C: Constrain>(
 
 #[allow(clippy::too_many_arguments)]
 fn advance_planned<C: Constrain>(
-    rings: Rings,
+    rings: KernelRings,
     original: &[[f32; 3]],
     fields: &mut Fields,
     points: &mut Vec<[f32; 3]>,
@@ -134,7 +134,7 @@ fn advance_planned<C: Constrain>(
 /// What both passes read besides the fields: the rings, the original positions and
 /// `(alpha, beta)`.
 struct Kernel<'a> {
-    rings: Rings<'a>,
+    rings: KernelRings<'a>,
     original: &'a [[f32; 3]],
     alpha_beta: (f32, f32),
 }
@@ -325,7 +325,7 @@ mod tests {
         let mesh = brainmask();
         let topology = Topology::build(&mesh);
         let n = mesh.vertex_count();
-        let rings = Rings::new(&topology, n).expect("built for this mesh");
+        let rings = KernelRings::new(&topology, n).expect("built for this mesh");
         let chunks = n.div_ceil(CHUNK);
         let lead = (rings.span() as usize).div_ceil(CHUNK);
         // A mesh from a volume reaches a few slices along, far less than its vertex count.
@@ -376,7 +376,7 @@ mod tests {
     fn the_plan_sweeps_where_rings_reach_near_and_threads_are_few() {
         let mesh = brainmask();
         let topology = Topology::build(&mesh);
-        let rings = Rings::new(&topology, mesh.vertex_count()).expect("built for this mesh");
+        let rings = KernelRings::new(&topology, mesh.vertex_count()).expect("built for this mesh");
         let runs = |plan| match plan {
             Plan::Sweep { runs, .. } => runs.len(),
             Plan::TwoPass => 0,
@@ -391,7 +391,7 @@ mod tests {
         )
         .expect("the sample");
         let tube_topology = Topology::build(&tube);
-        let tube_rings = Rings::new(&tube_topology, tube.vertex_count()).expect("rings");
+        let tube_rings = KernelRings::new(&tube_topology, tube.vertex_count()).expect("rings");
         assert_eq!(runs(Plan::choose(tube_rings, 1)), 1);
         assert_eq!(Plan::choose(tube_rings, 2), Plan::TwoPass);
     }

@@ -27,7 +27,7 @@ pub(crate) use sinc_coefficients::sinc_coefficients;
 
 use crate::mesh::{Mesh, Topology};
 use constraint::{Constrain, Free, Limits};
-use rings::{Fields, Rings};
+use rings::{Fields, KernelRings};
 
 /// Watches a smoothing run. The local-error measure drifts its reference vertices after every
 /// step (as a [`Follower`], inside the step's pass); sweeps over iterations measure along one
@@ -161,7 +161,7 @@ fn run(
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
     let original = &mesh.positions;
-    let Some(rings) = Rings::new(topology, original.len()) else {
+    let Some(rings) = KernelRings::new(topology, original.len()) else {
         return resume.map_or_else(|| original.clone(), |r| r.0);
     };
     if params.filter == Filter::Sinc {
@@ -210,7 +210,7 @@ fn run(
 
 /// One call's iterations of a Laplace, Taubin or HC run.
 struct Advance<'a> {
-    rings: Rings<'a>,
+    rings: KernelRings<'a>,
     original: &'a [[f32; 3]],
     params: &'a Params,
     weights: Option<&'a [f32]>,

@@ -14,12 +14,12 @@ pub(crate) const CHUNK: usize = 1024;
 /// against the vertex count, so every kernel can gather neighbours without further checks
 /// failing.
 #[derive(Clone, Copy)]
-pub(crate) struct Rings<'a> {
+pub(crate) struct KernelRings<'a> {
     padded: &'a PaddedRing,
     vertex_count: usize,
 }
 
-impl<'a> Rings<'a> {
+impl<'a> KernelRings<'a> {
     /// `None` when the topology does not describe `vertex_count` vertices (built for another
     /// mesh; see [`PaddedRing::describes`], checked when the topology was built).
     pub(crate) fn new(topology: &'a Topology, vertex_count: usize) -> Option<Self> {
@@ -224,7 +224,7 @@ mod tests {
             let mesh = double_cone(k);
             let topology = Topology::build(&mesh);
             let n = mesh.vertex_count();
-            let rings = Rings::new(&topology, n).expect("built for this mesh");
+            let rings = KernelRings::new(&topology, n).expect("built for this mesh");
             let q = Field::from_points(&mesh.positions);
             let means: Vec<Option<[f32; 4]>> = (0..n.div_ceil(CHUNK))
                 .flat_map(|c| rings.chunk(c).collect::<Vec<_>>())

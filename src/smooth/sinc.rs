@@ -26,7 +26,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz0, Field, Rings, CHUNK};
+use super::rings::{xyz0, Field, KernelRings, CHUNK};
 use super::sinc_coefficients::sinc_coefficients;
 use super::{follow_parts, StepObserver};
 use crate::mesh::bounding_box;
@@ -34,14 +34,14 @@ use crate::mesh::bounding_box;
 /// Runs the windowed-sinc filter of degree `iterations` (one neighbour pass per degree).
 /// Reports the result `iterations` times as a step and once as iteration `iterations`.
 pub(crate) fn run<C: Constrain>(
-    rings: Rings,
+    rings: KernelRings,
     original: &[[f32; 3]],
     passband: f32,
     iterations: u32,
     constraint: &C,
     observer: &mut dyn StepObserver,
 ) -> Vec<[f32; 3]> {
-    let Some(mut terms) = Terms::start(rings, original, passband, iterations) else {
+    let Some(mut terms) = ChebyshevSeries::start(rings, original, passband, iterations) else {
         return original.to_vec();
     };
     while !terms.advance(rings, u32::MAX) {}
@@ -82,7 +82,7 @@ fn follow_points(observer: &mut dyn StepObserver, positions: &[[f32; 3]]) {
 
 /// The recurrence under way: the terms so far summed into the estimate. Advancing it a few
 /// terms at a time gives the same result, bit for bit, as running it through.
-pub(crate) struct Terms {
+pub(crate) struct ChebyshevSeries {
     /// The series' coefficients, `c_0 ..= c_iterations`.
     c: Vec<f32>,
     /// The highest term summed so far.
@@ -93,10 +93,10 @@ pub(crate) struct Terms {
     estimate: Vec<[f32; 3]>,
 }
 
-impl Terms {
+impl ChebyshevSeries {
     /// The first two terms; `None` when nothing moves (no iterations, or no vertices).
     pub(crate) fn start(
-        rings: Rings,
+        rings: KernelRings,
         original: &[[f32; 3]],
         passband: f32,
         iterations: u32,
@@ -130,7 +130,7 @@ impl Terms {
     }
 
     /// Sums up to `more` further terms; returns whether every term is summed.
-    pub(crate) fn advance(&mut self, rings: Rings, more: u32) -> bool {
+    pub(crate) fn advance(&mut self, rings: KernelRings, more: u32) -> bool {
         let last = self.c.len() - 1;
         let end = last.min(self.k.saturating_add(more as usize));
         while self.k < end {
@@ -161,7 +161,7 @@ impl Terms {
 /// From `z0 = x - centre`: `current = T_1 z0`, `estimate = centre + c0 z0 + c1 T_1 z0`.
 /// Isolated vertices stay at `original`.
 fn first_term(
-    rings: Rings,
+    rings: KernelRings,
     original: &[[f32; 3]],
     centre: [f32; 3],
     [c0, c1]: [f32; 2],
@@ -196,7 +196,7 @@ fn first_term(
 
 /// Overwrites `previous` (T_{k-1} x) with T_{k+1} x and adds `ck` times it to the estimate.
 fn next_term(
-    rings: Rings,
+    rings: KernelRings,
     ck: f32,
     current: &Field,
     previous: &mut Field,

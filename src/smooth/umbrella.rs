@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz, xyz0, Field, Fields, Rings, CHUNK};
+use super::rings::{xyz, xyz0, Field, Fields, KernelRings, CHUNK};
 use super::{follow_parts, FollowPart, StepObserver};
 
 /// Runs iterations `done + 1 ..= done + more` of the umbrella steps `factors` (Laplace:
@@ -11,7 +11,7 @@ use super::{follow_parts, FollowPart, StepObserver};
 /// reporting after every step and iteration; the positions the observer sees are laid out in
 /// `points`. Returns whether `points` holds the last iteration's positions.
 pub(crate) fn advance<C: Constrain>(
-    rings: Rings,
+    rings: KernelRings,
     fields: &mut Fields,
     points: &mut Vec<[f32; 3]>,
     factors: &[f32],
@@ -44,7 +44,7 @@ pub(crate) fn advance<C: Constrain>(
 /// One Jacobi umbrella step: `dst_i = src_i + factor * (mean_{N(i)} src - src_i)`, constrained;
 /// each chunk then goes to its follower part. Isolated vertices keep their position.
 fn step<C: Constrain>(
-    rings: Rings,
+    rings: KernelRings,
     factor: f32,
     src: &Field,
     dst: &mut Field,
