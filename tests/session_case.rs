@@ -7,7 +7,7 @@ mod label_maps;
 
 use label_maps::{open_in_session, read};
 use meshsmooth::export::Container;
-use meshsmooth::session::{Session, StructureChange};
+use meshsmooth::session::{Session, StructureChange, StructureOutcome};
 
 /// The page's session opens a label map in a worker (read, extract, then a mesh's stages), makes the
 /// first structure the model with its voxel size, and opens another structure on request.
@@ -291,11 +291,14 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     // Workers on this thread answer at once.
     assert!(session.step_suggest_all());
     assert!(!session.background().suggesting_all());
-    let outcome = session.background().suggest_all_json().unwrap();
-    assert_eq!(
-        (outcome["done"].as_u64(), outcome["total"].as_u64()),
-        (Some(4), Some(4))
-    );
+    let outcome = session.background().suggest_all().unwrap();
+    assert_eq!((outcome.done, outcome.total), (4, 4));
+    let suggested: Vec<meshsmooth::smooth::Params> = (outcome.structures.iter())
+        .filter_map(|o| match o {
+            Some(StructureOutcome::Suggested { params, .. }) => Some(*params),
+            _ => None,
+        })
+        .collect();
 
     let options = SuggestAllOptions {
         tau: 0.5,
@@ -328,8 +331,12 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
             want.smoothed.as_ref().unwrap().positions
         );
         assert_eq!(smoothed.metrics, want.smoothed.as_ref().unwrap().metrics);
-        assert_eq!(outcome["structures"][i]["params"], want.params.to_json());
     }
+    let want: Vec<_> = expected.structures.iter().map(|s| s.params).collect();
+    assert_eq!(
+        suggested, want,
+        "each structure's outcome names its parameters"
+    );
     // Drawn as suggested.
     let others = session.case().other_structures();
     assert_eq!(
@@ -340,7 +347,7 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     session.begin_open("case_phantom_shared.seg.nrrd", bytes);
     session.poll_opening().expect("done").expect("opens");
     assert!(
-        session.background().suggest_all_json().is_none(),
+        session.background().suggest_all().is_none(),
         "a new file starts over"
     );
 }

@@ -33,6 +33,7 @@ pub use document::CaseDocument;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use opening::LoadProgress;
 pub use structures::{OtherStructure, StructureChange};
+pub use suggest_all::{StructureOutcome, SuggestAllReport};
 pub use weights::WeightsSummary;
 
 use crate::worker::{Pool, SmoothJob};

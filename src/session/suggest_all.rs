@@ -5,6 +5,8 @@
 
 use super::{Background, Session};
 use crate::case::{Smoothed, SuggestAllOptions};
+use crate::metrics::Metrics;
+use crate::smooth::Params;
 use crate::suggest::SearchMethod;
 use crate::worker::{metrics_of, Reply, StructureJob};
 
@@ -15,9 +17,37 @@ pub struct SuggestAll {
     /// Each structure's job still to answer.
     waiting: Vec<(usize, StructureJob)>,
     total: usize,
-    /// Per structure, what it got: `{name, params, evaluations, metrics}` or `{name, error}`.
-    outcome: Vec<serde_json::Value>,
+    /// Per structure, what it got (`None` until it answers).
+    outcome: Vec<Option<StructureOutcome>>,
     cancelled: bool,
+}
+
+/// What one structure got from "Suggest all", under its name.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StructureOutcome {
+    /// Its suggestion: the parameters, how many sets the search measured and the measures of
+    /// the structure smoothed with them.
+    Suggested {
+        name: String,
+        params: Params,
+        evaluations: usize,
+        metrics: Metrics,
+    },
+    Failed {
+        name: String,
+        why: String,
+    },
+}
+
+/// The last "Suggest all" as it stands.
+#[derive(Clone, Copy, Debug)]
+pub struct SuggestAllReport<'a> {
+    pub options: SuggestAllOptions,
+    /// Per structure of the case, what it got so far.
+    pub structures: &'a [Option<StructureOutcome>],
+    pub done: usize,
+    pub total: usize,
+    pub cancelled: bool,
 }
 
 impl Session {
@@ -57,7 +87,7 @@ impl Session {
             options: Some(options),
             waiting,
             total,
-            outcome: vec![serde_json::Value::Null; total],
+            outcome: vec![None; total],
             cancelled: false,
         };
         Ok(())
@@ -91,7 +121,7 @@ impl Session {
         for (i, reply) in came {
             let outcome = self.take_structure_suggestion(i, reply, options.tau);
             if let Some(slot) = self.suggest_all.outcome.get_mut(i) {
-                *slot = outcome;
+                *slot = Some(outcome);
             }
         }
         any
@@ -99,33 +129,37 @@ impl Session {
 
     /// Applies structure `i`'s answer: the model's structure takes the parameters (its result
     /// follows), another keeps them with its smoothed surface.
-    fn take_structure_suggestion(&mut self, i: usize, reply: Reply, tau: f64) -> serde_json::Value {
+    fn take_structure_suggestion(&mut self, i: usize, reply: Reply, tau: f64) -> StructureOutcome {
         let name = self
             .doc
             .case
             .structures
             .get(i)
             .map_or(String::new(), |s| s.name.clone());
+        let failed = |why: &str| StructureOutcome::Failed {
+            name: name.clone(),
+            why: why.to_string(),
+        };
         let suggested = match reply {
             Reply::Suggested {
                 suggested: Some(s), ..
             } => s,
             Reply::Suggested {
                 suggested: None, ..
-            } => return serde_json::json!({"name": name, "error": "nothing to smooth"}),
-            Reply::Failed { why, .. } => return serde_json::json!({"name": name, "error": why}),
-            _ => return serde_json::json!({"name": name, "error": "another reply"}),
+            } => return failed("nothing to smooth"),
+            Reply::Failed { why, .. } => return failed(&why),
+            _ => return failed("another reply"),
         };
         let metrics = match metrics_of(&suggested.metrics) {
             Ok(m) => m,
-            Err(why) => return serde_json::json!({"name": name, "error": why}),
+            Err(why) => return failed(&why),
         };
-        let summary = serde_json::json!({
-            "name": name,
-            "params": suggested.params.to_json(),
-            "evaluations": suggested.evaluations,
-            "metrics": metrics,
-        });
+        let summary = StructureOutcome::Suggested {
+            name,
+            params: suggested.params,
+            evaluations: suggested.evaluations,
+            metrics: metrics.clone(),
+        };
         if self.doc.current_structure() == Some(i) {
             // The engines smooth it again for the view, to the same surface.
             let _ = self.doc.set_params(suggested.params);
@@ -144,7 +178,7 @@ impl Session {
     }
 }
 
-impl Background<'_> {
+impl<'a> Background<'a> {
     /// Whether "Suggest all" is under way.
     pub fn suggesting_all(&self) -> bool {
         !self.suggest_all.waiting.is_empty()
@@ -157,17 +191,15 @@ impl Background<'_> {
             .then(|| (s.total - s.waiting.len(), s.total))
     }
 
-    /// The last "Suggest all": `{tau, search, structures: [...], cancelled, done, total}`.
-    pub fn suggest_all_json(&self) -> Option<serde_json::Value> {
-        let s = &self.suggest_all;
-        let options = s.options?;
-        Some(serde_json::json!({
-            "tau": options.tau,
-            "search": options.method,
-            "structures": s.outcome,
-            "done": s.total - s.waiting.len(),
-            "total": s.total,
-            "cancelled": s.cancelled,
-        }))
+    /// The last "Suggest all" since the case opened, as far as it got.
+    pub fn suggest_all(&self) -> Option<SuggestAllReport<'a>> {
+        let s = self.suggest_all;
+        Some(SuggestAllReport {
+            options: s.options?,
+            structures: &s.outcome,
+            done: s.total - s.waiting.len(),
+            total: s.total,
+            cancelled: s.cancelled,
+        })
     }
 }

@@ -81,7 +81,7 @@ fn suggest_all(
             &c,
             started,
             |s| !s.background().suggesting_all(),
-            |s| s.background().suggest_all_json(),
+            |s| super::json::suggest_all(&s.background()),
         )
     })
 }

@@ -3,7 +3,7 @@
 //! CLI prints the same thing (`info --json`, `measure --json`, `sweep --json`, `case check
 //! --json`) the shape is the CLI's.
 
-use crate::session::{Background, CaseDocument, Session, StructureChange};
+use crate::session::{Background, CaseDocument, Session, StructureChange, StructureOutcome};
 use serde_json::{json, Value};
 
 /// The model's mesh report, as `info --json` prints it.
@@ -152,6 +152,31 @@ pub(crate) fn guidance(background: &Background) -> Value {
         })).collect::<Vec<_>>(),
         "problem": background.guidance_problem(),
     })
+}
+
+/// The last "Suggest all": `{tau, search, structures, done, total, cancelled}`, each structure
+/// `{name, params, evaluations, metrics}`, `{name, error}` or null until it answers.
+pub(crate) fn suggest_all(background: &Background) -> Option<Value> {
+    let report = background.suggest_all()?;
+    let outcome = |o: &Option<StructureOutcome>| match o {
+        Some(StructureOutcome::Suggested {
+            name,
+            params,
+            evaluations,
+            metrics,
+        }) => json!({"name": name, "params": params.to_json(), "evaluations": evaluations,
+            "metrics": metrics}),
+        Some(StructureOutcome::Failed { name, why }) => json!({"name": name, "error": why}),
+        None => Value::Null,
+    };
+    Some(json!({
+        "tau": report.options.tau,
+        "search": report.options.method,
+        "structures": report.structures.iter().map(outcome).collect::<Vec<_>>(),
+        "done": report.done,
+        "total": report.total,
+        "cancelled": report.cancelled,
+    }))
 }
 
 /// The last checks' report as `case check --json` prints it, with whether the structures are
