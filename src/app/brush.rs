@@ -1,12 +1,12 @@
 //! The weight brush: with the brush on, a left drag over the view paints per-vertex smoothing
-//! weights into the session (lock, weaken or erase under a circle of a radius in mm), a circle
+//! weights into the model's structure (lock, weaken or erase under a circle of a radius in mm), a circle
 //! shows the brush's footprint under the pointer, and the view shows the weights.
 //!
-//! Picking and the footprint are [`crate::view`]'s; the weights and what they do are the
-//! session's. A fast stroke is filled in with dabs spaced half a brush radius apart on screen.
+//! Picking and the footprint are [`crate::view`]'s; the weights are the case document's, and
+//! what they do the engines'. A fast stroke is filled in with dabs spaced half a brush radius apart on screen.
 
 use super::document::now_ms;
-use crate::session::Session;
+use crate::session::CaseDocument;
 use crate::view::{brush_footprint, pick_triangle, Hit, OrbitCamera};
 use eframe::egui;
 use glam::Vec2;
@@ -68,23 +68,23 @@ impl Default for Brush {
 
 impl Brush {
     /// The brush's controls in the Smoothing panel.
-    pub fn panel(&mut self, ui: &mut egui::Ui, session: &mut Session) {
+    pub fn panel(&mut self, ui: &mut egui::Ui, case: &mut CaseDocument) {
         ui.horizontal(|ui| {
             ui.toggle_value(&mut self.active, "Weight brush")
                 .on_hover_text(
                     "P: left drag paints where smoothing may act; Ctrl/⌘ + left drag or the \
                      middle button orbits meanwhile",
                 );
-            let painted = session.case().weights().is_some();
+            let painted = case.weights().is_some();
             if ui
                 .add_enabled(painted, egui::Button::new("Clear"))
                 .on_hover_text("Every vertex free again")
                 .clicked()
             {
-                session.case_mut().clear_weights();
+                case.clear_weights();
             }
         });
-        if !self.active && session.case().weights().is_none() {
+        if !self.active && case.weights().is_none() {
             return;
         }
         ui.horizontal(|ui| {
@@ -120,7 +120,7 @@ impl Brush {
                     .suffix(" mm"),
             );
         });
-        if let Some(w) = session.case().weights_summary() {
+        if let Some(w) = case.weights_summary() {
             ui.small(format!(
                 "{} vertices painted, {} locked (lowest weight {:.2})",
                 w.painted, w.locked, w.min
@@ -139,7 +139,7 @@ impl Brush {
         ui: &egui::Ui,
         response: &egui::Response,
         camera: &OrbitCamera,
-        session: &mut Session,
+        case: &mut CaseDocument,
         surface: SurfaceKey,
     ) {
         if !self.active {
@@ -153,12 +153,11 @@ impl Brush {
 
         let mut footprints = Vec::new();
         {
-            let Some(model) = session.case().model() else {
+            let Some(model) = case.model() else {
                 return;
             };
             let positions = match surface.1 {
-                Some(_) => session
-                    .case()
+                Some(_) => case
                     .last_result()
                     .map_or(&model.mesh().positions, |r| &r.positions),
                 None => &model.mesh().positions,
@@ -198,11 +197,10 @@ impl Brush {
             }
         }
         for footprint in footprints {
-            let weights = session.case_mut();
             match self.mode {
-                BrushMode::Lock => weights.paint_weights(&footprint, 0.0),
-                BrushMode::Weaken => weights.paint_weights(&footprint, 1.0 - self.strength),
-                BrushMode::Erase => weights.erase_weights(&footprint),
+                BrushMode::Lock => case.paint_weights(&footprint, 0.0),
+                BrushMode::Weaken => case.paint_weights(&footprint, 1.0 - self.strength),
+                BrushMode::Erase => case.erase_weights(&footprint),
             };
         }
         self.draw_circle(ui, camera, rect, size);

@@ -1,11 +1,11 @@
 //! The side panel's controls: the filter with a slider and a number field per parameter, the
 //! displacement bound (in mm, or voxel diagonals when the voxel size is known), the measures of the current result, and what the colours show.
 //!
-//! Every edit goes to the session as a whole parameter set; the session refuses invalid sets
-//! (e.g. Taubin's mu >= -lambda) and the message shows under the controls until fixed.
+//! The panels edit the case document alone. Every edit goes to it as a whole parameter set;
+//! it refuses invalid sets (e.g. Taubin's mu >= -lambda) and the message shows under the controls until fixed.
 
 use super::document::EngineTimings;
-use crate::session::{ColorField, Session};
+use crate::session::{CaseDocument, ColorField};
 use crate::smooth::{Filter, Params};
 use eframe::egui;
 
@@ -105,16 +105,16 @@ fn filter_sliders(ui: &mut egui::Ui, p: &mut Params) {
 
 impl Controls {
     /// The filter and its parameters.
-    pub fn filter(&mut self, ui: &mut egui::Ui, session: &mut Session) {
-        let mut p: Params = *session.case().params();
+    pub fn filter(&mut self, ui: &mut egui::Ui, case: &mut CaseDocument) {
+        let mut p: Params = *case.params();
         ui.horizontal_wrapped(|ui| {
             for f in Filter::ALL {
                 if ui
-                    .selectable_label(session.case().filter() == f, filter_label(f))
+                    .selectable_label(case.filter() == f, filter_label(f))
                     .clicked()
                 {
-                    session.case_mut().set_filter(f);
-                    p = *session.case().params();
+                    case.set_filter(f);
+                    p = *case.params();
                 }
             }
         });
@@ -126,7 +126,7 @@ impl Controls {
             ui.label("iterations");
             ui.add(egui::Slider::new(&mut p.iterations, min_it..=max_it));
         });
-        let voxel = session.case().voxel_diagonal().map(|d| d as f32);
+        let voxel = case.voxel_diagonal().map(|d| d as f32);
         ui.horizontal(|ui| {
             let mut bounded = p.max_displacement.is_some();
             ui.checkbox(&mut bounded, "max displacement")
@@ -144,8 +144,8 @@ impl Controls {
         if ui.small_button("Defaults").clicked() {
             p = Params::defaults(p.filter);
         }
-        if p != *session.case().params() {
-            self.refused = session.case_mut().set_params(p).err();
+        if p != *case.params() {
+            self.refused = case.set_params(p).err();
         }
         if let Some(why) = &self.refused {
             ui.colored_label(ui.visuals().warn_fg_color, why);
@@ -192,13 +192,13 @@ fn percent(v: f64) -> String {
 }
 
 /// The measures of the latest result, as a table.
-pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<EngineTimings>) {
-    let Some(result) = session.case().last_result() else {
+pub fn measures(ui: &mut egui::Ui, case: &CaseDocument, timings: Option<EngineTimings>) {
+    let Some(result) = case.last_result() else {
         ui.label("Not smoothed yet.");
         return;
     };
     let m = &result.metrics;
-    let vd = session.case().voxel_diagonal();
+    let vd = case.voxel_diagonal();
     let mm = |v: f64| match vd {
         Some(d) => format!("{v:.3} mm ({:.2} vd)", v / d),
         None => format!("{v:.3} mm"),
@@ -239,7 +239,7 @@ pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<EngineTimi
                 format!("{:.4}", m.score),
             );
         });
-    if session.case().result().is_none() {
+    if case.result().is_none() {
         ui.small("Updating…");
     } else if let Some(t) = timings {
         ui.small(t.describe());
@@ -247,15 +247,15 @@ pub fn measures(ui: &mut egui::Ui, session: &Session, timings: Option<EngineTimi
 }
 
 /// What the colours show (None: plain shading), and the voxel size for voxel-diagonal units.
-pub fn coloring(ui: &mut egui::Ui, field: &mut Option<ColorField>, session: &mut Session) {
+pub fn coloring(ui: &mut egui::Ui, field: &mut Option<ColorField>, case: &mut CaseDocument) {
     ui.horizontal_wrapped(|ui| {
         ui.selectable_value(field, None, "Shading");
         for f in ColorField::ALL {
             ui.selectable_value(field, Some(f), f.name());
         }
     });
-    let mut known = session.case().voxel_size().is_some();
-    let mut size = session.case().voxel_size().unwrap_or([1.0; 3]);
+    let mut known = case.voxel_size().is_some();
+    let mut size = case.voxel_size().unwrap_or([1.0; 3]);
     ui.horizontal(|ui| {
         ui.checkbox(&mut known, "voxel size").on_hover_text(
             "The segmentation's voxel spacing: distances then also read in voxel diagonals (vd)",
@@ -273,8 +273,8 @@ pub fn coloring(ui: &mut egui::Ui, field: &mut Option<ColorField>, session: &mut
         }
     });
     let wanted = known.then_some(size);
-    if wanted != session.case().voxel_size() {
+    if wanted != case.voxel_size() {
         // The drag values' range keeps the sizes valid.
-        let _ = session.case_mut().set_voxel_size(wanted);
+        let _ = case.set_voxel_size(wanted);
     }
 }

@@ -1,9 +1,9 @@
 //! Window/level-style parameter dragging over the view: holding the right button, horizontal
 //! travel drives one smoothing parameter and vertical travel another (chosen per filter in the
-//! Smoothing panel), through the session, so the mesh and the measures follow while dragging;
+//! Smoothing panel), through the case document, so the mesh and the measures follow while dragging;
 //! the values are drawn beside the cursor. The mapping is [`crate::view::dragged_params`].
 
-use crate::session::Session;
+use crate::session::CaseDocument;
 use crate::smooth::{Filter, Params};
 use crate::suggest::Param;
 use crate::view::{default_drag_axes, drag_choices, dragged_params};
@@ -80,10 +80,10 @@ impl DragParams {
         });
     }
 
-    /// This frame's right-button input over the view: sets the parameters through the session
-    /// (the travel from where the button went down, so the frame it is released in counts
+    /// This frame's right-button input over the view: sets the parameters through the case
+    /// document (the travel from where the button went down, so the frame it is released in counts
     /// too) and draws their values beside the cursor while the button is held.
-    pub fn interact(&mut self, ui: &egui::Ui, response: &egui::Response, session: &mut Session) {
+    pub fn interact(&mut self, ui: &egui::Ui, response: &egui::Response, case: &mut CaseDocument) {
         let (pressed, held, origin, pointer) = ui.input(|i| {
             (
                 i.pointer.button_pressed(BUTTON),
@@ -93,29 +93,29 @@ impl DragParams {
             )
         });
         if pressed && response.is_pointer_button_down_on() {
-            self.start = origin.map(|o| (*session.case().params(), o));
+            self.start = origin.map(|o| (*case.params(), o));
         }
         let (Some((start, origin)), Some(pointer)) = (self.start, pointer) else {
             self.start = None;
             return;
         };
-        if start.filter != session.case().filter() {
+        if start.filter != case.filter() {
             // The filter changed under the drag (a key): carry on from its values.
-            self.start = Some((*session.case().params(), pointer));
+            self.start = Some((*case.params(), pointer));
             return;
         }
         let axes = self.axes[slot(start.filter)];
         let delta = pointer - origin;
         let p = dragged_params(&start, axes, Vec2::new(delta.x, delta.y));
-        if p != *session.case().params() {
+        if p != *case.params() {
             // dragged_params keeps the parameters valid.
-            let _ = session.case_mut().set_params(p);
+            let _ = case.set_params(p);
         }
         if !held {
             self.start = None;
             return;
         }
-        let p = session.case().params();
+        let p = case.params();
         let text = if axes[0] == axes[1] {
             format!("{} {}", label(axes[0]), value_text(axes[0], p))
         } else {

@@ -406,19 +406,19 @@ impl Shell {
             }
         }
         ui.heading("Smoothing");
-        self.controls.filter(ui, &mut doc.session);
+        self.controls.filter(ui, doc.session.case_mut());
         self.drag_params.panel(ui, doc.session.case().filter());
         ui.separator();
-        self.brush.panel(ui, &mut doc.session);
+        self.brush.panel(ui, doc.session.case_mut());
         ui.separator();
         ui.heading("Suggest");
         self.guide.show(ui, &mut doc.session);
         ui.separator();
         ui.heading("Measures");
-        controls::measures(ui, &doc.session, timings);
+        controls::measures(ui, doc.session.case(), timings);
         ui.separator();
         ui.heading("Colours");
-        controls::coloring(ui, &mut self.coloring, &mut doc.session);
+        controls::coloring(ui, &mut self.coloring, doc.session.case_mut());
         drop(guard);
         if add_files {
             self.open_picker(true);

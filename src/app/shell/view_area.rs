@@ -61,8 +61,9 @@ impl Shell {
                 let surface = (doc.session.case().model_id(), shown);
                 let camera = viewer.camera();
                 self.brush
-                    .interact(ui, &response, camera, &mut doc.session, surface);
-                self.drag_params.interact(ui, &response, &mut doc.session);
+                    .interact(ui, &response, camera, doc.session.case_mut(), surface);
+                self.drag_params
+                    .interact(ui, &response, doc.session.case_mut());
                 doc.view = ViewReport {
                     rect: response.rect.into(),
                     pose: Some(viewer.pose()),
