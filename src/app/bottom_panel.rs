@@ -29,10 +29,10 @@ impl BottomPanel {
 
     /// Draws the next gallery picture, and shows the gallery when the API asked for it.
     pub fn update(&mut self, ctx: &egui::Context, doc: &mut Document) {
-        self.gallery.update(ctx, &doc.session);
+        self.gallery.update(ctx, doc.session());
         if std::mem::take(&mut doc.show_gallery) {
             self.gallery_tab = true;
-            self.set_open(true, &mut doc.session);
+            self.set_open(true, doc.session_mut());
         }
     }
 

@@ -183,7 +183,8 @@ pub struct ViewAsks {
 }
 
 pub struct Document {
-    pub session: Session,
+    /// The case and the engines; the shell reads the case through [`Self::case`].
+    session: Session,
     pub backend: Backend,
     /// Timings of the last result.
     pub timings: Option<EngineTimings>,
@@ -220,6 +221,34 @@ pub struct Document {
 pub type SharedDocument = Rc<RefCell<Document>>;
 
 impl Document {
+    /// The open case, its current structure and its model.
+    pub fn case(&self) -> &crate::session::CaseDocument {
+        self.session.case()
+    }
+
+    pub fn case_mut(&mut self) -> &mut crate::session::CaseDocument {
+        self.session.case_mut()
+    }
+
+    /// What guidance, Suggest all and the checks found.
+    pub fn background(&self) -> crate::session::Background<'_> {
+        self.session.background()
+    }
+
+    /// Openings, the CPU engine and the background work, for the panels that start or stop it.
+    pub fn session(&self) -> &Session {
+        &self.session
+    }
+
+    pub fn session_mut(&mut self) -> &mut Session {
+        &mut self.session
+    }
+
+    /// The session beside the panel layout the panels write, for panels that need both.
+    pub fn session_and_panel(&mut self) -> (&mut Session, &mut PanelLayout) {
+        (&mut self.session, &mut self.panel)
+    }
+
     pub fn new(backend: Backend) -> Self {
         Self {
             session: Session::default(),

@@ -15,7 +15,7 @@ pub fn progress(ui: &mut egui::Ui, doc: &Document, reading: &[Reading]) {
                 .text(text),
         );
     };
-    if let Some(l) = doc.session.loading() {
+    if let Some(l) = doc.session().loading() {
         let text = format!("opening: {} ({}/{})", l.doing, l.stage + 1, l.total);
         bar(ui, l.fraction, 220.0, text);
     } else if let Some(fraction) = reading.first().and_then(|r| r.fraction()) {
@@ -43,13 +43,13 @@ pub fn view_messages(
     showing_original: bool,
 ) -> Vec<(String, egui::Color32)> {
     let mut lines = Vec::new();
-    if let Some(error) = doc.session.error().or(extra_error) {
+    if let Some(error) = doc.session().error().or(extra_error) {
         lines.push((error.to_string(), ui.visuals().error_fg_color));
     }
     for r in reading {
         lines.push((format!("{}…", r.describe()), egui::Color32::WHITE));
     }
-    if let Some(l) = doc.session.loading() {
+    if let Some(l) = doc.session().loading() {
         let text = format!("Opening {}: {}…", l.name, l.doing);
         lines.push((text, egui::Color32::WHITE));
     }

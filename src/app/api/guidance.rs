@@ -47,10 +47,10 @@ fn suggest(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut(JsVal
 fn sweep(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Promise> {
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move || {
-        if d.borrow().session.case().model().is_none() {
+        if d.borrow().case().model().is_none() {
             return settled(Err("no mesh is open: call loadMesh first".into()));
         }
-        d.borrow_mut().session.set_graphs_wanted(true);
+        d.borrow_mut().session_mut().set_graphs_wanted(true);
         when_ready(
             &d,
             &c,
@@ -73,8 +73,8 @@ fn suggest_all(
     Closure::new(move |options: JsValue| {
         let started = {
             let mut doc = d.borrow_mut();
-            tau_and_search(&doc.session, &options, "suggestAll")
-                .and_then(|(tau, method)| doc.session.start_suggest_all(tau, method))
+            tau_and_search(doc.session(), &options, "suggestAll")
+                .and_then(|(tau, method)| doc.session_mut().start_suggest_all(tau, method))
         };
         started_work(
             &d,
@@ -90,7 +90,7 @@ fn suggest_all(
 fn check_structures(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Promise> {
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move || {
-        let started = d.borrow_mut().session.start_checks();
+        let started = d.borrow_mut().session_mut().start_checks();
         started_work(
             &d,
             &c,
@@ -107,10 +107,10 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
     Closure::new(move || {
         {
             let mut doc = d.borrow_mut();
-            if doc.session.case().model().is_none() {
+            if doc.case().model().is_none() {
                 return settled(Err("no mesh is open: call loadMesh first".into()));
             }
-            doc.session.start_gallery();
+            doc.session_mut().start_gallery();
             doc.show_gallery = true;
         }
         when_ready(
@@ -135,7 +135,7 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
 /// (default: grid, as the CLI); returns what the answer must match.
 fn start_suggest(doc: &SharedDocument, options: &JsValue) -> Result<(f64, SearchMethod), String> {
     let mut doc = doc.borrow_mut();
-    let session = &mut doc.session;
+    let session = doc.session_mut();
     let (tau, method) = tau_and_search(session, options, "suggest")?;
     session.case_mut().set_tau(tau)?;
     session.start_suggest(method);

@@ -74,7 +74,7 @@ impl Embedding {
             }
             return;
         }
-        if doc.session.loading().is_some() || doc.busy() {
+        if doc.session().loading().is_some() || doc.busy() {
             return;
         }
         let key = case_key(doc);
@@ -84,7 +84,7 @@ impl Embedding {
     }
 
     fn post_structures(&self, event: &str, doc: &Document) {
-        let detail = super::json::structures(doc.session.case()).unwrap_or_default();
+        let detail = super::json::structures(doc.case()).unwrap_or_default();
         self.post_event(event, &detail);
     }
 
@@ -120,7 +120,7 @@ fn parent_origin(value: &str) -> Result<String, String> {
 type CaseKey = (u64, Option<usize>, u64);
 
 fn case_key(doc: &Document) -> CaseKey {
-    let s = doc.session.case();
+    let s = doc.case();
     (s.case_version(), s.current_structure(), s.revision())
 }
 

@@ -132,7 +132,7 @@ fn when_current(
     ctx: &egui::Context,
     answer: impl Fn(&crate::session::Session) -> Result<JsValue, String> + 'static,
 ) -> Promise {
-    if doc.borrow().session.case().model().is_none() {
+    if doc.borrow().case().model().is_none() {
         return Promise::reject(&error("no mesh is open: call loadMesh first"));
     }
     let doc = doc.clone();
@@ -205,7 +205,7 @@ fn setter(
     let (doc, ctx) = (doc.clone(), ctx.clone());
     Closure::new(move |value: JsValue| {
         let mut doc = doc.borrow_mut();
-        edit(&mut doc.session, value).map_err(|e| error(&e))?;
+        edit(doc.session_mut(), value).map_err(|e| error(&e))?;
         doc.step_cpu_engine();
         // With the work in the CPU engine's workers, their reply wakes the page: a frame now
         // would only draw the old surface while the new one is computed.
@@ -316,7 +316,7 @@ fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Res
     api.define(
         "clearWeights",
         Closure::<dyn FnMut()>::new(move || {
-            d.borrow_mut().session.case_mut().clear_weights();
+            d.borrow_mut().case_mut().clear_weights();
             crate::app::wake(&c);
         }),
     )

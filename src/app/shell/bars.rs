@@ -41,7 +41,7 @@ impl Shell {
             {
                 let open = self.bottom.open;
                 self.bottom
-                    .set_open(open, &mut self.doc.borrow_mut().session);
+                    .set_open(open, self.doc.borrow_mut().session_mut());
             }
             ui.toggle_value(&mut self.show_original, "Original")
                 .on_hover_text("Before/after: show the original mesh (B)");
@@ -66,7 +66,7 @@ impl Shell {
     pub(super) fn status_bar(&self, ui: &mut egui::Ui) {
         let doc = self.doc.borrow();
         ui.horizontal(|ui| {
-            if let Some(model) = doc.session.case().model() {
+            if let Some(model) = doc.case().model() {
                 ui.label(format!(
                     "{}: {} vertices, {} faces",
                     model.name, model.report.vertices, model.report.faces

@@ -98,7 +98,7 @@ fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
                     bytes,
                 }),
                 Err(reason) => {
-                    doc.session.fail(&file.name, &reason);
+                    doc.session_mut().fail(&file.name, &reason);
                 }
             }
         }
@@ -145,8 +145,8 @@ impl Shell {
             // The viewer shows no guidance: nothing runs for it in the background.
             let mut doc = doc.borrow_mut();
             doc.reading = reading;
-            doc.session.set_graphs_wanted(!reading);
-            doc.session.set_suggest_on_open(!reading);
+            doc.session_mut().set_graphs_wanted(!reading);
+            doc.session_mut().set_suggest_on_open(!reading);
         }
         doc.borrow_mut().shortcuts = query::param("shortcuts").as_deref() != Some("off");
         // A link's view is of the case it names.
@@ -193,7 +193,7 @@ impl Shell {
         let Ok(doc) = self.doc.try_borrow() else {
             return false;
         };
-        let session = &doc.session;
+        let session = doc.session();
         self.files.reading().is_empty()
             && (!session.opening_unanswered() || !session.cpu_engine().threaded())
     }
@@ -225,13 +225,13 @@ impl Shell {
     /// The file dialog, to open files as a case or (`add`) to add them to the open one.
     fn open_picker(&mut self, add: bool) {
         if let Err(e) = self.files.open_picker(add) {
-            self.doc.borrow_mut().session.fail("a file", &e);
+            self.doc.borrow_mut().session_mut().fail("a file", &e);
         }
     }
 
     fn export(&mut self, format: ExportFormat) {
         let doc = self.doc.borrow();
-        let session = &doc.session;
+        let session = doc.session();
         let Some(model) = session.case().model() else {
             return;
         };
@@ -277,28 +277,24 @@ impl Shell {
                         .copied(),
                 };
             }
-            Action::Filter(k) => self
-                .doc
-                .borrow_mut()
-                .session
-                .case_mut()
-                .set_filter(Filter::ALL[k]),
+            Action::Filter(k) => self.doc.borrow_mut().case_mut().set_filter(Filter::ALL[k]),
             Action::ExportGlb => self.export(ExportFormat::Glb),
             Action::ToggleHelp => self.help_open = !self.help_open,
             Action::ApplySuggestion => {
                 let mut doc = self.doc.borrow_mut();
-                if let Some(s) = doc.session.background().suggestion() {
-                    let _ = doc.session.case_mut().set_params(s.suggestion.params);
+                if let Some(s) = doc.background().suggestion() {
+                    let _ = doc.case_mut().set_params(s.suggestion.params);
                 }
             }
             Action::ToggleGraphs => {
                 let open = !self.bottom.open;
                 self.bottom
-                    .set_open(open, &mut self.doc.borrow_mut().session);
+                    .set_open(open, self.doc.borrow_mut().session_mut());
             }
             Action::ToggleBrush => self.brush.active = !self.brush.active,
             Action::CancelBackground => {
-                let session = &mut self.doc.borrow_mut().session;
+                let mut doc = self.doc.borrow_mut();
+                let session = doc.session_mut();
                 session.cancel_suggest();
                 session.cancel_gallery();
             }
@@ -310,39 +306,36 @@ impl Shell {
         let doc = &mut *guard;
         let timings = doc.timings;
         let mut add_files = false;
-        for action in self.structures.show(ui, &doc.session, &mut doc.panel) {
+        let (session, panel) = doc.session_and_panel();
+        for action in self.structures.show(ui, session, panel) {
             let done = match action {
                 StructureAction::AddFiles => {
                     add_files = true;
                     Ok(())
                 }
                 StructureAction::Select(i) => doc.select_structure(i),
-                StructureAction::Change(i, change) => {
-                    doc.session.case_mut().set_structure(i, change)
-                }
-                StructureAction::Solo(i) => doc.session.case_mut().solo_structure(i),
+                StructureAction::Change(i, change) => doc.case_mut().set_structure(i, change),
+                StructureAction::Solo(i) => doc.case_mut().solo_structure(i),
                 StructureAction::CaseText(title, description) => {
-                    doc.session
-                        .case_mut()
+                    doc.case_mut()
                         .set_case_text(Some(&title), Some(&description));
                     Ok(())
                 }
                 StructureAction::SuggestAll => {
-                    let tau = doc.session.case().tau();
+                    let tau = doc.case().tau();
                     let method = self.guide.method;
-                    doc.session.start_suggest_all(tau, method)
+                    doc.session_mut().start_suggest_all(tau, method)
                 }
-                StructureAction::Check => doc.session.start_checks(),
+                StructureAction::Check => doc.session_mut().start_checks(),
                 StructureAction::CancelSuggestAll => {
-                    doc.session.cancel_suggest_all();
+                    doc.session_mut().cancel_suggest_all();
                     Ok(())
                 }
                 StructureAction::ExportCase => {
-                    let file = doc.session.case().case_file();
+                    let file = doc.case().case_file();
                     let stem = file.split('.').next().filter(|s| !s.is_empty());
                     let name = format!("{}_case.glb", stem.unwrap_or("case"));
-                    doc.session
-                        .case()
+                    doc.case()
                         .export_case(crate::export::Container::Glb)
                         .and_then(|bytes| download::save(&name, &bytes, "model/gltf-binary"))
                 }
@@ -352,19 +345,19 @@ impl Shell {
             }
         }
         ui.heading("Smoothing");
-        self.controls.filter(ui, doc.session.case_mut());
-        self.drag_params.panel(ui, doc.session.case().filter());
+        self.controls.filter(ui, doc.case_mut());
+        self.drag_params.panel(ui, doc.case().filter());
         ui.separator();
-        self.brush.panel(ui, doc.session.case_mut());
+        self.brush.panel(ui, doc.case_mut());
         ui.separator();
         ui.heading("Suggest");
-        self.guide.show(ui, &mut doc.session);
+        self.guide.show(ui, doc.session_mut());
         ui.separator();
         ui.heading("Measures");
-        controls::measures(ui, doc.session.case(), timings);
+        controls::measures(ui, doc.case(), timings);
         ui.separator();
         ui.heading("Colours");
-        controls::coloring(ui, &mut self.coloring, doc.session.case_mut());
+        controls::coloring(ui, &mut self.coloring, doc.case_mut());
         drop(guard);
         if add_files {
             self.open_picker(true);
@@ -397,12 +390,13 @@ impl eframe::App for Shell {
         // While a worker opens a file, the open model is worked on as before.
         self.pictures(&ctx);
         let opening = self.doc.borrow_mut().step_loading();
-        let opened = opening == Opening::Done && self.doc.borrow().session.loading().is_none();
+        let opened = opening == Opening::Done && self.doc.borrow().session().loading().is_none();
         if let Some(link) = self.link.take_if(|_| opened) {
             self.take_up_link(link);
         }
         {
-            let session = &mut self.doc.borrow_mut().session;
+            let mut doc = self.doc.borrow_mut();
+            let session = doc.session_mut();
             session.step_suggest_all();
             session.step_checks();
         }
@@ -429,7 +423,7 @@ impl eframe::App for Shell {
             if let Some(embedding) = &mut self.embedding {
                 embedding.after_frame(&mut doc);
             }
-            self.case_text.update(&doc.session);
+            self.case_text.update(doc.session());
             self.repainting = doc.working();
             if self.repainting && doc.working_elsewhere() {
                 // The replies wake the page; this only moves the progress on. Frames drawn
@@ -460,7 +454,7 @@ impl Shell {
     /// The background's guidance steps on, its runs on the GPU engine when it takes them.
     fn step_guidance(&mut self) {
         let mut doc = self.doc.borrow_mut();
-        let vertices = (doc.session.case().model()).map_or(0, |m| m.mesh().vertex_count());
+        let vertices = (doc.case().model()).map_or(0, |m| m.mesh().vertex_count());
         let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
         doc.guidance_on_gpu = offload.is_some();
         doc.compute_guidance(offload);
@@ -468,7 +462,7 @@ impl Shell {
             gpu.guidance_sent();
         }
         if let Some(why) = self.gpu.as_mut().and_then(|g| g.take_evaluator_failure()) {
-            doc.session.guidance_engine_failed(&why);
+            doc.session_mut().guidance_engine_failed(&why);
         }
     }
 
@@ -488,7 +482,10 @@ impl Shell {
                 .show(ui, |ui| {
                     let mut doc = self.doc.borrow_mut();
                     let doc = &mut *doc;
-                    self.bottom.show(ui, &mut doc.session, &mut doc.panel)
+                    {
+                        let (session, panel) = doc.session_and_panel();
+                        self.bottom.show(ui, session, panel)
+                    }
                 });
         } else {
             self.doc.borrow_mut().panel = Default::default();
@@ -498,7 +495,7 @@ impl Shell {
             .default_size(260.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
-                    if let Some(model) = self.doc.borrow().session.case().model() {
+                    if let Some(model) = self.doc.borrow().case().model() {
                         report_view::show(ui, model);
                     }
                 });

@@ -57,8 +57,8 @@ impl Shell {
                 let doc = &mut *guard;
                 let was = self.coloring == Some(ColorField::LocalError);
                 let mut error_colours = was;
-                let actions =
-                    case_reader::show(ui, &doc.session, &mut doc.panel, &mut error_colours);
+                let (session, panel) = doc.session_and_panel();
+                let actions = case_reader::show(ui, session, panel, &mut error_colours);
                 if error_colours != was {
                     self.coloring = error_colours.then_some(ColorField::LocalError);
                 }
@@ -66,9 +66,9 @@ impl Shell {
                     let done = match action {
                         StructureAction::Select(i) => doc.select_structure(i),
                         StructureAction::Change(i, change) => {
-                            doc.session.case_mut().set_structure(i, change)
+                            doc.case_mut().set_structure(i, change)
                         }
-                        StructureAction::Solo(i) => doc.session.case_mut().solo_structure(i),
+                        StructureAction::Solo(i) => doc.case_mut().solo_structure(i),
                         _ => Ok(()),
                     };
                     if let Err(e) = done {

@@ -17,13 +17,7 @@ impl Shell {
             egui::Rect::from_min_size(egui::pos2(r.left, r.top), egui::vec2(r.width, r.height));
         if let Some(png) = self.picture.take(view, ctx.pixels_per_point()) {
             if std::mem::take(&mut self.picture.download) {
-                let stem = doc
-                    .session
-                    .case()
-                    .case_file()
-                    .split('.')
-                    .next()
-                    .unwrap_or("");
+                let stem = doc.case().case_file().split('.').next().unwrap_or("");
                 let name = format!("{}_view.png", if stem.is_empty() { "case" } else { stem });
                 if let Err(e) = (png.as_ref())
                     .map_err(String::clone)
@@ -82,11 +76,11 @@ impl Shell {
         let link = match link {
             Ok(link) => link,
             Err(e) => {
-                doc.session.fail("the link", &e);
+                doc.session_mut().fail("the link", &e);
                 return;
             }
         };
-        let count = doc.session.case().case_structures().len();
+        let count = doc.case().case_structures().len();
         let mut problems = Vec::new();
         for &i in link
             .hidden
@@ -103,7 +97,7 @@ impl Shell {
                 opacity: (link.opacity.iter().find(|(j, _)| *j == i)).map(|(_, a)| *a),
                 ..Default::default()
             };
-            if let Err(e) = doc.session.case_mut().set_structure(i, change) {
+            if let Err(e) = doc.case_mut().set_structure(i, change) {
                 problems.push(e);
             }
         }
@@ -116,7 +110,7 @@ impl Shell {
         }
         self.pending_pose = link.camera;
         if !problems.is_empty() {
-            doc.session.fail("the link", &problems.join("; "));
+            doc.session_mut().fail("the link", &problems.join("; "));
         }
     }
 }

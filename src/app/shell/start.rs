@@ -25,7 +25,7 @@ pub(super) fn open_start_model(
         }
         Some(Err(e)) => {
             let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
-            doc.borrow_mut().session.fail("?model", &e);
+            doc.borrow_mut().session_mut().fail("?model", &e);
             false
         }
         Some(Ok(model)) => {
@@ -47,7 +47,7 @@ pub(super) fn embed(doc: &SharedDocument, ctx: &egui::Context) -> Option<api::Em
     let embedding = match api::Embedding::from_query()? {
         Ok(embedding) => embedding,
         Err(e) => {
-            doc.borrow_mut().session.fail("?parent", &e);
+            doc.borrow_mut().session_mut().fail("?parent", &e);
             return None;
         }
     };
@@ -98,7 +98,7 @@ pub(super) fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Con
             }));
             let pool = Pool::with_view_worker(Box::new(w));
             log::info!("CPU engine: {}", pool.to_json());
-            doc.borrow_mut().session.set_cpu_engine(pool);
+            doc.borrow_mut().session_mut().set_cpu_engine(pool);
         }
         Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
     }

@@ -58,12 +58,11 @@ impl Shell {
                     Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
                     _ => None,
                 };
-                let surface = (doc.session.case().model_id(), shown);
+                let surface = (doc.case().model_id(), shown);
                 let camera = viewer.camera();
                 self.brush
-                    .interact(ui, &response, camera, doc.session.case_mut(), surface);
-                self.drag_params
-                    .interact(ui, &response, doc.session.case_mut());
+                    .interact(ui, &response, camera, doc.case_mut(), surface);
+                self.drag_params.interact(ui, &response, doc.case_mut());
                 doc.view = ViewReport {
                     rect: response.rect.into(),
                     pose: Some(viewer.pose()),
@@ -98,8 +97,8 @@ fn point(
     at: (&crate::view::OrbitCamera, [f32; 4]),
     doc: &mut Document,
 ) {
-    let clicked = pointing.update(ui, response, at, &doc.session);
-    let current = doc.session.case().current_structure();
+    let clicked = pointing.update(ui, response, at, doc.session());
+    let current = doc.case().current_structure();
     if let (true, Some(i)) = (reading, clicked.filter(|&i| Some(i) != current)) {
         if let Err(e) = doc.select_structure(i) {
             log::warn!("{e}");

@@ -50,7 +50,7 @@ impl Shell {
             return;
         };
         let doc = self.doc.borrow();
-        let session = &doc.session;
+        let session = doc.session();
         if session.case().model().is_none() {
             return;
         }
