@@ -200,15 +200,14 @@ impl Pool {
         self.carrier.threaded()
     }
 
-    /// What `state()` says of the CPU engine: its workers, whether they are threads, and how
-    /// many openings were asked of them.
-    pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
-            "workers": self.workers(),
-            "view_worker": self.view_worker.is_some(),
-            "threaded": self.carrier.threaded(),
-            "openings": self.openings,
-        })
+    /// Whether a worker is kept for the view's smoothing and openings.
+    pub fn has_view_worker(&self) -> bool {
+        self.view_worker.is_some()
+    }
+
+    /// How many openings were asked of the workers.
+    pub fn openings(&self) -> u64 {
+        self.openings
     }
 
     /// Whether any worker is doing something or anything waits to be handed out.

@@ -111,7 +111,7 @@ pub(crate) fn session_state(session: &Session, busy: bool) -> Value {
         "params": case.params().to_json(),
         "tau": case.tau(),
         "busy": busy,
-        "cpu_engine": session.cpu_engine().to_json(),
+        "cpu_engine": cpu_engine(session.cpu_engine()),
         "weights": case.weights_summary(),
         "structures": structures(case),
         "loading": session.loading().map(|l| json!({
@@ -188,6 +188,17 @@ pub(crate) fn checks(background: &Background) -> Value {
     let mut report = report.clone();
     report["current"] = background.checks_current().into();
     report
+}
+
+/// What `state()` says of the CPU engine: its workers, whether they are threads, and how many
+/// openings were asked of them.
+pub fn cpu_engine(pool: &crate::worker::Pool) -> Value {
+    json!({
+        "workers": pool.workers(),
+        "view_worker": pool.has_view_worker(),
+        "threaded": pool.threaded(),
+        "openings": pool.openings(),
+    })
 }
 
 #[cfg(test)]

@@ -97,7 +97,7 @@ pub(super) fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Con
                 }
             }));
             let pool = Pool::with_view_worker(Box::new(w));
-            log::info!("CPU engine: {}", pool.to_json());
+            log::info!("CPU engine: {}", crate::app::api::json::cpu_engine(&pool));
             doc.borrow_mut().session_mut().set_cpu_engine(pool);
         }
         Err(why) => log::error!("no engine workers, the CPU engine runs on the page: {why}"),
