@@ -187,7 +187,8 @@ impl CaseDocument {
 
     /// The smoothed mesh (the original while nothing is smoothed) in `format`: normals, the
     /// given colours and, in GLB `extras`, the filter, parameters and measures. Nothing of the
-    /// input file's header is written.
+    /// input file's header is written. Refused while the result is of parameters since changed,
+    /// so that a file never states parameters its surface was not made with.
     pub fn export(
         &self,
         format: ExportFormat,
@@ -195,7 +196,10 @@ impl CaseDocument {
     ) -> Result<Vec<u8>, String> {
         let model = self.model().ok_or("no mesh is open")?;
         let triangles = model.mesh().triangles.clone();
-        let (mesh, extras) = match self.last_result() {
+        if self.result().is_none() && self.last_result().is_some() {
+            return Err("the surface for the current parameters is still being computed".into());
+        }
+        let (mesh, extras) = match self.result() {
             Some(r) => (
                 Mesh::new(r.positions.clone(), triangles),
                 Some(export::smoothing_extras(self.params(), &r.metrics)),

@@ -164,6 +164,20 @@ fn exports_carry_the_smoothing_and_read_back() {
 }
 
 #[test]
+fn an_export_never_states_parameters_its_surface_was_not_made_with() {
+    let mut s = sample_session();
+    s.smooth_cpu();
+    s.case_mut()
+        .set_params_json(&serde_json::json!({"iterations": 7}))
+        .unwrap();
+    let stale = s.case().export(ExportFormat::Glb, None);
+    assert!(stale.unwrap_err().contains("still being computed"));
+    s.smooth_cpu();
+    let glb = s.case().export(ExportFormat::Glb, None).unwrap();
+    assert!(String::from_utf8_lossy(&glb).contains("\"iterations\":7"));
+}
+
+#[test]
 fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     let mut s = sample_session();
     s.case_mut()
