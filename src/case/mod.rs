@@ -39,8 +39,9 @@ pub struct Case {
     pub structures: Vec<CaseStructure>,
 }
 
-/// One structure of a case.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// One structure of a case. Two are equal when they would be written the same: the memory of
+/// other filters and the revision count are the editor's, not the case's.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseStructure {
     pub name: String,
     /// Display (sRGB) colour and opacity, each in [0, 1].
@@ -78,8 +79,9 @@ pub struct CaseStructure {
     pub revision: u64,
 }
 
-/// A structure's smoothed surface and its measures against the original.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A structure's smoothed surface and its measures against the original; equal when they
+/// would be written the same.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Smoothed {
     #[serde(with = "crate::mesh::flat_bytes")]
     pub positions: Vec<[f32; 3]>,
@@ -93,6 +95,25 @@ pub struct Smoothed {
     /// The structure's [`CaseStructure::revision`] it was made for.
     #[serde(skip)]
     pub revision: u64,
+}
+
+impl PartialEq for CaseStructure {
+    fn eq(&self, o: &Self) -> bool {
+        (self.name == o.name && self.color == o.color && self.visible == o.visible)
+            && (self.group == o.group && self.description == o.description)
+            && (self.source == o.source && self.label == o.label)
+            && (self.voxel_size == o.voxel_size && self.voxels == o.voxels)
+            && (self.original == o.original && self.params == o.params && self.tau == o.tau)
+            && (self.weights == o.weights && self.smoothed == o.smoothed)
+    }
+}
+
+impl PartialEq for Smoothed {
+    fn eq(&self, o: &Self) -> bool {
+        self.positions == o.positions
+            && self.metrics == o.metrics
+            && self.local_error == o.local_error
+    }
 }
 
 impl Smoothed {

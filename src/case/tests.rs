@@ -117,3 +117,17 @@ fn groups_are_listed_once_in_the_order_they_first_appear() {
     );
     assert_eq!(case.structures.len(), 5);
 }
+
+#[test]
+fn structures_are_equal_when_they_would_be_written_the_same() {
+    let mut a = CaseStructure::from_mesh("a", tetra(), [1.0, 0.0, 0.0]);
+    pipeline::smooth_structure(&mut a);
+    let mut b = a.clone();
+    // The editor's memory of other filters and its revision count are not written.
+    b.set_filter(Filter::Taubin);
+    b.set_filter(Filter::Hc);
+    assert_ne!(a.revision, b.revision);
+    assert_eq!(a, b);
+    b.tau += 0.1;
+    assert_ne!(a, b, "a written setting differs");
+}
