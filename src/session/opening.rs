@@ -5,7 +5,6 @@
 
 use super::{Model, Session};
 use crate::case::{self, Case};
-use crate::io::{self, Format};
 use crate::model::Opened;
 use crate::segmentation::NamedBytes;
 use crate::worker::{Input, LoadJob, NamedFile, Reply};
@@ -191,25 +190,11 @@ impl Session {
     /// surface takes those of the model before it, so files opened one after another smooth
     /// alike.
     fn take_file(&mut self, name: &str, first_file: &str, case: Case, model: Model) {
-        let own_params = io::is_label_map(first_file)
-            || matches!(
-                Format::from_name(first_file),
-                Some(Format::Glb | Format::Gltf)
-            );
-        let before = (self.doc.structure())
-            .filter(|_| !own_params)
-            .map(|s| (s.params, s.other_params.clone(), s.tau));
         // A "Suggest all" or checks of the structures before are of no use now.
         self.cancel_suggest_all();
         self.suggest_all = Default::default();
         self.checks = Default::default();
-        self.doc.adopt(case, name, model);
-        let first = self.doc.case.structures.first_mut();
-        if let (Some((params, others, tau)), Some(s)) = (before, first) {
-            s.set_params(params);
-            s.other_params = others;
-            s.set_tau(tau);
-        }
+        self.doc.adopt(case, name, first_file, model);
         self.became_model();
     }
 

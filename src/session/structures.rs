@@ -4,6 +4,7 @@
 
 use super::{CaseDocument, Model};
 use crate::case::{Case, CaseStructure};
+use crate::io::{self, Format};
 use crate::metrics::Metrics;
 use crate::model;
 use crate::segmentation::default_color;
@@ -176,14 +177,29 @@ impl CaseDocument {
             .collect()
     }
 
-    /// Makes `case` (opened from `file`) the open case, its first structure (with `model`
-    /// built) the model.
-    pub(super) fn adopt(&mut self, case: Case, file: &str, model: Model) {
+    /// Makes `case` (opened from `file`, the first of its files `first_file`) the open case, its
+    /// first structure (with `model` built) the model.
+    pub(super) fn adopt(&mut self, case: Case, file: &str, first_file: &str, model: Model) {
+        // A bare surface has no settings of its own: it keeps the ones the user was trying.
+        // Label maps and case glTFs bring each structure's own.
+        let own_settings = io::is_label_map(first_file)
+            || matches!(
+                Format::from_name(first_file),
+                Some(Format::Glb | Format::Gltf)
+            );
+        let before = (self.structure())
+            .filter(|_| !own_settings)
+            .map(|s| (s.params, s.other_params.clone(), s.tau));
         self.case = case;
         self.case_file = file.to_string();
         self.current = 0;
         self.models.clear();
         self.models.keep(0, model);
+        if let (Some((params, others, tau)), Some(s)) = (before, self.case.structures.first_mut()) {
+            s.set_params(params);
+            s.other_params = others;
+            s.set_tau(tau);
+        }
         self.case_version += 1;
         self.became_model();
     }
