@@ -235,6 +235,7 @@ fn suggest_all_gives_each_structure_its_own_parameters_and_can_be_cancelled() {
         filter: None,
         method: SearchMethod::Local,
         max_volume_change: None,
+        learn: false,
     };
     let cancelled = suggest_all(&mut case, &options, &|_| false).expect("no error");
     assert!(cancelled.iter().all(Option::is_none));
@@ -355,6 +356,7 @@ fn suggest_all_at_tau_half_brings_every_phantom_surface_closer_to_the_truth() {
         filter: None,
         method: SearchMethod::Grid,
         max_volume_change: Some(0.05),
+        learn: false,
     };
     suggest_all(&mut case, &options, &|_| true).expect("suggests");
     let after = case::check(&case, true);
@@ -390,5 +392,43 @@ fn suggest_all_at_tau_half_brings_every_phantom_surface_closer_to_the_truth() {
         changes.new_crossings.is_empty(),
         "{:?}",
         changes.new_crossings
+    );
+}
+
+/// The learned search (each structure's local search starting where smaller structures'
+/// searches ended) finds each phantom structure's score within 1% of the full grid's minimum.
+#[test]
+fn the_learned_search_lands_within_one_percent_of_the_grid_on_the_phantom() {
+    let run = |method, learn| {
+        let mut case = phantom();
+        let options = SuggestAllOptions {
+            tau: 0.5,
+            filter: None,
+            method,
+            max_volume_change: Some(0.05),
+            learn,
+        };
+        let suggestions = suggest_all(&mut case, &options, &|_| true).expect("suggests");
+        suggestions
+            .into_iter()
+            .map(|s| s.expect("every structure suggested"))
+            .collect::<Vec<_>>()
+    };
+    let grid = run(SearchMethod::Grid, false);
+    let learned = run(SearchMethod::Local, true);
+    let (grid_sets, learned_sets): (usize, usize) = (
+        grid.iter().map(|s| s.evaluations).sum(),
+        learned.iter().map(|s| s.evaluations).sum(),
+    );
+    for (g, l) in grid.iter().zip(&learned) {
+        println!(
+            "S grid {:.5} learned {:.5} {:?}",
+            g.score, l.score, l.params
+        );
+        assert!(l.score <= g.score * 1.01, "{} above {}", l.score, g.score);
+    }
+    assert!(
+        5 * learned_sets < grid_sets,
+        "{learned_sets} sets against the grid's {grid_sets}"
     );
 }

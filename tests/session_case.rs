@@ -286,8 +286,12 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
         ..Case::default()
     };
     assert_eq!(expected.structures[0].params, *session.case().params());
-    assert!(session.start_suggest_all(1.5, SearchMethod::Local).is_err());
-    session.start_suggest_all(0.5, SearchMethod::Local).unwrap();
+    assert!(session
+        .start_suggest_all(1.5, SearchMethod::Local, false)
+        .is_err());
+    session
+        .start_suggest_all(0.5, SearchMethod::Local, false)
+        .unwrap();
     // Workers on this thread answer at once.
     assert!(session.step_suggest_all());
     assert!(!session.background().suggesting_all());
@@ -305,9 +309,10 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
         filter: None,
         method: SearchMethod::Local,
         max_volume_change: Some(0.05),
+        learn: false,
     };
     let mut liver = expected.structures[0].clone();
-    let first = case::suggest_structure(&mut liver, &options, &mut |_| true)
+    let first = case::suggest_structure(&mut liver, &options, &[], &mut |_| true)
         .unwrap()
         .unwrap();
     case::suggest_all(&mut expected, &options, &|_| true).unwrap();
@@ -587,4 +592,53 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
     assert!(session.loading().is_none(), "nothing left to add");
     assert_eq!(session.case().case_structures().len(), 5, "the case stays");
+}
+
+/// Learning, the page hands the structures out batch by batch as `case build` does, so each
+/// structure's search starts at the same sets and every structure gets the CLI's suggestion.
+#[test]
+fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
+    use meshsmooth::case::{self, Case, SuggestAllOptions, LEARNING_BATCH};
+    use meshsmooth::session::Session;
+    use meshsmooth::suggest::SearchMethod;
+    let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
+    let mut session = Session::default();
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes.clone());
+    session.poll_opening().expect("done").expect("opens");
+    // Three copies of the phantom: more structures than one batch.
+    for copy in ["copy1.seg.nrrd", "copy2.seg.nrrd"] {
+        session.begin_add(copy, bytes.clone());
+        session.poll_opening().expect("done").expect("adds");
+    }
+    let count = session.case().case_structures().len();
+    assert!(count > 2 * LEARNING_BATCH, "{count} structures");
+    let mut expected = Case {
+        structures: session.case().case_structures().to_vec(),
+        ..Case::default()
+    };
+    session
+        .start_suggest_all(0.5, SearchMethod::Local, true)
+        .unwrap();
+    while session.background().suggesting_all() {
+        assert!(
+            session.step_suggest_all(),
+            "workers on this thread answer at once"
+        );
+    }
+    let options = SuggestAllOptions {
+        tau: 0.5,
+        filter: None,
+        method: SearchMethod::Local,
+        max_volume_change: Some(0.05),
+        learn: true,
+    };
+    let want = case::suggest_all(&mut expected, &options, &|_| true).unwrap();
+    let outcome = session.background().suggest_all().unwrap();
+    assert_eq!((outcome.done, outcome.total), (count, count));
+    for (i, (got, want)) in outcome.structures.iter().zip(&want).enumerate() {
+        let Some(StructureOutcome::Suggested { params, .. }) = got else {
+            panic!("structure {i}: {got:?}");
+        };
+        assert_eq!(*params, want.unwrap().params, "structure {i}");
+    }
 }

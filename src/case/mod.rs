@@ -17,7 +17,8 @@ pub use from_files::{
     surface_structure, CaseOpenError,
 };
 pub use pipeline::{
-    smooth_structure, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllProgress,
+    smooth_structure, starts_from, suggest_all, suggest_structure, SuggestAllOptions,
+    SuggestAllProgress, LEARNING_BATCH,
 };
 pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
 

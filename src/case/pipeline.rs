@@ -9,9 +9,9 @@ use rayon::prelude::*;
 use super::{Case, CaseStructure, Smoothed};
 use crate::mesh::Topology;
 use crate::metrics::{measure_vertices, smooth_drifting, Original};
-use crate::smooth::Filter;
+use crate::smooth::{Filter, Params};
 use crate::suggest::{
-    search_evaluator, suggest_for_goal, Goal, SearchMethod, SuggestError, Suggestion,
+    search_evaluator, suggest_for_goal, suggest_from, Goal, SearchMethod, SuggestError, Suggestion,
 };
 
 /// Smooths a structure from its original with its parameters and weights and measures the
@@ -42,6 +42,9 @@ pub struct SuggestAllOptions {
     pub method: SearchMethod,
     /// Each structure's suggestion changes its volume by at most this fraction, when given.
     pub max_volume_change: Option<f64>,
+    /// With the local search: start each structure's search where the searches of structures
+    /// finished before it ended, smallest structures first, instead of at the corners.
+    pub learn: bool,
 }
 
 /// How far "Suggest all" has come: structures finished, of all, and parameter sets measured.
@@ -83,33 +86,56 @@ pub fn suggest_all(
         }
         !cancelled.load(Ordering::Relaxed)
     };
-    // The largest first, so the pool is not left waiting on one big structure at the end.
+    let learning = options.learn && options.method == SearchMethod::Local;
+    // The largest first, so the pool is not left waiting on one big structure at the end;
+    // learning, the smallest first, so the large ones start where the small ones ended.
     let mut order: Vec<usize> = (0..total).collect();
-    order.sort_by_key(|&i| std::cmp::Reverse(case.structures[i].original.vertex_count()));
+    order.sort_by_key(|&i| case.structures[i].original.vertex_count());
+    if !learning {
+        order.reverse();
+    }
     let work: Vec<(usize, CaseStructure)> = order
         .into_iter()
         .map(|i| (i, case.structures[i].clone()))
         .collect();
-    let results: Vec<(usize, Outcome)> = work
-        .into_par_iter()
-        .with_max_len(1)
-        .map(|(i, mut s)| {
-            if cancelled.load(Ordering::Relaxed) {
-                return (i, Ok(None));
-            }
-            if let Some(filter) = options.filter {
-                s.set_filter(filter);
-            }
-            let outcome = suggest_structure(&mut s, options, &mut |_| {
-                evaluations.fetch_add(1, Ordering::Relaxed);
-                tell(false)
-            });
-            if matches!(outcome, Ok(Some(_))) {
-                tell(true);
-            }
-            (i, outcome.map(|o| o.map(|sg| (sg, s))))
-        })
-        .collect();
+    // Learning goes batch by batch, each starting from the batches before it: the same starts
+    // on any number of threads, so the page's workers find what the CLI finds.
+    let batch = if learning {
+        LEARNING_BATCH
+    } else {
+        total.max(1)
+    };
+    let mut learned: Vec<Params> = Vec::new();
+    let mut results: Vec<(usize, Outcome)> = Vec::with_capacity(total);
+    for part in work.chunks(batch) {
+        let outcomes: Vec<(usize, Outcome)> = (part.to_vec().into_par_iter())
+            .with_max_len(1)
+            .map(|(i, mut s)| {
+                if cancelled.load(Ordering::Relaxed) {
+                    return (i, Ok(None));
+                }
+                if let Some(filter) = options.filter {
+                    s.set_filter(filter);
+                }
+                let starts = starts_from(&learned, s.params.filter);
+                let outcome = suggest_structure(&mut s, options, &starts, &mut |_| {
+                    evaluations.fetch_add(1, Ordering::Relaxed);
+                    tell(false)
+                });
+                if matches!(outcome, Ok(Some(_))) {
+                    tell(true);
+                }
+                (i, outcome.map(|o| o.map(|sg| (sg, s))))
+            })
+            .collect();
+        if learning {
+            learned.extend(outcomes.iter().filter_map(|(_, o)| match o {
+                Ok(Some((sg, _))) => Some(sg.params),
+                _ => None,
+            }));
+        }
+        results.extend(outcomes);
+    }
     let mut suggestions = vec![None; total];
     let mut first_error = None;
     for (i, result) in results {
@@ -131,13 +157,48 @@ pub fn suggest_all(
     }
 }
 
+/// How many structures, smallest first, search at once when they learn from each other.
+pub const LEARNING_BATCH: usize = 4;
+
+/// Where a structure's search starts, from the suggestions of the structures finished before
+/// it: the three `filter`'s searches ended at most often. None (the corners) before any.
+pub fn starts_from(learned: &[Params], filter: Filter) -> Vec<Params> {
+    let mut counted: Vec<(Params, usize)> = Vec::new();
+    for p in learned.iter().filter(|p| p.filter == filter) {
+        match counted.iter_mut().find(|(q, _)| same_point(q, p)) {
+            Some((_, n)) => *n += 1,
+            None => counted.push((*p, 1)),
+        }
+    }
+    // The most frequent first; among equals the latest (`learned` is in order of size: the
+    // nearest in size).
+    counted.reverse();
+    counted.sort_by_key(|&(_, n)| std::cmp::Reverse(n));
+    counted.into_iter().take(3).map(|(p, _)| p).collect()
+}
+
+fn same_point(a: &Params, b: &Params) -> bool {
+    a.iterations == b.iterations
+        && [
+            (a.alpha, b.alpha),
+            (a.beta, b.beta),
+            (a.lambda, b.lambda),
+            (a.mu, b.mu),
+        ]
+        .iter()
+        .all(|(x, y)| (x - y).abs() < 1e-6)
+        && (a.passband - b.passband).abs() < 1e-9
+}
+
 /// A structure's suggestion and the structure smoothed with it; `None` when cancelled or empty.
 type Outcome = Result<Option<(Suggestion, CaseStructure)>, SuggestError>;
 
 /// One structure's suggestion, applied and smoothed; `None` when it has no vertices.
+/// `starts`, when not empty, are where its local search starts ([`starts_from`]).
 pub fn suggest_structure(
     s: &mut CaseStructure,
     options: &SuggestAllOptions,
+    starts: &[Params],
     on_progress: &mut dyn FnMut(crate::suggest::Progress) -> bool,
 ) -> Result<Option<Suggestion>, SuggestError> {
     if s.original.vertex_count() == 0 {
@@ -151,8 +212,12 @@ pub fn suggest_structure(
         tau: options.tau,
         max_volume_change: options.max_volume_change,
     };
-    let suggestion =
-        suggest_for_goal(&mut evaluator, &s.params, goal, options.method, on_progress)?;
+    let suggestion = match options.method {
+        SearchMethod::Local if !starts.is_empty() => {
+            suggest_from(&mut evaluator, &s.params, goal, starts, on_progress)?
+        }
+        method => suggest_for_goal(&mut evaluator, &s.params, goal, method, on_progress)?,
+    };
     s.set_params(suggestion.params);
     s.set_tau(options.tau);
     let smoothed = smooth_on(s, &original);

@@ -44,9 +44,10 @@ pub(super) struct BuildArgs {
     /// (hc for new structures).
     #[arg(long, value_parser = parse_filter)]
     filter: Option<Filter>,
-    /// grid (every grid point) or local (faster).
-    #[arg(long, default_value = "grid", value_parser = parse_search)]
-    search: SearchMethod,
+    /// grid (every grid point), local (the paper's, from the corners) or learned (the local
+    /// search from where the searches of smaller structures ended).
+    #[arg(long, default_value = "learned", value_parser = parse_case_search)]
+    search: (SearchMethod, bool),
     /// The most volume a structure's suggestion may take off or add, in percent of its
     /// original volume, or `none`: thin structures (vessels) lose volume faster than the
     /// score weighs it.
@@ -118,8 +119,9 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     let options = SuggestAllOptions {
         tau: args.tau,
         filter: args.filter,
-        method: args.search,
+        method: args.search.0,
         max_volume_change: args.max_volume_change.0.map(|p| p / 100.0),
+        learn: args.search.1,
     };
     let suggest_started = Instant::now();
     let suggestions = suggest_all_shown(&mut case, &options)?;
@@ -201,6 +203,16 @@ fn gltf_options(args: &BuildArgs, container: Container) -> CaseGltfOptions {
 /// A percentage, or none.
 #[derive(Clone, Copy, Debug)]
 struct Percent(Option<f64>);
+
+/// A case's search: a [`SearchMethod`] and whether structures learn from each other.
+fn parse_case_search(name: &str) -> Result<(SearchMethod, bool), String> {
+    match name {
+        "learned" => Ok((SearchMethod::Local, true)),
+        _ => parse_search(name)
+            .map(|m| (m, false))
+            .map_err(|e| format!("{e}, or learned")),
+    }
+}
 
 fn parse_percent(text: &str) -> Result<Percent, String> {
     if text == "none" {

@@ -4,7 +4,8 @@
 //! and cancel; the structure that is the model takes its suggestion as new parameters.
 
 use super::{Background, Session};
-use crate::case::{Smoothed, SuggestAllOptions};
+use crate::case::{starts_from, Smoothed, SuggestAllOptions, LEARNING_BATCH};
+use crate::mesh::Mesh;
 use crate::metrics::Metrics;
 use crate::smooth::Params;
 use crate::suggest::SearchMethod;
@@ -16,11 +17,18 @@ pub struct SuggestAll {
     options: Option<SuggestAllOptions>,
     /// Each structure's job still to answer.
     waiting: Vec<(usize, StructureJob)>,
+    /// The structures not yet handed to a worker.
+    queued: std::collections::VecDeque<Work>,
+    /// The structures in the order they are handed out (learning: smallest first).
+    order: Vec<usize>,
     total: usize,
     /// Per structure, what it got (`None` until it answers).
     outcome: Vec<Option<StructureOutcome>>,
     cancelled: bool,
 }
+
+/// One structure's part: its index, surface, parameters and weights.
+type Work = (usize, Mesh, Params, Option<Vec<f32>>);
 
 /// What one structure got from "Suggest all", under its name.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,7 +61,12 @@ pub struct SuggestAllReport<'a> {
 impl Session {
     /// Starts "Suggest all" at `tau` with `method` for every structure of the open case, each
     /// from its own filter and parameters (bound included). Replaces one under way.
-    pub fn start_suggest_all(&mut self, tau: f64, method: SearchMethod) -> Result<(), String> {
+    pub fn start_suggest_all(
+        &mut self,
+        tau: f64,
+        method: SearchMethod,
+        learn: bool,
+    ) -> Result<(), String> {
         if !(0.0..=1.0).contains(&tau) {
             return Err(format!("tau = {tau} is out of range: [0, 1]"));
         }
@@ -66,36 +79,68 @@ impl Session {
             // As `case build` does by default: thin structures lose volume faster than the
             // score weighs it.
             max_volume_change: Some(0.05),
+            learn: learn && method == SearchMethod::Local,
         };
-        let work: Vec<_> = (self.doc.case.structures.iter().enumerate())
+        let mut work: Vec<Work> = (self.doc.case.structures.iter().enumerate())
             .map(|(i, s)| (i, s.original.clone(), s.params, s.weights.clone()))
             .collect();
-        let mut work = work;
-        // The largest first, so no worker is left with one big structure at the end.
-        work.sort_by_key(|w| std::cmp::Reverse(w.1.vertex_count()));
+        // As `case build`: learning, the smallest first; else the largest first, so no worker
+        // is left with one big structure at the end.
+        work.sort_by_key(|w| w.1.vertex_count());
+        if !options.learn {
+            work.reverse();
+        }
         let total = work.len();
-        let waiting = work
-            .into_iter()
-            .map(|(i, mesh, params, weights)| {
-                (
-                    i,
-                    self.cpu.suggest_structure(mesh, params, weights, options),
-                )
-            })
-            .collect();
         self.suggest_all = SuggestAll {
             options: Some(options),
-            waiting,
+            order: work.iter().map(|w| w.0).collect(),
+            queued: work.into(),
             total,
             outcome: vec![None; total],
-            cancelled: false,
+            ..SuggestAll::default()
         };
+        self.hand_out_structures();
         Ok(())
+    }
+
+    /// Gives the workers the queued structures: all at once, or learning, as `case build`
+    /// does: batch by batch, each structure starting where the batches before ended.
+    fn hand_out_structures(&mut self) {
+        let Some(options) = self.suggest_all.options else {
+            return;
+        };
+        if options.learn && !self.suggest_all.waiting.is_empty() {
+            return;
+        }
+        let batch = if options.learn {
+            LEARNING_BATCH
+        } else {
+            usize::MAX
+        };
+        let all = &self.suggest_all;
+        let learned: Vec<Params> = (all.order.iter())
+            .filter_map(|&i| match all.outcome.get(i) {
+                Some(Some(StructureOutcome::Suggested { params, .. })) => Some(*params),
+                _ => None,
+            })
+            .collect();
+        for _ in 0..batch {
+            let Some((i, mesh, params, weights)) = self.suggest_all.queued.pop_front() else {
+                break;
+            };
+            let starts = match options.learn {
+                true => starts_from(&learned, params.filter),
+                false => Vec::new(),
+            };
+            let job = (self.cpu).suggest_structure(mesh, params, weights, options, starts);
+            self.suggest_all.waiting.push((i, job));
+        }
     }
 
     /// Stops "Suggest all": structures already done keep what they got.
     pub fn cancel_suggest_all(&mut self) {
         let jobs: Vec<StructureJob> = self.suggest_all.waiting.drain(..).map(|w| w.1).collect();
+        self.suggest_all.queued.clear();
         if !jobs.is_empty() {
             self.cpu.forget_structures(&jobs);
             self.suggest_all.cancelled = true;
@@ -124,6 +169,7 @@ impl Session {
                 *slot = Some(outcome);
             }
         }
+        self.hand_out_structures();
         any
     }
 
@@ -181,14 +227,14 @@ impl Session {
 impl<'a> Background<'a> {
     /// Whether "Suggest all" is under way.
     pub fn suggesting_all(&self) -> bool {
-        !self.suggest_all.waiting.is_empty()
+        !self.suggest_all.waiting.is_empty() || !self.suggest_all.queued.is_empty()
     }
 
     /// Structures done and in all, while "Suggest all" is under way.
     pub fn suggest_all_progress(&self) -> Option<(usize, usize)> {
         let s = &self.suggest_all;
         self.suggesting_all()
-            .then(|| (s.total - s.waiting.len(), s.total))
+            .then(|| (s.total - s.waiting.len() - s.queued.len(), s.total))
     }
 
     /// The last "Suggest all" since the case opened, as far as it got.
@@ -197,7 +243,7 @@ impl<'a> Background<'a> {
         Some(SuggestAllReport {
             options: s.options?,
             structures: &s.outcome,
-            done: s.total - s.waiting.len(),
+            done: s.total - s.waiting.len() - s.queued.len(),
             total: s.total,
             cancelled: s.cancelled,
         })

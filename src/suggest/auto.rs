@@ -145,6 +145,25 @@ pub fn suggest_for_goal(
     suggestion.ok_or(SuggestError::Empty)
 }
 
+/// [`suggest_for_goal`]'s local search started at `starts` (see [`LocalSearch::starting_at`]);
+/// the corners where no start fits.
+pub fn suggest_from(
+    evaluator: &mut dyn Evaluator,
+    base: &Params,
+    goal: Goal,
+    starts: &[Params],
+    on_progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<Suggestion, SuggestError> {
+    check_tau(goal.tau)?;
+    if let Some(limit) = goal.max_volume_change.filter(|l| l.is_nan() || *l < 0.0) {
+        return Err(SuggestError::VolumeLimit(limit));
+    }
+    let task = LocalSearch::new(base.filter, base, goal.tau)?
+        .limiting_volume(goal.max_volume_change)
+        .starting_at(starts);
+    Ok(run(task, evaluator, on_progress)?.suggestion)
+}
+
 /// `smooth --auto`: the suggestion for a freshly loaded mesh, without progress reporting.
 pub fn suggest_for_mesh(
     mesh: &Mesh,

@@ -63,6 +63,26 @@ impl LocalSearch {
         })
     }
 
+    /// Starts its searches at `starts` (parameter sets of this filter, on the grid) instead of
+    /// the corners: where similar meshes' searches ended, so that one or two short searches
+    /// stand in for the corners' long ones. Sets off the grid are left out; with none left the
+    /// corners stay.
+    pub fn starting_at(mut self, starts: &[Params]) -> Self {
+        let mut points: Vec<GridPoint> = Vec::new();
+        for p in starts.iter().filter(|p| p.filter == self.space.filter) {
+            let point = self.space.point_of(p);
+            if let Some(point) = point.filter(|&q| self.space.is_valid(&self.base, q)) {
+                if !points.contains(&point) {
+                    points.push(point);
+                }
+            }
+        }
+        if !points.is_empty() {
+            self.starts = points;
+        }
+        self
+    }
+
     /// Looks only among the sets that change the volume by at most `limit` (a fraction), when
     /// given: the search walks out of the sets past it towards it.
     pub fn limiting_volume(mut self, limit: Option<f64>) -> Self {
@@ -264,6 +284,47 @@ mod tests {
             "{}",
             out.suggestion.evaluations
         );
+    }
+
+    #[test]
+    fn a_search_started_near_the_minimum_finds_it_for_a_fraction_of_the_corners_cost() {
+        let space = ParamSpace::of(Filter::Hc);
+        let base = Params::defaults(Filter::Hc);
+        let centre = GridPoint([4, 6, 5]);
+        let from_corners = local(Filter::Hc, 0.5, &mut FnEvaluator::new(bowl(&space, centre)));
+        let near = space.params_at(&base, GridPoint([5, 6, 4]));
+        // Another filter's set and one off the grid are no starts; the near one is.
+        let off_grid = Params {
+            alpha: 0.123,
+            ..base
+        };
+        let starts = [Params::defaults(Filter::Taubin), off_grid, near];
+        let task = LocalSearch::new(Filter::Hc, &base, 0.5)
+            .unwrap()
+            .starting_at(&starts);
+        let mut ev = FnEvaluator::new(bowl(&space, centre));
+        let out = run(task, &mut ev, &mut |_| true).unwrap();
+        assert_eq!(out.minima, vec![centre]);
+        assert_eq!(out.paths[0][0], GridPoint([5, 6, 4]));
+        let (warm, cold) = (
+            out.suggestion.evaluations,
+            from_corners.suggestion.evaluations,
+        );
+        assert!(
+            3 * warm <= cold,
+            "{warm} sets from near, {cold} from the corners"
+        );
+        // With no start that fits, the corners stay.
+        let task = LocalSearch::new(Filter::Hc, &base, 0.5)
+            .unwrap()
+            .starting_at(&[off_grid]);
+        let out = run(
+            task,
+            &mut FnEvaluator::new(bowl(&space, centre)),
+            &mut |_| true,
+        )
+        .unwrap();
+        assert_eq!(out.paths.len(), space.dims());
     }
 
     #[test]

@@ -67,6 +67,8 @@ pub enum Request {
         params: Params,
         weights: Option<Vec<f32>>,
         options: SuggestAllOptions,
+        /// Where its local search starts ([`crate::case::starts_from`]); empty: the corners.
+        starts: Vec<Params>,
     },
     /// The checks between `case`'s structures: as opened, and as shown ([`Reply::Checked`]).
     CheckCase { job: u64, case: Box<Case> },
@@ -224,7 +226,10 @@ impl Worker {
                 params,
                 weights,
                 options,
-            } => Some(suggest_structure(job, mesh, params, weights, &options)),
+                starts,
+            } => Some(suggest_structure(
+                job, mesh, params, weights, &options, &starts,
+            )),
             Request::CheckCase { job, case } => Some(check_case(job, &case, clock)),
         }
     }
@@ -337,11 +342,12 @@ fn suggest_structure(
     params: Params,
     weights: Option<Vec<f32>>,
     options: &SuggestAllOptions,
+    starts: &[Params],
 ) -> Reply {
     let mut structure = CaseStructure::from_mesh("", mesh, [1.0; 3]);
     structure.set_params(params);
     structure.set_weights(weights);
-    match case::suggest_structure(&mut structure, options, &mut |_| true) {
+    match case::suggest_structure(&mut structure, options, starts, &mut |_| true) {
         Ok(suggestion) => {
             let suggested = suggestion.zip(structure.smoothed).map(|(s, smoothed)| {
                 Box::new(StructureSuggestion {

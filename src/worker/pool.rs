@@ -226,6 +226,7 @@ impl Pool {
         params: Params,
         weights: Option<Vec<f32>>,
         options: SuggestAllOptions,
+        starts: Vec<Params>,
     ) -> StructureJob {
         let job = self.new_job();
         let request = Request::SuggestStructure {
@@ -234,6 +235,7 @@ impl Pool {
             params,
             weights,
             options,
+            starts,
         };
         self.structure_jobs.push_back((job, request));
         self.pump();

@@ -141,7 +141,9 @@ fn the_view_worker_smooths_at_once_while_the_others_are_busy() {
             filter: None,
             method: crate::suggest::SearchMethod::Local,
             max_volume_change: None,
+            learn: false,
         },
+        Vec::new(),
     );
     let view = pool.smooth(&m, &params(Filter::Hc, 20), 0.5, true);
     let jobs = |worker: usize| -> Vec<String> {

@@ -73,8 +73,10 @@ fn suggest_all(
     Closure::new(move |options: JsValue| {
         let started = {
             let mut doc = d.borrow_mut();
-            tau_and_search(doc.session(), &options, "suggestAll")
-                .and_then(|(tau, method)| doc.session_mut().start_suggest_all(tau, method))
+            tau_and_search(doc.session(), &options, "suggestAll").and_then(|(tau, search)| {
+                let (method, learn) = search;
+                doc.session_mut().start_suggest_all(tau, method, learn)
+            })
         };
         started_work(
             &d,
@@ -136,7 +138,10 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
 fn start_suggest(doc: &SharedDocument, options: &JsValue) -> Result<(f64, SearchMethod), String> {
     let mut doc = doc.borrow_mut();
     let session = doc.session_mut();
-    let (tau, method) = tau_and_search(session, options, "suggest")?;
+    let (tau, (method, learned)) = tau_and_search(session, options, "suggest")?;
+    if learned {
+        return Err("suggest: the learned search is Suggest all's: use grid or local".into());
+    }
     session.case_mut().set_tau(tau)?;
     session.start_suggest(method);
     Ok((tau, method))
@@ -147,7 +152,7 @@ fn tau_and_search(
     session: &Session,
     options: &JsValue,
     what: &str,
-) -> Result<(f64, SearchMethod), String> {
+) -> Result<(f64, (SearchMethod, bool)), String> {
     let options = if options.is_undefined() || options.is_null() {
         serde_json::json!({})
     } else {
@@ -162,12 +167,14 @@ fn tau_and_search(
             .as_f64()
             .ok_or_else(|| format!("{what}: tau must be a number in [0, 1], got {v}"))?,
     };
-    let method = match options.get("search") {
-        None | Some(serde_json::Value::Null) => SearchMethod::Grid,
+    let search = match options.get("search") {
+        None | Some(serde_json::Value::Null) => (SearchMethod::Grid, false),
+        Some(v) if v.as_str() == Some("learned") => (SearchMethod::Local, true),
         Some(v) => v
             .as_str()
             .and_then(SearchMethod::from_name)
-            .ok_or_else(|| format!("{what}: unknown search {v}: use grid or local"))?,
+            .map(|m| (m, false))
+            .ok_or_else(|| format!("{what}: unknown search {v}: use grid, local or learned"))?,
     };
-    Ok((tau, method))
+    Ok((tau, search))
 }

@@ -323,8 +323,10 @@ impl Shell {
                 }
                 StructureAction::SuggestAll => {
                     let tau = doc.case().tau();
+                    // Local: each structure's search starts where smaller ones' ended.
                     let method = self.guide.method;
-                    doc.session_mut().start_suggest_all(tau, method)
+                    let learn = method == crate::suggest::SearchMethod::Local;
+                    doc.session_mut().start_suggest_all(tau, method, learn)
                 }
                 StructureAction::Check => doc.session_mut().start_checks(),
                 StructureAction::CancelSuggestAll => {
