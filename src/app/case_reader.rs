@@ -6,7 +6,9 @@
 use eframe::egui;
 
 use super::document::{PanelLayout, StructureRow};
-use super::structure_list::{listed_groups, measures, show_box, solo_button, StructureAction};
+use super::structure_list::{
+    filter_field, grouped_rows, measures, show_box, solo_button, StructureAction,
+};
 use crate::case::CaseStructure;
 use crate::session::{Session, StructureChange};
 
@@ -16,10 +18,11 @@ pub fn show(
     ui: &mut egui::Ui,
     session: &Session,
     layout: &mut PanelLayout,
-    error_colours: &mut bool,
+    (filter, error_colours): (&mut String, &mut bool),
 ) -> Vec<StructureAction> {
     layout.structures.clear();
     layout.structure_name = None;
+    layout.structure_filter = None;
     let mut actions = Vec::new();
     let Some(current) = session.case().current_structure() else {
         return actions;
@@ -47,22 +50,15 @@ pub fn show(
             }
         }
     });
-    let groups = listed_groups(list);
+    filter_field(ui, filter, list.len(), layout);
     egui::ScrollArea::vertical()
         .max_height(ui.available_height() * 0.5)
         .id_salt("case structures")
         .show(ui, |ui| {
-            for group in groups {
-                if let Some(name) = group {
-                    ui.label(egui::RichText::new(name).strong());
-                }
-                for (i, s) in list.iter().enumerate() {
-                    if s.group.as_deref() == group {
-                        let drawn = row(ui, i, s, i == current, &mut actions);
-                        layout.structures.push(drawn);
-                    }
-                }
-            }
+            grouped_rows(ui, list, filter, |ui, i, s| {
+                let drawn = row(ui, i, s, i == current, &mut actions);
+                layout.structures.push(drawn);
+            });
         });
     ui.separator();
     if let Some(s) = list.get(current) {

@@ -113,9 +113,10 @@ pub struct PanelLayout {
     pub graphs: Vec<GraphColumn>,
     /// The gallery cards' visible rectangles, in gallery order.
     pub gallery: Vec<PageRect>,
-    /// The Structures list's rows as drawn, and its Name field.
+    /// The Structures list's rows as drawn, its Name field and its filter field.
     pub structures: Vec<StructureRow>,
     pub structure_name: Option<PageRect>,
+    pub structure_filter: Option<PageRect>,
 }
 
 /// One row of the Structures list: its visibility box, show-alone button and name (which
@@ -157,6 +158,7 @@ impl PanelLayout {
                 "name": r.name.to_json(),
             })).collect::<Vec<_>>(),
             "structure_name": self.structure_name.map(PageRect::to_json),
+            "structure_filter": self.structure_filter.map(PageRect::to_json),
         })
     }
 }

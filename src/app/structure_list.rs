@@ -35,6 +35,8 @@ pub struct StructureList {
     /// The title and description being edited, and the session's when they were taken (the
     /// API may change those: then the fields show the new ones).
     case_text: ((String, String), (String, String)),
+    /// Shows only the structures whose name or group contains it.
+    filter: String,
 }
 
 /// The model's name, group and description as edited, and what the session had when they
@@ -61,6 +63,7 @@ impl StructureList {
     ) -> Vec<StructureAction> {
         layout.structures.clear();
         layout.structure_name = None;
+        layout.structure_filter = None;
         let mut actions = Vec::new();
         let Some(current) = session.case().current_structure() else {
             return actions;
@@ -73,26 +76,19 @@ impl StructureList {
                 actions.push(StructureAction::AddFiles);
             }
         });
-        let groups = listed_groups(list);
+        filter_field(ui, &mut self.filter, list.len(), layout);
         let flagged = session.background().flagged_structures();
         egui::ScrollArea::vertical()
             .max_height(220.0)
             .id_salt("structure list")
             .show(ui, |ui| {
-                for group in groups {
-                    if let Some(name) = group {
-                        ui.label(egui::RichText::new(name).strong());
-                    }
-                    for (i, s) in list.iter().enumerate() {
-                        if s.group.as_deref() == group {
-                            let flag = flagged.contains(&i);
-                            let measures = measures(s, session, i);
-                            let state = (i == current, flag);
-                            let drawn = row(ui, (i, s, &measures), state, &mut actions);
-                            layout.structures.push(drawn);
-                        }
-                    }
-                }
+                grouped_rows(ui, list, &self.filter, |ui, i, s| {
+                    let flag = flagged.contains(&i);
+                    let measures = measures(s, session, i);
+                    let state = (i == current, flag);
+                    let drawn = row(ui, (i, s, &measures), state, &mut actions);
+                    layout.structures.push(drawn);
+                });
             });
         if let Some(s) = list.get(current) {
             self.selected_fields(ui, session, (current, s), layout, &mut actions);
@@ -299,16 +295,60 @@ fn measured(m: &Metrics, diagonal: Option<f64>) -> String {
     )
 }
 
-/// The order a list shows groups in: ungrouped structures first, then each group where its
-/// first structure stands.
-pub fn listed_groups(list: &[CaseStructure]) -> Vec<Option<&str>> {
-    let mut groups: Vec<Option<&str>> = vec![None];
-    for g in list.iter().filter_map(|s| s.group.as_deref()) {
-        if !groups.contains(&Some(g)) {
-            groups.push(Some(g));
+/// More structures than this and the list offers a filter by name.
+const FILTER_FROM: usize = 8;
+
+/// The filter field over a list of `count` structures, when it has enough to need one;
+/// `layout` gets where it was drawn.
+pub fn filter_field(
+    ui: &mut egui::Ui,
+    filter: &mut String,
+    count: usize,
+    layout: &mut PanelLayout,
+) {
+    layout.structure_filter = None;
+    if count <= FILTER_FROM && filter.is_empty() {
+        return;
+    }
+    ui.horizontal(|ui| {
+        let field = ui.add(
+            egui::TextEdit::singleline(filter)
+                .hint_text("filter by name or group")
+                .desired_width(160.0),
+        );
+        layout.structure_filter = Some(field.rect.into());
+        if !filter.is_empty() && ui.small_button("×").on_hover_text("Clear").clicked() {
+            filter.clear();
+        }
+    });
+}
+
+/// The structures of `list` that `filter` keeps, ungrouped ones first, then each group under a
+/// header that folds (open while a filter is set); `row` draws one.
+pub fn grouped_rows(
+    ui: &mut egui::Ui,
+    list: &[CaseStructure],
+    filter: &str,
+    mut row: impl FnMut(&mut egui::Ui, usize, &CaseStructure),
+) {
+    for (group, rows) in crate::case::listed(list, filter) {
+        let mut draw = |ui: &mut egui::Ui| {
+            for &i in &rows {
+                row(ui, i, &list[i]);
+            }
+        };
+        match group {
+            None => draw(ui),
+            Some(name) => {
+                let title = format!("{name} ({})", rows.len());
+                egui::CollapsingHeader::new(egui::RichText::new(title).strong())
+                    .id_salt(("group", name))
+                    .default_open(true)
+                    .open((!filter.trim().is_empty()).then_some(true))
+                    .show(ui, draw);
+            }
         }
     }
-    groups
 }
 
 /// The box that shows or hides structure `i` (`s`).

@@ -300,5 +300,29 @@ impl Case {
     }
 }
 
+/// The structures as a list shows them: the ungrouped ones, then each group's, groups in
+/// the order they first appear; only those whose name or group contains `filter` (any
+/// case), and no group left empty by it.
+pub fn listed<'a>(
+    structures: &'a [CaseStructure],
+    filter: &str,
+) -> Vec<(Option<&'a str>, Vec<usize>)> {
+    let filter = filter.trim().to_lowercase();
+    let matches = |text: &str| text.to_lowercase().contains(&filter);
+    let mut listed: Vec<(Option<&str>, Vec<usize>)> = vec![(None, Vec::new())];
+    for (i, s) in structures.iter().enumerate() {
+        let group = s.group.as_deref();
+        if !filter.is_empty() && !matches(&s.name) && !group.is_some_and(matches) {
+            continue;
+        }
+        match listed.iter_mut().find(|(g, _)| *g == group) {
+            Some((_, rows)) => rows.push(i),
+            None => listed.push((group, vec![i])),
+        }
+    }
+    listed.retain(|(_, rows)| !rows.is_empty());
+    listed
+}
+
 #[cfg(test)]
 mod tests;

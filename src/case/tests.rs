@@ -156,3 +156,38 @@ fn searches_start_where_the_structures_before_ended_most_often() {
     // The most frequent first, then the latest; Taubin's set is not HC's start.
     assert_eq!(starts, vec![hc(0.0, 20), hc(0.3, 40), hc(0.2, 30)]);
 }
+
+#[test]
+fn a_list_shows_the_ungrouped_first_then_each_group_and_filters_by_name_or_group() {
+    let structure = |name: &str, group: Option<&str>| CaseStructure {
+        group: group.map(str::to_string),
+        ..CaseStructure::from_mesh(name, tetra(), [1.0, 0.0, 0.0])
+    };
+    let case = Case {
+        structures: vec![
+            structure("Aorta", Some("Vessels")),
+            structure("Liver", None),
+            structure("rib_left_1", Some("Bones")),
+            structure("Portal vein", Some("Vessels")),
+            structure("kidney_left", None),
+        ],
+        ..Case::default()
+    };
+    let listed = |filter| listed(&case.structures, filter);
+    let all = listed("");
+    assert_eq!(
+        all,
+        vec![
+            (None, vec![1, 4]),
+            (Some("Vessels"), vec![0, 3]),
+            (Some("Bones"), vec![2])
+        ]
+    );
+    assert_eq!(
+        listed(" LEFT"),
+        vec![(None, vec![4]), (Some("Bones"), vec![2])]
+    );
+    // A group's name keeps all its members.
+    assert_eq!(listed("vessel"), vec![(Some("Vessels"), vec![0, 3])]);
+    assert!(listed("spleen").is_empty());
+}

@@ -74,6 +74,21 @@ testIn(WEBGPU_RUN, "S1 the JHU atlas opens into its 48 structures, as the CLI ex
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");
         await app.metrics();
         await app.screenshot("S1-jhu-first-structure");
+
+        // 48 structures: the list offers a filter; typing keeps the rows whose name holds it
+        // (without a colour table they are "label 1" to "label 48": "label 4" keeps 4, 40-48).
+        const centre = (r) => [r.x + r.width / 2, r.y + r.height / 2];
+        let state = await app.stateWhen((s) => s.layout.structures.length === 48 && s.layout.structure_filter, "every row and the filter field");
+        await app.page.mouse.click(...centre(state.layout.structure_filter));
+        await app.page.keyboard.type("LABEL 4");
+        const wanted = run.structures.structures.flatMap((s, i) => (s.name.toLowerCase().includes("label 4") ? [i] : []));
+        assert.equal(wanted.length, 10);
+        state = await app.stateWhen((s) => s.layout.structures.length === wanted.length, "only the rows of label 4 and 40-48");
+        assert.deepEqual(state.layout.structures.map((r) => r.index), wanted);
+        await app.screenshot("S1-jhu-list-filtered");
+        await app.page.keyboard.press("Control+A");
+        await app.page.keyboard.press("Backspace");
+        await app.stateWhen((s) => s.layout.structures.length === 48, "every row again");
     });
 });
 

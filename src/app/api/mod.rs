@@ -60,12 +60,12 @@
 //!   its clipping plane (as `setView` takes it, or null) and the name of the structure under
 //!   the pointer (or null); `layout`:
 //!   `{graphs: [{param, strips: [{x, y, width, height, x0, x1}]}], gallery: [{x, y, width,
-//!   height}], structures: [{index, visible, solo, name}], structure_name}`, where the graphs'
-//!   plot areas (with the parameter values at their left and right edges), the gallery's
-//!   visible cards, the Structures list's rows (their show box, S button and name) and its
-//!   Name field were drawn; `checks`: the last checks' report with `current` (every
-//!   structure shows the surface checked: hiding or selecting one keeps it, smoothing one
-//!   anew does not), or null; `guidance`:
+//!   height}], structures: [{index, visible, solo, name}], structure_name, structure_filter}`,
+//!   where the graphs' plot areas (with the parameter values at their left and right edges),
+//!   the gallery's visible cards, the Structures list's rows (their show box, S button and
+//!   name), its Name field and its filter field (lists of more than 8) were drawn; `checks`:
+//!   the last checks' report with `current` (every structure shows the surface checked:
+//!   hiding or selecting one keeps it, smoothing one anew does not), or null; `guidance`:
 //!   background work under way, whether the graphs are current, the suggestion and the gallery)
 //! - `clearWeights()`: every vertex free again (undoes the weight brush)
 //! - `screenshot(): Promise<Uint8Array>`: a PNG of the 3D view as the next frame draws it

@@ -67,6 +67,8 @@ pub struct Shell {
     structures: StructureList,
     /// The page is the viewer (`?mode=viewer`): the case's structures and the view, no editing.
     reading: bool,
+    /// The viewer's filter of its structure list.
+    reading_filter: String,
     /// The structure under the pointer.
     pointing: Pointing,
     /// The page that embeds this one (`?parent=ORIGIN`), told what happens here.
@@ -175,6 +177,7 @@ impl Shell {
             framed_case: None,
             structures: StructureList::default(),
             reading,
+            reading_filter: String::new(),
             pointing: Pointing::default(),
             embedding,
             picture: Picture::default(),

@@ -58,7 +58,8 @@ impl Shell {
                 let was = self.coloring == Some(ColorField::LocalError);
                 let mut error_colours = was;
                 let (session, panel) = doc.session_and_panel();
-                let actions = case_reader::show(ui, session, panel, &mut error_colours);
+                let filter = &mut self.reading_filter;
+                let actions = case_reader::show(ui, session, panel, (filter, &mut error_colours));
                 if error_colours != was {
                     self.coloring = error_colours.then_some(ColorField::LocalError);
                 }
