@@ -77,7 +77,8 @@ pub fn from_gltf_scene(scene: GltfScene, source: &str) -> Result<Case, CaseRecor
             .to_string()
     };
     // Our own files keep the data's millimetres inside the meshes, with the frame's
-    // conversion on the root alone: the stored positions are the case's, bit for bit.
+    // conversion on the root alone: the stored positions are the case's, bit for bit (or, in a
+    // compressed file, on a lattice the structure's own node scales to millimetres).
     let ours = record.is_some();
     let structures = scene
         .nodes
@@ -107,7 +108,8 @@ fn structure(
         name: name.clone(),
         detail,
     };
-    let matrix = if ours { IDENTITY } else { node.matrix };
+    // Ours keep millimetres in the node's frame: a quantized mesh's node scales its lattice.
+    let matrix = if ours { node.local } else { node.matrix };
     let (shown, original) = surfaces(&node, &matrix).map_err(|d| fail(d.into()))?;
     let color = node.base_color.map(|[r, g, b, a]| {
         [

@@ -9,6 +9,7 @@ use ::gltf::json::Root;
 use base64::Engine as _;
 
 use super::super::{Format, LoadError, Location};
+use super::meshopt::Compression;
 
 /// An accessor's elements, resolved to one buffer and bounds-checked against its declared length.
 #[derive(Clone, Copy, Debug)]
@@ -102,8 +103,14 @@ fn view_span(
 }
 
 /// Resolves accessor `index` and checks that every element it reads lies inside its buffer view,
-/// and the view inside its buffer's declared `byteLength`.
-pub(super) fn layout(root: &Root, index: usize, format: Format) -> Result<Layout, LoadError> {
+/// and the view inside its buffer's declared `byteLength`. A compressed view's elements are read
+/// from its decoded buffer (see [`Compression`]).
+pub(super) fn layout(
+    root: &Root,
+    compression: &Compression,
+    index: usize,
+    format: Format,
+) -> Result<Layout, LoadError> {
     let err = |detail: String| syntax(format, "accessor", index, detail);
     let a = root
         .accessors
@@ -156,6 +163,10 @@ pub(super) fn layout(root: &Root, index: usize, format: Format) -> Result<Layout
     // still only declared: the bytes are checked when the buffer is loaded.
     let to_usize =
         |v: u64| usize::try_from(v).map_err(|_| err("too large for this platform".into()));
+    let (buffer_index, view_offset) = match compression.source(view_index) {
+        Some(decoded) => (decoded, 0),
+        None => (buffer_index, view_offset),
+    };
     Ok(Layout {
         accessor: index,
         buffer: buffer_index,
@@ -168,10 +179,27 @@ pub(super) fn layout(root: &Root, index: usize, format: Format) -> Result<Layout
     })
 }
 
-/// Loads the buffers marked in `needed`: the GLB BIN chunk or a base64 data URI. A buffer that
-/// names an external file is refused: parsers see bytes only, never the file system.
+/// Loads the buffers marked in `needed` (the file's, then the decoded views': see
+/// [`Compression::buffer_count`]), with the buffers the decoded ones read from.
 pub(super) fn load_buffers<'a>(
     root: &'a Root,
+    compression: &Compression,
+    bin: Option<&'a [u8]>,
+    needed: &[bool],
+    format: Format,
+) -> Result<Vec<Option<Cow<'a, [u8]>>>, LoadError> {
+    let mut needed = needed.to_vec();
+    compression.mark_sources(&mut needed);
+    let mut buffers = load_file_buffers(root, compression, bin, &needed, format)?;
+    compression.decode(&mut buffers, &needed, format)?;
+    Ok(buffers)
+}
+
+/// Loads the file's buffers marked in `needed`: the GLB BIN chunk or a base64 data URI. A buffer
+/// that names an external file is refused: parsers see bytes only, never the file system.
+fn load_file_buffers<'a>(
+    root: &'a Root,
+    compression: &Compression,
     bin: Option<&'a [u8]>,
     needed: &[bool],
     format: Format,
@@ -183,6 +211,16 @@ pub(super) fn load_buffers<'a>(
             continue;
         }
         let data: Cow<'a, [u8]> = match buffer.uri.as_deref() {
+            None if compression.is_fallback(i) => {
+                return Err(syntax(
+                    format,
+                    "buffer",
+                    i,
+                    "is an EXT_meshopt_compression fallback without data, yet a view that is \
+                     not compressed reads it"
+                        .into(),
+                ))
+            }
             None => match (i, bin) {
                 (0, Some(bin)) => Cow::Borrowed(bin),
                 _ => {

@@ -9,6 +9,7 @@ use super::super::{Format, LoadError, Location};
 use std::borrow::Cow;
 
 use super::accessor::{layout, load_buffers, read_indices, read_vectors, Layout};
+use super::meshopt::Compression;
 use super::scene::{determinant3, transform_point, Instance, IDENTITY};
 use crate::mesh::Mesh;
 
@@ -43,33 +44,35 @@ fn max_triangles(mode: Mode, n: usize) -> u64 {
 
 pub(super) fn merge(
     root: &Root,
+    compression: &Compression,
     instances: &[Instance],
     bin: Option<&[u8]>,
     format: Format,
 ) -> Result<Mesh, LoadError> {
-    let jobs = plan(root, instances, format)?;
-    let needed = check_totals(root, &jobs, format)?;
-    let buffers = load_buffers(root, bin, &needed, format)?;
+    let jobs = plan(root, compression, instances, format)?;
+    let needed = check_totals(compression.buffer_count(), &jobs, format)?;
+    let buffers = load_buffers(root, compression, bin, &needed, format)?;
     assemble(&jobs, &buffers, format)
 }
 
 /// [`merge`] with every buffer already loaded (a reader that merges node by node).
 pub(super) fn merge_loaded(
     root: &Root,
+    compression: &Compression,
     instances: &[Instance],
     buffers: &[Option<Cow<[u8]>>],
     format: Format,
 ) -> Result<Mesh, LoadError> {
-    let jobs = plan(root, instances, format)?;
-    check_totals(root, &jobs, format)?;
+    let jobs = plan(root, compression, instances, format)?;
+    check_totals(buffers.len(), &jobs, format)?;
     assemble(&jobs, buffers, format)
 }
 
 /// Refuses totals past the caps; returns which buffers the jobs read.
-fn check_totals(root: &Root, jobs: &[Job], format: Format) -> Result<Vec<bool>, LoadError> {
+fn check_totals(buffers: usize, jobs: &[Job], format: Format) -> Result<Vec<bool>, LoadError> {
     let mut vertex_total = 0u64;
     let mut triangle_total = 0u64;
-    let mut needed = vec![false; root.buffers.len()];
+    let mut needed = vec![false; buffers];
     for job in jobs {
         vertex_total = vertex_total.saturating_add(job.positions.count as u64);
         let refs = job.indices.as_ref().unwrap_or(&job.positions).count;
@@ -234,6 +237,7 @@ fn push_unless_repeated(push: &mut impl FnMut([u32; 3]), t: [u32; 3]) {
 /// The triangle primitives of every instance, in order, with accessors checked.
 fn plan<'a>(
     root: &Root,
+    compression: &Compression,
     instances: &'a [Instance],
     format: Format,
 ) -> Result<Vec<Job<'a>>, LoadError> {
@@ -266,10 +270,10 @@ fn plan<'a>(
             jobs.push(Job {
                 instance,
                 mode,
-                positions: layout(root, position.value(), format)?,
+                positions: layout(root, compression, position.value(), format)?,
                 indices: primitive
                     .indices
-                    .map(|i| layout(root, i.value(), format))
+                    .map(|i| layout(root, compression, i.value(), format))
                     .transpose()?,
             });
         }

@@ -8,6 +8,7 @@
 mod accessor;
 mod assemble;
 mod glb;
+mod meshopt;
 mod nodes;
 mod scene;
 
@@ -37,15 +38,17 @@ pub(super) fn parse(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
         (Format::Gltf, bytes, 0, None)
     };
     let root = document(json, json_offset, format)?;
+    let compression = meshopt::Compression::parse(json, &root, format)?;
     let mut instances = scene::instances(&root, format)?;
     if written_here(&root) {
-        // Our files keep millimetres inside the meshes and the frame on the root: read the
-        // positions as stored, so that what was exported reopens where it was.
+        // Our files keep millimetres inside the meshes (or on a quantization lattice that
+        // the mesh's own node scales to them) and the frame on the root: read the positions
+        // in the mesh node's frame, so that what was exported reopens where it was.
         for i in &mut instances {
-            i.matrix = scene::IDENTITY;
+            i.matrix = i.local;
         }
     }
-    assemble::merge(&root, &instances, bin, format)
+    assemble::merge(&root, &compression, &instances, bin, format)
 }
 
 /// Whether the scene carries meshsmooth's record of its frame (a file written here).
@@ -120,6 +123,7 @@ fn check_required_extensions(root: &Root, format: Format) -> Result<(), LoadErro
     ];
     for ext in &root.extensions_required {
         let readable = ext == "KHR_mesh_quantization"
+            || ext == meshopt::NAME
             || ext == "KHR_lights_punctual"
             || APPEARANCE.iter().any(|p| ext.starts_with(p));
         if !readable {

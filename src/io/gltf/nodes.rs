@@ -12,6 +12,7 @@ use serde_json::Value;
 
 use super::accessor::{layout, load_buffers, read_vectors, Layout};
 use super::assemble::merge_loaded;
+use super::meshopt::Compression;
 use super::scene::{instances, Instance, Mat4, IDENTITY};
 use super::{glb, Format, LoadError, Location};
 use crate::mesh::Mesh;
@@ -33,6 +34,9 @@ pub struct GltfNode {
     pub ancestors: Vec<String>,
     /// Node space to the scene's world (column-major, `m[column][row]`).
     pub matrix: Mat4,
+    /// The node's own transform, the part of `matrix` below its parent (in a case written
+    /// here, the quantization lattice to millimetres; else the identity).
+    pub local: Mat4,
     /// Every triangle primitive of the mesh, positions in node space as stored.
     pub mesh: Mesh,
     /// The first morph target's position displacements (a one-primitive mesh only).
@@ -53,11 +57,17 @@ pub fn read_scene(bytes: &[u8], format: Format) -> Result<GltfScene, LoadError> 
         (format, bytes, 0, None)
     };
     let root = super::document(json, json_offset, format)?;
+    let compression = Compression::parse(json, &root, format)?;
     let placed = instances(&root, format)?;
-    let buffers = load_buffers(&root, bin, &vec![true; root.buffers.len()], format)?;
+    // Every buffer and decoded view but the fallbacks, which hold no data.
+    let needed: Vec<bool> = (0..compression.buffer_count())
+        .map(|i| !compression.is_fallback(i))
+        .collect();
+    let buffers = load_buffers(&root, &compression, bin, &needed, format)?;
     let parents = parents(&root);
+    let document = (&root, &compression);
     let nodes = (placed.iter())
-        .map(|instance| read_node(&root, &parents, &buffers, instance, format))
+        .map(|instance| read_node(document, &parents, &buffers, instance, format))
         .collect::<Result<_, _>>()?;
     let scene = root.scene.map_or(0, |s| s.value());
     let extras = root
@@ -70,7 +80,7 @@ pub fn read_scene(bytes: &[u8], format: Format) -> Result<GltfScene, LoadError> 
 /// One placed mesh of the scene as a node: its mesh in its own frame, its morph target and
 /// local error where it has one primitive, its material's colour, names and extras.
 fn read_node(
-    root: &Root,
+    (root, compression): (&Root, &Compression),
     parents: &[Option<usize>],
     buffers: &[Option<Cow<[u8]>>],
     instance: &Instance,
@@ -80,7 +90,13 @@ fn read_node(
         matrix: IDENTITY,
         ..instance.clone()
     };
-    let mesh = merge_loaded(root, std::slice::from_ref(&local), buffers, format)?;
+    let mesh = merge_loaded(
+        root,
+        compression,
+        std::slice::from_ref(&local),
+        buffers,
+        format,
+    )?;
     let gltf_mesh = &root.meshes[instance.mesh];
     let node = &root.nodes[instance.node];
     let single = match gltf_mesh.primitives.as_slice() {
@@ -94,7 +110,7 @@ fn read_node(
             .ok_or_else(|| bad(format, "buffer", l.buffer, "was not loaded".into()))
     };
     let per_vertex = |index: usize, what: &str| -> Result<Layout, LoadError> {
-        let l = layout(root, index, format)?;
+        let l = layout(root, compression, index, format)?;
         if l.count != mesh.vertex_count() {
             return Err(bad(
                 format,
@@ -141,6 +157,7 @@ fn read_node(
             .unwrap_or_default(),
         ancestors: ancestor_names(root, parents, instance.node),
         matrix: instance.matrix,
+        local: instance.local,
         mesh,
         morph_target,
         local_error,

@@ -21,6 +21,8 @@ pub(super) struct Instance {
     pub node: usize,
     pub mesh: usize,
     pub matrix: Mat4,
+    /// The node's own transform (its frame's part of `matrix`).
+    pub local: Mat4,
 }
 
 fn syntax(format: Format, what: &'static str, index: usize, detail: String) -> LoadError {
@@ -89,12 +91,14 @@ pub(super) fn instances(root: &Root, format: Format) -> Result<Vec<Instance>, Lo
                 ))
             }
         }
-        let world = multiply(&parent, &local_matrix(node, index, format)?);
+        let local = local_matrix(node, index, format)?;
+        let world = multiply(&parent, &local);
         if let Some(mesh) = node.mesh {
             out.push(Instance {
                 node: index,
                 mesh: mesh.value(),
                 matrix: world,
+                local,
             });
         }
         for child in node.children.iter().flatten().rev() {
