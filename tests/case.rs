@@ -69,9 +69,11 @@ fn a_case_glb_reads_back_as_the_same_case() {
         smooth_structure(s);
     }
     for container in [Container::Glb, Container::Gltf] {
+        // Float arrays as they are: exact. The compressed default is checked below.
         let options = CaseGltfOptions {
             container,
             local_error: true,
+            compressed: false,
             ..Default::default()
         };
         let first = write_case(&case, &options).expect("writes");
@@ -115,6 +117,94 @@ fn a_case_glb_reads_back_as_the_same_case() {
     }
 }
 
+/// The compressed default: what reopens is the case within the quantization error each
+/// structure's record states (far below 0.05 voxel diagonals), and quantizing it again changes
+/// no position.
+#[test]
+fn a_compressed_case_reads_back_within_its_stated_quantization_error() {
+    let mut case = phantom();
+    case.structures[1].group = Some("Vessels".into());
+    case.structures[0].color[3] = 0.4;
+    for s in case.structures.iter_mut().take(3) {
+        smooth_structure(s);
+    }
+    let options = CaseGltfOptions {
+        local_error: true,
+        ..Default::default()
+    };
+    let first = write_case(&case, &options).expect("writes");
+    let raw = CaseGltfOptions {
+        compressed: false,
+        ..options
+    };
+    let uncompressed = write_case(&case, &raw).expect("writes");
+    assert!(
+        first.len() * 2 < uncompressed.len(),
+        "compressed {} bytes, uncompressed {}",
+        first.len(),
+        uncompressed.len()
+    );
+    let doc = glb_json(&first);
+    let back = from_gltf_scene(load_gltf_scene(&first, "case.glb").expect("reads"), "c.glb")
+        .expect("a case");
+    assert_eq!(back.structures.len(), case.structures.len());
+    let far = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+        (a.iter().zip(b))
+            .map(|(p, q)| {
+                (0..3)
+                    .map(|k| f64::from(p[k] - q[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    for (a, b) in case.structures.iter().zip(&back.structures) {
+        let node = (doc["nodes"].as_array().expect("nodes").iter())
+            .find(|n| n["name"] == a.name.as_str())
+            .expect("a node per structure");
+        let q = &node["extras"]["meshsmooth"]["quantization"];
+        let stated = q["max_error_mm"].as_f64().expect("stated in mm");
+        let diagonal = a.voxel_diagonal().expect("a label map's structure");
+        assert_eq!(
+            q["max_error_voxel_diagonals"].as_f64(),
+            Some(stated / diagonal)
+        );
+        assert!(
+            stated < 0.05 * diagonal && stated > 0.0,
+            "{}: {stated} mm",
+            a.name
+        );
+        let moved = far(a.positions(), b.positions())
+            .max(far(&a.original.positions, &b.original.positions));
+        // The record states the largest of these exactly.
+        assert_eq!(moved, stated, "{}", a.name);
+        // The index codec keeps each triangle's winding, not which corner comes first.
+        let first_corner = |t: &[u32; 3]| {
+            let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        };
+        let turned = |m: &meshsmooth::mesh::Mesh| -> Vec<[u32; 3]> {
+            m.triangles.iter().map(first_corner).collect()
+        };
+        assert_eq!(turned(&a.original), turned(&b.original), "{}", a.name);
+        assert_eq!((&a.name, a.color, &a.group), (&b.name, b.color, &b.group));
+        assert_eq!(
+            a.smoothed.as_ref().map(|s| (&s.metrics, &s.local_error)),
+            b.smoothed.as_ref().map(|s| (&s.metrics, &s.local_error))
+        );
+    }
+    let again = write_case(&back, &options).expect("writes again");
+    let twice = from_gltf_scene(
+        load_gltf_scene(&again, "again.glb").expect("reads"),
+        "again.glb",
+    )
+    .expect("a case");
+    for (b, c) in back.structures.iter().zip(&twice.structures) {
+        assert_eq!(b.positions(), c.positions(), "{}: quantized again", b.name);
+        assert_eq!(b.original, c.original, "{}", b.name);
+    }
+}
+
 #[test]
 fn the_case_glb_has_groups_materials_and_the_quality_record() {
     let mut case = phantom();
@@ -153,7 +243,18 @@ fn the_case_glb_has_groups_materials_and_the_quality_record() {
     let material = &doc["materials"][primitive["material"].as_u64().expect("m") as usize];
     assert_eq!(material["alphaMode"], "BLEND");
     assert!(material["extensions"]["KHR_materials_unlit"].is_object());
-    assert_eq!(doc["extensionsUsed"][0], "KHR_materials_unlit");
+    assert_eq!(
+        doc["extensionsUsed"],
+        serde_json::json!([
+            "EXT_meshopt_compression",
+            "KHR_mesh_quantization",
+            "KHR_materials_unlit"
+        ])
+    );
+    assert_eq!(
+        doc["extensionsRequired"],
+        serde_json::json!(["EXT_meshopt_compression", "KHR_mesh_quantization"])
+    );
     // An unsmoothed structure has no morph target to slide to.
     let liver = nodes.iter().find(|n| n["name"] == "liver").expect("liver");
     let liver_mesh = &doc["meshes"][liver["mesh"].as_u64().expect("mesh") as usize];

@@ -65,8 +65,9 @@ fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
         "--json",
     ]));
     assert_eq!(again["title"], "Abdominal phantom");
-    // The original comes back from the morph target: to the ulp at worst, where no f32 step
-    // from the smoothed position lands on it exactly.
+    // The original comes back from the morph target quantized (the record states by how
+    // much: about a thousandth of a millimetre here), which moves the measures of the
+    // staircase by a few parts in ten thousand at most.
     for (a, b) in list
         .iter()
         .zip(again["structures"].as_array().expect("list"))
@@ -77,7 +78,7 @@ fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
             let (x, y) = (&a["metrics"][key], &b["metrics"][key]);
             let (x, y) = (x.as_f64().expect("n"), y.as_f64().expect("n"));
             assert!(
-                (x - y).abs() <= 1e-6 * x.abs(),
+                (x - y).abs() <= 1e-3 * x.abs(),
                 "{}: {key} {x} then {y}",
                 a["name"]
             );
@@ -85,6 +86,42 @@ fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
     }
     let text = std::fs::read_to_string(&gltf).expect("a .gltf is JSON text");
     assert!(text.contains("data:application/octet-stream;base64,"));
+    assert!(
+        text.contains("\"EXT_meshopt_compression\""),
+        "compressed by default"
+    );
+
+    // --uncompressed writes float arrays for tools that cannot decode; info reads both alike.
+    let raw = tmp("phantom_case_raw.glb");
+    meshsmooth(&[
+        "case",
+        "build",
+        &data("labelmaps/case_phantom_shared.nii.gz"),
+        "--colors",
+        &data("labelmaps/case_phantom_shared_labels.txt"),
+        "--search",
+        "local",
+        "--title",
+        "Abdominal phantom",
+        "--uncompressed",
+        "-o",
+        raw.to_str().expect("utf-8"),
+    ]);
+    let bytes = std::fs::read(&raw).expect("written");
+    assert!(!String::from_utf8_lossy(&bytes[..4096.min(bytes.len())]).contains("meshopt"));
+    let compressed = std::fs::metadata(&glb).expect("written").len();
+    assert!(
+        compressed * 2 < bytes.len() as u64,
+        "{compressed} vs {}",
+        bytes.len()
+    );
+    let info_raw = json(&meshsmooth(&[
+        "case",
+        "info",
+        raw.to_str().expect("utf-8"),
+        "--json",
+    ]));
+    assert_eq!(info_raw["structures"], info["structures"]);
 }
 
 #[test]

@@ -85,6 +85,10 @@ pub(super) struct BuildArgs {
     /// Keep the data's RAS millimetres instead of glTF's metres with +Y up.
     #[arg(long)]
     millimetres: bool,
+    /// Write float arrays as they are, for tools that cannot decode KHR_mesh_quantization and
+    /// EXT_meshopt_compression (by default the arrays are quantized and compressed).
+    #[arg(long)]
+    uncompressed: bool,
     #[arg(long)]
     json: bool,
 }
@@ -197,6 +201,7 @@ fn gltf_options(args: &BuildArgs, container: Container) -> CaseGltfOptions {
         original_as_morph_target: !args.no_original,
         local_error: args.local_error,
         unlit: args.unlit,
+        compressed: !args.uncompressed,
     }
 }
 

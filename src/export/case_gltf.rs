@@ -4,7 +4,9 @@
 //! 1/1000 and turns superior to +Y and anterior to +Z (a viewer at +Z faces the patient), which
 //! leaves the patient's left at +X, a proper rotation, so no winding changes. Under it a node
 //! per group, and under those (or the root) a named node, mesh and material per structure.
-//! Positions stay in millimetres inside the meshes, so reading a case back is exact.
+//! Positions stay in millimetres inside the meshes, so reading an uncompressed case back is
+//! exact; a compressed one (the default: see `compressed`) keeps them on a quantization lattice
+//! that each structure's own node scales to millimetres.
 //!
 //! Each structure's node carries its quality record in `extras` (see `case::record`); the
 //! original staircase can ride along as a morph target (a viewer's weight slides from the
@@ -14,14 +16,17 @@
 use base64::Engine as _;
 use serde_json::{json, Value};
 
+use super::compressed::{self, Placement, Surfaces};
 use super::glb::{
     container, floats, geometry, index_bytes, Builder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT,
-    TRIANGLES, UNSIGNED_INT,
+    MESHOPT, TRIANGLES, UNSIGNED_INT,
 };
 use super::{check, ExportError, ExportOptions};
 use crate::case::{structure_record, Case, CaseStructure, CASE_KEY};
 use crate::mesh::{bounding_box, vertex_normals, Mesh};
 use crate::srgb;
+
+const QUANTIZATION: &str = "KHR_mesh_quantization";
 
 /// Which frame the file's coordinates are in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,6 +64,9 @@ pub struct CaseGltfOptions {
     pub local_error: bool,
     /// `KHR_materials_unlit`: colours show exactly as chosen, without lighting.
     pub unlit: bool,
+    /// Quantized (`KHR_mesh_quantization`) and compressed (`EXT_meshopt_compression`); else
+    /// float arrays as they are, for tools that cannot decode.
+    pub compressed: bool,
 }
 
 impl Default for CaseGltfOptions {
@@ -69,6 +77,7 @@ impl Default for CaseGltfOptions {
             original_as_morph_target: true,
             local_error: false,
             unlit: false,
+            compressed: true,
         }
     }
 }
@@ -102,13 +111,22 @@ fn scene_parts(
     let mut group_nodes: Vec<(&str, usize)> = Vec::new();
     for s in &case.structures {
         let index = meshes.len();
-        meshes.push(structure_mesh(b, s, index, options)?);
+        let (mesh, placement) = structure_mesh(b, s, index, options)?;
+        meshes.push(mesh);
         materials.push(material(s, options.unlit));
         let mut record = structure_record(s);
         if let Some(color) = s.color.get(..3) {
             record["color"] = json!([color[0], color[1], color[2], s.color[3]]);
         }
-        nodes.push(json!({ "name": s.name, "mesh": index, "extras": { CASE_KEY: record } }));
+        let mut node = json!({ "name": s.name, "mesh": index });
+        if let Some(Placement { lattice, record: q }) = placement {
+            // The lattice's stored integers to millimetres, under the root's frame.
+            node["translation"] = json!(lattice.offset);
+            node["scale"] = json!([lattice.step, lattice.step, lattice.step]);
+            record["quantization"] = q;
+        }
+        node["extras"] = json!({ CASE_KEY: record });
+        nodes.push(node);
         let node = nodes.len() - 1;
         match s.group.as_deref() {
             None => root_children.push(node),
@@ -179,20 +197,37 @@ pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, Exp
         "accessors": b.accessors,
         "bufferViews": b.views,
     });
-    if options.unlit {
-        document["extensionsUsed"] = json!(["KHR_materials_unlit"]);
+    let mut used = Vec::new();
+    if options.compressed {
+        used = vec![MESHOPT, QUANTIZATION];
+        document["extensionsRequired"] = json!(used);
     }
+    if options.unlit {
+        used.push("KHR_materials_unlit");
+    }
+    if !used.is_empty() {
+        document["extensionsUsed"] = json!(used);
+    }
+    // Compressed views declare their uncompressed place in a fallback buffer with no data.
+    let fallback = options.compressed.then(
+        || json!({ "byteLength": b.fallback, "extensions": { MESHOPT: { "fallback": true } } }),
+    );
     match options.container {
         Container::Glb => {
-            document["buffers"] = json!([{ "byteLength": b.bin.len() }]);
+            let buffers: Vec<Value> = std::iter::once(json!({ "byteLength": b.bin.len() }))
+                .chain(fallback)
+                .collect();
+            document["buffers"] = json!(buffers);
             container(&document, b.bin).ok_or_else(too_large)
         }
         Container::Gltf => {
             let data = base64::engine::general_purpose::STANDARD.encode(&b.bin);
-            document["buffers"] = json!([{
+            let buffer = json!({
                 "byteLength": b.bin.len(),
                 "uri": format!("data:application/octet-stream;base64,{data}"),
-            }]);
+            });
+            let buffers: Vec<Value> = std::iter::once(buffer).chain(fallback).collect();
+            document["buffers"] = json!(buffers);
             serde_json::to_vec_pretty(&document).map_err(|e| ExportError::TooLarge {
                 format: "glTF",
                 detail: e.to_string(),
@@ -215,13 +250,13 @@ fn push_child(node: &mut Value, child: usize) {
 }
 
 /// A structure's mesh: the surface as shown, its normals, and the optional morph target and
-/// local error.
+/// local error; compressed, with where its lattice places it.
 fn structure_mesh(
     b: &mut Builder,
     s: &CaseStructure,
     material: usize,
     options: &CaseGltfOptions,
-) -> Result<Value, ExportError> {
+) -> Result<(Value, Option<Placement>), ExportError> {
     let shown = Mesh::new(s.positions().to_vec(), s.original.triangles.clone());
     let normals = vertex_normals(&shown.positions, &shown.triangles);
     check(
@@ -231,12 +266,23 @@ fn structure_mesh(
             ..Default::default()
         },
     )?;
+    let morph = options.original_as_morph_target && s.smoothed_now().is_some();
+    let local_error =
+        (s.smoothed_now().and_then(|m| m.local_error.as_deref())).filter(|_| options.local_error);
+    if options.compressed {
+        let surfaces = Surfaces {
+            shown: &shown,
+            normals: &normals,
+            original: morph.then_some(&s.original),
+            local_error,
+            voxel_diagonal: s.voxel_diagonal(),
+        };
+        let (primitive, placement) = compressed::structure_mesh(b, &surfaces, material)?;
+        return Ok((mesh_of(s, primitive, morph), Some(placement)));
+    }
     let mut attributes = geometry(b, &shown, Some(&normals));
     let n = shown.vertex_count();
-    if let (true, Some(errors)) = (
-        options.local_error,
-        s.smoothed_now().and_then(|m| m.local_error.as_ref()),
-    ) {
+    if let Some(errors) = local_error {
         let bytes: Vec<u8> = errors.iter().flat_map(|v| v.to_le_bytes()).collect();
         attributes["_LOCAL_ERROR"] = json!(b.push(
             &bytes,
@@ -252,14 +298,22 @@ fn structure_mesh(
     let mut primitive = json!({
         "attributes": attributes, "indices": indices, "material": material, "mode": TRIANGLES,
     });
-    let mut mesh = json!({ "name": s.name });
-    if let (true, Some(_)) = (options.original_as_morph_target, s.smoothed_now()) {
+    if morph {
         primitive["targets"] = json!([morph_target(b, &s.original, &shown, &normals)]);
+    }
+    Ok((mesh_of(s, primitive, morph), None))
+}
+
+/// The glTF mesh around a structure's primitive; with a morph target, its weight at the
+/// smoothed surface and its name.
+fn mesh_of(s: &CaseStructure, primitive: Value, morph: bool) -> Value {
+    let mut mesh = json!({ "name": s.name });
+    if morph {
         mesh["weights"] = json!([0.0]);
         mesh["extras"] = json!({ "targetNames": ["segmentation"] });
     }
     mesh["primitives"] = json!([primitive]);
-    Ok(mesh)
+    mesh
 }
 
 /// The original as displacements from the shown surface (positions and normals).

@@ -5,7 +5,7 @@
 use serde_json::{json, Value};
 
 use super::case_gltf::{SceneFrame, RAS_MM_TO_GLTF};
-use super::{ExportError, ExportOptions};
+use super::{meshopt, ExportError, ExportOptions};
 use crate::case::CASE_KEY;
 use crate::mesh::{bounding_box, Mesh};
 
@@ -13,6 +13,9 @@ pub(super) const ARRAY_BUFFER: u32 = 34962;
 pub(super) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 pub(super) const FLOAT: u32 = 5126;
 const UNSIGNED_BYTE: u32 = 5121;
+const UNSIGNED_SHORT: u32 = 5123;
+/// The compression extension's name, in views, buffers and the extension lists.
+pub(super) const MESHOPT: &str = "EXT_meshopt_compression";
 pub(super) const UNSIGNED_INT: u32 = 5125;
 pub(super) const TRIANGLES: u32 = 4;
 
@@ -22,6 +25,8 @@ pub(super) struct Builder {
     pub(super) bin: Vec<u8>,
     pub(super) views: Vec<Value>,
     pub(super) accessors: Vec<Value>,
+    /// The length of the fallback buffer (1) that compressed views declare their place in.
+    pub(super) fallback: usize,
 }
 
 impl Builder {
@@ -42,6 +47,80 @@ impl Builder {
         accessor["bufferView"] = json!(view);
         self.accessors.push(accessor);
         self.accessors.len() - 1
+    }
+}
+
+impl Builder {
+    /// Appends `raw` (elements of `stride` bytes) compressed as `EXT_meshopt_compression`'s
+    /// attributes; returns the accessor index of `accessor`.
+    pub(super) fn push_attributes(
+        &mut self,
+        raw: &[u8],
+        stride: usize,
+        accessor: Value,
+    ) -> Result<usize, ExportError> {
+        let data = meshopt::encode_attributes(raw, stride).ok_or_else(codec_failed)?;
+        let mut view = self.compressed_view(raw.len(), &data, stride, "ATTRIBUTES");
+        view["byteStride"] = json!(stride);
+        view["target"] = json!(ARRAY_BUFFER);
+        Ok(self.add(view, accessor))
+    }
+
+    /// Appends a triangle list's indices compressed as `EXT_meshopt_compression`'s triangles,
+    /// 16-bit where the vertices allow; returns the accessor index.
+    pub(super) fn push_triangles(
+        &mut self,
+        indices: &[u32],
+        vertex_count: usize,
+    ) -> Result<usize, ExportError> {
+        let data = meshopt::encode_triangles(indices, vertex_count).ok_or_else(codec_failed)?;
+        let (stride, component) = if vertex_count <= 1 << 16 {
+            (2, UNSIGNED_SHORT)
+        } else {
+            (4, UNSIGNED_INT)
+        };
+        let mut view = self.compressed_view(indices.len() * stride, &data, stride, "TRIANGLES");
+        view["target"] = json!(ELEMENT_ARRAY_BUFFER);
+        let accessor =
+            json!({"componentType": component, "count": indices.len(), "type": "SCALAR"});
+        Ok(self.add(view, accessor))
+    }
+
+    /// A view of `raw_len` bytes in the fallback buffer whose data is `data` in buffer 0.
+    fn compressed_view(&mut self, raw_len: usize, data: &[u8], stride: usize, mode: &str) -> Value {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let view = json!({
+            "buffer": 1,
+            "byteOffset": self.fallback,
+            "byteLength": raw_len,
+            "extensions": { MESHOPT: {
+                "buffer": 0,
+                "byteOffset": self.bin.len(),
+                "byteLength": data.len(),
+                "byteStride": stride,
+                "mode": mode,
+                "count": raw_len / stride,
+            }},
+        });
+        self.bin.extend_from_slice(data);
+        self.fallback += raw_len.next_multiple_of(4);
+        view
+    }
+
+    fn add(&mut self, view: Value, mut accessor: Value) -> usize {
+        accessor["bufferView"] = json!(self.views.len());
+        self.views.push(view);
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+}
+
+fn codec_failed() -> ExportError {
+    ExportError::TooLarge {
+        format: "glTF",
+        detail: "the meshopt encoder refused the data".into(),
     }
 }
 
@@ -80,8 +159,7 @@ pub(super) fn write(mesh: &Mesh, options: &ExportOptions) -> Result<Vec<u8>, Exp
     }
     let mut b = Builder {
         bin: Vec::with_capacity(estimate as usize),
-        views: Vec::new(),
-        accessors: Vec::new(),
+        ..Default::default()
     };
     let mut attributes = geometry(&mut b, mesh, options.normals);
     if let Some(colors) = options.colors {

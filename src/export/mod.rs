@@ -3,7 +3,9 @@
 //! Nothing from an input file's header is ever written (STL headers often carry patient names).
 
 mod case_gltf;
+mod compressed;
 mod glb;
+mod meshopt;
 mod obj;
 mod ply;
 mod stl;
