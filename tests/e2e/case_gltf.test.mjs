@@ -15,7 +15,7 @@ import { basename, join } from "node:path";
 import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
-import { readGlb } from "./lib/glb.mjs";
+import { meshNodes, readGlb } from "./lib/glb.mjs";
 import { meshPath, outputDir } from "./lib/paths.mjs";
 import { assertNotBlank, colourHistogram, decodePng } from "./lib/png.mjs";
 import { WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
@@ -124,49 +124,44 @@ async function expectedStructures(c) {
 
 /**
  * Every node with a mesh, in scene order (depth first, as three traverses): its name, its
- * material, and its POSITION data (RAS mm): vertex count, accessor min/max, mean.
+ * material, and its positions (RAS mm, decoded and dequantized where compressed): vertex
+ * count, min/max, mean.
  */
 function glbStructures(bytes) {
-    const { json, bin } = readGlb(bytes);
-    const structures = [];
+    const { json } = readGlb(bytes);
+    const materials = [];
     const visit = (index) => {
         const node = json.nodes[index];
         if (node.mesh !== undefined) {
             const primitives = json.meshes[node.mesh].primitives;
-            const min = [Infinity, Infinity, Infinity];
-            const max = [-Infinity, -Infinity, -Infinity];
-            const sum = [0, 0, 0];
-            let count = 0;
-            for (const primitive of primitives) {
-                const accessor = json.accessors[primitive.attributes.POSITION];
-                assert.equal(accessor.componentType, 5126, "POSITION is float");
-                const view = json.bufferViews[accessor.bufferView];
-                const stride = view.byteStride ?? 12;
-                const start = (view.byteOffset ?? 0) + (accessor.byteOffset ?? 0);
-                for (let i = 0; i < accessor.count; i++) {
-                    for (let k = 0; k < 3; k++) sum[k] += bin.readFloatLE(start + i * stride + 4 * k);
-                }
-                count += accessor.count;
-                for (let k = 0; k < 3; k++) {
-                    min[k] = Math.min(min[k], accessor.min[k]);
-                    max[k] = Math.max(max[k], accessor.max[k]);
-                }
-            }
-            const material = json.materials[primitives[0].material] ?? {};
-            structures.push({
-                name: node.name,
-                baseColorFactor: material.pbrMetallicRoughness?.baseColorFactor ?? [1, 1, 1, 1],
-                alphaMode: material.alphaMode ?? "OPAQUE",
-                vertices: count,
-                min,
-                max,
-                mean: sum.map((s) => s / count),
-            });
+            assert.equal(primitives.length, 1, "one primitive per structure");
+            materials.push(json.materials[primitives[0].material] ?? {});
         }
         for (const child of node.children ?? []) visit(child);
     };
     for (const root of json.scenes[json.scene ?? 0].nodes) visit(root);
-    return structures;
+    return meshNodes(bytes).map((n, i) => {
+        const min = [Infinity, Infinity, Infinity];
+        const max = [-Infinity, -Infinity, -Infinity];
+        const sum = [0, 0, 0];
+        n.positions.forEach((v, j) => {
+            const k = j % 3;
+            min[k] = Math.min(min[k], v);
+            max[k] = Math.max(max[k], v);
+            sum[k] += v;
+        });
+        const count = n.positions.length / 3;
+        return {
+            name: n.name,
+            baseColorFactor: materials[i].pbrMetallicRoughness?.baseColorFactor ?? [1, 1, 1, 1],
+            alphaMode: materials[i].alphaMode ?? "OPAQUE",
+            vertices: count,
+            min,
+            max,
+            mean: sum.map((s) => s / count),
+            quantization: n.quantization,
+        };
+    });
 }
 
 /** An sRGB component (0..1) in linear light, as three's Color holds it. */
@@ -246,6 +241,15 @@ CASES.forEach((c, n) => {
             }),
         );
         assert.ok(numErrors === 0 && numWarnings === 0, `glTF-Validator on ${file}: ${summary}${truncated ? " (list truncated)" : ""}:\n${listed.join("\n")}`);
+        // Compressed by default: both extensions required, each structure's quantization error
+        // stated and below 0.05 voxel diagonals.
+        const { json } = readGlb(bytes);
+        assert.deepEqual(json.extensionsRequired, ["EXT_meshopt_compression", "KHR_mesh_quantization"], "the case is compressed");
+        for (const s of glbStructures(bytes)) {
+            const q = s.quantization;
+            assert.ok(q && q.max_error_mm > 0, `${s.name}: its record states the quantization`);
+            assert.ok(q.max_error_voxel_diagonals < 0.05, `${s.name}: ${q.max_error_voxel_diagonals} voxel diagonals`);
+        }
         assert.equal(report.info.drawCallCount, c.structures, "one draw call (mesh primitive) per structure");
     });
 

@@ -48,6 +48,7 @@ const PAGE = `<!doctype html>
 const CHECK_SCRIPT = `
 import * as THREE from "three";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
+import { MeshoptDecoder } from "three/addons/libs/meshopt_decoder.module.js";
 
 let loaded = null;
 
@@ -61,7 +62,8 @@ window.gltfCheck = {
         const response = await fetch(url);
         if (!response.ok) throw new Error(url + ": HTTP " + response.status);
         const bytes = await response.arrayBuffer();
-        const gltf = await new GLTFLoader().parseAsync(bytes, "");
+        // Case glTFs are EXT_meshopt_compression'ed: three decodes them with its MeshoptDecoder.
+        const gltf = await new GLTFLoader().setMeshoptDecoder(MeshoptDecoder).parseAsync(bytes, "");
         loaded = gltf.scene;
         loaded.updateMatrixWorld(true);
         const meshes = [];
