@@ -18,12 +18,13 @@ work=target/fuzz
 mkdir -p "$work"
 
 corpus() {
-    # A seed directory of small shared files with the given extensions.
+    # A seed directory of small shared files with the given extensions, and this folder's seeds
+    # (tests/fuzz/seeds: a compressed case GLB, which the shared data has none of).
     local dir="$work/corpus-$1"
     shift
     mkdir -p "$dir"
     for pattern in "$@"; do
-        find "$data" -name "$pattern" -size -2M -exec cp -n {} "$dir/" \;
+        find "$data" tests/fuzz/seeds -name "$pattern" -size -2M -exec cp -n {} "$dir/" \;
     done
     echo "$dir"
 }
