@@ -87,17 +87,7 @@ pub fn suggest_all(
         !cancelled.load(Ordering::Relaxed)
     };
     let learning = options.learn && options.method == SearchMethod::Local;
-    // The largest first, so the pool is not left waiting on one big structure at the end;
-    // learning, the smallest first, so the large ones start where the small ones ended.
-    let mut order: Vec<usize> = (0..total).collect();
-    order.sort_by_key(|&i| case.structures[i].original.vertex_count());
-    if !learning {
-        order.reverse();
-    }
-    let work: Vec<(usize, CaseStructure)> = order
-        .into_iter()
-        .map(|i| (i, case.structures[i].clone()))
-        .collect();
+    let work = in_order(case, learning);
     // Learning goes batch by batch, each starting from the batches before it: the same starts
     // on any number of threads, so the page's workers find what the CLI finds.
     let batch = if learning {
@@ -136,7 +126,30 @@ pub fn suggest_all(
         }
         results.extend(outcomes);
     }
-    let mut suggestions = vec![None; total];
+    keep(case, results)
+}
+
+/// Copies of the structures in the order they are searched: the largest first, so the pool is
+/// not left waiting on one big structure at the end; learning, the smallest first, so the
+/// large ones start where the small ones ended.
+fn in_order(case: &Case, learning: bool) -> Vec<(usize, CaseStructure)> {
+    let mut order: Vec<usize> = (0..case.structures.len()).collect();
+    order.sort_by_key(|&i| case.structures[i].original.vertex_count());
+    if !learning {
+        order.reverse();
+    }
+    (order.into_iter())
+        .map(|i| (i, case.structures[i].clone()))
+        .collect()
+}
+
+/// Puts each structure that got a suggestion back into `case`; every suggestion in the case's
+/// order, or the first error.
+fn keep(
+    case: &mut Case,
+    results: Vec<(usize, Outcome)>,
+) -> Result<Vec<Option<Suggestion>>, SuggestError> {
+    let mut suggestions = vec![None; case.structures.len()];
     let mut first_error = None;
     for (i, result) in results {
         match result {

@@ -187,7 +187,7 @@ pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, Exp
             "structures": case.structures.len(),
         }},
     });
-    let mut document = json!({
+    let document = json!({
         "asset": { "version": "2.0", "generator": concat!("meshsmooth ", env!("CARGO_PKG_VERSION")) },
         "scene": 0,
         "scenes": [scene],
@@ -197,6 +197,15 @@ pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, Exp
         "accessors": b.accessors,
         "bufferViews": b.views,
     });
+    finish(document, b, options)
+}
+
+/// The document with its extensions and buffers, in its container.
+fn finish(
+    mut document: Value,
+    b: Builder,
+    options: &CaseGltfOptions,
+) -> Result<Vec<u8>, ExportError> {
     let mut used = Vec::new();
     if options.compressed {
         used = vec![MESHOPT, QUANTIZATION];

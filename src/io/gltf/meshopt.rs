@@ -177,22 +177,7 @@ fn compressed(
     let err = |detail: String| syntax(format, "buffer view", index, format!("{NAME}: {detail}"));
     let raw = RawView::deserialize(ext).map_err(|e| err(e.to_string()))?;
     let view = &root.buffer_views[index];
-    let mode = match raw.mode.as_str() {
-        "ATTRIBUTES" => Mode::Attributes,
-        "TRIANGLES" => Mode::Triangles,
-        other => {
-            return Err(LoadError::Unsupported {
-                format,
-                detail: format!("buffer view {index}: {NAME} mode '{other}' is not readable"),
-            })
-        }
-    };
-    if let Some(filter) = raw.filter.as_deref().filter(|f| *f != "NONE") {
-        return Err(LoadError::Unsupported {
-            format,
-            detail: format!("buffer view {index}: {NAME} filter '{filter}' is not readable"),
-        });
-    }
+    let mode = mode_of(&raw, index, format)?;
     let stride = raw.byte_stride;
     let stride_ok = match mode {
         Mode::Attributes => stride > 0 && stride % 4 == 0 && stride <= 256,
@@ -248,6 +233,22 @@ fn compressed(
         count: raw.count,
         mode,
     })
+}
+
+/// The view's mode, when it is one read here (the filters and `INDICES` are not).
+fn mode_of(raw: &RawView, index: usize, format: Format) -> Result<Mode, LoadError> {
+    let unsupported = |what: String| LoadError::Unsupported {
+        format,
+        detail: format!("buffer view {index}: {NAME} {what} is not readable"),
+    };
+    if let Some(filter) = raw.filter.as_deref().filter(|f| *f != "NONE") {
+        return Err(unsupported(format!("filter '{filter}'")));
+    }
+    match raw.mode.as_str() {
+        "ATTRIBUTES" => Ok(Mode::Attributes),
+        "TRIANGLES" => Ok(Mode::Triangles),
+        other => Err(unsupported(format!("mode '{other}'"))),
+    }
 }
 
 /// The fewest compressed bytes that decode to `count` elements of `stride` bytes: the header

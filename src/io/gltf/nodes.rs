@@ -109,21 +109,9 @@ fn read_node(
             .and_then(|b| b.as_deref())
             .ok_or_else(|| bad(format, "buffer", l.buffer, "was not loaded".into()))
     };
-    let per_vertex = |index: usize, what: &str| -> Result<Layout, LoadError> {
+    let per_vertex = |index: usize, what: &str| {
         let l = layout(root, compression, index, format)?;
-        if l.count != mesh.vertex_count() {
-            return Err(bad(
-                format,
-                "accessor",
-                index,
-                format!(
-                    "{what} has {} entries for {} vertices",
-                    l.count,
-                    mesh.vertex_count()
-                ),
-            ));
-        }
-        Ok(l)
+        one_per_vertex(l, mesh.vertex_count(), (index, what), format)
     };
     let morph_target = match single.and_then(|p| p.targets.as_ref()?.first()?.positions) {
         Some(a) => {
@@ -164,6 +152,20 @@ fn read_node(
         base_color,
         extras: raw_json(node.extras.as_deref()),
     })
+}
+
+/// `l`, when it has one entry per vertex of a mesh of `vertices`.
+fn one_per_vertex(
+    l: Layout,
+    vertices: usize,
+    (index, what): (usize, &str),
+    format: Format,
+) -> Result<Layout, LoadError> {
+    if l.count != vertices {
+        let detail = format!("{what} has {} entries for {vertices} vertices", l.count);
+        return Err(bad(format, "accessor", index, detail));
+    }
+    Ok(l)
 }
 
 fn bad(format: Format, what: &'static str, index: usize, detail: String) -> LoadError {
