@@ -8,6 +8,8 @@ use serde_json::Value;
 
 #[path = "common/label_maps.rs"]
 mod label_maps;
+#[path = "common/nifti.rs"]
+mod nifti;
 
 use label_maps::{inside_shape, open, read};
 
@@ -180,38 +182,9 @@ fn the_phantom_surfaces_lie_within_half_a_voxel_diagonal_of_the_analytic_shapes(
 
 /// A NIfTI-1 file of `dims` uint8 labels with the given sform (code 2) and qform code 0.
 fn nifti_bytes(dims: [usize; 3], sform: [[f32; 4]; 3], voxels: &[u8]) -> Vec<u8> {
-    let mut h = vec![0u8; 352];
-    h[0..4].copy_from_slice(&348i32.to_le_bytes());
-    let dim: [i16; 8] = [
-        3,
-        dims[0] as i16,
-        dims[1] as i16,
-        dims[2] as i16,
-        1,
-        1,
-        1,
-        1,
-    ];
-    for (i, d) in dim.iter().enumerate() {
-        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
-    }
-    h[70..72].copy_from_slice(&2i16.to_le_bytes()); // datatype uint8
-    h[72..74].copy_from_slice(&8i16.to_le_bytes()); // bitpix
-    let pixdim = [1.0f32, 1.0, 1.0, 1.0];
-    for (i, p) in pixdim.iter().enumerate() {
-        h[76 + 4 * i..80 + 4 * i].copy_from_slice(&p.to_le_bytes());
-    }
-    h[108..112].copy_from_slice(&352f32.to_le_bytes()); // vox_offset
-    h[254..256].copy_from_slice(&2i16.to_le_bytes()); // sform_code
-    for (r, row) in sform.iter().enumerate() {
-        for (c, v) in row.iter().enumerate() {
-            let at = 280 + 16 * r + 4 * c;
-            h[at..at + 4].copy_from_slice(&v.to_le_bytes());
-        }
-    }
-    h[344..348].copy_from_slice(b"n+1\0");
-    h.extend_from_slice(voxels);
-    h
+    let mut bytes = nifti::nifti_header(dims, sform, [1.0; 3]);
+    bytes.extend_from_slice(voxels);
+    bytes
 }
 
 /// The same label map on a plain grid and through an oblique, mirrored sform: the second's

@@ -19,14 +19,8 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BIN = os.environ.get("MESHSMOOTH_BIN", os.path.join(ROOT, "target", "release", "meshsmooth"))
-DATA = os.environ.get("MESHSMOOTH_DATA", os.path.join(ROOT, "..", "shared", "data"))
-
-MAPS = {
-    "jhu": ("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz", "labelmaps/JHU-WhiteMatter-labels-1mm.nii.txt"),
-    "phantom": ("labelmaps/case_phantom_shared.nii.gz", "labelmaps/case_phantom_shared_labels.txt"),
-}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from suggest_all import BIN, DATA, MAPS  # noqa: E402  (the same tool, data and maps)
 
 
 def build(label_map, table, search, tau, out):
