@@ -7,8 +7,11 @@ use std::cell::Cell;
 use std::time::{Duration, Instant};
 use Location::{Byte, Line};
 
+#[path = "common/glb.rs"]
+mod glb_file;
 #[path = "io_broken/mutations.rs"]
 mod mutations;
+use glb_file::glb;
 use mutations::XorShift;
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/");
@@ -603,27 +606,6 @@ fn compressed_case() -> (serde_json::Value, Vec<u8>) {
     (doc, bytes[bin_at + 8..bin_at + 8 + bin_len].to_vec())
 }
 
-fn glb_of(doc: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
-    let mut json = serde_json::to_vec(doc).expect("JSON");
-    while !json.len().is_multiple_of(4) {
-        json.push(b' ');
-    }
-    let mut bin = bin.to_vec();
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    let mut out = b"glTF".to_vec();
-    out.extend(2u32.to_le_bytes());
-    out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
-    out.extend((json.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(json);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
-}
-
 /// The buffer view of the mesh's POSITION accessor.
 fn position_view(doc: &serde_json::Value) -> usize {
     let a = doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
@@ -637,7 +619,7 @@ fn position_view(doc: &serde_json::Value) -> usize {
 #[test]
 fn a_compressed_case_reads_back_quantized() {
     let (doc, bin) = compressed_case();
-    let mesh = load_as(&glb_of(&doc, &bin), Format::Glb).expect("reads");
+    let mesh = load_as(&glb(&doc, &bin), Format::Glb).expect("reads");
     assert_eq!(mesh.vertex_count(), 4);
     // 10 mm on a power-of-two lattice: the corners are lattice points, read back exactly.
     assert_eq!(mesh.positions[1], [10.0, 0.0, 0.0]);
@@ -653,7 +635,7 @@ fn compressed_views_that_lie_about_their_size_fail_before_allocating() {
     let mut d = doc.clone();
     d["bufferViews"][view]["extensions"]["EXT_meshopt_compression"]["count"] = 3.into();
     let e = error_at(
-        &glb_of(&d, &bin),
+        &glb(&d, &bin),
         Format::Glb,
         "Syntax",
         Location::Item("buffer view", view),
@@ -669,7 +651,7 @@ fn compressed_views_that_lie_about_their_size_fail_before_allocating() {
     d["bufferViews"][view]["byteOffset"] = 0.into();
     d["buffers"][1]["byteLength"] = (8 * count).into();
     let e = error_at(
-        &glb_of(&d, &bin),
+        &glb(&d, &bin),
         Format::Glb,
         "Syntax",
         Location::Item("buffer view", view),
@@ -681,7 +663,7 @@ fn compressed_views_that_lie_about_their_size_fail_before_allocating() {
     d["bufferViews"][view]["extensions"]["EXT_meshopt_compression"]["byteOffset"] =
         (bin.len() as u64).into();
     let e = error_at(
-        &glb_of(&d, &bin),
+        &glb(&d, &bin),
         Format::Glb,
         "Syntax",
         Location::Item("buffer view", view),
@@ -692,7 +674,7 @@ fn compressed_views_that_lie_about_their_size_fail_before_allocating() {
     let mut d = doc.clone();
     d["bufferViews"][view]["extensions"]["EXT_meshopt_compression"]["byteStride"] = 6.into();
     error_at(
-        &glb_of(&d, &bin),
+        &glb(&d, &bin),
         Format::Glb,
         "Syntax",
         Location::Item("buffer view", view),
@@ -711,7 +693,7 @@ fn corrupt_or_unreadable_compressed_data_is_refused_naming_the_view() {
     let mut broken = bin.clone();
     broken[at] = 0x55;
     let e = error_at(
-        &glb_of(&doc, &broken),
+        &glb(&doc, &broken),
         Format::Glb,
         "Syntax",
         Location::Item("buffer view", view),
@@ -724,13 +706,13 @@ fn corrupt_or_unreadable_compressed_data_is_refused_naming_the_view() {
         let mut broken = bin.clone();
         let i = (rng.next() as usize) % broken.len();
         broken[i] ^= (rng.next() as u8) | 1;
-        let _ = load_as(&glb_of(&doc, &broken), Format::Glb);
+        let _ = load_as(&glb(&doc, &broken), Format::Glb);
     }
 
     // Filters are not read here: said so, not misread.
     let mut d = doc.clone();
     d["bufferViews"][view]["extensions"]["EXT_meshopt_compression"]["filter"] = "OCTAHEDRAL".into();
-    let e = error_kind(&glb_of(&d, &bin), Format::Glb, "Unsupported");
+    let e = error_kind(&glb(&d, &bin), Format::Glb, "Unsupported");
     says(&e, "OCTAHEDRAL");
 
     // A view that is not compressed cannot read the fallback buffer, which has no data.
@@ -740,7 +722,7 @@ fn corrupt_or_unreadable_compressed_data_is_refused_naming_the_view() {
         .expect("view")
         .remove("extensions");
     let e = error_at(
-        &glb_of(&d, &bin),
+        &glb(&d, &bin),
         Format::Glb,
         "Syntax",
         Location::Item("buffer", 1),

@@ -2,7 +2,10 @@
 //! merging, index types, strips and fans, and a corpus of broken files that must each fail
 //! cleanly, saying where.
 
+#[path = "common/glb.rs"]
+mod glb_file;
 use base64::Engine as _;
+use glb_file::glb;
 use meshsmooth::io::{load, load_as, Format, LoadError, Location};
 use meshsmooth::mesh::{bounding_box, Mesh};
 use serde_json::{json, Value};
@@ -94,27 +97,6 @@ impl Asset {
     fn glb(&self) -> Vec<u8> {
         glb(&self.json(json!({"byteLength": self.bin.len()})), &self.bin)
     }
-}
-
-fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut json = doc.to_string().into_bytes();
-    while !json.len().is_multiple_of(4) {
-        json.push(b' ');
-    }
-    let mut bin = bin.to_vec();
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    let mut out = b"glTF".to_vec();
-    out.extend(2u32.to_le_bytes());
-    out.extend(((28 + json.len() + bin.len()) as u32).to_le_bytes());
-    out.extend((json.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(&json);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(&bin);
-    out
 }
 
 const TRIANGLE: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
