@@ -89,18 +89,25 @@ fn extract_to_glb_gives_a_named_node_per_structure_in_metres_with_y_up() {
     assert_eq!(doc["nodes"][0]["matrix"][0], -0.001);
     assert_eq!(doc["materials"].as_array().expect("materials").len(), 2);
     assert_eq!(doc["nodes"][2]["extras"]["meshsmooth"]["label"], 3);
-    // Millimetres when asked: no root transform.
+    let required = &doc["extensionsRequired"];
+    assert!(
+        required.to_string().contains("EXT_meshopt_compression"),
+        "{required}"
+    );
+    // Millimetres when asked: no root transform; float arrays when asked.
     let raw = tmp("phantom_mm.glb");
     let out = meshsmooth(&[
         "extract",
         &data("labelmaps/case_phantom_shared.seg.nrrd"),
         "--millimetres",
+        "--uncompressed",
         "-o",
         raw.to_str().expect("utf-8"),
     ]);
     assert!(out.status.success());
     let doc = glb_json(&std::fs::read(&raw).expect("written"));
     assert!(doc["nodes"][0].get("matrix").is_none());
+    assert!(doc.get("extensionsRequired").is_none());
     assert_eq!(doc["nodes"].as_array().expect("nodes").len(), 5);
 }
 

@@ -32,6 +32,10 @@ pub(super) struct ExtractArgs {
     /// Keep the GLB in the data's RAS millimetres instead of glTF's metres with +Y up.
     #[arg(long)]
     millimetres: bool,
+    /// Write the GLB's float arrays as they are, for tools that cannot decode
+    /// KHR_mesh_quantization and EXT_meshopt_compression (as `case build --uncompressed`).
+    #[arg(long)]
+    uncompressed: bool,
     #[arg(long)]
     json: bool,
 }
@@ -64,12 +68,15 @@ pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
     let written = match &destination {
         Destination::Folder(dir) => write_folder(dir, &structures)?,
         Destination::Glb(path) => {
-            let frame = if args.millimetres {
-                SceneFrame::Millimetres
-            } else {
-                SceneFrame::Gltf
+            let options = CaseGltfOptions {
+                frame: match args.millimetres {
+                    true => SceneFrame::Millimetres,
+                    false => SceneFrame::Gltf,
+                },
+                compressed: !args.uncompressed,
+                ..Default::default()
             };
-            write_glb(path, &structures, source.as_deref(), frame)?;
+            write_glb(path, &structures, source.as_deref(), &options)?;
             vec![path.display().to_string(); structures.len()]
         }
     };
@@ -167,15 +174,11 @@ fn write_glb(
     path: &Path,
     structures: &[Structure],
     source: Option<&str>,
-    frame: SceneFrame,
+    options: &CaseGltfOptions,
 ) -> Result<(), String> {
     let case = Case::from_label_map(structures.to_vec(), source);
-    let options = CaseGltfOptions {
-        frame,
-        ..Default::default()
-    };
     let bytes =
-        export::write_case(&case, &options).map_err(|e| format!("{}: {e}", path.display()))?;
+        export::write_case(&case, options).map_err(|e| format!("{}: {e}", path.display()))?;
     super::write_file(path, &bytes)
 }
 
