@@ -190,17 +190,13 @@ pub fn starts_from(learned: &[Params], filter: Filter) -> Vec<Params> {
     counted.into_iter().take(3).map(|(p, _)| p).collect()
 }
 
+/// The same grid point: every parameter equal but the bound, which each structure keeps.
 fn same_point(a: &Params, b: &Params) -> bool {
-    a.iterations == b.iterations
-        && [
-            (a.alpha, b.alpha),
-            (a.beta, b.beta),
-            (a.lambda, b.lambda),
-            (a.mu, b.mu),
-        ]
-        .iter()
-        .all(|(x, y)| (x - y).abs() < 1e-6)
-        && (a.passband - b.passband).abs() < 1e-9
+    let unbound = |p: &Params| Params {
+        max_displacement: None,
+        ..*p
+    };
+    unbound(a) == unbound(b)
 }
 
 /// A structure's suggestion and the structure smoothed with it; `None` when cancelled or empty.
