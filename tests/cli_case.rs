@@ -9,23 +9,29 @@ fn data(rel: &str) -> String {
     common_cli::data(rel).display().to_string()
 }
 
-#[test]
-fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
-    let glb = tmp("phantom_case.glb");
-    let out = meshsmooth(&[
-        "case",
-        "build",
-        &data("labelmaps/case_phantom_shared.nii.gz"),
-        "--colors",
-        &data("labelmaps/case_phantom_shared_labels.txt"),
-        "--search",
-        "local",
+/// `case build` of the phantom with its colour table and the local search into `out`.
+fn build_phantom(out: &std::path::Path, more: &[&str]) -> std::process::Output {
+    let (map, table) = (
+        data("labelmaps/case_phantom_shared.nii.gz"),
+        data("labelmaps/case_phantom_shared_labels.txt"),
+    );
+    let mut args = vec![
+        "case", "build", &map, "--colors", &table, "--search", "local",
+    ];
+    args.extend([
         "--title",
         "Abdominal phantom",
         "-o",
-        glb.to_str().expect("utf-8"),
-        "--json",
+        out.to_str().expect("utf-8"),
     ]);
+    args.extend(more);
+    meshsmooth(&args)
+}
+
+#[test]
+fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
+    let glb = tmp("phantom_case.glb");
+    let out = build_phantom(&glb, &["--json"]);
     let built = json(&out);
     let list = built["structures"].as_array().expect("structures");
     assert_eq!(list.len(), 4);
@@ -93,20 +99,7 @@ fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
 
     // --uncompressed writes float arrays for tools that cannot decode; info reads both alike.
     let raw = tmp("phantom_case_raw.glb");
-    meshsmooth(&[
-        "case",
-        "build",
-        &data("labelmaps/case_phantom_shared.nii.gz"),
-        "--colors",
-        &data("labelmaps/case_phantom_shared_labels.txt"),
-        "--search",
-        "local",
-        "--title",
-        "Abdominal phantom",
-        "--uncompressed",
-        "-o",
-        raw.to_str().expect("utf-8"),
-    ]);
+    build_phantom(&raw, &["--uncompressed"]);
     let bytes = std::fs::read(&raw).expect("written");
     assert!(!String::from_utf8_lossy(&bytes[..4096.min(bytes.len())]).contains("meshopt"));
     let compressed = std::fs::metadata(&glb).expect("written").len();

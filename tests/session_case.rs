@@ -1,13 +1,13 @@
 //! The page's session as a case: a label map's structures (each shown and smoothed its own
-//! way, with Gibson's bound by default), files added to the case, "Suggest all", and the case
-//! glTF it writes reopened as the same case.
+//! way, with Gibson's bound by default), files added to the case, and the case glTF it writes
+//! reopened as the same case. "Suggest all" in the session: tests/session_suggest_all.rs.
 
 #[path = "common/label_maps.rs"]
 mod label_maps;
 
 use label_maps::{open_in_session, read};
 use meshsmooth::export::Container;
-use meshsmooth::session::{Session, StructureChange, StructureOutcome};
+use meshsmooth::session::{Session, StructureChange};
 
 /// The page's session opens a label map in a worker (read, extract, then a mesh's stages), makes the
 /// first structure the model with its voxel size, and opens another structure on request.
@@ -273,95 +273,6 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     assert_eq!(session.case().case_structures()[2].name, "tumor");
 }
 
-/// "Suggest all" in the page's session: each structure gets what the CLI's pipeline suggests for
-/// it (its own filter and bound), the model's structure as its new parameters, the others kept
-/// with their smoothed surfaces; cancelling leaves the rest as they were.
-#[test]
-fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
-    use meshsmooth::case::{self, Case, SuggestAllOptions};
-    use meshsmooth::session::Session;
-    use meshsmooth::suggest::SearchMethod;
-    let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
-    let mut session = Session::default();
-    session.begin_open("case_phantom_shared.seg.nrrd", bytes.clone());
-    session.poll_opening().expect("done").expect("opens");
-    // Each structure starts from its own filter and bound, the model's as the session has it.
-    let mut expected = Case {
-        structures: session.case().case_structures().to_vec(),
-        ..Case::default()
-    };
-    assert_eq!(expected.structures[0].params, *session.case().params());
-    assert!(session
-        .start_suggest_all(1.5, SearchMethod::Local, false)
-        .is_err());
-    session
-        .start_suggest_all(0.5, SearchMethod::Local, false)
-        .unwrap();
-    // Workers on this thread answer at once.
-    assert!(session.step_suggest_all());
-    assert!(!session.background().suggesting_all());
-    let outcome = session.background().suggest_all().unwrap();
-    assert_eq!((outcome.done, outcome.total), (4, 4));
-    let suggested: Vec<meshsmooth::smooth::Params> = (outcome.structures.iter())
-        .filter_map(|o| match o {
-            Some(StructureOutcome::Suggested { params, .. }) => Some(*params),
-            _ => None,
-        })
-        .collect();
-
-    let options = SuggestAllOptions {
-        tau: 0.5,
-        filter: None,
-        method: SearchMethod::Local,
-        max_volume_change: Some(0.05),
-        learn: false,
-    };
-    let mut liver = expected.structures[0].clone();
-    let first = case::suggest_structure(&mut liver, &options, &[], &mut |_| true)
-        .unwrap()
-        .unwrap();
-    case::suggest_all(&mut expected, &options, &|_| true).unwrap();
-    assert_eq!(
-        *session.case().params(),
-        first.params,
-        "the model takes its suggestion"
-    );
-    session.smooth_cpu();
-    assert_eq!(
-        session.case().result().unwrap().positions,
-        liver.smoothed.as_ref().unwrap().positions
-    );
-    for i in 1..4 {
-        let kept = &session.case().case_structures()[i];
-        let want = &expected.structures[i];
-        assert_eq!(kept.params, want.params, "structure {i}");
-        let smoothed = kept.smoothed.as_ref().unwrap();
-        assert_eq!(
-            smoothed.positions,
-            want.smoothed.as_ref().unwrap().positions
-        );
-        assert_eq!(smoothed.metrics, want.smoothed.as_ref().unwrap().metrics);
-    }
-    let want: Vec<_> = expected.structures.iter().map(|s| s.params).collect();
-    assert_eq!(
-        suggested, want,
-        "each structure's outcome names its parameters"
-    );
-    // Drawn as suggested.
-    let others = session.case().other_structures();
-    assert_eq!(
-        others[0].positions,
-        &expected.structures[1].smoothed.as_ref().unwrap().positions[..]
-    );
-
-    session.begin_open("case_phantom_shared.seg.nrrd", bytes);
-    session.poll_opening().expect("done").expect("opens");
-    assert!(
-        session.background().suggest_all().is_none(),
-        "a new file starts over"
-    );
-}
-
 /// The largest difference of two position lists, in mm.
 /// The largest position quantization error (mm) a compressed case GLB's records state.
 fn quantization_error(glb: &[u8]) -> f32 {
@@ -616,53 +527,4 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
     assert!(session.loading().is_none(), "nothing left to add");
     assert_eq!(session.case().case_structures().len(), 5, "the case stays");
-}
-
-/// Learning, the page hands the structures out batch by batch as `case build` does, so each
-/// structure's search starts at the same sets and every structure gets the CLI's suggestion.
-#[test]
-fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
-    use meshsmooth::case::{self, Case, SuggestAllOptions, LEARNING_BATCH};
-    use meshsmooth::session::Session;
-    use meshsmooth::suggest::SearchMethod;
-    let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
-    let mut session = Session::default();
-    session.begin_open("case_phantom_shared.seg.nrrd", bytes.clone());
-    session.poll_opening().expect("done").expect("opens");
-    // Three copies of the phantom: more structures than one batch.
-    for copy in ["copy1.seg.nrrd", "copy2.seg.nrrd"] {
-        session.begin_add(copy, bytes.clone());
-        session.poll_opening().expect("done").expect("adds");
-    }
-    let count = session.case().case_structures().len();
-    assert!(count > 2 * LEARNING_BATCH, "{count} structures");
-    let mut expected = Case {
-        structures: session.case().case_structures().to_vec(),
-        ..Case::default()
-    };
-    session
-        .start_suggest_all(0.5, SearchMethod::Local, true)
-        .unwrap();
-    while session.background().suggesting_all() {
-        assert!(
-            session.step_suggest_all(),
-            "workers on this thread answer at once"
-        );
-    }
-    let options = SuggestAllOptions {
-        tau: 0.5,
-        filter: None,
-        method: SearchMethod::Local,
-        max_volume_change: Some(0.05),
-        learn: true,
-    };
-    let want = case::suggest_all(&mut expected, &options, &|_| true).unwrap();
-    let outcome = session.background().suggest_all().unwrap();
-    assert_eq!((outcome.done, outcome.total), (count, count));
-    for (i, (got, want)) in outcome.structures.iter().zip(&want).enumerate() {
-        let Some(StructureOutcome::Suggested { params, .. }) = got else {
-            panic!("structure {i}: {got:?}");
-        };
-        assert_eq!(*params, want.unwrap().params, "structure {i}");
-    }
 }

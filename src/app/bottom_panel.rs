@@ -1,9 +1,10 @@
 //! The panel under the view: the model quality graphs or the gallery, one at a time. The
 //! graphs are kept current in the background only while they are shown.
 
-use super::document::{Document, GraphColumn, PanelLayout};
+use super::document::Document;
 use super::gallery_view::GalleryView;
 use super::graphs;
+use super::layout::{GraphColumn, PanelLayout};
 use crate::session::{Activity, Session};
 use eframe::egui;
 

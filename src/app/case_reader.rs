@@ -5,7 +5,7 @@
 
 use eframe::egui;
 
-use super::document::{PanelLayout, StructureRow};
+use super::layout::{PanelLayout, StructureRow};
 use super::structure_list::{
     filter_field, grouped_rows, measures, show_box, solo_button, StructureAction,
 };

@@ -8,7 +8,7 @@
 //! the parameter. Where the filter diverges (the mesh comes out rougher than the original) the
 //! curves break off and red bars mark the samples: those values are never suggested.
 
-use super::document::GraphColumn;
+use super::layout::GraphColumn;
 use crate::session::Session;
 use crate::smooth::Params;
 use crate::suggest::{Curve, Param};

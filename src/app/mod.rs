@@ -35,6 +35,7 @@ mod gallery_view;
 mod gpu_engine;
 mod graphs;
 mod guide;
+mod layout;
 mod legend;
 mod orientation_marker;
 mod page;

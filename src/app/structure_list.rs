@@ -5,7 +5,7 @@
 
 use eframe::egui;
 
-use super::document::{PanelLayout, StructureRow};
+use super::layout::{PanelLayout, StructureRow};
 use crate::case::CaseStructure;
 use crate::metrics::Metrics;
 use crate::session::{Session, StructureChange};

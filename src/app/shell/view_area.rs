@@ -5,7 +5,8 @@ use eframe::egui;
 
 use super::view_sync::Positions;
 use super::Shell;
-use crate::app::document::{Document, ViewReport};
+use crate::app::document::Document;
+use crate::app::layout::ViewReport;
 use crate::app::pointing::Pointing;
 use crate::app::{legend, orientation_marker, status, view_tools, viewer};
 

@@ -1,0 +1,100 @@
+//! Where the page drew what tests and the embedding page click (egui draws on a canvas
+//! without a DOM), as `state()` reports it: the view, the graphs, the gallery, the structure
+//! list.
+
+use crate::view::CameraPose;
+
+/// A rectangle on the page in points (CSS pixels at zoom 1), as `state()` reports it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PageRect {
+    pub left: f32,
+    pub top: f32,
+    pub width: f32,
+    pub height: f32,
+}
+
+impl PageRect {
+    pub fn to_json(self) -> serde_json::Value {
+        serde_json::json!({"x": self.left, "y": self.top, "width": self.width, "height": self.height})
+    }
+}
+
+impl From<eframe::egui::Rect> for PageRect {
+    fn from(r: eframe::egui::Rect) -> Self {
+        Self {
+            left: r.left(),
+            top: r.top(),
+            width: r.width(),
+            height: r.height(),
+        }
+    }
+}
+
+/// The 3D view's part of `state()`: where it is on the page, whether the weight brush is on
+/// and how long its latest pick took.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewReport {
+    pub rect: PageRect,
+    /// Where the camera is.
+    pub pose: Option<CameraPose>,
+    pub brush_on: bool,
+    pub pick_ms: Option<f64>,
+}
+
+/// Where the bottom panel's clickable parts were drawn in the latest frame (points), for
+/// `state().layout`: egui draws on a canvas without a DOM, so tests find them here.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PanelLayout {
+    /// The quality graphs shown: one column per parameter.
+    pub graphs: Vec<GraphColumn>,
+    /// The gallery cards' visible rectangles, in gallery order.
+    pub gallery: Vec<PageRect>,
+    /// The Structures list's rows as drawn, its Name field and its filter field.
+    pub structures: Vec<StructureRow>,
+    pub structure_name: Option<PageRect>,
+    pub structure_filter: Option<PageRect>,
+}
+
+/// One row of the Structures list: its visibility box, show-alone button and name (which
+/// selects it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StructureRow {
+    pub index: usize,
+    pub visible: PageRect,
+    pub solo: PageRect,
+    pub name: PageRect,
+}
+
+/// One parameter's column of graphs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GraphColumn {
+    pub param: &'static str,
+    /// Each strip's plot area and the parameter values at its left and right edges: a value's
+    /// x is `left + width * (value - x0) / (x1 - x0)`.
+    pub strips: Vec<(PageRect, [f64; 2])>,
+}
+
+impl PanelLayout {
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "graphs": self.graphs.iter().map(|c| serde_json::json!({
+                "param": c.param,
+                "strips": c.strips.iter().map(|(r, x)| {
+                    let mut s = r.to_json();
+                    s["x0"] = serde_json::json!(x[0]);
+                    s["x1"] = serde_json::json!(x[1]);
+                    s
+                }).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+            "gallery": self.gallery.iter().map(|r| r.to_json()).collect::<Vec<_>>(),
+            "structures": self.structures.iter().map(|r| serde_json::json!({
+                "index": r.index,
+                "visible": r.visible.to_json(),
+                "solo": r.solo.to_json(),
+                "name": r.name.to_json(),
+            })).collect::<Vec<_>>(),
+            "structure_name": self.structure_name.map(PageRect::to_json),
+            "structure_filter": self.structure_filter.map(PageRect::to_json),
+        })
+    }
+}
