@@ -18,6 +18,14 @@ mod label_maps;
 
 use label_maps::{inside_shape, read};
 
+#[path = "common/glb.rs"]
+mod glb;
+
+#[path = "common/vertex_match.rs"]
+mod vertex_match;
+
+use vertex_match::{match_vertices, triangles_as_written, triangles_sorted};
+
 fn phantom() -> Case {
     let (bytes, table) = (read(PHANTOM), read(TABLE));
     let files = [NamedBytes {
@@ -145,12 +153,30 @@ fn a_compressed_case_reads_back_within_its_stated_quantization_error() {
         uncompressed.len()
     );
     let doc = glb_json(&first);
-    let back = from_gltf_scene(load_gltf_scene(&first, "case.glb").expect("reads"), "c.glb")
+    let snapped = from_gltf_scene(load_gltf_scene(&first, "case.glb").expect("reads"), "c.glb")
         .expect("a case");
+    // Read without the voxel grid, the originals stay where the file put them.
+    let mut unsnapped = doc.clone();
+    for n in unsnapped["nodes"].as_array_mut().expect("nodes") {
+        if let Some(r) = n
+            .pointer_mut("/extras/meshsmooth")
+            .and_then(Value::as_object_mut)
+        {
+            r.remove("voxel_to_world");
+        }
+    }
+    let bin_at = 20 + u32::from_le_bytes(first[12..16].try_into().expect("4")) as usize;
+    let bin = &first[bin_at + 8..];
+    let back = from_gltf_scene(
+        load_gltf_scene(&glb::glb(&unsnapped, bin), "case.glb").expect("reads"),
+        "c.glb",
+    )
+    .expect("a case");
     assert_eq!(back.structures.len(), case.structures.len());
-    let far = |a: &[[f32; 3]], b: &[[f32; 3]]| {
-        (a.iter().zip(b))
-            .map(|(p, q)| {
+    let far = |a: &[[f32; 3]], b: &[[f32; 3]], m: &[usize]| {
+        (b.iter().enumerate())
+            .map(|(i, q)| {
+                let p = a[m[i]];
                 (0..3)
                     .map(|k| f64::from(p[k] - q[k]).powi(2))
                     .sum::<f64>()
@@ -174,24 +200,48 @@ fn a_compressed_case_reads_back_within_its_stated_quantization_error() {
             "{}: {stated} mm",
             a.name
         );
-        let moved = far(a.positions(), b.positions())
-            .max(far(&a.original.positions, &b.original.positions));
+        // Vertices come back in the codecs' order: the staircase says which is which.
+        let m = match_vertices(&a.original.positions, &b.original.positions, stated * 1.001);
+        let moved = far(a.positions(), b.positions(), &m).max(far(
+            &a.original.positions,
+            &b.original.positions,
+            &m,
+        ));
         // The record states the largest of these exactly.
         assert_eq!(moved, stated, "{}", a.name);
-        // The index codec keeps each triangle's winding, not which corner comes first.
-        let first_corner = |t: &[u32; 3]| {
-            let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
-            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
-        };
-        let turned = |m: &meshsmooth::mesh::Mesh| -> Vec<[u32; 3]> {
-            m.triangles.iter().map(first_corner).collect()
-        };
-        assert_eq!(turned(&a.original), turned(&b.original), "{}", a.name);
+        assert_eq!(
+            triangles_sorted(&a.original.triangles),
+            triangles_as_written(&b.original.triangles, &m),
+            "{}",
+            a.name
+        );
         assert_eq!((&a.name, a.color, &a.group), (&b.name, b.color, &b.group));
         assert_eq!(
-            a.smoothed.as_ref().map(|s| (&s.metrics, &s.local_error)),
-            b.smoothed.as_ref().map(|s| (&s.metrics, &s.local_error))
+            a.smoothed.as_ref().map(|s| &s.metrics),
+            b.smoothed.as_ref().map(|s| &s.metrics)
         );
+        let errors = |s: &meshsmooth::case::CaseStructure| {
+            s.smoothed.as_ref().and_then(|s| s.local_error.clone())
+        };
+        let reordered = errors(b).map(|e| {
+            let mut out = vec![0.0; e.len()];
+            for (i, v) in e.into_iter().enumerate() {
+                out[m[i]] = v;
+            }
+            out
+        });
+        assert_eq!(errors(a), reordered, "{}", a.name);
+    }
+    // With it, each staircase comes back exactly where extraction placed it.
+    for (a, b) in case.structures.iter().zip(&snapped.structures) {
+        let m = match_vertices(&a.original.positions, &b.original.positions, 1e-3);
+        assert_eq!(
+            far(&a.original.positions, &b.original.positions, &m),
+            0.0,
+            "{}",
+            a.name
+        );
+        assert_eq!(b.grid, a.grid);
     }
     let again = write_case(&back, &options).expect("writes again");
     let twice = from_gltf_scene(
@@ -200,8 +250,20 @@ fn a_compressed_case_reads_back_within_its_stated_quantization_error() {
     )
     .expect("a case");
     for (b, c) in back.structures.iter().zip(&twice.structures) {
-        assert_eq!(b.positions(), c.positions(), "{}: quantized again", b.name);
-        assert_eq!(b.original, c.original, "{}", b.name);
+        // Lattice points quantized again are the same points, exactly.
+        let m = match_vertices(&b.original.positions, &c.original.positions, 0.0);
+        assert_eq!(
+            far(b.positions(), c.positions(), &m),
+            0.0,
+            "{}: quantized again",
+            b.name
+        );
+        assert_eq!(
+            triangles_sorted(&b.original.triangles),
+            triangles_as_written(&c.original.triangles, &m),
+            "{}",
+            b.name
+        );
     }
 }
 
@@ -320,8 +382,12 @@ fn any_gltf_opens_as_a_case_of_its_nodes() {
     let names: Vec<&str> = back.structures.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(names, ["a", "b"]);
     // Placed by the root's transform: metres, +Y up, as any glTF is read.
-    let p = back.structures[1].original.positions[1];
-    assert!((p[0] - (-0.006)).abs() < 1e-7, "{p:?}");
+    let points = &back.structures[1].original.positions;
+    let near = |p: &[f32; 3], q: [f32; 3]| (0..3).all(|k| (p[k] - q[k]).abs() < 1e-7);
+    assert!(
+        points.iter().any(|p| near(p, [-0.006, 0.0, 0.0])),
+        "{points:?}"
+    );
     assert!(back.structures.iter().all(|s| s.smoothed.is_none()));
     let green = back.structures[1].color;
     assert!((green[1] - 1.0).abs() < 1e-6 && green[0].abs() < 1e-6);

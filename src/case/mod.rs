@@ -10,6 +10,7 @@ mod from_files;
 mod pipeline;
 mod record;
 pub mod relations;
+mod voxel_grid;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
 pub use from_files::{
@@ -24,6 +25,7 @@ pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
 
 use serde::{Deserialize, Serialize};
 
+use crate::io::Affine;
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
 use crate::segmentation::Structure;
@@ -60,6 +62,9 @@ pub struct CaseStructure {
     pub voxel_size: Option<[f64; 3]>,
     /// Its voxels in the label map (after dropping specks), when it came from one.
     pub voxels: Option<usize>,
+    /// The voxel grid it was extracted on, when it came from a label map: its original's
+    /// vertices lie at the grid's edge midpoints, which a quantized file's reader snaps to.
+    pub grid: Option<Affine>,
     /// The surface as opened (the staircase of a label map), in world millimetres.
     pub original: Mesh,
     /// The structure's own filter and parameters, bound included.
@@ -103,7 +108,7 @@ impl PartialEq for CaseStructure {
         (self.name == o.name && self.color == o.color && self.visible == o.visible)
             && (self.group == o.group && self.description == o.description)
             && (self.source == o.source && self.label == o.label)
-            && (self.voxel_size == o.voxel_size && self.voxels == o.voxels)
+            && (self.voxel_size == o.voxel_size && self.voxels == o.voxels && self.grid == o.grid)
             && (self.original == o.original && self.params == o.params && self.tau == o.tau)
             && (self.weights == o.weights && self.smoothed == o.smoothed)
     }
@@ -147,6 +152,7 @@ impl CaseStructure {
             source: None,
             label: None,
             voxel_size: None,
+            grid: None,
             voxels: None,
             original: mesh,
             params: Params::defaults(DEFAULT_FILTER),
@@ -167,6 +173,7 @@ impl CaseStructure {
         s.label = Some(structure.label);
         s.voxel_size = Some(structure.voxel_size);
         s.voxels = Some(structure.voxels);
+        s.grid = Some(structure.grid);
         s.params.max_displacement = s.default_bound();
         s
     }

@@ -5,8 +5,8 @@
 
 use serde_json::{json, Value};
 
-use super::{Case, CaseStructure, Smoothed};
-use crate::io::{GltfNode, GltfScene, Mat4};
+use super::{voxel_grid, Case, CaseStructure, Smoothed};
+use crate::io::{Affine, GltfNode, GltfScene, Mat4};
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
 use crate::segmentation::default_color;
@@ -36,6 +36,7 @@ pub fn structure_record(s: &CaseStructure) -> Value {
         "visible": s.visible,
         "color": s.color,
         "voxel_size_mm": s.voxel_size,
+        "voxel_to_world": s.grid.map(|g| g.0),
         "voxels": s.voxels,
         "voxel_diagonal_mm": diagonal,
         "filter": s.params.filter,
@@ -146,6 +147,14 @@ fn structure(
         // where the author goes on from.
         _ => s.original = shown,
     }
+    let quantized = record
+        .pointer("/quantization/max_error_mm")
+        .and_then(Value::as_f64);
+    if let (Some(grid), Some(error)) = (s.grid, quantized) {
+        if let Some(exact) = voxel_grid::on_grid(&s.original.positions, &grid, error * 1.01) {
+            s.original.positions = exact;
+        }
+    }
     Ok(s)
 }
 
@@ -194,6 +203,7 @@ fn read_looks(s: &mut CaseStructure, record: &Value, node: &GltfNode, ours: bool
         .or(s.source.take());
     s.label = record.get("label").and_then(Value::as_i64);
     s.voxel_size = floats::<3>(record.get("voxel_size_mm"));
+    s.grid = record.get("voxel_to_world").and_then(grid);
     s.voxels = record
         .get("voxels")
         .and_then(Value::as_u64)
@@ -216,6 +226,19 @@ fn read_smoothing(s: &mut CaseStructure, record: &Value) -> Result<(), String> {
         None => Params::defaults(filter),
     };
     Ok(())
+}
+
+/// A 3 x 4 matrix, row by row.
+fn grid(value: &Value) -> Option<Affine> {
+    let rows = value.as_array()?;
+    if rows.len() != 3 {
+        return None;
+    }
+    let mut m = [[0.0; 4]; 3];
+    for (r, row) in m.iter_mut().zip(rows) {
+        *r = floats::<4>(Some(row))?;
+    }
+    Some(Affine(m))
 }
 
 fn floats<const N: usize>(value: Option<&Value>) -> Option<[f64; N]> {

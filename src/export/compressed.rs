@@ -6,22 +6,29 @@
 //! `offset + step * q` millimetres, a translation and uniform scale on the structure's node, so
 //! the root keeps the frame's conversion alone. The step is a power of two and the offset a
 //! multiple of it, so the lattice's points are exact in f32 and a reopened case, quantized
-//! again, lands on the same points. The original is stored as integer steps from the surface
-//! on the same lattice, so it is exactly its lattice point too. Normals are 8-bit normalized;
-//! the original's normals are their difference from those, 8-bit where every component fits
-//! the normalized range and float where one does not. `_LOCAL_ERROR` stays float.
+//! again, lands on the same points. A structure extracted from voxels gets the coarsest such
+//! lattice within a small part of its voxel diagonal; others the finest that 16 bits cover.
+//! The original is stored as integer steps from the surface on the same lattice, so it is
+//! exactly its lattice point too. Normals are 8-bit normalized. The morph target carries no
+//! normals: a staircase's normals, as differences from smooth ones, took more than a fifth of
+//! the file, and viewers that slide to it (ours) light it from its positions; the uncompressed
+//! file keeps them. `_LOCAL_ERROR` stays float.
 
 use serde_json::{json, Value};
 
 use super::glb::{Builder, FLOAT, TRIANGLES};
+use super::meshopt::codec_order;
 use super::ExportError;
-use crate::mesh::{vertex_normals, Mesh};
+use crate::mesh::Mesh;
 
 const BYTE: u32 = 5120;
 const SHORT: u32 = 5122;
 const UNSIGNED_SHORT: u32 = 5123;
 /// The largest stored position value (16 bits).
 const Q_MAX: f64 = 65535.0;
+/// The largest quantization error a structure extracted from voxels allows, in its voxel
+/// diagonals: far below what smoothing moves, and coarse lattices compress better.
+const LATTICE_ERROR_VOXEL_DIAGONALS: f64 = 0.04;
 /// Normals' scale: 8-bit signed normalized.
 const NORMAL_MAX: f32 = 127.0;
 
@@ -33,8 +40,12 @@ pub(super) struct Lattice {
 }
 
 impl Lattice {
-    /// The finest power-of-two lattice whose 16-bit range covers `points` (at least one).
-    pub(super) fn covering<'a>(points: impl Iterator<Item = &'a [f32; 3]> + Clone) -> Lattice {
+    /// The coarsest power-of-two lattice whose steps are at most `max_step` mm (when given),
+    /// or the finest one whose 16-bit range covers `points` where that is coarser.
+    pub(super) fn covering<'a>(
+        points: impl Iterator<Item = &'a [f32; 3]> + Clone,
+        max_step: Option<f64>,
+    ) -> Lattice {
         let mut min = [f64::INFINITY; 3];
         let mut max = [f64::NEG_INFINITY; 3];
         for p in points {
@@ -46,6 +57,9 @@ impl Lattice {
         let extent = (0..3).map(|k| max[k] - min[k]).fold(0.0, f64::max);
         // A point (or nothing) still gets a lattice; -40 keeps the step a normal f32.
         let mut exponent = (extent / Q_MAX).log2().ceil().max(-40.0) as i32;
+        if let Some(coarsest) = max_step.filter(|s| s.is_finite() && *s > 0.0) {
+            exponent = exponent.max(coarsest.log2().floor().clamp(-40.0, 40.0) as i32);
+        }
         loop {
             let step = 2f64.powi(exponent);
             let offset = min.map(|m| ((m / step).floor() * step) as f32);
@@ -125,13 +139,21 @@ fn bounds<const N: usize, T: Copy + Into<f64>>(values: &[[T; N]]) -> (Vec<f64>, 
     (min, max)
 }
 
-/// Unit normals as 8-bit normalized integers.
-fn quantize_normal(n: [f32; 3]) -> [i8; 3] {
-    n.map(|v| (v * NORMAL_MAX).round().clamp(-NORMAL_MAX, NORMAL_MAX) as i8)
-}
-
-fn normal_value(q: [i8; 3]) -> [f32; 3] {
-    q.map(|v| f32::from(v) / NORMAL_MAX)
+/// A unit normal as `EXT_meshopt_compression`'s octahedral filter stores it in 8 bits: its
+/// point on the octahedron |x| + |y| + |z| = 1 as x and y, the lower half folded over the
+/// upper, and 1.0 in z. Two numbers where xyz takes three compress better, as precisely.
+fn octahedral(n: [f32; 3]) -> [i8; 4] {
+    let l1 = n[0].abs() + n[1].abs() + n[2].abs();
+    if l1.is_nan() || l1 <= 0.0 {
+        return [0, 0, NORMAL_MAX as i8, 0];
+    }
+    let (mut u, mut v) = (n[0] / l1, n[1] / l1);
+    if n[2] < 0.0 {
+        let sign = |x: f32| if x >= 0.0 { 1.0 } else { -1.0 };
+        (u, v) = ((1.0 - v.abs()) * sign(u), (1.0 - u.abs()) * sign(v));
+    }
+    let q = |x: f32| (x * NORMAL_MAX).round().clamp(-NORMAL_MAX, NORMAL_MAX) as i8;
+    [q(u), q(v), NORMAL_MAX as i8, 0]
 }
 
 /// What the compressed mesh of a structure adds to its node: the lattice (as the node's
@@ -151,16 +173,46 @@ pub(super) struct Surfaces<'a> {
     pub voxel_diagonal: Option<f64>,
 }
 
-/// A structure's primitive, quantized and compressed: its attributes, indices and morph target.
+/// A structure's primitive, quantized and compressed: its attributes, indices and morph target,
+/// with vertices and triangles in the order the codecs compress best.
 pub(super) fn structure_mesh(
     b: &mut Builder,
     s: &Surfaces,
     material: usize,
 ) -> Result<(Value, Placement), ExportError> {
+    let (triangles, old_of_new) = codec_order(&s.shown.triangles, s.shown.positions.len());
+    let pick =
+        |v: &[[f32; 3]]| -> Vec<[f32; 3]> { old_of_new.iter().map(|&i| v[i as usize]).collect() };
+    let shown = Mesh::new(pick(&s.shown.positions), triangles);
+    let normals = pick(s.normals);
+    let original = s
+        .original
+        .map(|o| Mesh::new(pick(&o.positions), shown.triangles.clone()));
+    let local_error: Option<Vec<f32>> = s
+        .local_error
+        .map(|e| old_of_new.iter().map(|&i| e[i as usize]).collect());
+    let ordered = Surfaces {
+        shown: &shown,
+        normals: &normals,
+        original: original.as_ref(),
+        local_error: local_error.as_deref(),
+        voxel_diagonal: s.voxel_diagonal,
+    };
+    ordered_mesh(b, &ordered, material)
+}
+
+fn ordered_mesh(
+    b: &mut Builder,
+    s: &Surfaces,
+    material: usize,
+) -> Result<(Value, Placement), ExportError> {
     let shown = &s.shown.positions;
+    // A point lies within half a step on each axis of its lattice point.
+    let max_step =
+        (s.voxel_diagonal).map(|d| 2.0 * LATTICE_ERROR_VOXEL_DIAGONALS * d / 3f64.sqrt());
     let lattice = match s.original {
-        Some(o) => Lattice::covering(shown.iter().chain(&o.positions)),
-        None => Lattice::covering(shown.iter()),
+        Some(o) => Lattice::covering(shown.iter().chain(&o.positions), max_step),
+        None => Lattice::covering(shown.iter(), max_step),
     };
     let (q, mut worst) = quantized_positions(&lattice, shown);
     let n = q.len();
@@ -170,14 +222,18 @@ pub(super) fn structure_mesh(
         8,
         json!({"componentType": UNSIGNED_SHORT, "count": n, "type": "VEC3", "min": min, "max": max}),
     )?;
-    let normals: Vec<[i8; 3]> = super::glb::unit_normals(s.normals)
-        .into_iter()
-        .map(quantize_normal)
+    let normals: Vec<[i8; 4]> = (super::glb::unit_normals(s.normals).into_iter())
+        .map(octahedral)
         .collect();
-    let normal = b.push_attributes(
-        &padded(&normals, 0i8, |v| v.to_le_bytes().to_vec()),
+    let normal = b.push_filtered_attributes(
+        &normals
+            .iter()
+            .flatten()
+            .map(|v| v.to_le_bytes()[0])
+            .collect::<Vec<u8>>(),
         4,
         json!({"componentType": BYTE, "normalized": true, "count": n, "type": "VEC3"}),
+        "OCTAHEDRAL",
     )?;
     let mut attributes = json!({ "POSITION": position, "NORMAL": normal });
     if let Some(errors) = s.local_error {
@@ -194,7 +250,7 @@ pub(super) fn structure_mesh(
         "attributes": attributes, "indices": indices, "material": material, "mode": TRIANGLES,
     });
     if let Some(original) = s.original {
-        let (target, original_worst) = morph_target(b, &lattice, &q, original, &normals)?;
+        let (target, original_worst) = morph_target(b, &lattice, &q, original)?;
         worst = worst.max(original_worst);
         primitive["targets"] = json!([target]);
     }
@@ -208,15 +264,13 @@ pub(super) fn structure_mesh(
     Ok((primitive, Placement { lattice, record }))
 }
 
-/// The original on the surface's lattice, as integer steps from the surface, and its normals
-/// as differences from the surface's stored ones; with the original's largest quantization
-/// error (mm).
+/// The original on the surface's lattice, as integer steps from the surface, with its largest
+/// quantization error (mm).
 fn morph_target(
     b: &mut Builder,
     lattice: &Lattice,
     shown: &[[u16; 3]],
     original: &Mesh,
-    shown_normals: &[[i8; 3]],
 ) -> Result<(Value, f64), ExportError> {
     let (q, worst) = quantized_positions(lattice, &original.positions);
     let steps: Vec<[i32; 3]> = (q.iter().zip(shown))
@@ -240,30 +294,7 @@ fn morph_target(
             json!({"componentType": FLOAT, "count": count, "type": "VEC3", "min": min, "max": max}),
         )?
     };
-    let unit = super::glb::unit_normals(&vertex_normals(&original.positions, &original.triangles));
-    let turns: Vec<[f32; 3]> = (unit.iter().zip(shown_normals))
-        .map(|(o, s)| {
-            let s = normal_value(*s);
-            std::array::from_fn(|k| o[k] - s[k])
-        })
-        .collect();
-    let normal = if turns.iter().flatten().all(|d| d.abs() <= 1.0) {
-        let q: Vec<[i8; 3]> = turns.iter().map(|&t| quantize_normal(t)).collect();
-        b.push_attributes(
-            &padded(&q, 0i8, |v| v.to_le_bytes().to_vec()),
-            4,
-            json!({"componentType": BYTE, "normalized": true, "count": count, "type": "VEC3"}),
-        )?
-    } else {
-        // A normal turned so far that a component changes by more than 1 does not fit the
-        // normalized range; floats keep it rather than clamping it.
-        b.push_attributes(
-            &super::glb::floats(&turns),
-            12,
-            json!({"componentType": FLOAT, "count": count, "type": "VEC3"}),
-        )?
-    };
-    Ok((json!({ "POSITION": position, "NORMAL": normal }), worst))
+    Ok((json!({ "POSITION": position }), worst))
 }
 
 #[cfg(test)]
@@ -273,7 +304,7 @@ mod tests {
     #[test]
     fn the_lattice_covers_the_points_within_half_a_step() {
         let points = [[-12.3, 40.0, 7.25], [88.1, 41.5, 9.0], [0.0, 120.7, -3.0]];
-        let l = Lattice::covering(points.iter());
+        let l = Lattice::covering(points.iter(), None);
         assert!(l.step.log2().fract() == 0.0, "a power of two: {}", l.step);
         // The extent is 100.4 mm (x): 2^-9 mm steps are the finest whose 65535 hold it.
         assert_eq!(l.step, 2f32.powi(-9));
@@ -283,7 +314,7 @@ mod tests {
             // Quantizing a lattice point again gives the same point.
             assert_eq!(l.position(l.quantize(back).map(f64::from)), back);
         }
-        let one = Lattice::covering([[5.0, 5.0, 5.0]].iter());
+        let one = Lattice::covering([[5.0, 5.0, 5.0]].iter(), None);
         assert_eq!(
             one.position(one.quantize([5.0; 3]).map(f64::from)),
             [5.0; 3]
@@ -291,12 +322,27 @@ mod tests {
     }
 
     #[test]
-    fn normals_keep_eight_bits() {
-        let n = [0.6, 0.0, -0.8];
-        let back = normal_value(quantize_normal(n));
-        assert!(n
-            .iter()
-            .zip(back)
-            .all(|(a, b)| (a - b).abs() <= 0.5 / 127.0));
+    fn octahedral_normals_decode_within_a_degree_and_a_half() {
+        use meshopt_rs::vertex::filter::decode_filter_oct_8;
+        let mut worst = 0.0f32;
+        for i in 0..2000 {
+            // A spiral over the sphere, both halves, and the axes.
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / 2000.0;
+            let r = (1.0 - z * z).sqrt();
+            let a = i as f32 * 2.399_963;
+            for n in [
+                [r * a.cos(), r * a.sin(), z],
+                [0.0, 0.0, -1.0],
+                [-1.0, 0.0, 0.0],
+            ] {
+                let mut stored = [octahedral(n).map(|v| v.to_le_bytes()[0])];
+                decode_filter_oct_8(&mut stored);
+                let back: [f32; 3] = std::array::from_fn(|k| f32::from(stored[0][k] as i8) / 127.0);
+                let l = back.iter().map(|v| v * v).sum::<f32>().sqrt();
+                let cos = (0..3).map(|k| back[k] * n[k]).sum::<f32>() / l;
+                worst = worst.max(cos.clamp(-1.0, 1.0).acos().to_degrees());
+            }
+        }
+        assert!(worst < 1.5, "{worst} degrees");
     }
 }

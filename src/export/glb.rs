@@ -59,8 +59,22 @@ impl Builder {
         stride: usize,
         accessor: Value,
     ) -> Result<usize, ExportError> {
+        self.push_filtered_attributes(raw, stride, accessor, "NONE")
+    }
+
+    /// [`Self::push_attributes`] for data `filter` (one of the extension's) has encoded.
+    pub(super) fn push_filtered_attributes(
+        &mut self,
+        raw: &[u8],
+        stride: usize,
+        accessor: Value,
+        filter: &str,
+    ) -> Result<usize, ExportError> {
         let data = meshopt::encode_attributes(raw, stride).ok_or_else(codec_failed)?;
         let mut view = self.compressed_view(raw.len(), &data, stride, "ATTRIBUTES");
+        if filter != "NONE" {
+            view["extensions"][MESHOPT]["filter"] = json!(filter);
+        }
         view["byteStride"] = json!(stride);
         view["target"] = json!(ARRAY_BUFFER);
         Ok(self.add(view, accessor))

@@ -19,7 +19,7 @@ pub const MAX_LABELS: usize = u16::MAX as usize;
 
 /// Voxel index `(i, j, k)` to world RAS millimetres: `world = m * [i, j, k, 1]`, row-major rows
 /// of a 3 x 4 matrix.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Affine(pub [[f64; 4]; 3]);
 
 impl Affine {
@@ -37,6 +37,28 @@ impl Affine {
     pub fn apply(&self, ijk: [f64; 3]) -> [f64; 3] {
         let m = &self.0;
         std::array::from_fn(|r| m[r][0] * ijk[0] + m[r][1] * ijk[1] + m[r][2] * ijk[2] + m[r][3])
+    }
+
+    /// The voxel index of a world point; `None` when the grid is degenerate.
+    pub fn inverse_apply(&self, world: [f64; 3]) -> Option<[f64; 3]> {
+        let m = &self.0;
+        let det = self.determinant();
+        if !det.is_normal() {
+            return None;
+        }
+        let d: [f64; 3] = std::array::from_fn(|r| world[r] - m[r][3]);
+        // Cramer's rule: the index is the solution of the linear part times it = d.
+        let column = |c: usize| -> [f64; 3] { std::array::from_fn(|r| m[r][c]) };
+        let (a, b, c) = (column(0), column(1), column(2));
+        let det3 = |x: [f64; 3], y: [f64; 3], z: [f64; 3]| {
+            x[0] * (y[1] * z[2] - y[2] * z[1]) - y[0] * (x[1] * z[2] - x[2] * z[1])
+                + z[0] * (x[1] * y[2] - x[2] * y[1])
+        };
+        Some([
+            det3(d, b, c) / det,
+            det3(a, d, c) / det,
+            det3(a, b, d) / det,
+        ])
     }
 
     /// Length of each voxel axis in mm (the columns' norms).

@@ -4,7 +4,7 @@
 use super::extract::{surfaces_by_code, to_world};
 use super::palette::default_color;
 use super::specks::drop_small_components;
-use crate::io::{LabelMap, Segment};
+use crate::io::{Affine, LabelMap, Segment};
 use crate::mesh::Mesh;
 
 /// Which labels to extract.
@@ -30,6 +30,9 @@ pub struct Structure {
     pub voxels: usize,
     /// Voxel size along i, j, k in mm.
     pub voxel_size: [f64; 3],
+    /// The voxel grid it was extracted on: its vertices lie at the world points of the grid's
+    /// edge midpoints.
+    pub grid: Affine,
     /// Closed, outward-wound, manifold.
     pub mesh: Mesh,
 }
@@ -135,6 +138,7 @@ pub fn extract(
                 color,
                 voxels: counts[code],
                 voxel_size,
+                grid: map.affine,
                 mesh,
             });
         }

@@ -12,6 +12,9 @@ use std::borrow::Cow;
 use ::gltf::json::Root;
 use meshopt_rs::index::buffer::decode_index_buffer;
 use meshopt_rs::vertex::buffer::decode_vertex_buffer;
+use meshopt_rs::vertex::filter::{
+    decode_filter_exp, decode_filter_oct_16, decode_filter_oct_8, decode_filter_quat,
+};
 use serde::Deserialize;
 
 use super::super::{Format, LoadError, Location};
@@ -28,6 +31,18 @@ enum Mode {
     Triangles,
 }
 
+/// What the decoder applies to decoded attributes, as the extension defines it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Filter {
+    None,
+    /// Unit vectors as octahedral x, y with 1.0 in z, 8 or 16 bits each (strides 4 and 8).
+    Octahedral,
+    /// Rotations as three components and the index of the fourth, 16 bits each (stride 8).
+    Quaternion,
+    /// Floats as a 24-bit mantissa and an 8-bit exponent (strides of whole 4 bytes).
+    Exponential,
+}
+
 /// A view's compressed form, as its extension object declares it.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Compressed {
@@ -37,6 +52,7 @@ pub(super) struct Compressed {
     stride: usize,
     count: u64,
     mode: Mode,
+    filter: Filter,
 }
 
 #[derive(Deserialize)]
@@ -177,16 +193,23 @@ fn compressed(
     let err = |detail: String| syntax(format, "buffer view", index, format!("{NAME}: {detail}"));
     let raw = RawView::deserialize(ext).map_err(|e| err(e.to_string()))?;
     let view = &root.buffer_views[index];
-    let mode = mode_of(&raw, index, format)?;
+    let (mode, filter) = mode_of(&raw, index, format)?;
     let stride = raw.byte_stride;
     let stride_ok = match mode {
         Mode::Attributes => stride > 0 && stride % 4 == 0 && stride <= 256,
         Mode::Triangles => (stride == 2 || stride == 4) && raw.count % 3 == 0,
     };
-    if !stride_ok {
+    let filter_ok = match filter {
+        Filter::None | Filter::Exponential => true,
+        Filter::Octahedral => stride == 4 || stride == 8,
+        Filter::Quaternion => stride == 8,
+    };
+    if !stride_ok || !filter_ok {
         return Err(err(format!(
-            "byteStride {stride} with count {} does not suit mode {}",
-            raw.count, raw.mode
+            "byteStride {stride} with count {} does not suit mode {} and filter {}",
+            raw.count,
+            raw.mode,
+            raw.filter.as_deref().unwrap_or("NONE")
         )));
     }
     if let Some(own) = view.byte_stride.filter(|s| s.0 as u64 != stride) {
@@ -232,23 +255,35 @@ fn compressed(
         stride: stride as usize,
         count: raw.count,
         mode,
+        filter,
     })
 }
 
-/// The view's mode, when it is one read here (the filters and `INDICES` are not).
-fn mode_of(raw: &RawView, index: usize, format: Format) -> Result<Mode, LoadError> {
+/// The view's mode and filter, when they are ones read here (`INDICES` is not; a filter only
+/// applies to attributes).
+fn mode_of(raw: &RawView, index: usize, format: Format) -> Result<(Mode, Filter), LoadError> {
     let unsupported = |what: String| LoadError::Unsupported {
         format,
         detail: format!("buffer view {index}: {NAME} {what} is not readable"),
     };
-    if let Some(filter) = raw.filter.as_deref().filter(|f| *f != "NONE") {
-        return Err(unsupported(format!("filter '{filter}'")));
-    }
-    match raw.mode.as_str() {
-        "ATTRIBUTES" => Ok(Mode::Attributes),
-        "TRIANGLES" => Ok(Mode::Triangles),
-        other => Err(unsupported(format!("mode '{other}'"))),
-    }
+    let mode = match raw.mode.as_str() {
+        "ATTRIBUTES" => Mode::Attributes,
+        "TRIANGLES" => Mode::Triangles,
+        other => return Err(unsupported(format!("mode '{other}'"))),
+    };
+    let filter = match (raw.filter.as_deref().unwrap_or("NONE"), mode) {
+        ("NONE", _) => Filter::None,
+        ("OCTAHEDRAL", Mode::Attributes) => Filter::Octahedral,
+        ("QUATERNION", Mode::Attributes) => Filter::Quaternion,
+        ("EXPONENTIAL", Mode::Attributes) => Filter::Exponential,
+        (other, _) => {
+            return Err(unsupported(format!(
+                "filter '{other}' in mode {}",
+                raw.mode
+            )))
+        }
+    };
+    Ok((mode, filter))
 }
 
 /// The fewest compressed bytes that decode to `count` elements of `stride` bytes: the header
@@ -293,7 +328,53 @@ fn decode_view(
         Mode::Attributes => decode_attributes(data, c.stride, size),
         Mode::Triangles => decode_triangles(data, c.stride, size),
     };
-    decoded.ok_or_else(|| err("the compressed data is corrupt".into()))
+    let mut decoded = decoded.ok_or_else(|| err("the compressed data is corrupt".into()))?;
+    unfilter(&mut decoded, c.filter, c.stride);
+    Ok(decoded)
+}
+
+/// Applies `filter` to decoded elements of `stride` bytes (a stride the filter allows).
+fn unfilter(bytes: &mut [u8], filter: Filter, stride: usize) {
+    // The crate's filters take the elements as typed slices: copy through them, as the
+    // bytes' alignment is not known.
+    fn through<T: Copy + Default, const N: usize>(
+        bytes: &mut [u8],
+        from: fn([u8; N]) -> T,
+        to: fn(T) -> [u8; N],
+        apply: fn(&mut [T]),
+    ) {
+        let mut typed: Vec<T> = (bytes.chunks_exact(N))
+            .map(|c| from(c.try_into().unwrap_or([0; N])))
+            .collect();
+        apply(&mut typed);
+        for (c, t) in bytes.chunks_exact_mut(N).zip(typed) {
+            c.copy_from_slice(&to(t));
+        }
+    }
+    let shorts = |b: [u8; 8]| std::array::from_fn(|k| u16::from_le_bytes([b[2 * k], b[2 * k + 1]]));
+    let short_bytes = |s: [u16; 4]| {
+        let mut out = [0u8; 8];
+        for (k, v) in s.iter().enumerate() {
+            out[2 * k..2 * k + 2].copy_from_slice(&v.to_le_bytes());
+        }
+        out
+    };
+    match (filter, stride) {
+        (Filter::None, _) => {}
+        (Filter::Octahedral, 4) => through::<[u8; 4], 4>(bytes, |b| b, |b| b, decode_filter_oct_8),
+        (Filter::Octahedral, _) => {
+            through::<[u16; 4], 8>(bytes, shorts, short_bytes, decode_filter_oct_16)
+        }
+        (Filter::Quaternion, _) => {
+            through::<[u16; 4], 8>(bytes, shorts, short_bytes, decode_filter_quat)
+        }
+        (Filter::Exponential, _) => through::<u32, 4>(
+            bytes,
+            u32::from_le_bytes,
+            u32::to_le_bytes,
+            decode_filter_exp,
+        ),
+    }
 }
 
 /// Attribute data of `size` bytes in `stride`-byte elements (a multiple of 4 up to 256).
