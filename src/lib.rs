@@ -1,8 +1,8 @@
 //! meshsmooth: visually guided smoothing of anatomical surface meshes.
 //!
 //! Data flows one way: bytes -> [`io`] (parse, weld) -> [`mesh`] (indexed mesh, CSR topology,
-//! report) -> [`smooth`] (CPU reference) -> [`metrics`] -> [`export`]. The command-line tool
-//! (native) and the web app (wasm32) sit on top and own no algorithm. [`view`] is the 3D view's
+//! report) -> [`smooth`] (CPU reference) -> [`metrics`] -> [`simplify`] -> [`export`]. The
+//! command-line tool (native) and the web app (wasm32) sit on top and own no algorithm. [`view`] is the 3D view's
 //! camera and shading record, kept apart from the app so it is tested natively.
 
 pub mod case;
@@ -16,6 +16,7 @@ pub mod metrics;
 pub mod model;
 pub mod segmentation;
 pub mod session;
+pub mod simplify;
 pub mod smooth;
 pub mod srgb;
 pub mod suggest;

@@ -55,7 +55,12 @@ fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
         "--json",
     ]));
     assert_eq!(info["title"], "Abdominal phantom");
-    assert_eq!(info["structures"], built["structures"]);
+    // What the file states of how it was written rides beside each structure's record.
+    let (read, files) = records_and_files(&info);
+    assert!(files
+        .iter()
+        .all(|f| f["quantization"]["max_error_mm"].as_f64().is_some()));
+    assert_eq!(read, built["structures"]);
 
     // A case glTF is an input like any other: built again from it, the structures are kept
     // and suggested again from their originals.
@@ -114,7 +119,23 @@ fn case_build_smooths_every_structure_and_case_info_reads_the_file_back() {
         raw.to_str().expect("utf-8"),
         "--json",
     ]));
-    assert_eq!(info_raw["structures"], info["structures"]);
+    let (read_raw, files_raw) = records_and_files(&info_raw);
+    assert_eq!(read_raw, read);
+    assert!(files_raw.iter().all(|f| f["quantization"].is_null()));
+}
+
+/// `case info --json`'s structures without their `file` objects, and those objects.
+fn records_and_files(info: &serde_json::Value) -> (serde_json::Value, Vec<serde_json::Value>) {
+    let mut records = info["structures"].clone();
+    let files = (records.as_array_mut().expect("structures").iter_mut())
+        .map(|s| {
+            s.as_object_mut()
+                .expect("record")
+                .remove("file")
+                .expect("file")
+        })
+        .collect();
+    (records, files)
 }
 
 #[test]
@@ -142,4 +163,40 @@ fn case_build_refuses_what_it_cannot_do_naming_the_file() {
     let out = meshsmooth(&["case", "info", broken.to_str().expect("utf-8")]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("broken.nii.gz"));
+}
+
+/// `--simplify` writes a smaller case whose records state each structure's deviation, which
+/// `case info` reads back; a distance that is no distance is refused.
+#[test]
+fn case_build_simplifies_within_a_distance_and_case_info_reads_it() {
+    let (full, small) = (tmp("phantom_full.glb"), tmp("phantom_simplified.glb"));
+    assert!(build_phantom(&full, &[]).status.success());
+    let built = json(&build_phantom(&small, &["--simplify", "0.1", "--json"]));
+    assert!(built["export_seconds"].as_f64().is_some());
+    let size = |p: &std::path::Path| std::fs::metadata(p).expect("written").len();
+    assert!(
+        size(&small) < size(&full),
+        "{} >= {}",
+        size(&small),
+        size(&full)
+    );
+    let info = json(&meshsmooth(&[
+        "case",
+        "info",
+        small.to_str().expect("utf-8"),
+        "--json",
+    ]));
+    let structures = info["structures"].as_array().expect("structures");
+    assert_eq!(structures.len(), 4);
+    for s in structures {
+        let r = &s["file"]["simplification"];
+        assert_eq!(r["simplified"], true, "{s}");
+        let vd = r["max_deviation_voxel_diagonals"].as_f64().expect("stated");
+        assert!(vd > 0.0 && vd <= 0.1, "{vd}");
+    }
+    for bad in ["0", "nan", "inf"] {
+        let out = build_phantom(&tmp("never.glb"), &["--simplify", bad]);
+        assert!(!out.status.success(), "--simplify {bad}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--simplify"));
+    }
 }

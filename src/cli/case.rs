@@ -10,7 +10,7 @@ use super::params::filter as parse_filter;
 use super::progress::ProgressLine;
 use super::suggest::parse_search;
 use crate::case::{self, Case, SuggestAllOptions, SuggestAllProgress};
-use crate::export::{self, CaseGltfOptions, Container, SceneFrame};
+use crate::export::{self, CaseGltfOptions, Container, SceneFrame, Simplification};
 use crate::segmentation::{ExtractOptions, OpenOptions};
 use crate::smooth::Filter;
 use crate::suggest::{Progress, SearchMethod, Suggestion};
@@ -19,7 +19,7 @@ use crate::suggest::{Progress, SearchMethod, Suggestion};
 pub(super) enum CaseCommand {
     /// Suggest and smooth every structure, then write one case glTF (.glb, or .gltf with the
     /// buffer embedded).
-    Build(BuildArgs),
+    Build(Box<BuildArgs>),
     /// Print a case glTF's structures, parameters and measures.
     Info {
         file: PathBuf,
@@ -89,6 +89,18 @@ pub(super) struct BuildArgs {
     /// EXT_meshopt_compression (by default the arrays are quantized and compressed).
     #[arg(long)]
     uncompressed: bool,
+    /// Simplify each structure's surface within this many of its voxel diagonals of the
+    /// smoothed one (the record states the deviation measured), for a smaller download.
+    #[arg(
+        long,
+        value_name = "VOXEL_DIAGONALS",
+        conflicts_with = "triangle_budget"
+    )]
+    simplify: Option<f64>,
+    /// Simplify the surfaces to about this many triangles in the whole case, shared in
+    /// proportion to each structure's (the record states each deviation measured).
+    #[arg(long, value_name = "TRIANGLES")]
+    triangle_budget: Option<usize>,
     #[arg(long)]
     json: bool,
 }
@@ -102,6 +114,12 @@ pub(super) fn run(command: &CaseCommand) -> Result<(), String> {
 
 fn build(args: &BuildArgs) -> Result<(), String> {
     super::check_tau(args.tau)?;
+    if args.simplify.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
+        return Err("--simplify takes a distance in voxel diagonals above 0".into());
+    }
+    if args.triangle_budget == Some(0) {
+        return Err("--triangle-budget takes a count of triangles above 0".into());
+    }
     let container = container(&args.output)?;
     super::check_destination(&args.output)?;
     let started = Instant::now();
@@ -133,8 +151,10 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     let after = case::check(&case, true);
     let changes = case::relations::changes(&before, &after);
 
+    let export_started = Instant::now();
     let bytes = export::write_case(&case, &gltf_options(args, container))
         .map_err(|e| format!("{}: {e}", args.output.display()))?;
+    let export_seconds = export_started.elapsed().as_secs_f64();
     super::write_file(&args.output, &bytes)?;
 
     let evaluations: usize = suggestions.iter().flatten().map(|s| s.evaluations).sum();
@@ -145,6 +165,7 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         out["evaluations"] = serde_json::json!(evaluations);
         out["open_seconds"] = serde_json::json!(opened);
         out["suggest_seconds"] = serde_json::json!(suggest_seconds);
+        out["export_seconds"] = serde_json::json!(export_seconds);
         out["seconds"] = serde_json::json!(started.elapsed().as_secs_f64());
         out["bytes"] = serde_json::json!(bytes.len());
         outln!("{}", super::to_json(&out)?);
@@ -202,6 +223,11 @@ fn gltf_options(args: &BuildArgs, container: Container) -> CaseGltfOptions {
         local_error: args.local_error,
         unlit: args.unlit,
         compressed: !args.uncompressed,
+        simplify: match (args.simplify, args.triangle_budget) {
+            (Some(v), _) => Some(Simplification::VoxelDiagonals(v)),
+            (None, Some(n)) => Some(Simplification::TriangleBudget(n)),
+            (None, None) => None,
+        },
     }
 }
 
@@ -259,9 +285,28 @@ fn info(file: &Path, json: bool) -> Result<(), String> {
     let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
     let name = file.display().to_string();
     let scene = crate::io::load_gltf_scene(&bytes, &name).map_err(|e| format!("{name}: {e}"))?;
+    // What the file states of how it was written, which the case does not hold.
+    let written: Vec<serde_json::Value> = (scene.nodes.iter())
+        .map(|n| {
+            let record = n.extras.as_ref().and_then(|e| e.get(case::CASE_KEY));
+            let mut w = serde_json::json!({});
+            for key in ["quantization", "simplification"] {
+                if let Some(v) = record.and_then(|r| r.get(key)) {
+                    w[key] = v.clone();
+                }
+            }
+            w
+        })
+        .collect();
     let case = case::from_gltf_scene(scene, &name).map_err(|e| format!("{name}: {e}"))?;
     if json {
-        outln!("{}", super::to_json(&case_json(&case))?);
+        let mut out = case_json(&case);
+        if let Some(list) = out["structures"].as_array_mut() {
+            for (s, w) in list.iter_mut().zip(&written) {
+                s["file"] = w.clone();
+            }
+        }
+        outln!("{}", super::to_json(&out)?);
     } else {
         if !case.title.is_empty() {
             outln!("{}", case.title);
@@ -270,6 +315,24 @@ fn info(file: &Path, json: bool) -> Result<(), String> {
             outln!("{}", case.description);
         }
         out!("{}", table(&case));
+        let simplified: Vec<&serde_json::Value> = (written.iter())
+            .map(|w| &w["simplification"])
+            .filter(|r| r["simplified"] == true)
+            .collect();
+        if !simplified.is_empty() {
+            let count =
+                |key: &str| -> u64 { simplified.iter().filter_map(|r| r[key].as_u64()).sum() };
+            let worst = (simplified.iter())
+                .filter_map(|r| r["max_deviation_voxel_diagonals"].as_f64())
+                .fold(0.0, f64::max);
+            outln!(
+                "{} structures simplified: {} -> {} triangles, at most {worst:.3} voxel diagonals \
+                 from the smoothed surfaces",
+                simplified.len(),
+                count("triangles_before"),
+                count("triangles")
+            );
+        }
     }
     Ok(())
 }

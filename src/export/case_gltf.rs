@@ -21,6 +21,9 @@ use super::glb::{
     container, floats, geometry, index_bytes, Builder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT,
     MESHOPT, TRIANGLES, UNSIGNED_INT,
 };
+use super::simplified::{
+    record as simplification_record, simplify_case, written, Simplification, Written,
+};
 use super::{check, ExportError, ExportOptions};
 use crate::case::{structure_record, Case, CaseStructure, CASE_KEY};
 use crate::mesh::{bounding_box, vertex_normals, Mesh};
@@ -54,7 +57,7 @@ pub enum Container {
 }
 
 /// What a case glTF carries beyond the structures' surfaces, materials and records.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CaseGltfOptions {
     pub frame: SceneFrame,
     pub container: Container,
@@ -67,6 +70,8 @@ pub struct CaseGltfOptions {
     /// Quantized (`KHR_mesh_quantization`) and compressed (`EXT_meshopt_compression`); else
     /// float arrays as they are, for tools that cannot decode.
     pub compressed: bool,
+    /// Simplified surfaces for the download; else each as smoothed.
+    pub simplify: Option<Simplification>,
 }
 
 impl Default for CaseGltfOptions {
@@ -78,6 +83,7 @@ impl Default for CaseGltfOptions {
             local_error: false,
             unlit: false,
             compressed: true,
+            simplify: None,
         }
     }
 }
@@ -109,12 +115,18 @@ fn scene_parts(
     let mut materials = Vec::new();
     let mut root_children = Vec::new();
     let mut group_nodes: Vec<(&str, usize)> = Vec::new();
-    for s in &case.structures {
+    let simplified = options.simplify.map(|how| simplify_case(case, how));
+    for (i, s) in case.structures.iter().enumerate() {
         let index = meshes.len();
-        let (mesh, placement) = structure_mesh(b, s, index, options)?;
+        let done = simplified.as_ref().and_then(|all| all[i].as_ref());
+        let surfaces = written(s, done, options.local_error);
+        let (mesh, placement) = structure_mesh(b, s, &surfaces, index, options)?;
         meshes.push(mesh);
         materials.push(material(s, options.unlit));
         let mut record = structure_record(s);
+        if let Some(how) = options.simplify {
+            record["simplification"] = simplification_record(s, how, done);
+        }
         if let Some(color) = s.color.get(..3) {
             record["color"] = json!([color[0], color[1], color[2], s.color[3]]);
         }
@@ -263,33 +275,33 @@ fn push_child(node: &mut Value, child: usize) {
 fn structure_mesh(
     b: &mut Builder,
     s: &CaseStructure,
+    w: &Written,
     material: usize,
     options: &CaseGltfOptions,
 ) -> Result<(Value, Option<Placement>), ExportError> {
-    let shown = Mesh::new(s.positions().to_vec(), s.original.triangles.clone());
+    let shown = &w.shown;
     let normals = vertex_normals(&shown.positions, &shown.triangles);
     check(
-        &shown,
+        shown,
         &ExportOptions {
             normals: Some(&normals),
             ..Default::default()
         },
     )?;
     let morph = options.original_as_morph_target && s.smoothed_now().is_some();
-    let local_error =
-        (s.smoothed_now().and_then(|m| m.local_error.as_deref())).filter(|_| options.local_error);
+    let local_error = w.local_error.as_deref();
     if options.compressed {
         let surfaces = Surfaces {
-            shown: &shown,
+            shown,
             normals: &normals,
-            original: morph.then_some(&s.original),
+            original: morph.then_some(&w.original),
             local_error,
             voxel_diagonal: s.voxel_diagonal(),
         };
         let (primitive, placement) = compressed::structure_mesh(b, &surfaces, material)?;
         return Ok((mesh_of(s, primitive, morph), Some(placement)));
     }
-    let mut attributes = geometry(b, &shown, Some(&normals));
+    let mut attributes = geometry(b, shown, Some(&normals));
     let n = shown.vertex_count();
     if let Some(errors) = local_error {
         let bytes: Vec<u8> = errors.iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -300,7 +312,7 @@ fn structure_mesh(
         ));
     }
     let indices = b.push(
-        &index_bytes(&shown),
+        &index_bytes(shown),
         ELEMENT_ARRAY_BUFFER,
         json!({"componentType": UNSIGNED_INT, "count": 3 * shown.triangle_count(), "type": "SCALAR"}),
     );
@@ -308,7 +320,7 @@ fn structure_mesh(
         "attributes": attributes, "indices": indices, "material": material, "mode": TRIANGLES,
     });
     if morph {
-        primitive["targets"] = json!([morph_target(b, &s.original, &shown, &normals)]);
+        primitive["targets"] = json!([morph_target(b, &w.original, shown, &normals)]);
     }
     Ok((mesh_of(s, primitive, morph), None))
 }

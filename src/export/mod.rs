@@ -8,9 +8,11 @@ mod glb;
 mod meshopt;
 mod obj;
 mod ply;
+mod simplified;
 mod stl;
 
 pub use case_gltf::{write_case, CaseGltfOptions, Container, SceneFrame, RAS_MM_TO_GLTF};
+pub use simplified::Simplification;
 
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
