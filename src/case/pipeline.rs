@@ -87,7 +87,6 @@ pub fn suggest_all(
         !cancelled.load(Ordering::Relaxed)
     };
     let learning = options.learn && options.method == SearchMethod::Local;
-    let work = in_order(case, learning);
     // Learning goes batch by batch, each starting from the batches before it: the same starts
     // on any number of threads, so the page's workers find what the CLI finds.
     let batch = if learning {
@@ -96,9 +95,17 @@ pub fn suggest_all(
         total.max(1)
     };
     let mut learned: Vec<Params> = Vec::new();
-    let mut results: Vec<(usize, Outcome)> = Vec::with_capacity(total);
-    for part in work.chunks(batch) {
-        let outcomes: Vec<(usize, Outcome)> = (part.to_vec().into_par_iter())
+    let mut kept = Kept {
+        suggestions: vec![None; total],
+        first_error: None,
+    };
+    for part in in_order(case, learning).chunks(batch) {
+        // Copies of this batch's structures only, each back in the case as it finishes its
+        // batch: a case of millions of vertices is never held twice.
+        let copies: Vec<(usize, CaseStructure)> = (part.iter())
+            .map(|&i| (i, case.structures[i].clone()))
+            .collect();
+        let outcomes: Vec<(usize, Outcome)> = (copies.into_par_iter())
             .with_max_len(1)
             .map(|(i, mut s)| {
                 if cancelled.load(Ordering::Relaxed) {
@@ -124,49 +131,47 @@ pub fn suggest_all(
                 _ => None,
             }));
         }
-        results.extend(outcomes);
+        kept.keep(case, outcomes);
     }
-    keep(case, results)
+    match kept.first_error {
+        Some(e) => Err(e),
+        None => Ok(kept.suggestions),
+    }
 }
 
-/// Copies of the structures in the order they are searched: the largest first, so the pool is
-/// not left waiting on one big structure at the end; learning, the smallest first, so the
-/// large ones start where the small ones ended.
-fn in_order(case: &Case, learning: bool) -> Vec<(usize, CaseStructure)> {
+/// The structures in the order they are searched: the largest first, so the pool is not left
+/// waiting on one big structure at the end; learning, the smallest first, so the large ones
+/// start where the small ones ended.
+fn in_order(case: &Case, learning: bool) -> Vec<usize> {
     let mut order: Vec<usize> = (0..case.structures.len()).collect();
     order.sort_by_key(|&i| case.structures[i].original.vertex_count());
     if !learning {
         order.reverse();
     }
-    (order.into_iter())
-        .map(|i| (i, case.structures[i].clone()))
-        .collect()
+    order
 }
 
-/// Puts each structure that got a suggestion back into `case`; every suggestion in the case's
-/// order, or the first error.
-fn keep(
-    case: &mut Case,
-    results: Vec<(usize, Outcome)>,
-) -> Result<Vec<Option<Suggestion>>, SuggestError> {
-    let mut suggestions = vec![None; case.structures.len()];
-    let mut first_error = None;
-    for (i, result) in results {
-        match result {
-            Ok(Some((suggestion, structure))) => {
-                case.structures[i] = structure;
-                suggestions[i] = Some(suggestion);
-            }
-            Ok(None) => {}
-            Err(SuggestError::Cancelled) => {}
-            Err(e) => {
-                first_error.get_or_insert(e);
+/// Each structure's suggestion in the case's order, and the first error met.
+struct Kept {
+    suggestions: Vec<Option<Suggestion>>,
+    first_error: Option<SuggestError>,
+}
+
+impl Kept {
+    /// Puts each structure of `outcomes` that got a suggestion back into `case`.
+    fn keep(&mut self, case: &mut Case, outcomes: Vec<(usize, Outcome)>) {
+        for (i, result) in outcomes {
+            match result {
+                Ok(Some((suggestion, structure))) => {
+                    case.structures[i] = structure;
+                    self.suggestions[i] = Some(suggestion);
+                }
+                Ok(None) | Err(SuggestError::Cancelled) => {}
+                Err(e) => {
+                    self.first_error.get_or_insert(e);
+                }
             }
         }
-    }
-    match first_error {
-        Some(e) => Err(e),
-        None => Ok(suggestions),
     }
 }
 
