@@ -3,17 +3,14 @@
 
 use serde_json::{json, Value};
 
-use super::relations::{marks, relations, PairRelation, RelationChanges};
+use super::relations::{marks, relations, PairRelation, RelationChanges, Surface};
 use super::Case;
-use crate::mesh::Mesh;
 
 /// The relations of every pair of structures that come near each other: of the originals, or
 /// of the surfaces as shown. Each structure tolerates half its voxel diagonal (the
 /// segmentation cannot place its boundary closer than that), a surface mesh none.
 pub fn check(case: &Case, shown: bool) -> Vec<PairRelation> {
-    let meshes = surfaces(case, shown);
-    let refs: Vec<_> = meshes.iter().collect();
-    relations(&refs, &tolerances(case))
+    relations(&surfaces(case, shown), &tolerances(case))
 }
 
 /// The vertices of each structure's surface as shown that make the warnings of `changed`
@@ -26,19 +23,19 @@ pub fn check_marks(
     if changed.left_inside.is_empty() && changed.new_crossings.is_empty() {
         return vec![Vec::new(); case.structures.len()];
     }
-    let meshes = surfaces(case, true);
-    let refs: Vec<_> = meshes.iter().collect();
-    marks(&refs, &tolerances(case), before, changed)
+    marks(&surfaces(case, true), &tolerances(case), before, changed)
 }
 
-fn surfaces(case: &Case, shown: bool) -> Vec<Mesh> {
+/// Each structure's surface, borrowed from the case (a whole-body case is not copied to be
+/// checked).
+fn surfaces(case: &Case, shown: bool) -> Vec<Surface<'_>> {
     (case.structures.iter())
-        .map(|s| {
-            if shown {
-                s.surface()
-            } else {
-                s.original.clone()
-            }
+        .map(|s| Surface {
+            positions: match s.smoothed_now() {
+                Some(m) if shown => &m.positions,
+                _ => &s.original.positions,
+            },
+            triangles: &s.original.triangles,
         })
         .collect()
 }

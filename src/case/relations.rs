@@ -67,9 +67,13 @@ pub struct RelationChanges {
 ///
 /// # Panics
 /// When `tolerance` and `meshes` differ in length.
-pub fn relations(meshes: &[&Mesh], tolerance: &[f64]) -> Vec<PairRelation> {
+pub fn relations<'a, S: Into<Surface<'a>> + Copy>(
+    meshes: &[S],
+    tolerance: &[f64],
+) -> Vec<PairRelation> {
     assert_eq!(meshes.len(), tolerance.len(), "one tolerance per structure");
-    let boxes: Vec<Option<Box3>> = meshes.iter().map(|m| Box3::of(&m.positions)).collect();
+    let meshes: Vec<Surface> = meshes.iter().map(|&m| m.into()).collect();
+    let boxes: Vec<Option<Box3>> = meshes.iter().map(|m| Box3::of(m.positions)).collect();
     let tolerance: Vec<f64> = tolerance.iter().map(|t| t.max(0.0)).collect();
     let mut pairs = Vec::new();
     for a in 0..meshes.len() {
@@ -105,8 +109,8 @@ pub fn relations(meshes: &[&Mesh], tolerance: &[f64]) -> Vec<PairRelation> {
             let (sa, sb) = (solids[a].as_ref()?, solids[b].as_ref()?);
             let cap = tol.enclosure + tol.crossing;
             let (ab, ba) = rayon::join(
-                || reach(&meshes[a].positions, sa.bounds, sb, cap),
-                || reach(&meshes[b].positions, sb.bounds, sa, cap),
+                || reach(meshes[a].positions, sa.bounds, sb, cap),
+                || reach(meshes[b].positions, sb.bounds, sa, cap),
             );
             let overlap_depth = ab.depth.max(ba.depth);
             Some(PairRelation {
@@ -163,13 +167,14 @@ pub fn changes(before: &[PairRelation], after: &[PairRelation]) -> RelationChang
 ///
 /// # Panics
 /// When `tolerance` and `meshes` differ in length.
-pub fn marks(
-    meshes: &[&Mesh],
+pub fn marks<'a, S: Into<Surface<'a>> + Copy>(
+    meshes: &[S],
     tolerance: &[f64],
     before: &[PairRelation],
     changed: &RelationChanges,
 ) -> Vec<Vec<u32>> {
     assert_eq!(meshes.len(), tolerance.len(), "one tolerance per structure");
+    let meshes: Vec<Surface> = meshes.iter().map(|&m| m.into()).collect();
     let tol = |a: usize, b: usize| Tolerance {
         crossing: tolerance[a].max(tolerance[b]).max(0.0),
         enclosure: tolerance[a].max(0.0) + tolerance[b].max(0.0),
@@ -197,13 +202,13 @@ pub fn marks(
     }
     let mut solids: HashMap<usize, Solid> = HashMap::new();
     for &(_, other, _) in &asks {
-        if let (None, Some(bounds)) = (solids.get(&other), Box3::of(&meshes[other].positions)) {
-            solids.insert(other, Solid::new(meshes[other], bounds));
+        if let (None, Some(bounds)) = (solids.get(&other), Box3::of(meshes[other].positions)) {
+            solids.insert(other, Solid::new(&meshes[other], bounds));
         }
     }
     let mut out = vec![Vec::new(); meshes.len()];
     for (marked, other, mark) in &asks {
-        let (Some(solid), Some(bounds)) = (solids.get(other), Box3::of(&meshes[*marked].positions))
+        let (Some(solid), Some(bounds)) = (solids.get(other), Box3::of(meshes[*marked].positions))
         else {
             continue;
         };
@@ -286,6 +291,22 @@ impl Box3 {
     }
 }
 
+/// A structure's surface as the checks read it, borrowed: its positions and triangles.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface<'a> {
+    pub positions: &'a [[f32; 3]],
+    pub triangles: &'a [[u32; 3]],
+}
+
+impl<'a> From<&'a Mesh> for Surface<'a> {
+    fn from(m: &'a Mesh) -> Self {
+        Surface {
+            positions: &m.positions,
+            triangles: &m.triangles,
+        }
+    }
+}
+
 /// A structure made ready to be asked about points: rays for inside, a tree for distances.
 struct Solid {
     bounds: Box3,
@@ -294,10 +315,10 @@ struct Solid {
 }
 
 impl Solid {
-    fn new(mesh: &Mesh, bounds: Box3) -> Self {
+    fn new(mesh: &Surface, bounds: Box3) -> Self {
         let (rays, distance) = rayon::join(
-            || RayBvh::new(&mesh.positions, &mesh.triangles),
-            || TriangleBvh::new(&mesh.positions, &mesh.triangles),
+            || RayBvh::new(mesh.positions, mesh.triangles),
+            || TriangleBvh::new(mesh.positions, mesh.triangles),
         );
         Self {
             bounds,
