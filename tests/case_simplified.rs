@@ -6,11 +6,15 @@ use meshsmooth::case::{self, from_gltf_scene, smooth_structure, Case};
 use meshsmooth::export::{write_case, CaseGltfOptions, Simplification};
 use meshsmooth::io::load_gltf_scene;
 use meshsmooth::mesh::{Mesh, MeshReport, Topology};
-use meshsmooth::metrics::TriangleBvh;
 use serde_json::Value;
 
 #[path = "common/label_maps.rs"]
 mod label_maps;
+
+#[path = "common/surface_deviation.rs"]
+mod surface_deviation;
+
+use surface_deviation::measured;
 
 fn smoothed_phantom() -> Case {
     let structures = label_maps::open(
@@ -22,32 +26,6 @@ fn smoothed_phantom() -> Case {
         smooth_structure(s);
     }
     case
-}
-
-/// The deviation as the record defines it, measured between two surfaces that share no
-/// vertex numbering: the farthest vertex of `full` from `simplified`, and the farthest centroid
-/// or edge midpoint of `simplified` from `full`.
-fn measured(full: &Mesh, simplified: &Mesh) -> f64 {
-    let to_simplified = TriangleBvh::new(&simplified.positions, &simplified.triangles);
-    let away = (to_simplified.distances(&full.positions).into_iter()).fold(0.0, f64::max);
-    let to_full = TriangleBvh::new(&full.positions, &full.triangles);
-    let p = |v: u32| simplified.positions[v as usize];
-    let samples: Vec<[f32; 3]> = (simplified.triangles.iter())
-        .flat_map(|t| {
-            let [a, b, c] = t.map(p);
-            let mix = |w: [f32; 3]| -> [f32; 3] {
-                std::array::from_fn(|k| w[0] * a[k] + w[1] * b[k] + w[2] * c[k])
-            };
-            [
-                mix([1.0 / 3.0; 3]),
-                mix([0.5, 0.5, 0.0]),
-                mix([0.0, 0.5, 0.5]),
-                mix([0.5, 0.0, 0.5]),
-            ]
-        })
-        .collect();
-    let back = (to_full.distances(&samples).into_iter()).fold(0.0, f64::max);
-    away.max(back)
 }
 
 #[test]

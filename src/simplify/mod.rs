@@ -135,6 +135,3 @@ const SLIVER: f64 = 0.01;
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
-
-#[cfg(test)]
-mod tests;

@@ -34,9 +34,15 @@ fn compressed_case() -> (serde_json::Value, Vec<u8>) {
 
 /// The buffer view of the mesh's POSITION accessor.
 fn position_view(doc: &serde_json::Value) -> usize {
-    let a = doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
-        .as_u64()
-        .expect("POSITION");
+    view_of(
+        doc,
+        &doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"],
+    )
+}
+
+/// The buffer view of `accessor` (an accessor's index in the document).
+fn view_of(doc: &serde_json::Value, accessor: &serde_json::Value) -> usize {
+    let a = accessor.as_u64().expect("an accessor");
     doc["accessors"][a as usize]["bufferView"]
         .as_u64()
         .expect("view") as usize
@@ -143,21 +149,14 @@ fn corrupt_or_unreadable_compressed_data_is_refused_naming_the_view() {
     says(&e, "WAVELET");
 
     // A filter on triangles, or one whose elements the stride cannot hold.
-    let triangles = doc["accessors"][doc["meshes"][0]["primitives"][0]["indices"]
-        .as_u64()
-        .expect("indices") as usize]["bufferView"]
-        .as_u64()
-        .expect("view") as usize;
+    let primitive = &doc["meshes"][0]["primitives"][0];
+    let triangles = view_of(&doc, &primitive["indices"]);
     let mut d = doc.clone();
     d["bufferViews"][triangles]["extensions"]["EXT_meshopt_compression"]["filter"] =
         "OCTAHEDRAL".into();
     let e = error_kind(&glb(&d, &bin), Format::Glb, "Unsupported");
     says(&e, "OCTAHEDRAL");
-    let normals = doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"]
-        .as_u64()
-        .expect("NORMAL") as usize]["bufferView"]
-        .as_u64()
-        .expect("view") as usize;
+    let normals = view_of(&doc, &primitive["attributes"]["NORMAL"]);
     let mut d = doc.clone();
     d["bufferViews"][normals]["extensions"]["EXT_meshopt_compression"]["filter"] =
         "QUATERNION".into();
