@@ -6,9 +6,10 @@
 //! `offset + step * q` millimetres, a translation and uniform scale on the structure's node, so
 //! the root keeps the frame's conversion alone. The step is a power of two and the offset a
 //! multiple of it, so the lattice's points are exact in f32 and a reopened case, quantized
-//! again, lands on the same points; each structure gets the finest that 16 bits cover. The
-//! original is stored as integer steps from the surface on the same lattice, so it is
-//! exactly its lattice point too. Normals are 8-bit octahedral. The morph target carries no
+//! again, lands on the same points. A structure extracted from voxels gets the coarsest such
+//! lattice within a small part of its voxel diagonal; others the finest that 16 bits cover.
+//! The original is stored as integer steps from the surface on the same lattice, so it is
+//! exactly its lattice point too. Normals are 8-bit normalized. The morph target carries no
 //! normals: a staircase's normals, as differences from smooth ones, took more than a fifth of
 //! the file, and viewers that slide to it (ours) light it from its positions; the uncompressed
 //! file keeps them. `_LOCAL_ERROR` stays float.
@@ -16,6 +17,7 @@
 use serde_json::{json, Value};
 
 use super::glb::{Builder, FLOAT, TRIANGLES};
+use super::meshopt::codec_order;
 use super::ExportError;
 use crate::mesh::Mesh;
 
@@ -24,6 +26,9 @@ const SHORT: u32 = 5122;
 const UNSIGNED_SHORT: u32 = 5123;
 /// The largest stored position value (16 bits).
 const Q_MAX: f64 = 65535.0;
+/// The largest quantization error a structure extracted from voxels allows, in its voxel
+/// diagonals: far below what smoothing moves, and coarse lattices compress better.
+const LATTICE_ERROR_VOXEL_DIAGONALS: f64 = 0.04;
 /// Normals' scale: 8-bit signed normalized.
 const NORMAL_MAX: f32 = 127.0;
 
@@ -168,13 +173,32 @@ pub(super) struct Surfaces<'a> {
     pub voxel_diagonal: Option<f64>,
 }
 
-/// A structure's primitive, quantized and compressed: its attributes, indices and morph target.
+/// A structure's primitive, quantized and compressed: its attributes, indices and morph target,
+/// with vertices and triangles in the order the codecs compress best.
 pub(super) fn structure_mesh(
     b: &mut Builder,
     s: &Surfaces,
     material: usize,
 ) -> Result<(Value, Placement), ExportError> {
-    ordered_mesh(b, s, material)
+    let (triangles, old_of_new) = codec_order(&s.shown.triangles, s.shown.positions.len());
+    let pick =
+        |v: &[[f32; 3]]| -> Vec<[f32; 3]> { old_of_new.iter().map(|&i| v[i as usize]).collect() };
+    let shown = Mesh::new(pick(&s.shown.positions), triangles);
+    let normals = pick(s.normals);
+    let original = s
+        .original
+        .map(|o| Mesh::new(pick(&o.positions), shown.triangles.clone()));
+    let local_error: Option<Vec<f32>> = s
+        .local_error
+        .map(|e| old_of_new.iter().map(|&i| e[i as usize]).collect());
+    let ordered = Surfaces {
+        shown: &shown,
+        normals: &normals,
+        original: original.as_ref(),
+        local_error: local_error.as_deref(),
+        voxel_diagonal: s.voxel_diagonal,
+    };
+    ordered_mesh(b, &ordered, material)
 }
 
 fn ordered_mesh(
@@ -183,9 +207,9 @@ fn ordered_mesh(
     material: usize,
 ) -> Result<(Value, Placement), ExportError> {
     let shown = &s.shown.positions;
-    // The finest lattice: a coarser one (within 0.04 voxel diagonals) takes a fifth off the
-    // file but moves the surface a reopened case shows by up to a tenth of a millimetre.
-    let max_step = None;
+    // A point lies within half a step on each axis of its lattice point.
+    let max_step =
+        (s.voxel_diagonal).map(|d| 2.0 * LATTICE_ERROR_VOXEL_DIAGONALS * d / 3f64.sqrt());
     let lattice = match s.original {
         Some(o) => Lattice::covering(shown.iter().chain(&o.positions), max_step),
         None => Lattice::covering(shown.iter(), max_step),

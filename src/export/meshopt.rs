@@ -5,6 +5,8 @@
 use meshopt_rs::index::buffer::{encode_index_buffer, encode_index_buffer_bound};
 use meshopt_rs::index::IndexEncodingVersion;
 use meshopt_rs::vertex::buffer::{encode_vertex_buffer, encode_vertex_buffer_bound};
+use meshopt_rs::vertex::cache::optimize_vertex_cache_strip;
+use meshopt_rs::vertex::fetch::optimize_vertex_fetch_remap;
 use meshopt_rs::vertex::VertexEncodingVersion;
 
 /// Attribute data of `stride`-byte elements (4, 8, 12 or 16), compressed; `None` for any other
@@ -44,4 +46,37 @@ pub(super) fn encode_triangles(indices: &[u32], vertex_count: usize) -> Option<V
     let written = encode_index_buffer(&mut out, indices, IndexEncodingVersion::V1)?;
     out.truncate(written);
     Some(out)
+}
+
+/// The order in which the codecs compress a mesh best: triangles reordered for the vertex
+/// cache (the index codec encodes recently seen edges and vertices in a few bits), then
+/// vertices in the order the triangles first use them (the vertex codec encodes each vertex as
+/// a difference from the one before). Returns the triangles on the new vertex numbers and, for
+/// each new vertex, its old number; vertices no triangle uses are left out.
+pub(super) fn codec_order(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+) -> (Vec<[u32; 3]>, Vec<u32>) {
+    let flat: Vec<u32> = triangles.iter().flatten().copied().collect();
+    let mut cached = vec![0u32; flat.len()];
+    optimize_vertex_cache_strip(&mut cached, &flat, vertex_count);
+    let mut remap = vec![0u32; vertex_count];
+    let kept = optimize_vertex_fetch_remap(&mut remap, &cached);
+    let mut old_of_new = vec![0u32; kept];
+    for (old, &new) in remap.iter().enumerate() {
+        if let Some(slot) = old_of_new.get_mut(new as usize) {
+            *slot = old as u32;
+        }
+    }
+    let renumbered = cached
+        .chunks_exact(3)
+        .map(|t| {
+            [
+                remap[t[0] as usize],
+                remap[t[1] as usize],
+                remap[t[2] as usize],
+            ]
+        })
+        .collect();
+    (renumbered, old_of_new)
 }

@@ -236,7 +236,18 @@ impl CaseDocument {
         if revision != self.revision || !fits {
             return false;
         }
-        self.case.structures[self.current].keep(result);
+        let structure = &mut self.case.structures[self.current];
+        let mut result = result;
+        // A surface the structure already holds for these settings (a case file's, quantized;
+        // a search's) stays the one shown and written: the engine's recomputation brings its
+        // per-vertex measures, made on a surface within the file's stated quantization error.
+        if let Some(held) = (structure.smoothed.take())
+            .filter(|h| h.revision == structure.revision && h.vertex_measures().is_none())
+            .filter(|h| h.positions.len() == n)
+        {
+            result.positions = held.positions;
+        }
+        structure.keep(result);
         true
     }
 }

@@ -15,7 +15,7 @@ use crate::view;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Positions {
     Original,
-    /// The surface the model's structure keeps for these parameters, until the engine's.
+    /// The surface the model's structure holds for these parameters (a case file's, a search's).
     Kept,
     /// The CPU engine's result for this revision.
     Cpu(u64),
@@ -69,7 +69,7 @@ impl Shell {
         }
         let toward = doc.view_asks.toward_segmentation;
         let gpu = self.gpu.as_ref();
-        let wanted = wanted_positions(session, gpu, self.show_original, toward);
+        let wanted = wanted_positions(session, gpu, self.show_original, toward, shown.positions);
         if shown.positions != Some(wanted)
             && upload_positions(viewer, rs, session, gpu, wanted, shown.positions, toward)
         {
@@ -139,6 +139,7 @@ fn wanted_positions(
     gpu: Option<&GpuEngine>,
     show_original: bool,
     toward: f32,
+    shown: Option<Positions>,
 ) -> Positions {
     let result = session.case().last_result();
     let before_result = if session.case().kept_surface().is_some() {
@@ -153,7 +154,16 @@ fn wanted_positions(
             Positions::Toward(r.revision, toward.to_bits())
         })
     } else if let Some(gpu) = gpu {
-        (gpu.submitted(session.case().model_id())).map_or(before_result, Positions::Gpu)
+        // The structure's own surface (a case file's) is shown rather than the engine's
+        // recomputation of it; the engine's buffers stay while they are what is shown.
+        match gpu.submitted(session.case().model_id()) {
+            Some(run)
+                if before_result == Positions::Original || shown == Some(Positions::Gpu(run)) =>
+            {
+                Positions::Gpu(run)
+            }
+            _ => before_result,
+        }
     } else {
         result.map_or(before_result, |r| Positions::Cpu(r.revision))
     }
