@@ -144,3 +144,40 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
         assert_eq!(*params, want.unwrap().params, "structure {i}");
     }
 }
+
+/// "Suggest all" on some structures: those get their suggestions, the others keep their
+/// parameters; an index past the case is refused.
+#[test]
+fn suggest_all_on_some_structures_leaves_the_others_as_they_were() {
+    use meshsmooth::session::Session;
+    use meshsmooth::suggest::SearchMethod;
+    let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
+    let mut session = Session::default();
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes);
+    session.poll_opening().expect("done").expect("opens");
+    let before: Vec<_> = (session.case().case_structures().iter())
+        .map(|s| s.params)
+        .collect();
+    let refused = session.start_suggest_some(0.5, SearchMethod::Local, false, &[1, 4]);
+    assert!(refused.unwrap_err().contains("structure 4 does not exist"));
+    session
+        .start_suggest_some(0.5, SearchMethod::Local, false, &[1, 3])
+        .unwrap();
+    while session.background().suggesting_all() {
+        session.step_suggest_all();
+    }
+    let outcome = session.background().suggest_all().unwrap();
+    assert_eq!((outcome.done, outcome.total), (2, 2));
+    let got: Vec<bool> = outcome.structures.iter().map(Option::is_some).collect();
+    assert_eq!(got, [false, true, false, true]);
+    let after: Vec<_> = (session.case().case_structures().iter())
+        .map(|s| s.params)
+        .collect();
+    assert_eq!((after[0], after[2]), (before[0], before[2]));
+    for i in [1, 3] {
+        match &outcome.structures[i] {
+            Some(StructureOutcome::Suggested { params, .. }) => assert_eq!(after[i], *params),
+            other => panic!("structure {i}: {other:?}"),
+        }
+    }
+}

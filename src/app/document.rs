@@ -320,6 +320,7 @@ impl Document {
     pub fn working_elsewhere(&self) -> bool {
         self.backend == Backend::Cpu
             && !self.guidance_on_gpu
+            && self.session.case_export_progress().is_none()
             && self.session.cpu_engine().threaded()
     }
 
@@ -331,6 +332,7 @@ impl Document {
             || self.session.loading().is_some()
             || self.session.background().suggesting_all()
             || self.session.background().checking()
+            || self.session.case_export_progress().is_some()
     }
 
     /// The CPU engine's share of this frame: asks its workers for the current parameters'

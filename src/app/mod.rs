@@ -23,6 +23,7 @@
 mod api;
 mod bottom_panel;
 mod brush;
+mod case_export_view;
 mod case_reader;
 mod case_text;
 mod controls;

@@ -21,7 +21,11 @@ pub enum StructureAction {
     AddFiles,
     /// Check the structures against each other (what lies inside what, what crosses).
     Check,
-    ExportCase,
+    /// Write the case glTF with these options (its size shows before it is saved).
+    ExportCase(crate::export::CaseGltfOptions),
+    CancelExport,
+    /// Save the case glTF written.
+    SaveCase,
     /// "Suggest all" at the Suggest panel's tau, or cancel it.
     SuggestAll,
     CancelSuggestAll,
@@ -37,6 +41,7 @@ pub struct StructureList {
     case_text: ((String, String), (String, String)),
     /// Shows only the structures whose name or group contains it.
     filter: String,
+    export: super::case_export_view::ExportChoice,
 }
 
 /// The model's name, group and description as edited, and what the session had when they
@@ -216,14 +221,8 @@ impl StructureList {
                 }
             }
         });
+        self.export.show(ui, session, actions);
         ui.horizontal(|ui| {
-            if ui
-                .button("Export case (GLB)")
-                .on_hover_text("Every structure as shown, smoothed ones with their originals and records, in metres with Y up")
-                .clicked()
-            {
-                actions.push(StructureAction::ExportCase);
-            }
             if session.background().checking() {
                 // No spinner: it would draw frames for as long as a worker checks.
                 ui.label("checking…");

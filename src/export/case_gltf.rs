@@ -22,11 +22,13 @@ use super::glb::{
     MESHOPT, TRIANGLES, UNSIGNED_INT,
 };
 use super::simplified::{
-    record as simplification_record, simplify_case, written, Simplification, Written,
+    record as simplification_record, simplify_case, simplify_structure, written, Simplification,
+    Written,
 };
 use super::{check, ExportError, ExportOptions};
 use crate::case::{structure_record, Case, CaseStructure, CASE_KEY};
 use crate::mesh::{bounding_box, vertex_normals, Mesh};
+use crate::simplify::Simplified;
 use crate::srgb;
 
 const QUANTIZATION: &str = "KHR_mesh_quantization";
@@ -96,33 +98,87 @@ pub const RAS_MM_TO_GLTF: [f64; 16] = [
     0.0, 0.0, 0.0, 1.0,
 ];
 
-/// The scene's nodes (the root first, then each structure, with a node per group after its
-/// first structure), the structures' meshes and their materials.
-struct SceneParts {
+/// A case glTF written one structure at a time: the CLI adds every structure at once, the page
+/// one per frame, showing how far it got and the file's size so far.
+pub struct CaseWriter {
+    options: CaseGltfOptions,
+    b: Builder,
+    /// The root first (filled in at the end), then each structure, with a node per group
+    /// after its first structure.
     nodes: Vec<Value>,
     meshes: Vec<Value>,
     materials: Vec<Value>,
+    root_children: Vec<usize>,
+    group_nodes: Vec<(String, usize)>,
+    /// Triangles in the case before simplification (a triangle budget's share of each).
+    case_triangles: usize,
+    triangles: usize,
 }
 
-fn scene_parts(
-    case: &Case,
-    title: &str,
-    options: &CaseGltfOptions,
-    b: &mut Builder,
-) -> Result<SceneParts, ExportError> {
-    let mut nodes = vec![json!({})];
-    let mut meshes = Vec::new();
-    let mut materials = Vec::new();
-    let mut root_children = Vec::new();
-    let mut group_nodes: Vec<(&str, usize)> = Vec::new();
-    let simplified = options.simplify.map(|how| simplify_case(case, how));
-    for (i, s) in case.structures.iter().enumerate() {
-        let index = meshes.len();
-        let done = simplified.as_ref().and_then(|all| all[i].as_ref());
+impl CaseWriter {
+    /// A writer for `case`; errors when it has no structure or would not fit a GLB.
+    pub fn new(case: &Case, options: &CaseGltfOptions) -> Result<Self, ExportError> {
+        if case.structures.is_empty() {
+            return Err(ExportError::NoTriangles);
+        }
+        let estimate: u64 = (case.structures.iter())
+            .map(|s| {
+                s.original.vertex_count() as u64 * 44 + s.original.triangle_count() as u64 * 12
+            })
+            .sum();
+        if estimate > u64::from(u32::MAX) {
+            return Err(too_large());
+        }
+        Ok(Self {
+            options: *options,
+            b: Builder::default(),
+            nodes: vec![json!({})],
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            root_children: Vec::new(),
+            group_nodes: Vec::new(),
+            case_triangles: (case.structures.iter())
+                .map(|s| s.original.triangle_count())
+                .sum(),
+            triangles: 0,
+        })
+    }
+
+    /// Structures written so far.
+    pub fn structures(&self) -> usize {
+        self.meshes.len()
+    }
+
+    /// Triangles written so far.
+    pub fn triangles(&self) -> usize {
+        self.triangles
+    }
+
+    /// Bytes of the binary buffer so far (the file adds its JSON to them).
+    pub fn buffer_bytes(&self) -> usize {
+        self.b.bin.len()
+    }
+
+    /// Writes the next structure, `s` (simplified first when the options say so).
+    pub fn add(&mut self, s: &CaseStructure) -> Result<(), ExportError> {
+        let done =
+            (self.options.simplify).and_then(|how| simplify_structure(s, how, self.case_triangles));
+        self.add_simplified(s, done.as_ref())
+    }
+
+    /// Writes the next structure, `s`, with its simplified triangles where it has them.
+    fn add_simplified(
+        &mut self,
+        s: &CaseStructure,
+        done: Option<&Simplified>,
+    ) -> Result<(), ExportError> {
+        let index = self.meshes.len();
+        let options = self.options;
         let surfaces = written(s, done, options.local_error);
-        let (mesh, placement) = structure_mesh(b, s, &surfaces, index, options)?;
-        meshes.push(mesh);
-        materials.push(material(s, options.unlit));
+        let (mesh, placement) = structure_mesh(&mut self.b, s, &surfaces, index, &options)?;
+        self.triangles += surfaces.shown.triangle_count();
+        self.meshes.push(mesh);
+        self.materials.push(material(s, options.unlit));
         let mut record = structure_record(s);
         if let Some(how) = options.simplify {
             record["simplification"] = simplification_record(s, how, done);
@@ -138,78 +194,70 @@ fn scene_parts(
             record["quantization"] = q;
         }
         node["extras"] = json!({ CASE_KEY: record });
-        nodes.push(node);
-        let node = nodes.len() - 1;
+        self.nodes.push(node);
+        let node = self.nodes.len() - 1;
         match s.group.as_deref() {
-            None => root_children.push(node),
-            Some(group) => match group_nodes.iter().find(|(g, _)| *g == group) {
-                Some(&(_, g)) => push_child(&mut nodes[g], node),
+            None => self.root_children.push(node),
+            Some(group) => match self.group_nodes.iter().find(|(g, _)| g == group) {
+                Some(&(_, g)) => push_child(&mut self.nodes[g], node),
                 None => {
-                    nodes.push(json!({ "name": group, "children": [node] }));
-                    group_nodes.push((group, nodes.len() - 1));
-                    root_children.push(nodes.len() - 1);
+                    self.nodes
+                        .push(json!({ "name": group, "children": [node] }));
+                    self.group_nodes
+                        .push((group.to_string(), self.nodes.len() - 1));
+                    self.root_children.push(self.nodes.len() - 1);
                 }
             },
         }
+        Ok(())
     }
-    let mut root = json!({ "name": title, "children": root_children });
-    if options.frame == SceneFrame::Gltf {
-        root["matrix"] = json!(RAS_MM_TO_GLTF);
+
+    /// The file, once every structure of `case` is written.
+    pub fn finish(mut self, case: &Case) -> Result<Vec<u8>, ExportError> {
+        let title = if case.title.is_empty() {
+            "case"
+        } else {
+            &case.title
+        };
+        let mut root = json!({ "name": title, "children": self.root_children });
+        if self.options.frame == SceneFrame::Gltf {
+            root["matrix"] = json!(RAS_MM_TO_GLTF);
+        }
+        self.nodes[0] = root;
+        let scene = json!({
+            "name": title,
+            "nodes": [0],
+            "extras": { CASE_KEY: {
+                "title": case.title,
+                "description": case.description,
+                "frame": self.options.frame.name(),
+                "units": "mm",
+                "structures": case.structures.len(),
+            }},
+        });
+        let document = json!({
+            "asset": { "version": "2.0", "generator": concat!("meshsmooth ", env!("CARGO_PKG_VERSION")) },
+            "scene": 0,
+            "scenes": [scene],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "accessors": self.b.accessors,
+            "bufferViews": self.b.views,
+        });
+        finish(document, self.b, &self.options)
     }
-    nodes[0] = root;
-    Ok(SceneParts {
-        nodes,
-        meshes,
-        materials,
-    })
 }
 
-/// Serialises the case.
+/// Serialises the case (its structures simplified in parallel where threads are).
 pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, ExportError> {
-    if case.structures.is_empty() {
-        return Err(ExportError::NoTriangles);
+    let mut writer = CaseWriter::new(case, options)?;
+    let simplified = options.simplify.map(|how| simplify_case(case, how));
+    for (i, s) in case.structures.iter().enumerate() {
+        let done = simplified.as_ref().and_then(|all| all[i].as_ref());
+        writer.add_simplified(s, done)?;
     }
-    let estimate: u64 = case
-        .structures
-        .iter()
-        .map(|s| s.original.vertex_count() as u64 * 44 + s.original.triangle_count() as u64 * 12)
-        .sum();
-    if estimate > u64::from(u32::MAX) {
-        return Err(too_large());
-    }
-    let title = if case.title.is_empty() {
-        "case"
-    } else {
-        &case.title
-    };
-    let mut b = Builder::default();
-    let SceneParts {
-        nodes,
-        meshes,
-        materials,
-    } = scene_parts(case, title, options, &mut b)?;
-    let scene = json!({
-        "name": title,
-        "nodes": [0],
-        "extras": { CASE_KEY: {
-            "title": case.title,
-            "description": case.description,
-            "frame": options.frame.name(),
-            "units": "mm",
-            "structures": case.structures.len(),
-        }},
-    });
-    let document = json!({
-        "asset": { "version": "2.0", "generator": concat!("meshsmooth ", env!("CARGO_PKG_VERSION")) },
-        "scene": 0,
-        "scenes": [scene],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": materials,
-        "accessors": b.accessors,
-        "bufferViews": b.views,
-    });
-    finish(document, b, options)
+    writer.finish(case)
 }
 
 /// The document with its extensions and buffers, in its container.

@@ -11,7 +11,9 @@ mod ply;
 mod simplified;
 mod stl;
 
-pub use case_gltf::{write_case, CaseGltfOptions, Container, SceneFrame, RAS_MM_TO_GLTF};
+pub use case_gltf::{
+    write_case, CaseGltfOptions, CaseWriter, Container, SceneFrame, RAS_MM_TO_GLTF,
+};
 pub use simplified::Simplification;
 
 use crate::mesh::Mesh;

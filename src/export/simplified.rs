@@ -42,21 +42,26 @@ impl Simplification {
 /// Each structure's simplified triangles (in parallel where threads are), `None` where its
 /// surface is kept.
 pub(super) fn simplify_case(case: &Case, how: Simplification) -> Vec<Option<Simplified>> {
-    let total: usize = case
-        .structures
-        .iter()
+    let total: usize = (case.structures.iter())
         .map(|s| s.original.triangle_count())
         .sum();
-    case.structures
-        .par_iter()
-        .map(|s| {
-            let goal = how.goal(s, total)?;
-            simplify(
-                &Mesh::new(s.positions().to_vec(), s.original.triangles.clone()),
-                goal,
-            )
-        })
+    (case.structures.par_iter())
+        .map(|s| simplify_structure(s, how, total))
         .collect()
+}
+
+/// A structure's simplified triangles (`case_triangles`: the case's, for a budget's share),
+/// `None` where its surface is kept.
+pub(super) fn simplify_structure(
+    s: &CaseStructure,
+    how: Simplification,
+    case_triangles: usize,
+) -> Option<Simplified> {
+    let goal = how.goal(s, case_triangles)?;
+    simplify(
+        &Mesh::new(s.positions().to_vec(), s.original.triangles.clone()),
+        goal,
+    )
 }
 
 /// A structure's surfaces as the file holds them.

@@ -3,7 +3,7 @@
 
 use super::CaseDocument;
 use crate::case::Case;
-use crate::export::{self, CaseGltfOptions, Container};
+use crate::export::{self, CaseGltfOptions};
 
 impl CaseDocument {
     pub fn case_title(&self) -> &str {
@@ -38,15 +38,10 @@ impl CaseDocument {
         Some(case)
     }
 
-    /// The case glTF (`.glb`, or `.gltf` with its buffer embedded): metres with +Y up, each
-    /// smoothed structure with its original as a morph target and its local error.
-    pub fn export_case(&self, container: Container) -> Result<Vec<u8>, String> {
+    /// The case glTF with `options`: metres with +Y up, each smoothed structure with its
+    /// original as a morph target.
+    pub fn export_case(&self, options: &CaseGltfOptions) -> Result<Vec<u8>, String> {
         let case = self.to_case().ok_or("no mesh is open")?;
-        let options = CaseGltfOptions {
-            container,
-            local_error: true,
-            ..CaseGltfOptions::default()
-        };
-        export::write_case(&case, &options).map_err(|e| e.to_string())
+        export::write_case(&case, options).map_err(|e| e.to_string())
     }
 }

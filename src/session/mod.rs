@@ -15,6 +15,7 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod case;
+mod case_export;
 mod checks;
 mod colors;
 mod cpu;
@@ -28,6 +29,7 @@ mod suggest_all;
 mod weights;
 
 pub use crate::model::{Model, OpenFailure};
+pub use case_export::{ExportProgress, WrittenCase};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use document::CaseDocument;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
@@ -78,6 +80,7 @@ pub struct Session {
     additions: std::collections::VecDeque<(String, Vec<u8>)>,
     suggest_all: suggest_all::SuggestAll,
     checks: checks::Checks,
+    case_export: case_export::CaseExport,
     /// Whether a newly opened model gets a suggestion search (not in the viewer, which shows
     /// no suggestion).
     suggest_on_open: bool,
@@ -96,6 +99,7 @@ impl Default for Session {
             additions: Default::default(),
             suggest_all: Default::default(),
             checks: Default::default(),
+            case_export: Default::default(),
             suggest_on_open: true,
         }
     }

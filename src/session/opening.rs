@@ -194,6 +194,7 @@ impl Session {
         self.cancel_suggest_all();
         self.suggest_all = Default::default();
         self.checks = Default::default();
+        self.case_export = Default::default();
         self.doc.adopt(case, name, first_file, model);
         self.became_model();
     }

@@ -67,6 +67,24 @@ impl Session {
         method: SearchMethod,
         learn: bool,
     ) -> Result<(), String> {
+        let all: Vec<usize> = (0..self.doc.case.structures.len()).collect();
+        self.start_suggest_some(tau, method, learn, &all)
+    }
+
+    /// [`Self::start_suggest_all`] for the structures `which` (indices into the case).
+    pub fn start_suggest_some(
+        &mut self,
+        tau: f64,
+        method: SearchMethod,
+        learn: bool,
+        which: &[usize],
+    ) -> Result<(), String> {
+        let count = self.doc.case.structures.len();
+        if let Some(i) = which.iter().find(|&&i| i >= count) {
+            return Err(format!(
+                "structure {i} does not exist: the case has {count}"
+            ));
+        }
         if !(0.0..=1.0).contains(&tau) {
             return Err(format!("tau = {tau} is out of range: [0, 1]"));
         }
@@ -81,7 +99,9 @@ impl Session {
             max_volume_change: Some(0.05),
             learn: learn && method == SearchMethod::Local,
         };
-        let mut work: Vec<Work> = (self.doc.case.structures.iter().enumerate())
+        let structures = &self.doc.case.structures;
+        let mut work: Vec<Work> = (structures.iter().enumerate())
+            .filter(|(i, _)| which.contains(i))
             .map(|(i, s)| (i, s.original.clone(), s.params, s.weights.clone()))
             .collect();
         // As `case build`: learning, the smallest first; else the largest first, so no worker
@@ -96,7 +116,7 @@ impl Session {
             order: work.iter().map(|w| w.0).collect(),
             queued: work.into(),
             total,
-            outcome: vec![None; total],
+            outcome: vec![None; count],
             ..SuggestAll::default()
         };
         self.hand_out_structures();

@@ -10,7 +10,8 @@
 #   bash tests/e2e/run.sh --test-name-pattern='^5 '   (extra arguments go to node --test)
 #   bash tests/e2e/run.sh --bench      the browser benchmarks (*.bench.mjs) instead of the tests
 #
-# Screenshots and exported files: target/e2e/<mode>/; benchmark lines: target/e2e/bench.json.
+# Screenshots and exported files: target/e2e/<mode>/; benchmark lines: target/e2e/bench.json;
+# the whole-body label map: target/e2e/whole_body/ (E2E_WHOLE_BODY=DIR takes one made before).
 # Needs: web/node_modules (npm ci in web/, .ci/install.sh), /usr/bin/chromium, ../shared/data.
 # To test another build: E2E_DIST=/path/to/dist MESHSMOOTH_CLI=/path/to/meshsmooth (then the
 # CLI is not built here).
@@ -54,6 +55,15 @@ fi
 
 rm -rf target/e2e
 mkdir -p target/e2e
+
+# The whole-body CT label map whole_body.test.mjs opens, made afresh by its generator (never
+# committed).
+if [ -z "${E2E_WHOLE_BODY:-}" ] && [ "$profile" = test ]; then
+    cargo build --profile test --example whole_body --quiet
+    examples="${CARGO_TARGET_DIR:-target}/debug/examples"
+    export E2E_WHOLE_BODY="$PWD/target/e2e/whole_body"
+    "$examples/whole_body" "$E2E_WHOLE_BODY" > /dev/null
+fi
 
 failed=()
 for mode in ${E2E_MODES:-webgpu cpu}; do

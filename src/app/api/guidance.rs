@@ -64,7 +64,8 @@ fn sweep(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Pr
     })
 }
 
-/// `suggestAll({tau, search})`: every structure's suggestion, once all are searched.
+/// `suggestAll({tau, search, structures})`: every structure's suggestion (or those of the
+/// indices in `structures`), once all are searched.
 fn suggest_all(
     doc: &SharedDocument,
     ctx: &egui::Context,
@@ -73,9 +74,13 @@ fn suggest_all(
     Closure::new(move |options: JsValue| {
         let started = {
             let mut doc = d.borrow_mut();
+            let which = which_structures(&options);
             tau_and_search(doc.session(), &options, "suggestAll").and_then(|(tau, search)| {
                 let (method, learn) = search;
-                doc.session_mut().start_suggest_all(tau, method, learn)
+                match which? {
+                    Some(w) => doc.session_mut().start_suggest_some(tau, method, learn, &w),
+                    None => doc.session_mut().start_suggest_all(tau, method, learn),
+                }
             })
         };
         started_work(
@@ -148,6 +153,23 @@ fn start_suggest(doc: &SharedDocument, options: &JsValue) -> Result<(f64, Search
 }
 
 /// `{tau, search}` of `suggest` and `suggestAll` (tau: the session's, search: grid by default).
+/// The `structures` option: indices into the case, or `None` (absent: every structure).
+fn which_structures(options: &JsValue) -> Result<Option<Vec<usize>>, String> {
+    if options.is_undefined() || options.is_null() {
+        return Ok(None);
+    }
+    let bad =
+        |v: &serde_json::Value| format!("suggestAll: structures {v} must be a list of indices");
+    match from_js(options)?.get("structures") {
+        None | Some(serde_json::Value::Null) => Ok(None),
+        Some(serde_json::Value::Array(list)) => (list.iter())
+            .map(|v| v.as_u64().map(|i| i as usize).ok_or_else(|| bad(v)))
+            .collect::<Result<Vec<_>, _>>()
+            .map(Some),
+        Some(v) => Err(bad(v)),
+    }
+}
+
 fn tau_and_search(
     session: &Session,
     options: &JsValue,

@@ -122,7 +122,24 @@ pub(crate) fn session_state(session: &Session, busy: bool) -> Value {
             .collect::<Vec<_>>(),
         "guidance": guidance(&session.background()),
         "checks": checks(&session.background()),
+        "case_export": case_export(session),
     })
+}
+
+/// The case glTF being written (`writing`: structures done of all, bytes so far) or written
+/// and current (`written`: its bytes and triangles), and why the last one failed; null before
+/// any.
+fn case_export(session: &Session) -> Value {
+    let writing = session.case_export_progress().map(|p| {
+        json!({"done": p.structures_done, "total": p.structures, "bytes": p.bytes, "triangles": p.triangles})
+    });
+    let written =
+        (session.written_case()).map(|w| json!({"bytes": w.bytes.len(), "triangles": w.triangles}));
+    let error = session.case_export_error();
+    if writing.is_none() && written.is_none() && error.is_none() {
+        return Value::Null;
+    }
+    json!({"writing": writing, "written": written, "error": error})
 }
 
 /// The current quality graphs as `sweep --json` prints them, once they are current.

@@ -28,7 +28,8 @@
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current
 //!   parameters' result is computed
 //! - `exportMesh(format): Promise<Uint8Array>` for `glb stl ply obj`
-//! - `suggestAll({tau, search}): Promise<object>`: the suggestion for every structure, each
+//! - `suggestAll({tau, search, structures}): Promise<object>`: the suggestion for every
+//!   structure (or those whose indices `structures` lists), each
 //!   with its own filter and bound, one structure per engine worker, each then smoothed with
 //!   it; resolves with `{tau, search, structures: [{name, params, evaluations, metrics}],
 //!   done, total, cancelled}`
@@ -36,9 +37,15 @@
 //!   the CLI's `case build --json` `checks` (`pairs`, `left_inside`, `new_crossings`) with
 //!   `text` (the report's lines), `flagged` (the structures of its warnings, by index),
 //!   `marked_vertices` (per structure, how many of its vertices the view marks) and `ms`
-//! - `exportCase(format): Promise<Uint8Array>`: the case glTF (`glb`, the default, or `gltf`)
-//!   of every structure as shown and smoothed (a mesh alone is a case of one), once the
-//!   current parameters' result is computed; `setCase({title, description})` names the case
+//! - `exportCase(format, {simplify, triangle_budget, compressed}): Promise<Uint8Array>`: the
+//!   case glTF (`glb`, the default, or `gltf`) of every structure as shown and smoothed (a mesh
+//!   alone is a case of one), once the current parameters' result is computed: compressed
+//!   unless `compressed` is false, simplified within `simplify` voxel diagonals or to about
+//!   `triangle_budget` triangles when given (the file `writeCase` wrote when it is current);
+//!   `setCase({title, description})` names the case
+//! - `writeCase({simplify, triangle_budget}): Promise<{bytes, triangles}>`: writes the
+//!   compressed case glTF a structure per frame, as the page's "Write case" does (its progress
+//!   in `state().case_export`), and resolves with its size and triangles
 //! - `suggest({tau, search}): Promise<object>`: sets tau and searches (`grid`, the default, or
 //!   `local`) for the active filter; resolves with the CLI's `suggest --json` keys (the
 //!   suggestion is shown, not applied)
@@ -49,7 +56,8 @@
 //!   parameters, the CLI's `sweep --json` keys, once computed
 //! - `backend()`: `"webgpu"` or `"cpu"`
 //! - `state()`: `{model, vertices, faces, error, filter, params, tau, busy, weights, loading,
-//!   open_stages, backend, mode, timings, brush, view, layout, checks, guidance}` (`mode`:
+//!   open_stages, backend, mode, timings, brush, view, layout, checks, guidance,
+//!   case_export}` (`mode`:
 //!   `"viewer"` with `?mode=viewer`, else `"author"`) (`loading`: `{name, stage, stages,
 //!   doing}` while a file opens, else null; `open_stages`: `[{doing, ms}]`, the latest opening's
 //!   stages and their times in the worker; `timings`: the last result's `smooth_ms` and `measure_ms`
@@ -83,6 +91,7 @@
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
 
 mod case;
+mod export;
 mod files;
 mod guidance;
 pub(crate) mod json;
@@ -92,10 +101,10 @@ mod view;
 pub use messages::Embedding;
 
 use super::document::SharedDocument;
-use crate::export::{Container, ExportFormat};
+
 use eframe::egui;
 use files::{file_call, FileCall};
-use js_sys::{Function, Promise, Uint8Array};
+use js_sys::{Function, Promise};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::{JsCast, JsValue};
 
@@ -271,7 +280,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
     case::define(&api, doc, ctx)?;
     guidance::define(&api, doc, ctx)?;
     define_smoothing(&api, doc, ctx)?;
-    define_export(&api, doc, ctx)?;
+    export::define_export(&api, doc, ctx)?;
     define_page(&api, doc)?;
 
     js_sys::Reflect::set(&window, &"meshsmooth".into(), &api.object)
@@ -318,47 +327,6 @@ fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Res
         Closure::<dyn FnMut()>::new(move || {
             d.borrow_mut().case_mut().clear_weights();
             crate::app::wake(&c);
-        }),
-    )
-}
-
-/// `exportMesh` and `exportCase`, once the current parameters' result is there.
-fn define_export(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "exportMesh",
-        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
-            let name = format.as_string().unwrap_or_default();
-            let Some(format) = ExportFormat::from_extension(&name) else {
-                return settled(Err(format!(
-                    "unknown export format '{name}': use glb, stl, ply or obj"
-                )));
-            };
-            when_current(&d, &c, move |session| {
-                let bytes = session.case().export(format, None)?;
-                Ok(Uint8Array::from(bytes.as_slice()).into())
-            })
-        }),
-    )?;
-
-    let (d, c) = (doc.clone(), ctx.clone());
-    api.define(
-        "exportCase",
-        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
-            let name = format.as_string().unwrap_or_else(|| "glb".into());
-            let container = match name.as_str() {
-                "glb" => Container::Glb,
-                "gltf" => Container::Gltf,
-                _ => {
-                    return settled(Err(format!(
-                        "unknown case format '{name}': use glb or gltf"
-                    )))
-                }
-            };
-            when_current(&d, &c, move |session| {
-                let bytes = session.case().export_case(container)?;
-                Ok(Uint8Array::from(bytes.as_slice()).into())
-            })
         }),
     )
 }

@@ -39,6 +39,10 @@ use first_paint::FirstPaint;
 use start::{embed, gpu_engine, open_start_model, set_style, start_workers};
 use view_sync::Shown;
 
+/// Milliseconds of a frame the case glTF being written may take on this thread: the view
+/// stays usable (about ten frames a second) and the file is written at nearly full speed.
+const EXPORT_FRAME_MS: f64 = 80.0;
+
 pub struct Shell {
     doc: SharedDocument,
     files: FileInput,
@@ -336,13 +340,21 @@ impl Shell {
                     doc.session_mut().cancel_suggest_all();
                     Ok(())
                 }
-                StructureAction::ExportCase => {
+                StructureAction::ExportCase(options) => {
+                    doc.session_mut().start_case_export(options)
+                }
+                StructureAction::CancelExport => {
+                    doc.session_mut().cancel_case_export();
+                    Ok(())
+                }
+                StructureAction::SaveCase => {
                     let file = doc.case().case_file();
                     let stem = file.split('.').next().filter(|s| !s.is_empty());
                     let name = format!("{}_case.glb", stem.unwrap_or("case"));
-                    doc.case()
-                        .export_case(crate::export::Container::Glb)
-                        .and_then(|bytes| download::save(&name, &bytes, "model/gltf-binary"))
+                    match doc.session().written_case() {
+                        Some(w) => download::save(&name, &w.bytes, "model/gltf-binary"),
+                        None => Err("the case changed since it was written: write it again".into()),
+                    }
                 }
             };
             if let Err(e) = done {
@@ -404,6 +416,11 @@ impl eframe::App for Shell {
             let session = doc.session_mut();
             session.step_suggest_all();
             session.step_checks();
+            // Writing the case glTF takes this frame's share of time on this thread.
+            let start = now_ms();
+            while session.case_export_progress().is_some() && now_ms() - start < EXPORT_FRAME_MS {
+                session.step_case_export();
+            }
         }
         let arrived = opening == Opening::Done;
         if arrived {
