@@ -20,7 +20,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use crate::mesh::{to_f64, Mesh};
-use crate::metrics::TriangleBvh;
+use crate::metrics::{build_tree, TriangleBvh};
 use rays::{Location, RayBvh};
 
 /// What one pair of structures does, in one state (original or smoothed).
@@ -316,10 +316,10 @@ struct Solid {
 
 impl Solid {
     fn new(mesh: &Surface, bounds: Box3) -> Self {
-        let (rays, distance) = rayon::join(
-            || RayBvh::new(mesh.positions, mesh.triangles),
-            || TriangleBvh::new(mesh.positions, mesh.triangles),
-        );
+        let (p, t) = (mesh.positions, mesh.triangles);
+        let (tree, order) = build_tree(p, t);
+        let rays = RayBvh::from_tree(p, t, &tree, &order);
+        let distance = TriangleBvh::from_tree(p, t, tree, order);
         Self {
             bounds,
             rays,

@@ -28,17 +28,27 @@ pub(crate) struct Node {
 /// its nodes, root first, and the mesh's triangle indices in leaf order. Shared by the distance
 /// queries here and the ray casts of the checks between a case's structures.
 pub(crate) fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec<u32>) {
-    let mut items: Vec<(u32, [f32; 3])> = triangles
+    // Each triangle's centroid and box, read from the mesh once: the build then walks these
+    // in order at every level instead of gathering corners from all over the positions.
+    let mut items: Vec<Item> = triangles
         .iter()
         .enumerate()
         .map(|(t, tri)| {
-            let mut c = [0.0f32; 3];
-            for &v in tri {
-                for (k, ck) in c.iter_mut().enumerate() {
-                    *ck += positions[v as usize][k] / 3.0;
+            let corners = tri.map(|v| positions[v as usize]);
+            let mut item = Item {
+                id: t as u32,
+                centroid: [0.0; 3],
+                min: corners[0],
+                max: corners[0],
+            };
+            for c in &corners {
+                for (k, &x) in c.iter().enumerate() {
+                    item.centroid[k] += x / 3.0;
+                    item.min[k] = item.min[k].min(x);
+                    item.max[k] = item.max[k].max(x);
                 }
             }
-            (t as u32, c)
+            item
         })
         .collect();
     let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
@@ -49,9 +59,17 @@ pub(crate) fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec
             first: 0,
             count: 0,
         });
-        build(&mut nodes, 0, &mut items, 0, positions, triangles);
+        build(&mut nodes, 0, &mut items, 0);
     }
-    (nodes, items.iter().map(|&(t, _)| t).collect())
+    (nodes, items.iter().map(|item| item.id).collect())
+}
+
+/// A triangle while the tree is built.
+struct Item {
+    id: u32,
+    centroid: [f32; 3],
+    min: [f32; 3],
+    max: [f32; 3],
 }
 
 /// The closest point of a mesh to a query point.
@@ -76,6 +94,16 @@ impl TriangleBvh {
     /// Builds the tree over `triangles` (indices into `positions`, which must be in range).
     pub fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
         let (nodes, ids) = build_tree(positions, triangles);
+        Self::from_tree(positions, triangles, nodes, ids)
+    }
+
+    /// The tree of [`build_tree`] over the same mesh, built once for another use too.
+    pub(crate) fn from_tree(
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        nodes: Vec<Node>,
+        ids: Vec<u32>,
+    ) -> Self {
         let corners = ids
             .iter()
             .map(|&t| triangles[t as usize].map(|v| positions[v as usize]))
@@ -173,27 +201,15 @@ impl TriangleBvh {
 
 /// Fills `nodes[index]` for `items` (whose leaf order starts at `offset`) and recurses.
 /// Depth is bounded by log2 of the triangle count because every split halves the set.
-fn build(
-    nodes: &mut Vec<Node>,
-    index: usize,
-    items: &mut [(u32, [f32; 3])],
-    offset: usize,
-    positions: &[[f32; 3]],
-    triangles: &[[u32; 3]],
-) {
+fn build(nodes: &mut Vec<Node>, index: usize, items: &mut [Item], offset: usize) {
     let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     let (mut cmin, mut cmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for (t, c) in items.iter() {
-        for &v in &triangles[*t as usize] {
-            let p = positions[v as usize];
-            for k in 0..3 {
-                min[k] = min[k].min(p[k]);
-                max[k] = max[k].max(p[k]);
-            }
-        }
+    for item in items.iter() {
         for k in 0..3 {
-            cmin[k] = cmin[k].min(c[k]);
-            cmax[k] = cmax[k].max(c[k]);
+            min[k] = min[k].min(item.min[k]);
+            max[k] = max[k].max(item.max[k]);
+            cmin[k] = cmin[k].min(item.centroid[k]);
+            cmax[k] = cmax[k].max(item.centroid[k]);
         }
     }
     if items.len() <= LEAF_SIZE {
@@ -209,7 +225,7 @@ fn build(
         .max_by(|&a, &b| (cmax[a] - cmin[a]).total_cmp(&(cmax[b] - cmin[b])))
         .unwrap_or(0);
     let mid = items.len() / 2;
-    items.select_nth_unstable_by(mid, |a, b| a.1[axis].total_cmp(&b.1[axis]));
+    items.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
     let left = nodes.len();
     let placeholder = Node {
         min: [0.0; 3],
@@ -226,8 +242,8 @@ fn build(
         count: 0,
     };
     let (lo, hi) = items.split_at_mut(mid);
-    build(nodes, left, lo, offset, positions, triangles);
-    build(nodes, left + 1, hi, offset + mid, positions, triangles);
+    build(nodes, left, lo, offset);
+    build(nodes, left + 1, hi, offset + mid);
 }
 
 #[inline]

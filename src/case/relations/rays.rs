@@ -9,7 +9,7 @@
 //! edge signs are too close to call (it grazes an edge or a vertex) is thrown away and another
 //! one cast; a ray that meets the surface at its start means the point is on the surface.
 
-use crate::metrics::build_tree;
+use crate::metrics::TreeNode;
 
 /// Deeper than any median-split tree over `u32` triangle counts can grow.
 const STACK_DEPTH: usize = 64;
@@ -85,9 +85,21 @@ enum Hit {
 
 impl RayBvh {
     /// Builds the tree over `triangles` (indices into `positions`, which must be in range).
+    #[cfg(test)]
     pub(super) fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
+        let (tree, order) = crate::metrics::build_tree(positions, triangles);
+        Self::from_tree(positions, triangles, &tree, &order)
+    }
+
+    /// Over the tree `build_tree` made of the same mesh (`tree` and the triangles in leaf
+    /// `order`), built once for the distances too.
+    pub(super) fn from_tree(
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        tree: &[TreeNode],
+        order: &[u32],
+    ) -> Self {
         let shell_of = triangle_shells(positions.len(), triangles);
-        let (tree, order) = build_tree(positions, triangles);
         // The shared tree's boxes, widened a hair so that a ray along a box face is not lost
         // to rounding.
         let nodes = tree
