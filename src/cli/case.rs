@@ -136,7 +136,9 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         }
     }
     let opened = started.elapsed().as_secs_f64();
+    let checks_started = Instant::now();
     let before = case::check(&case, false);
+    let mut checks_seconds = checks_started.elapsed().as_secs_f64();
 
     let options = SuggestAllOptions {
         tau: args.tau,
@@ -148,7 +150,9 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     let suggest_started = Instant::now();
     let suggestions = suggest_all_shown(&mut case, &options)?;
     let suggest_seconds = suggest_started.elapsed().as_secs_f64();
+    let checks_started = Instant::now();
     let after = case::check(&case, true);
+    checks_seconds += checks_started.elapsed().as_secs_f64();
     let changes = case::relations::changes(&before, &after);
 
     let export_started = Instant::now();
@@ -165,6 +169,7 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         out["evaluations"] = serde_json::json!(evaluations);
         out["open_seconds"] = serde_json::json!(opened);
         out["suggest_seconds"] = serde_json::json!(suggest_seconds);
+        out["checks_seconds"] = serde_json::json!(checks_seconds);
         out["export_seconds"] = serde_json::json!(export_seconds);
         out["seconds"] = serde_json::json!(started.elapsed().as_secs_f64());
         out["bytes"] = serde_json::json!(bytes.len());
