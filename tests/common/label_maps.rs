@@ -2,6 +2,7 @@
 //! phantom's analytic shapes.
 #![allow(dead_code)]
 
+use meshsmooth::case::{self, relations::RelationChanges, Case};
 use meshsmooth::segmentation::{self, NamedBytes, OpenOptions, Structure};
 use meshsmooth::session::Session;
 use serde_json::Value;
@@ -35,6 +36,31 @@ pub fn open(path: &str, table: Option<&str>) -> Vec<Structure> {
         &OpenOptions::default(),
     )
     .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The shared phantom opened as a case, named by its colour table.
+pub fn phantom_case() -> Case {
+    const TABLE: &str = "labelmaps/case_phantom_shared_labels.txt";
+    let (bytes, table) = (read("labelmaps/case_phantom_shared.nii.gz"), read(TABLE));
+    let files = [NamedBytes {
+        name: "data/case_phantom_shared.nii.gz",
+        bytes: &bytes,
+    }];
+    let table = NamedBytes {
+        name: TABLE,
+        bytes: &table,
+    };
+    case::open(&files, Some(table), &OpenOptions::default()).expect("the phantom opens")
+}
+
+/// No structure left one it lay inside, and no surfaces cross that did not.
+pub fn assert_relations_kept(changes: &RelationChanges) {
+    assert!(changes.left_inside.is_empty(), "{:?}", changes.left_inside);
+    assert!(
+        changes.new_crossings.is_empty(),
+        "{:?}",
+        changes.new_crossings
+    );
 }
 
 /// Inside test of one phantom shape (ellipsoids, spheres, capsules) in its own frame (mm).
