@@ -101,7 +101,7 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
 #[test]
 fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
     use meshsmooth::case::{self, Case, SuggestAllOptions, LEARNING_BATCH};
-    use meshsmooth::session::Session;
+    use meshsmooth::session::{structure_work, Session};
     use meshsmooth::suggest::SearchMethod;
     let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
     let mut session = Session::default();
@@ -121,12 +121,36 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
     session
         .start_suggest_all(0.5, SearchMethod::Local, true)
         .unwrap();
+    // The time estimate's fraction: the work of the structures answered, each weighed by its
+    // size, rising batch by batch.
+    let work: Vec<f64> = (expected.structures.iter())
+        .map(|s| structure_work(s.original.vertex_count()))
+        .collect();
+    let mut done_before = 0.0;
     while session.background().suggesting_all() {
+        let done = session.background().suggest_all_work_done().unwrap();
+        let answered = session.background().suggest_all().unwrap().structures;
+        let expected_done: f64 = (work.iter().zip(answered))
+            .filter(|(_, o)| o.is_some())
+            .map(|(w, _)| w)
+            .sum::<f64>()
+            / work.iter().sum::<f64>();
+        assert!(
+            (done - expected_done).abs() < 1e-12,
+            "{done} {expected_done}"
+        );
+        assert!(
+            done >= done_before && done < 1.0,
+            "{done_before} then {done}"
+        );
+        done_before = done;
         assert!(
             session.step_suggest_all(),
             "workers on this thread answer at once"
         );
     }
+    assert!(done_before > 0.0, "some work was seen done before the end");
+    assert_eq!(session.background().suggest_all_work_done(), None);
     let options = SuggestAllOptions {
         tau: 0.5,
         filter: None,

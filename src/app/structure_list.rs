@@ -8,7 +8,7 @@ use eframe::egui;
 use super::layout::{PanelLayout, StructureRow};
 use crate::case::CaseStructure;
 use crate::metrics::Metrics;
-use crate::session::{Session, StructureChange};
+use crate::session::{seconds_left, Session, StructureChange};
 
 /// What the author did in the list this frame.
 pub enum StructureAction {
@@ -42,6 +42,8 @@ pub struct StructureList {
     /// Shows only the structures whose name or group contains it.
     filter: String,
     export: super::case_export_view::ExportChoice,
+    /// When the "Suggest all" under way started (page clock, ms), for its time estimate.
+    suggest_started: Option<f64>,
 }
 
 /// The model's name, group and description as edited, and what the session had when they
@@ -203,20 +205,37 @@ impl StructureList {
                 description.clone(),
             ));
         }
-        ui.horizontal(|ui| match session.background().suggest_all_progress() {
+        let background = session.background();
+        let progress = background.suggest_all_progress();
+        let now = super::document::now_ms();
+        // Started here (the button) or elsewhere (the API): from when it was first seen then.
+        let started = match progress {
+            Some(_) => *self.suggest_started.get_or_insert(now),
+            None => now,
+        };
+        ui.horizontal(|ui| match progress {
             Some((done, total)) => {
-                let bar = egui::ProgressBar::new(done as f32 / total.max(1) as f32)
-                    .desired_width(160.0)
-                    .text(format!("Suggest all: {done} of {total}"));
-                ui.add(bar);
+                let work = background.suggest_all_work_done().unwrap_or(0.0);
+                let left = seconds_left((now - started) / 1000.0, work)
+                    .map_or(String::new(), |s| format!(" · {} left", about(s)));
+                let bar = egui::ProgressBar::new(work as f32)
+                    .desired_width((ui.available_width() - 70.0).max(120.0))
+                    .text(format!("{done} of {total}{left}"));
+                ui.add(bar).on_hover_text(
+                    "Suggest all: the structures done, and the time left at the pace so far",
+                );
                 if ui.button("Cancel").clicked() {
                     actions.push(StructureAction::CancelSuggestAll);
                 }
             }
             None => {
+                if self.suggest_started.is_some_and(|t| t < now) {
+                    self.suggest_started = None;
+                }
                 let tip = "The suggestion at the Suggest panel's τ for every structure, each with \
                            its own filter and bound, then smoothed with it";
                 if ui.button("Suggest all").on_hover_text(tip).clicked() {
+                    self.suggest_started = Some(now);
                     actions.push(StructureAction::SuggestAll);
                 }
             }
@@ -439,4 +458,13 @@ fn row(
         }
     })
     .inner
+}
+
+/// A time still to come, as a person says it: "about 40 s", "about 3 min".
+fn about(seconds: f64) -> String {
+    if seconds < 90.0 {
+        format!("about {:.0} s", (seconds / 5.0).ceil().max(1.0) * 5.0)
+    } else {
+        format!("about {:.0} min", (seconds / 60.0).round())
+    }
 }

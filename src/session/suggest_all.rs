@@ -24,7 +24,23 @@ pub struct SuggestAll {
     total: usize,
     /// Per structure, what it got (`None` until it answers).
     outcome: Vec<Option<StructureOutcome>>,
+    /// Per structure, its share of the work ([`structure_work`]); 0 for those not asked.
+    work: Vec<f64>,
     cancelled: bool,
+}
+
+/// A structure's expected share of the work, in vertices: its vertices plus as many again as a
+/// search costs on any structure, however small (a search measures about as many parameter
+/// sets on a vessel as on the liver), fitted to the whole-body CT map's searches.
+pub fn structure_work(vertices: usize) -> f64 {
+    const PER_SEARCH: f64 = 2000.0;
+    vertices as f64 + PER_SEARCH
+}
+
+/// Seconds still to come, from `elapsed` seconds for `done` of the work (a fraction): the work
+/// left at the pace so far. `None` before any work is done.
+pub fn seconds_left(elapsed: f64, done: f64) -> Option<f64> {
+    (done > 0.0 && elapsed.is_finite()).then(|| elapsed * (1.0 - done.min(1.0)) / done)
 }
 
 /// One structure's part: its index, surface, parameters and weights.
@@ -111,12 +127,17 @@ impl Session {
             work.reverse();
         }
         let total = work.len();
+        let mut shares = vec![0.0; count];
+        for (i, mesh, ..) in &work {
+            shares[*i] = structure_work(mesh.vertex_count());
+        }
         self.suggest_all = SuggestAll {
             options: Some(options),
             order: work.iter().map(|w| w.0).collect(),
             queued: work.into(),
             total,
             outcome: vec![None; count],
+            work: shares,
             ..SuggestAll::default()
         };
         self.hand_out_structures();
@@ -257,6 +278,18 @@ impl<'a> Background<'a> {
             .then(|| (s.total - s.waiting.len() - s.queued.len(), s.total))
     }
 
+    /// The fraction of the work of "Suggest all" done, by [`structure_work`], while it is under
+    /// way: what a time estimate goes by.
+    pub fn suggest_all_work_done(&self) -> Option<f64> {
+        let s = self.suggest_all;
+        let total: f64 = s.work.iter().sum();
+        let done: f64 = (s.work.iter().zip(&s.outcome))
+            .filter(|(_, o)| o.is_some())
+            .map(|(w, _)| w)
+            .sum();
+        (self.suggesting_all() && total > 0.0).then(|| done / total)
+    }
+
     /// The last "Suggest all" since the case opened, as far as it got.
     pub fn suggest_all(&self) -> Option<SuggestAllReport<'a>> {
         let s = self.suggest_all;
@@ -267,5 +300,20 @@ impl<'a> Background<'a> {
             total: s.total,
             cancelled: s.cancelled,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_time_left_is_the_work_left_at_the_pace_so_far() {
+        assert_eq!(seconds_left(10.0, 0.25), Some(30.0));
+        assert_eq!(seconds_left(10.0, 1.0), Some(0.0));
+        assert_eq!(seconds_left(10.0, 0.0), None);
+        assert_eq!(seconds_left(f64::NAN, 0.5), None);
+        // A small structure weighs more than its vertices: its search costs about as much.
+        assert!(structure_work(100) / structure_work(200_000) > 100.0 / 200_000.0);
     }
 }

@@ -89,6 +89,17 @@ testIn(WEBGPU_RUN, "S1 the JHU atlas opens into its 48 structures, as the CLI ex
         await app.page.keyboard.press("Control+A");
         await app.page.keyboard.press("Backspace");
         await app.stateWhen((s) => s.layout.structures.length === 48, "every row again");
+
+        // Suggest all on the 48 structures tells how far it is by the work done, which the
+        // list's bar shows with the time left.
+        const running = app.call("suggestAll", { tau: 0.5, search: "learned" });
+        running.catch(() => {});
+        state = await app.stateWhen((s) => s.suggest_all && s.suggest_all.work_done > 0, "some of the work done");
+        const part = state.suggest_all;
+        assert.ok(part.work_done < 1 && part.done > 0 && part.done < part.total, JSON.stringify([part.work_done, part.done]));
+        await app.screenshot("S1-jhu-suggest-all-time-left");
+        const all = await running;
+        assert.deepEqual([all.done, all.total, all.work_done], [48, 48, null]);
     });
 });
 

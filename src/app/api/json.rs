@@ -123,6 +123,7 @@ pub(crate) fn session_state(session: &Session, busy: bool) -> Value {
         "guidance": guidance(&session.background()),
         "checks": checks(&session.background()),
         "case_export": case_export(session),
+        "suggest_all": suggest_all(&session.background()),
     })
 }
 
@@ -171,8 +172,9 @@ pub(crate) fn guidance(background: &Background) -> Value {
     })
 }
 
-/// The last "Suggest all": `{tau, search, structures, done, total, cancelled}`, each structure
-/// `{name, params, evaluations, metrics}`, `{name, error}` or null until it answers.
+/// The last "Suggest all": `{tau, search, structures, done, total, work_done, cancelled}`, each
+/// structure `{name, params, evaluations, metrics}`, `{name, error}` or null until it answers;
+/// `work_done`, while it runs, the fraction of the expected work done (null after).
 pub(crate) fn suggest_all(background: &Background) -> Option<Value> {
     let report = background.suggest_all()?;
     let outcome = |o: &Option<StructureOutcome>| match o {
@@ -192,6 +194,7 @@ pub(crate) fn suggest_all(background: &Background) -> Option<Value> {
         "structures": report.structures.iter().map(outcome).collect::<Vec<_>>(),
         "done": report.done,
         "total": report.total,
+        "work_done": background.suggest_all_work_done(),
         "cancelled": report.cancelled,
     }))
 }
