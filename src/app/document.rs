@@ -377,6 +377,11 @@ impl Document {
         state["backend"] = serde_json::json!(self.backend.name());
         state["mode"] = serde_json::json!(if self.reading { "viewer" } else { "author" });
         state["shortcuts"] = serde_json::json!(self.shortcuts);
+        // The page's own memory beside its workers' (each instance's peak: it only grows).
+        state["memory"] = serde_json::json!({
+            "page": super::workers::memory_bytes(),
+            "workers": self.session.cpu_engine().memory(),
+        });
         state["guidance"]["engine"] = serde_json::json!(if self.guidance_on_gpu {
             "webgpu"
         } else {

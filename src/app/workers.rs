@@ -114,7 +114,10 @@ fn reply_handler(
             let bytes = js_sys::Uint8Array::new(buffer).to_vec();
             match decode::<Reply>(&bytes) {
                 Ok(reply) => {
-                    paced = matches!(reply, Reply::Progress { .. } | Reply::Terms { .. });
+                    paced = matches!(
+                        reply,
+                        Reply::Progress { .. } | Reply::Terms { .. } | Reply::Memory { .. }
+                    );
                     inbox.borrow_mut().push((index, reply))
                 }
                 Err(why) => log::error!("engine worker {}: {why}", index + 1),
@@ -206,5 +209,19 @@ pub fn worker_handle(request: &[u8], tell: &js_sys::Function) -> Option<Vec<u8>>
             None
         }
     };
+    post(Reply::Memory {
+        bytes: memory_bytes(),
+    });
     reply.map(|r| encode(&r))
+}
+
+/// The bytes of this wasm instance's memory (the page's, or a worker's).
+pub fn memory_bytes() -> u64 {
+    wasm_bindgen::memory()
+        .dyn_into::<js_sys::WebAssembly::Memory>()
+        .map_or(0, |m| {
+            m.buffer()
+                .dyn_into::<js_sys::ArrayBuffer>()
+                .map_or(0, |b| u64::from(b.byte_length()))
+        })
 }

@@ -134,6 +134,9 @@ pub enum Reply {
     /// The worker stopped in the middle of its job (a trap in its module): whatever it was
     /// doing fails. The page's carrier makes this of a worker's error message.
     Broken { why: String },
+    /// The bytes of the worker's memory after a job (its peak: wasm memory only grows). Not a
+    /// job's answer.
+    Memory { bytes: u64 },
 }
 
 impl Reply {
@@ -147,7 +150,7 @@ impl Reply {
             | Reply::Suggested { job, .. }
             | Reply::Checked { job, .. }
             | Reply::Failed { job, .. } => Some(*job),
-            Reply::Broken { .. } => None,
+            Reply::Broken { .. } | Reply::Memory { .. } => None,
         }
     }
 }

@@ -140,6 +140,8 @@ pub struct Pool {
     /// The worker kept for the view's smoothing and openings, so a change of parameters never
     /// waits behind a guidance task or a structure of "Suggest all".
     view_worker: Option<usize>,
+    /// Each worker's memory as it last told ([`Reply::Memory`]); none on this thread.
+    memory: Vec<Option<u64>>,
 }
 
 /// One worker on this thread.
@@ -155,6 +157,7 @@ impl Pool {
         Self {
             carrier,
             busy: vec![None; workers],
+            memory: vec![None; workers],
             sent: None,
             next_job: 0,
             load: None,
@@ -198,6 +201,12 @@ impl Pool {
     /// Whether the workers run beside the caller's thread (else each job blocks it).
     pub fn threaded(&self) -> bool {
         self.carrier.threaded()
+    }
+
+    /// Each worker's memory in bytes as it last told (its peak), the view worker's last;
+    /// `None` for a worker that has not told (workers on this thread never do).
+    pub fn memory(&self) -> &[Option<u64>] {
+        &self.memory
     }
 
     /// Whether a worker is kept for the view's smoothing and openings.
@@ -441,6 +450,12 @@ impl Pool {
     }
 
     fn receive(&mut self, worker: usize, reply: Reply) {
+        if let Reply::Memory { bytes } = reply {
+            if let Some(slot) = self.memory.get_mut(worker) {
+                *slot = Some(bytes);
+            }
+            return;
+        }
         if let Reply::Progress {
             job,
             stage,

@@ -213,6 +213,47 @@ fn a_worker_without_a_model_says_so() {
 }
 
 #[test]
+fn a_workers_memory_is_kept_as_it_told_without_ending_its_job() {
+    /// Two workers on this thread that tell their memory before each answer, as the page's do.
+    struct Telling {
+        inner: InThread,
+        replies: Vec<(usize, Reply)>,
+    }
+    impl Carrier for Telling {
+        fn workers(&self) -> usize {
+            2
+        }
+        fn post(&mut self, worker: usize, request: &Request) {
+            let bytes = 1000 * (worker as u64 + 1);
+            self.replies.push((worker, Reply::Memory { bytes }));
+            self.inner.post(worker, request);
+        }
+        fn take_replies(&mut self) -> Vec<(usize, Reply)> {
+            let mut replies = std::mem::take(&mut self.replies);
+            replies.extend(self.inner.take_replies());
+            replies
+        }
+        fn threaded(&self) -> bool {
+            false
+        }
+    }
+    let original = sample();
+    let m = model(&original, None, 0);
+    let mut pool = Pool::new(Box::new(Telling {
+        inner: InThread::new(2),
+        replies: Vec::new(),
+    }));
+    assert_eq!(pool.memory(), [None, None], "nothing told yet");
+    let job = pool.smooth(&m, &params(Filter::Hc, 3), 0.5, false);
+    assert!(matches!(
+        pool.take_smoothed(job),
+        Some(Reply::Smoothed { .. })
+    ));
+    assert_eq!(pool.memory()[0], Some(1000), "{:?}", pool.memory());
+    assert!(!pool.busy(), "the answer, not the memory, ended the job");
+}
+
+#[test]
 fn a_broken_worker_fails_its_job_instead_of_holding_it() {
     /// A worker that traps in its first job, then works.
     struct Trapping {

@@ -84,6 +84,14 @@ testIn(EVERY_RUN, "W1 a whole-body CT label map: opened, suggested in part, writ
         const nodes = meshNodes(written);
         assert.equal(nodes.length, 114);
         assert.ok(nodes.every((n) => n.quantization?.max_error_voxel_diagonals < 0.05), "quantized within 0.05 voxel diagonals");
+
+        // The memory of the page and of each worker, as the API reports it (each one's peak).
+        const { memory, cpu_engine: engine } = await app.state();
+        assert.equal(memory.workers.length, engine.workers + (engine.view_worker ? 1 : 0));
+        assert.ok(memory.page > 0 && memory.workers.every((b) => b > 0), JSON.stringify(memory));
+        const mb = (b) => (b / 1e6).toFixed(0);
+        const sum = memory.page + memory.workers.reduce((a, b) => a + b, 0);
+        console.log(`W1 ${MODE}: memory: page ${mb(memory.page)} MB, workers ${memory.workers.map(mb).join(", ")} MB; ${mb(sum)} MB in all`);
     });
 
     // The viewer on a phone held upright: every structure listed, the case drawn.
