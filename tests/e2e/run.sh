@@ -56,11 +56,11 @@ fi
 rm -rf target/e2e
 mkdir -p target/e2e
 
-# The whole-body CT label map whole_body.test.mjs opens, made afresh by its generator (never
-# committed).
-if [ -z "${E2E_WHOLE_BODY:-}" ] && [ "$profile" = test ]; then
-    cargo build --profile test --example whole_body --quiet
-    examples="${CARGO_TARGET_DIR:-target}/debug/examples"
+# The whole-body CT label map whole_body.test.mjs and the benchmarks open, made afresh by its
+# generator (never committed).
+if [ -z "${E2E_WHOLE_BODY:-}" ]; then
+    cargo build --profile "$profile" --example whole_body --quiet
+    examples="${CARGO_TARGET_DIR:-target}/$profile_dir/examples"
     export E2E_WHOLE_BODY="$PWD/target/e2e/whole_body"
     "$examples/whole_body" "$E2E_WHOLE_BODY" > /dev/null
 fi
