@@ -22,13 +22,18 @@ pub struct WebWorkers {
     workers: Vec<web_sys::Worker>,
     inbox: Inbox,
     on_reply: OnReply,
-    _handlers: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
+    handlers: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
+    /// What a worker is started with (the glue's URL and the compiled module), kept to
+    /// restart one.
+    start: js_sys::Object,
+    ctx: egui::Context,
 }
 
 /// How many workers do the background's work (guidance, "Suggest all"): one per core, leaving
 /// one to the page and one to the view worker, at least one; the page's `?workers=N` overrides
-/// it (benchmarks compare pool sizes). The view worker comes on top: it runs only while the
-/// author waits for a result, so on two cores the page still has one most of the time.
+/// it (benchmarks compare pool sizes). The view worker comes on top: it runs while the author
+/// waits for a result, and takes structures of "Suggest all" meanwhile (restarted should the
+/// view need it), so on two cores "Suggest all" has both.
 pub fn pool_size() -> usize {
     let asked = super::query::param("workers").and_then(|n| n.parse::<usize>().ok());
     let cores = web_sys::window().map_or(1.0, |w| w.navigator().hardware_concurrency());
@@ -53,33 +58,45 @@ impl WebWorkers {
         let wasm = wasm_bindgen::module();
         let inbox: Inbox = Rc::default();
         let on_reply: OnReply = Rc::default();
-        let mut workers = Vec::new();
-        let mut handlers = Vec::new();
+        let start = js_sys::Object::new();
+        let set = |k: &str, v: &JsValue| js_sys::Reflect::set(&start, &k.into(), v);
+        set("glue", &glue.as_str().into())
+            .and_then(|_| set("wasm", &wasm))
+            .ok();
+        let mut pool = Self {
+            workers: Vec::new(),
+            inbox,
+            on_reply,
+            handlers: Vec::new(),
+            start,
+            ctx: ctx.clone(),
+        };
         let mut first = started_by_page();
         for index in 0..count.max(1) {
             let worker = match first.take() {
                 Some(worker) => worker,
                 None => new_worker(index)?,
             };
-            let handler = reply_handler(index, inbox.clone(), on_reply.clone(), ctx.clone());
-            worker.set_onmessage(Some(handler.as_ref().unchecked_ref()));
-            let start = js_sys::Object::new();
-            let set = |k: &str, v: &JsValue| js_sys::Reflect::set(&start, &k.into(), v);
-            set("glue", &glue.as_str().into())
-                .and_then(|_| set("wasm", &wasm))
-                .ok();
-            worker.post_message(&start).map_err(|e| {
-                format!("cannot start a worker: {}", super::page::js_error_text(&e))
-            })?;
-            workers.push(worker);
-            handlers.push(handler);
+            let handler = pool.begin(index, &worker)?;
+            pool.workers.push(worker);
+            pool.handlers.push(handler);
         }
-        Ok(Self {
-            workers,
-            inbox,
-            on_reply,
-            _handlers: handlers,
-        })
+        Ok(pool)
+    }
+
+    /// Hands `worker` (number `index`) its start message and returns its replies' handler.
+    fn begin(
+        &self,
+        index: usize,
+        worker: &web_sys::Worker,
+    ) -> Result<Closure<dyn FnMut(web_sys::MessageEvent)>, String> {
+        let (inbox, on_reply) = (self.inbox.clone(), self.on_reply.clone());
+        let handler = reply_handler(index, inbox, on_reply, self.ctx.clone());
+        worker.set_onmessage(Some(handler.as_ref().unchecked_ref()));
+        worker
+            .post_message(&self.start)
+            .map_err(|e| format!("cannot start a worker: {}", super::page::js_error_text(&e)))?;
+        Ok(handler)
     }
 }
 
@@ -180,6 +197,35 @@ impl Carrier for WebWorkers {
     }
 
     fn threaded(&self) -> bool {
+        true
+    }
+
+    fn restartable(&self) -> bool {
+        true
+    }
+
+    fn restart(&mut self, worker: usize) -> bool {
+        let fresh = match new_worker(worker) {
+            Ok(fresh) => fresh,
+            Err(why) => {
+                log::error!("{why}");
+                return false;
+            }
+        };
+        let handler = match self.begin(worker, &fresh) {
+            Ok(handler) => handler,
+            Err(why) => {
+                log::error!("{why}");
+                fresh.terminate();
+                return false;
+            }
+        };
+        // The old one's replies, come or still to come, are its job's: none is delivered.
+        let old = std::mem::replace(&mut self.workers[worker], fresh);
+        old.set_onmessage(None);
+        old.terminate();
+        self.inbox.borrow_mut().retain(|(w, _)| *w != worker);
+        self.handlers[worker] = handler;
         true
     }
 }

@@ -11,6 +11,8 @@ pub(crate) struct Deferred {
     deliver: Rc<Cell<bool>>,
     log: Log,
     threaded: bool,
+    /// Restarts so far, when it can restart a worker ([`Self::restarting`]).
+    restarts: Option<Rc<Cell<usize>>>,
 }
 
 /// Which worker was sent which request, in order.
@@ -33,8 +35,15 @@ impl Deferred {
             deliver: deliver.clone(),
             log: log.clone(),
             threaded: false,
+            restarts: None,
         };
         (carrier, deliver, log)
+    }
+
+    /// Can restart a worker as the page's can: its requests not yet delivered are dropped
+    /// and it starts afresh. Returns the count of restarts.
+    pub(crate) fn restarting(&mut self) -> Rc<Cell<usize>> {
+        self.restarts.get_or_insert_with(Rc::default).clone()
     }
 
     /// Says it runs in workers of its own, as the page's do: their replies come between
@@ -68,5 +77,19 @@ impl Carrier for Deferred {
 
     fn threaded(&self) -> bool {
         self.threaded
+    }
+
+    fn restartable(&self) -> bool {
+        self.restarts.is_some()
+    }
+
+    fn restart(&mut self, worker: usize) -> bool {
+        let Some(restarts) = &self.restarts else {
+            return false;
+        };
+        restarts.set(restarts.get() + 1);
+        self.posted.retain(|(w, _)| *w != worker);
+        self.inner.restart(worker);
+        true
     }
 }

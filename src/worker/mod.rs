@@ -5,9 +5,11 @@
 
 #[cfg(test)]
 pub(crate) mod deferred;
+mod in_thread;
 mod pool;
 
-pub use pool::{Carrier, InThread, LoadJob, Pool, SmoothJob, StructureJob};
+pub use in_thread::InThread;
+pub use pool::{Carrier, LoadJob, Pool, SmoothJob, StructureJob};
 
 use serde::{Deserialize, Serialize};
 

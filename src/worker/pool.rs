@@ -1,11 +1,15 @@
 //! The asking side of the engine workers: the queue, which worker does what, and the answers.
 //! Jobs are handed out one per worker at a time, so a job that a newer one supersedes while it
-//! waits is simply never handed out; a worker is never interrupted. The model and weights go to
-//! every worker once (each holds the model), so a search's parameter sets spread over the pool.
+//! waits is simply never handed out; a worker is never interrupted, but for the view worker
+//! lent to "Suggest all" (`view_worker`), restarted when the view needs it. The model and weights
+//! go to every worker once (each holds the model), so a search's parameter sets spread over the
+//! pool.
 
 use std::collections::{HashMap, VecDeque};
 
-use super::{Input, Reply, Request, Worker};
+use super::{InThread, Input, Reply, Request};
+
+mod view_worker;
 use crate::case::{Case, SuggestAllOptions};
 use crate::evaluate::{failed_terms, ModelRef, Offload, Request as TermsRequest, Terms};
 use crate::mesh::Mesh;
@@ -21,49 +25,13 @@ pub trait Carrier {
     fn take_replies(&mut self) -> Vec<(usize, Reply)>;
     /// Whether the workers run on other threads (else each request blocks its caller).
     fn threaded(&self) -> bool;
-}
-
-/// Workers on the calling thread: each request is done as it is posted. The native tests and
-/// the CLI-like callers use it; the page has real workers.
-pub struct InThread {
-    workers: Vec<Worker>,
-    replies: Vec<(usize, Reply)>,
-}
-
-impl InThread {
-    pub fn new(workers: usize) -> Self {
-        Self {
-            workers: (0..workers.max(1)).map(|_| Worker::default()).collect(),
-            replies: Vec::new(),
-        }
+    /// Whether [`Self::restart`] can stop a worker in the middle of its job.
+    fn restartable(&self) -> bool {
+        false
     }
-}
-
-impl Carrier for InThread {
-    fn workers(&self) -> usize {
-        self.workers.len()
-    }
-
-    fn post(&mut self, worker: usize, request: &Request) {
-        // Through the wire format, as the page's messages go.
-        let Ok(request) = super::decode::<Request>(&super::encode(request)) else {
-            return;
-        };
-        let mut told = Vec::new();
-        let reply = self.workers[worker].handle(request, &super::clock_ms, &mut |r| told.push(r));
-        let wired = told
-            .iter()
-            .chain(&reply)
-            .map(|r| super::decode(&super::encode(r)));
-        self.replies
-            .extend(wired.filter_map(Result::ok).map(|r| (worker, r)));
-    }
-
-    fn take_replies(&mut self) -> Vec<(usize, Reply)> {
-        std::mem::take(&mut self.replies)
-    }
-
-    fn threaded(&self) -> bool {
+    /// Stops `worker` whatever it is doing and starts it afresh, holding nothing; no reply of
+    /// the old one comes after. Returns whether it did.
+    fn restart(&mut self, _worker: usize) -> bool {
         false
     }
 }
@@ -122,6 +90,8 @@ pub struct Pool {
     load: Option<(u64, Request)>,
     /// How many openings were asked for.
     openings: u64,
+    /// How many times the view worker was taken back from a structure of "Suggest all".
+    restarts: u64,
     loaded: HashMap<u64, Reply>,
     load_stages: HashMap<u64, LoadStage>,
     smooths: VecDeque<QueuedSmooth>,
@@ -142,6 +112,9 @@ pub struct Pool {
     view_worker: Option<usize>,
     /// Each worker's memory as it last told ([`Reply::Memory`]); none on this thread.
     memory: Vec<Option<u64>>,
+    /// The structure of "Suggest all" lent to the view worker, and its request, to queue again
+    /// when the view takes its worker back.
+    lent: Option<(u64, Request)>,
 }
 
 /// One worker on this thread.
@@ -158,10 +131,12 @@ impl Pool {
             carrier,
             busy: vec![None; workers],
             memory: vec![None; workers],
+            lent: None,
             sent: None,
             next_job: 0,
             load: None,
             openings: 0,
+            restarts: 0,
             loaded: HashMap::new(),
             load_stages: HashMap::new(),
             smooths: VecDeque::new(),
@@ -212,6 +187,11 @@ impl Pool {
     /// Whether a worker is kept for the view's smoothing and openings.
     pub fn has_view_worker(&self) -> bool {
         self.view_worker.is_some()
+    }
+
+    /// How many times the view worker was restarted to take it back from "Suggest all".
+    pub fn restarts(&self) -> u64 {
+        self.restarts
     }
 
     /// How many openings were asked of the workers.
@@ -300,6 +280,11 @@ impl Pool {
         self.load = Some((job, Request::Load { job, name, input }));
         self.openings += 1;
         self.pump();
+        if self.load.is_some() && self.reclaim_view_worker() {
+            // The new worker holds no model: the next model goes to every worker again.
+            self.sent = None;
+            self.pump();
+        }
         LoadJob(job)
     }
 
@@ -345,6 +330,10 @@ impl Pool {
             supersedable,
         });
         self.pump();
+        if !self.smooths.is_empty() && self.reclaim_view_worker() {
+            self.send_model(model);
+            self.pump();
+        }
         SmoothJob(job)
     }
 
@@ -508,9 +497,9 @@ impl Pool {
         }
     }
 
-    /// Gives `worker` the next job: an opening first, then a smoothing, then (but to the view
-    /// worker) a structure of "Suggest all" or checks, then the terms asked, then those to
-    /// come. Returns whether there was one.
+    /// Gives `worker` the next job: an opening first, then a smoothing, then a structure of
+    /// "Suggest all" or checks (the view worker only a structure, and only when it can be
+    /// restarted), then the terms asked, then those to come. Returns whether there was one.
     fn hand_out(&mut self, worker: usize) -> bool {
         if let Some((job, request)) = self.load.take() {
             self.start(worker, job, Flight::Load, &request);
@@ -526,7 +515,7 @@ impl Pool {
             return true;
         }
         if self.view_worker == Some(worker) {
-            return false;
+            return self.lend_view_worker(worker);
         }
         if let Some((job, request)) = self.structure_jobs.pop_front() {
             self.start(worker, job, Flight::Structure, &request);

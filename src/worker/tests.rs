@@ -213,6 +213,83 @@ fn a_worker_without_a_model_says_so() {
 }
 
 #[test]
+fn the_view_worker_takes_structures_and_is_restarted_when_the_view_needs_it() {
+    let original = sample();
+    let m = model(&original, None, 0);
+    let (mut carrier, deliver, log) = Deferred::logged(2);
+    let restarts = carrier.restarting();
+    let mut pool = Pool::with_view_worker(Box::new(carrier));
+    let options = crate::case::SuggestAllOptions {
+        tau: 0.5,
+        filter: None,
+        method: crate::suggest::SearchMethod::Local,
+        max_volume_change: None,
+        learn: false,
+    };
+    let structures: Vec<StructureJob> = (0..2)
+        .map(|_| {
+            let mesh = original.mesh().clone();
+            pool.suggest_structure(mesh, params(Filter::Hc, 10), None, options, Vec::new())
+        })
+        .collect();
+    let names = |worker: usize| -> Vec<String> {
+        (log.borrow().iter())
+            .filter(|(w, _)| *w == worker)
+            .map(|(_, r)| {
+                format!("{r:?}")
+                    .split([' ', '{'])
+                    .next()
+                    .unwrap_or_default()
+                    .to_string()
+            })
+            .collect()
+    };
+    assert_eq!(names(0), ["SuggestStructure"]);
+    assert_eq!(
+        names(1),
+        ["SuggestStructure"],
+        "the idle view worker took one"
+    );
+    // The view asks for a smoothing: no worker is free, so the view worker is restarted, given
+    // the model again and the smoothing; its structure waits for the next free worker.
+    let view = pool.smooth(&m, &params(Filter::Hc, 20), 0.5, true);
+    assert_eq!(restarts.get(), 1);
+    assert_eq!(
+        names(1),
+        [
+            "SuggestStructure",
+            "Hold",
+            "Weights",
+            "Hold",
+            "Weights",
+            "Smooth"
+        ],
+        "the model went to every worker, then to the restarted one"
+    );
+    deliver.set(true);
+    let (mut smoothed, mut answers) = (None, vec![None, None]);
+    for _ in 0..20 {
+        pool.pump();
+        smoothed = smoothed.or_else(|| pool.take_smoothed(view));
+        for (answer, job) in answers.iter_mut().zip(&structures) {
+            *answer = answer.take().or_else(|| pool.take_structure_reply(*job));
+        }
+    }
+    assert!(
+        matches!(smoothed, Some(Reply::Smoothed { .. })),
+        "{smoothed:?}"
+    );
+    for answer in &answers {
+        assert!(
+            matches!(answer, Some(Reply::Suggested { .. })),
+            "{answer:?}"
+        );
+    }
+    assert_eq!((restarts.get(), pool.restarts()), (1, 1));
+    assert!(!pool.busy());
+}
+
+#[test]
 fn a_workers_memory_is_kept_as_it_told_without_ending_its_job() {
     /// Two workers on this thread that tell their memory before each answer, as the page's do.
     struct Telling {

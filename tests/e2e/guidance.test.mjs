@@ -1,14 +1,14 @@
 // End-to-end tests of the guidance features: suggestions, quality graphs and the gallery (the
 // frame rate while they compute is a benchmark: speed.bench.mjs).
 import assert from "node:assert/strict";
-import { mkdtempSync } from "node:fs";
+import { mkdtempSync, readFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
 import * as cli from "./lib/cli.mjs";
 import { jsonDifferences, metricDifferences } from "./lib/compare.mjs";
-import { ROOT } from "./lib/paths.mjs";
-import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
+import { ROOT, meshPath } from "./lib/paths.mjs";
+import { CPU_RUN, EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 const SAMPLE = join(ROOT, "web/sample/bent_tube_staircase.ply");
@@ -156,3 +156,32 @@ testIn(WEBGPU_RUN, "G3 the gallery shows five results; a click on one takes its 
     });
 });
 
+testIn(CPU_RUN, "G4 Suggest all takes the view worker too; a change of parameters meanwhile takes it back at once, and every structure still gets the CLI's suggestion", { timeout: TIMEOUT }, async () => {
+    const atlas = meshPath("labelmaps/JHU-WhiteMatter-labels-1mm.nii.gz");
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(atlas), "JHU-WhiteMatter-labels-1mm.nii.gz");
+        await app.metrics();
+        const running = app.call("suggestAll", { tau: 0.5, search: "learned" });
+        running.catch(() => {});
+        await app.stateWhen((s) => s.suggest_all?.work_done > 0, "some structures done");
+        // The view's result while both workers do structures: the view worker is restarted for
+        // it (should it be free at that moment, the next change finds it busy).
+        let restarts = 0;
+        for (let iterations = 11; iterations < 20 && restarts === 0; iterations += 1) {
+            const started = Date.now();
+            await app.setParams({ iterations });
+            const metrics = await app.metrics();
+            assert.ok(metrics.score >= 0, JSON.stringify(metrics));
+            const s = await state(app);
+            restarts = s.cpu_engine.restarts;
+            console.log(`G4: the view's result ${((Date.now() - started) / 1000).toFixed(2)} s after the change (view worker restarts: ${restarts}; Suggest all ${s.suggest_all.done} of 48)`);
+            if (s.suggest_all.done === 48) break;
+        }
+        assert.ok(restarts >= 1, "the view worker was taken back from a structure");
+        const all = await running;
+        assert.deepEqual([all.done, all.total, all.cancelled], [48, 48, false]);
+        const out = join(mkdtempSync(join(tmpdir(), "meshsmooth-g4-")), "jhu-case.glb");
+        const built = await cli.cliJson("case", "build", atlas, "--search", "learned", "-o", out, "--json");
+        all.structures.forEach((s, i) => assert.deepEqual(s.params, built.structures[i].params, `structure ${i}: the CLI's suggestion`));
+    });
+});

@@ -218,6 +218,7 @@ pub fn cpu_engine(pool: &crate::worker::Pool) -> Value {
         "view_worker": pool.has_view_worker(),
         "threaded": pool.threaded(),
         "openings": pool.openings(),
+        "restarts": pool.restarts(),
     })
 }
 
