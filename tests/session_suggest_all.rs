@@ -26,10 +26,10 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     };
     assert_eq!(expected.structures[0].params, *session.case().params());
     assert!(session
-        .start_suggest_all(1.5, SearchMethod::Local, false)
+        .start_suggest_all(1.5, SearchMethod::Local, false, 0.0)
         .is_err());
     session
-        .start_suggest_all(0.5, SearchMethod::Local, false)
+        .start_suggest_all(0.5, SearchMethod::Local, false, 0.0)
         .unwrap();
     // Workers on this thread answer at once.
     assert!(session.step_suggest_all());
@@ -119,7 +119,7 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
         ..Case::default()
     };
     session
-        .start_suggest_all(0.5, SearchMethod::Local, true)
+        .start_suggest_all(0.5, SearchMethod::Local, true, 5000.0)
         .unwrap();
     // The time estimate's fraction: the work of the structures answered, each weighed by its
     // size, rising batch by batch.
@@ -144,6 +144,13 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
             "{done_before} then {done}"
         );
         done_before = done;
+        // Ten seconds after its start (on the clock it was started by), the work left at
+        // that pace.
+        let left = session.background().suggest_all_seconds_left(15_000.0);
+        match done > 0.0 {
+            true => assert!((left.unwrap() - 10.0 * (1.0 - done) / done).abs() < 1e-9),
+            false => assert_eq!(left, None),
+        }
         assert!(
             session.step_suggest_all(),
             "workers on this thread answer at once"
@@ -151,6 +158,10 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
     }
     assert!(done_before > 0.0, "some work was seen done before the end");
     assert_eq!(session.background().suggest_all_work_done(), None);
+    assert_eq!(
+        session.background().suggest_all_seconds_left(15_000.0),
+        None
+    );
     let options = SuggestAllOptions {
         tau: 0.5,
         filter: None,
@@ -182,10 +193,10 @@ fn suggest_all_on_some_structures_leaves_the_others_as_they_were() {
     let before: Vec<_> = (session.case().case_structures().iter())
         .map(|s| s.params)
         .collect();
-    let refused = session.start_suggest_some(0.5, SearchMethod::Local, false, &[1, 4]);
+    let refused = session.start_suggest_some(0.5, (SearchMethod::Local, false), &[1, 4], 0.0);
     assert!(refused.unwrap_err().contains("structure 4 does not exist"));
     session
-        .start_suggest_some(0.5, SearchMethod::Local, false, &[1, 3])
+        .start_suggest_some(0.5, (SearchMethod::Local, false), &[1, 3], 0.0)
         .unwrap();
     while session.background().suggesting_all() {
         session.step_suggest_all();

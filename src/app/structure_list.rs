@@ -8,7 +8,7 @@ use eframe::egui;
 use super::layout::{PanelLayout, StructureRow};
 use crate::case::CaseStructure;
 use crate::metrics::Metrics;
-use crate::session::{seconds_left, Session, StructureChange};
+use crate::session::{Session, StructureChange};
 
 /// What the author did in the list this frame.
 pub enum StructureAction {
@@ -42,8 +42,6 @@ pub struct StructureList {
     /// Shows only the structures whose name or group contains it.
     filter: String,
     export: super::case_export_view::ExportChoice,
-    /// When the "Suggest all" under way started (page clock, ms), for its time estimate.
-    suggest_started: Option<f64>,
 }
 
 /// The model's name, group and description as edited, and what the session had when they
@@ -208,15 +206,10 @@ impl StructureList {
         let background = session.background();
         let progress = background.suggest_all_progress();
         let now = super::document::now_ms();
-        // Started here (the button) or elsewhere (the API): from when it was first seen then.
-        let started = match progress {
-            Some(_) => *self.suggest_started.get_or_insert(now),
-            None => now,
-        };
         ui.horizontal(|ui| match progress {
             Some((done, total)) => {
                 let work = background.suggest_all_work_done().unwrap_or(0.0);
-                let left = seconds_left((now - started) / 1000.0, work)
+                let left = (background.suggest_all_seconds_left(now))
                     .map_or(String::new(), |s| format!(" · {} left", about(s)));
                 let bar = egui::ProgressBar::new(work as f32)
                     .desired_width((ui.available_width() - 70.0).max(120.0))
@@ -229,13 +222,9 @@ impl StructureList {
                 }
             }
             None => {
-                if self.suggest_started.is_some_and(|t| t < now) {
-                    self.suggest_started = None;
-                }
                 let tip = "The suggestion at the Suggest panel's τ for every structure, each with \
                            its own filter and bound, then smoothed with it";
                 if ui.button("Suggest all").on_hover_text(tip).clicked() {
-                    self.suggest_started = Some(now);
                     actions.push(StructureAction::SuggestAll);
                 }
             }

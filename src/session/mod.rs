@@ -35,7 +35,7 @@ pub use document::CaseDocument;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use opening::LoadProgress;
 pub use structures::{OtherStructure, StructureChange};
-pub use suggest_all::{seconds_left, structure_work, StructureOutcome, SuggestAllReport};
+pub use suggest_all::{structure_work, StructureOutcome, SuggestAllReport};
 pub use weights::WeightsSummary;
 
 use crate::worker::{Pool, SmoothJob};

@@ -26,6 +26,8 @@ pub struct SuggestAll {
     outcome: Vec<Option<StructureOutcome>>,
     /// Per structure, its share of the work ([`structure_work`]); 0 for those not asked.
     work: Vec<f64>,
+    /// When it started, in the caller's milliseconds (the session keeps no clock).
+    started_ms: f64,
     cancelled: bool,
 }
 
@@ -39,7 +41,7 @@ pub fn structure_work(vertices: usize) -> f64 {
 
 /// Seconds still to come, from `elapsed` seconds for `done` of the work (a fraction): the work
 /// left at the pace so far. `None` before any work is done.
-pub fn seconds_left(elapsed: f64, done: f64) -> Option<f64> {
+fn seconds_left(elapsed: f64, done: f64) -> Option<f64> {
     (done > 0.0 && elapsed.is_finite()).then(|| elapsed * (1.0 - done.min(1.0)) / done)
 }
 
@@ -76,24 +78,26 @@ pub struct SuggestAllReport<'a> {
 
 impl Session {
     /// Starts "Suggest all" at `tau` with `method` for every structure of the open case, each
-    /// from its own filter and parameters (bound included). Replaces one under way.
+    /// from its own filter and parameters (bound included). Replaces one under way. `now_ms`
+    /// is the caller's clock, which the time left is measured by.
     pub fn start_suggest_all(
         &mut self,
         tau: f64,
         method: SearchMethod,
         learn: bool,
+        now_ms: f64,
     ) -> Result<(), String> {
         let all: Vec<usize> = (0..self.doc.case.structures.len()).collect();
-        self.start_suggest_some(tau, method, learn, &all)
+        self.start_suggest_some(tau, (method, learn), &all, now_ms)
     }
 
     /// [`Self::start_suggest_all`] for the structures `which` (indices into the case).
     pub fn start_suggest_some(
         &mut self,
         tau: f64,
-        method: SearchMethod,
-        learn: bool,
+        (method, learn): (SearchMethod, bool),
         which: &[usize],
+        now_ms: f64,
     ) -> Result<(), String> {
         let count = self.doc.case.structures.len();
         if let Some(i) = which.iter().find(|&&i| i >= count) {
@@ -138,6 +142,7 @@ impl Session {
             total,
             outcome: vec![None; count],
             work: shares,
+            started_ms: now_ms,
             ..SuggestAll::default()
         };
         self.hand_out_structures();
@@ -288,6 +293,13 @@ impl<'a> Background<'a> {
             .map(|(w, _)| w)
             .sum();
         (self.suggesting_all() && total > 0.0).then(|| done / total)
+    }
+
+    /// Seconds left of "Suggest all" at `now_ms` (the clock it was started by): the work left
+    /// at the pace so far; `None` before the first structure answers and after the last.
+    pub fn suggest_all_seconds_left(&self, now_ms: f64) -> Option<f64> {
+        let done = self.suggest_all_work_done()?;
+        seconds_left((now_ms - self.suggest_all.started_ms) / 1000.0, done)
     }
 
     /// The last "Suggest all" since the case opened, as far as it got.

@@ -77,9 +77,10 @@ fn suggest_all(
             let which = which_structures(&options);
             tau_and_search(doc.session(), &options, "suggestAll").and_then(|(tau, search)| {
                 let (method, learn) = search;
+                let now = crate::app::document::now_ms();
                 match which? {
-                    Some(w) => doc.session_mut().start_suggest_some(tau, method, learn, &w),
-                    None => doc.session_mut().start_suggest_all(tau, method, learn),
+                    Some(w) => doc.session_mut().start_suggest_some(tau, search, &w, now),
+                    None => doc.session_mut().start_suggest_all(tau, method, learn, now),
                 }
             })
         };
@@ -88,7 +89,7 @@ fn suggest_all(
             &c,
             started,
             |s| !s.background().suggesting_all(),
-            |s| super::json::suggest_all(&s.background()),
+            |s| super::json::suggest_all(&s.background(), crate::app::document::now_ms()),
         )
     })
 }

@@ -123,7 +123,7 @@ pub(crate) fn session_state(session: &Session, busy: bool) -> Value {
         "guidance": guidance(&session.background()),
         "checks": checks(&session.background()),
         "case_export": case_export(session),
-        "suggest_all": suggest_all(&session.background()),
+        "suggest_all": suggest_all(&session.background(), crate::app::document::now_ms()),
     })
 }
 
@@ -172,10 +172,11 @@ pub(crate) fn guidance(background: &Background) -> Value {
     })
 }
 
-/// The last "Suggest all": `{tau, search, structures, done, total, work_done, cancelled}`, each
-/// structure `{name, params, evaluations, metrics}`, `{name, error}` or null until it answers;
-/// `work_done`, while it runs, the fraction of the expected work done (null after).
-pub(crate) fn suggest_all(background: &Background) -> Option<Value> {
+/// The last "Suggest all": `{tau, search, structures, done, total, work_done, seconds_left,
+/// cancelled}`, each structure `{name, params, evaluations, metrics}`, `{name, error}` or null
+/// until it answers; `work_done`, while it runs, the fraction of the expected work done, and
+/// `seconds_left` the time that work takes at the pace so far (both null after).
+pub(crate) fn suggest_all(background: &Background, now_ms: f64) -> Option<Value> {
     let report = background.suggest_all()?;
     let outcome = |o: &Option<StructureOutcome>| match o {
         Some(StructureOutcome::Suggested {
@@ -195,6 +196,7 @@ pub(crate) fn suggest_all(background: &Background) -> Option<Value> {
         "done": report.done,
         "total": report.total,
         "work_done": background.suggest_all_work_done(),
+        "seconds_left": background.suggest_all_seconds_left(now_ms),
         "cancelled": report.cancelled,
     }))
 }

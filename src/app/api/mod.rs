@@ -32,7 +32,8 @@
 //!   structure (or those whose indices `structures` lists), each
 //!   with its own filter and bound, one structure per engine worker, each then smoothed with
 //!   it; resolves with `{tau, search, structures: [{name, params, evaluations, metrics}],
-//!   done, total, work_done, cancelled}` (`state().suggest_all` is the same while it runs)
+//!   done, total, work_done, seconds_left, cancelled}` (`state().suggest_all` is the same
+//!   while it runs)
 //! - `checkStructures(): Promise<object>`: the checks between the structures as they stand,
 //!   the CLI's `case build --json` `checks` (`pairs`, `left_inside`, `new_crossings`) with
 //!   `text` (the report's lines), `flagged` (the structures of its warnings, by index),

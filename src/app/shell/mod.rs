@@ -333,7 +333,8 @@ impl Shell {
                     // Local: each structure's search starts where smaller ones' ended.
                     let method = self.guide.method;
                     let learn = method == crate::suggest::SearchMethod::Local;
-                    doc.session_mut().start_suggest_all(tau, method, learn)
+                    let now = crate::app::document::now_ms();
+                    doc.session_mut().start_suggest_all(tau, method, learn, now)
                 }
                 StructureAction::Check => doc.session_mut().start_checks(),
                 StructureAction::CancelSuggestAll => {
