@@ -388,11 +388,7 @@ impl Pool {
             return;
         }
         if self.sent.map(|s| s.0) != Some(model.id) {
-            let hold = Request::Hold {
-                model: model.id,
-                mesh: model.original.mesh().clone(),
-            };
-            self.broadcast(&hold);
+            self.broadcast(&hold_request(model));
             // Whatever waits is for another model (an opening stays: it makes the next one).
             self.smooths.clear();
             self.in_flight
@@ -401,12 +397,7 @@ impl Pool {
             self.terms.clear();
         }
         if self.sent.is_none_or(|s| s.1 != model.weights_version) {
-            let weights = Request::Weights {
-                model: model.id,
-                version: model.weights_version,
-                weights: model.weights.map(<[f32]>::to_vec),
-            };
-            self.broadcast(&weights);
+            self.broadcast(&weights_request(model));
             self.terms.clear();
             self.asked = None;
             self.upcoming.clear();
@@ -474,6 +465,9 @@ impl Pool {
                 None => return,
             },
         };
+        if self.lent.as_ref().is_some_and(|(lent, _)| *lent == job) {
+            self.lent = None;
+        }
         match self.in_flight.remove(&job) {
             Some(Flight::Load) => {
                 self.loaded.insert(job, reply);
@@ -595,5 +589,22 @@ impl Offload for Pool {
 
     fn failure(&self) -> Option<String> {
         self.failure.clone()
+    }
+}
+
+/// The request that gives a worker the model to hold.
+fn hold_request(model: &ModelRef<'_>) -> Request {
+    Request::Hold {
+        model: model.id,
+        mesh: model.original.mesh().clone(),
+    }
+}
+
+/// The request that gives a worker the model's weights.
+fn weights_request(model: &ModelRef<'_>) -> Request {
+    Request::Weights {
+        model: model.id,
+        version: model.weights_version,
+        weights: model.weights.map(<[f32]>::to_vec),
     }
 }

@@ -53,16 +53,7 @@ impl Pool {
         let Some(view) = self.view_worker else {
             return;
         };
-        let hold = Request::Hold {
-            model: model.id,
-            mesh: model.original.mesh().clone(),
-        };
-        let weights = Request::Weights {
-            model: model.id,
-            version: model.weights_version,
-            weights: model.weights.map(<[f32]>::to_vec),
-        };
-        self.carrier.post(view, &hold);
-        self.carrier.post(view, &weights);
+        self.carrier.post(view, &super::hold_request(model));
+        self.carrier.post(view, &super::weights_request(model));
     }
 }
