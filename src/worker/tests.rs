@@ -289,37 +289,55 @@ fn the_view_worker_takes_structures_and_is_restarted_when_the_view_needs_it() {
     assert!(!pool.busy());
 }
 
-#[test]
-fn a_workers_memory_is_kept_as_it_told_without_ending_its_job() {
-    /// Two workers on this thread that tell their memory before each answer, as the page's do.
-    struct Telling {
-        inner: InThread,
-        replies: Vec<(usize, Reply)>,
-    }
-    impl Carrier for Telling {
-        fn workers(&self) -> usize {
-            2
+/// Workers on this thread with a hook in front: before each request the hook may give a reply
+/// of its own (first in the replies), and says whether the request reaches the worker.
+struct Hooked<F: FnMut(usize, &Request) -> (Option<Reply>, bool)> {
+    inner: InThread,
+    hook: F,
+    replies: Vec<(usize, Reply)>,
+}
+
+impl<F: FnMut(usize, &Request) -> (Option<Reply>, bool)> Hooked<F> {
+    fn new(workers: usize, hook: F) -> Self {
+        Self {
+            inner: InThread::new(workers),
+            hook,
+            replies: Vec::new(),
         }
-        fn post(&mut self, worker: usize, request: &Request) {
-            let bytes = 1000 * (worker as u64 + 1);
-            self.replies.push((worker, Reply::Memory { bytes }));
+    }
+}
+
+impl<F: FnMut(usize, &Request) -> (Option<Reply>, bool)> Carrier for Hooked<F> {
+    fn workers(&self) -> usize {
+        self.inner.workers()
+    }
+    fn post(&mut self, worker: usize, request: &Request) {
+        let (reply, goes_on) = (self.hook)(worker, request);
+        self.replies.extend(reply.map(|r| (worker, r)));
+        if goes_on {
             self.inner.post(worker, request);
         }
-        fn take_replies(&mut self) -> Vec<(usize, Reply)> {
-            let mut replies = std::mem::take(&mut self.replies);
-            replies.extend(self.inner.take_replies());
-            replies
-        }
-        fn threaded(&self) -> bool {
-            false
-        }
     }
+    fn take_replies(&mut self) -> Vec<(usize, Reply)> {
+        let mut replies = std::mem::take(&mut self.replies);
+        replies.extend(self.inner.take_replies());
+        replies
+    }
+    fn threaded(&self) -> bool {
+        false
+    }
+}
+
+#[test]
+fn a_workers_memory_is_kept_as_it_told_without_ending_its_job() {
     let original = sample();
     let m = model(&original, None, 0);
-    let mut pool = Pool::new(Box::new(Telling {
-        inner: InThread::new(2),
-        replies: Vec::new(),
-    }));
+    // Each worker tells its memory before each answer, as the page's do.
+    let telling = Hooked::new(2, |worker, _: &Request| {
+        let bytes = 1000 * (worker as u64 + 1);
+        (Some(Reply::Memory { bytes }), true)
+    });
+    let mut pool = Pool::new(Box::new(telling));
     assert_eq!(pool.memory(), [None, None], "nothing told yet");
     let job = pool.smooth(&m, &params(Filter::Hc, 3), 0.5, false);
     assert!(matches!(
@@ -332,41 +350,20 @@ fn a_workers_memory_is_kept_as_it_told_without_ending_its_job() {
 
 #[test]
 fn a_broken_worker_fails_its_job_instead_of_holding_it() {
-    /// A worker that traps in its first job, then works.
-    struct Trapping {
-        inner: InThread,
-        trapped: bool,
-        replies: Vec<(usize, Reply)>,
-    }
-    impl Carrier for Trapping {
-        fn workers(&self) -> usize {
-            1
-        }
-        fn post(&mut self, worker: usize, request: &Request) {
-            if matches!(request, Request::Smooth { .. } | Request::Terms { .. }) && !self.trapped {
-                self.trapped = true;
-                let why = "unreachable executed".to_string();
-                self.replies.push((worker, Reply::Broken { why }));
-                return;
-            }
-            self.inner.post(worker, request);
-        }
-        fn take_replies(&mut self) -> Vec<(usize, Reply)> {
-            let mut replies = std::mem::take(&mut self.replies);
-            replies.extend(self.inner.take_replies());
-            replies
-        }
-        fn threaded(&self) -> bool {
-            false
-        }
-    }
     let original = sample();
     let m = model(&original, None, 0);
-    let mut pool = Pool::new(Box::new(Trapping {
-        inner: InThread::new(1),
-        trapped: false,
-        replies: Vec::new(),
-    }));
+    // The worker traps in its first job, then works.
+    let mut trapped = false;
+    let trapping = Hooked::new(1, move |_, request: &Request| {
+        let job = matches!(request, Request::Smooth { .. } | Request::Terms { .. });
+        if job && !trapped {
+            trapped = true;
+            let why = "unreachable executed".to_string();
+            return (Some(Reply::Broken { why }), false);
+        }
+        (None, true)
+    });
+    let mut pool = Pool::new(Box::new(trapping));
     let broken = pool.smooth(&m, &params(Filter::Hc, 3), 0.5, false);
     let reply = pool.take_smoothed(broken);
     assert!(
