@@ -110,6 +110,9 @@ pub struct LabelMap {
     /// Segments the file names; empty when it names none (then a colour table or the default
     /// names apply).
     pub segments: Vec<Segment>,
+    /// Names and colours the format's convention gives the labels present (FreeSurfer's colour
+    /// table for MGH), used where neither the file nor the author's colour table names a label.
+    pub conventional: Vec<Segment>,
 }
 
 impl LabelMap {

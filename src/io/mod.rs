@@ -4,10 +4,12 @@
 
 mod color_table;
 mod error;
+mod freesurfer_lut;
 mod gltf;
 mod gzip;
 mod label_map;
 mod label_map_checks;
+mod mgh;
 mod nifti;
 mod nrrd;
 mod obj;
@@ -41,6 +43,8 @@ pub enum Format {
     Nifti,
     /// A label map (segmentation), read by [`load_label_map`], not by [`load`].
     Nrrd,
+    /// FreeSurfer's MGH/MGZ volume: a label map, read by [`load_label_map`].
+    Mgh,
     /// A label map's colour table, read by [`parse_color_table`].
     ColorTable,
 }
@@ -55,6 +59,7 @@ impl std::fmt::Display for Format {
             Format::Gltf => "glTF",
             Format::Nifti => "NIfTI",
             Format::Nrrd => "NRRD",
+            Format::Mgh => "MGH",
             Format::ColorTable => "colour table",
         })
     }
@@ -62,7 +67,7 @@ impl std::fmt::Display for Format {
 
 impl Format {
     /// The format named by a file name's extension (case-insensitive): a mesh format, or a
-    /// label-map one (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`).
+    /// label-map one (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`, `.mgh`, `.mgz`).
     pub fn from_name(name: &str) -> Option<Format> {
         if let Some(format) = read_label_map::label_format_of(name) {
             return Some(format);
@@ -80,7 +85,7 @@ impl Format {
 
     /// Whether files of this format hold label maps (segmentations) rather than meshes.
     pub fn is_label_map(self) -> bool {
-        matches!(self, Format::Nifti | Format::Nrrd)
+        matches!(self, Format::Nifti | Format::Nrrd | Format::Mgh)
     }
 }
 
@@ -116,7 +121,7 @@ pub fn load(bytes: &[u8], name: &str) -> Result<Mesh, LoadError> {
 
 /// Reads a mesh in the given format.
 pub fn load_as(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
-    let is_mesh = !matches!(format, Format::Nifti | Format::Nrrd | Format::ColorTable);
+    let is_mesh = !format.is_label_map() && format != Format::ColorTable;
     if bytes.is_empty() && is_mesh {
         return Err(LoadError::Empty { format });
     }
@@ -125,10 +130,12 @@ pub fn load_as(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
         Format::Obj => obj::parse(bytes),
         Format::Ply => ply::parse(bytes),
         Format::Glb | Format::Gltf => gltf::parse(bytes, format),
-        Format::Nifti | Format::Nrrd | Format::ColorTable => Err(LoadError::Unsupported {
-            format,
-            detail: "not a mesh format: open label maps as a segmentation (meshsmooth extract)"
-                .into(),
-        }),
+        Format::Nifti | Format::Nrrd | Format::Mgh | Format::ColorTable => {
+            Err(LoadError::Unsupported {
+                format,
+                detail: "not a mesh format: open label maps as a segmentation (meshsmooth extract)"
+                    .into(),
+            })
+        }
     }
 }

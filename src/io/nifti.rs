@@ -40,6 +40,7 @@ fn parse_raw(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadEr
         affine,
         layers: sink.finish()?,
         segments: Vec::new(),
+        conventional: Vec::new(),
     })
 }
 
@@ -72,6 +73,7 @@ fn parse_gzip(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadE
         affine,
         layers: sink.finish()?,
         segments: Vec::new(),
+        conventional: Vec::new(),
     })
 }
 

@@ -46,6 +46,7 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
         affine,
         layers: sink.finish()?,
         segments,
+        conventional: Vec::new(),
     })
 }
 

@@ -1,5 +1,6 @@
-//! Label maps in: NIfTI-1 and NIfTI-2 (`.nii`, `.nii.gz`) and NRRD (`.nrrd`, 3D Slicer's
-//! `.seg.nrrd`) into a [`LabelMap`]; colour tables that name the labels are in `color_table`.
+//! Label maps in: NIfTI-1 and NIfTI-2 (`.nii`, `.nii.gz`), NRRD (`.nrrd`, 3D Slicer's
+//! `.seg.nrrd`) and FreeSurfer's MGH (`.mgh`, `.mgz`) into a [`LabelMap`]; colour tables that
+//! name the labels are in `color_table`.
 //!
 //! Both formats are parsed here by hand rather than with the `nifti` crate: that crate reads
 //! NIfTI-1 only and allocates the volume from the header's dims before anything can bound them.
@@ -13,10 +14,11 @@
 //! where the voxel is at least the level, background elsewhere and at NaN.
 
 use super::label_map::{LabelMap, LabelMapOptions};
-use super::{nifti, nrrd, Format, LoadError};
+use super::{mgh, nifti, nrrd, Format, LoadError};
 
 /// Whether a file name is a label map this module reads (`.nii`, `.nii.gz`, `.nrrd` including
-/// `.seg.nrrd`, and detached `.nhdr` headers, which are refused with a reason), ignoring case.
+/// `.seg.nrrd`, `.mgh`, `.mgz`, and detached `.nhdr` headers, which are refused with a reason),
+/// ignoring case.
 pub fn is_label_map(name: &str) -> bool {
     label_format_of(name).is_some()
 }
@@ -27,6 +29,8 @@ pub(super) fn label_format_of(name: &str) -> Option<Format> {
         Some(Format::Nifti)
     } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
         Some(Format::Nrrd)
+    } else if lower.ends_with(".mgh") || lower.ends_with(".mgz") {
+        Some(Format::Mgh)
     } else {
         None
     }
@@ -54,11 +58,13 @@ pub fn load_label_map(
     }
     match format {
         Format::Nrrd => nrrd::parse(bytes, options),
+        Format::Mgh => mgh::parse(bytes, options),
         _ => nifti::parse(bytes, options),
     }
 }
 
-/// The label-map format of a file whose name does not say.
+/// The label-map format of a file whose name does not say (an uncompressed MGH by its version,
+/// 1, big-endian; gzip is taken for NIfTI).
 fn sniff(bytes: &[u8], name: &str) -> Result<Format, LoadError> {
     let size = |big: bool| {
         let b = <[u8; 4]>::try_from(bytes.get(..4)?).ok()?;
@@ -71,6 +77,8 @@ fn sniff(bytes: &[u8], name: &str) -> Result<Format, LoadError> {
     let nifti_size = |s: Option<i32>| matches!(s, Some(348 | 540));
     if bytes.starts_with(b"NRRD") {
         Ok(Format::Nrrd)
+    } else if bytes.starts_with(&[0, 0, 0, 1]) {
+        Ok(Format::Mgh)
     } else if super::gzip::is_gzip(bytes) || nifti_size(size(false)) || nifti_size(size(true)) {
         Ok(Format::Nifti)
     } else if let Some(format) = Format::from_name(name) {

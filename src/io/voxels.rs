@@ -15,6 +15,17 @@ use super::{Format, LoadError};
 pub(super) fn decode_gzip(
     mut inflater: Inflater<'_>,
     sink: &mut VoxelSink,
+    remaining: u64,
+) -> Result<(), LoadError> {
+    feed_from_gzip(&mut inflater, sink, remaining)?;
+    inflater.finish()
+}
+
+/// Decodes the next `remaining` inflated bytes into `sink`, leaving the rest of the stream
+/// unread (for formats with a footer after the voxels).
+pub(super) fn feed_from_gzip(
+    inflater: &mut Inflater<'_>,
+    sink: &mut VoxelSink,
     mut remaining: u64,
 ) -> Result<(), LoadError> {
     let mut buf = vec![0u8; 1 << 18];
@@ -27,7 +38,7 @@ pub(super) fn decode_gzip(
         sink.feed(&buf[..n])?;
         remaining -= n as u64;
     }
-    inflater.finish()
+    Ok(())
 }
 
 /// Whole numbers as labels: a value within this (relative) distance of an integer is that

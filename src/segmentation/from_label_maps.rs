@@ -150,10 +150,18 @@ fn as_mask(mut map: LabelMap) -> LabelMap {
 pub fn structure_name(file: &str) -> String {
     let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
     let lower = base.to_ascii_lowercase();
-    let stem_len = [".seg.nrrd", ".nii.gz", ".nii", ".nrrd", ".nhdr"]
-        .iter()
-        .find(|ext| lower.ends_with(*ext))
-        .map_or(base.len(), |ext| base.len() - ext.len());
+    let stem_len = [
+        ".seg.nrrd",
+        ".nii.gz",
+        ".nii",
+        ".nrrd",
+        ".nhdr",
+        ".mgz",
+        ".mgh",
+    ]
+    .iter()
+    .find(|ext| lower.ends_with(*ext))
+    .map_or(base.len(), |ext| base.len() - ext.len());
     base[..stem_len].replace('_', " ").trim().to_string()
 }
 

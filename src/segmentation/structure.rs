@@ -189,7 +189,8 @@ fn code_counts(codes: &[u16], n: usize) -> Vec<usize> {
     counts
 }
 
-/// A structure's name and colour: the file's segment, else the table's entry, else defaults.
+/// A structure's name and colour: the file's segment, else the table's entry, else the
+/// format's convention (FreeSurfer's table for MGH), else defaults.
 fn naming(
     map: &LabelMap,
     names: &[Segment],
@@ -202,14 +203,14 @@ fn naming(
         .iter()
         .find(|s| s.layer == layer && s.value == value);
     let table = names.iter().find(|s| s.value == value);
-    let name = own
-        .or(table)
-        .map(|s| s.name.trim().to_string())
-        .filter(|n| !n.is_empty())
-        .unwrap_or_else(|| format!("label {value}"));
-    let color = own
-        .and_then(|s| s.color)
-        .or_else(|| table.and_then(|s| s.color))
+    let convention = (map.conventional.iter()).find(|s| s.layer == layer && s.value == value);
+    let sources = [own, table, convention];
+    let name = (sources.iter().flatten())
+        .map(|s| s.name.trim())
+        .find(|n| !n.is_empty())
+        .map_or_else(|| format!("label {value}"), str::to_string);
+    let color = (sources.iter().flatten())
+        .find_map(|s| s.color)
         .unwrap_or_else(|| default_color(ordinal));
     (name, color)
 }

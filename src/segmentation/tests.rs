@@ -35,6 +35,7 @@ fn map_with(
         affine,
         layers: vec![LabelLayer { codes, values }],
         segments: Vec::new(),
+        conventional: Vec::new(),
     }
 }
 

@@ -18,13 +18,14 @@ work=target/fuzz
 mkdir -p "$work"
 
 corpus() {
-    # A seed directory of small shared files with the given extensions, and this folder's seeds
-    # (tests/fuzz/seeds: a compressed case GLB, which the shared data has none of).
+    # A seed directory of small shared files with the given extensions, the tests' own files
+    # (tests/data: MGZ volumes) and this folder's seeds (tests/fuzz/seeds: a compressed case
+    # GLB), which the shared data has none of.
     local dir="$work/corpus-$1"
     shift
     mkdir -p "$dir"
     for pattern in "$@"; do
-        find "$data" tests/fuzz/seeds -name "$pattern" -size -2M -exec cp -n {} "$dir/" \;
+        find "$data" tests/data tests/fuzz/seeds -name "$pattern" -size -2M -exec cp -n {} "$dir/" \;
     done
     echo "$dir"
 }
@@ -46,6 +47,7 @@ run() {
 # shorter inputs keep each run's buffers small and the runs many.
 run fuzz_nifti "$(corpus nifti '*.nii.gz')" 8192
 run fuzz_nrrd "$(corpus nrrd '*.nrrd')" 8192
+run fuzz_mgh "$(corpus mgh '*.mgz')" 8192
 run fuzz_stl "$(corpus stl '*.stl')"
 run fuzz_obj "$(corpus obj '*.obj')"
 run fuzz_ply "$(corpus ply '*.ply')"

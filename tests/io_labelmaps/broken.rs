@@ -1,7 +1,7 @@
 //! Broken label maps: each must be an error whose message names what is wrong, found quickly
 //! and without allocating from the header's claims; mutated files must never panic.
 
-use super::build::{gzip, nrrd, Nifti};
+use super::build::{gzip, mgh, nrrd, Nifti};
 use super::{error_of, PATTERN};
 use meshsmooth::io::{load_label_map, LabelMapOptions};
 
@@ -419,12 +419,21 @@ fn mutated_label_maps_never_panic() {
     let header = "type: short\ndimension: 4\nsizes: 2 2 3 2\nendian: big\nkinds: list domain domain domain\n\
         space: LPS\nspace directions: none (1,0,0) (0,2,0) (0,0,3)\nSegment0_Layer:=1\nencoding: ";
     let data: Vec<u8> = (0..24u16).flat_map(|v| (v % 5).to_be_bytes()).collect();
+    let mgh_seed = mgh(
+        [2, 3, 2, 1],
+        4,
+        1,
+        [0.5, 1.0, 2.0],
+        &[0, 1, 1, 0, 2, 2, 0, 0, 3, 0, 0, 0],
+    );
     let mut seeds: Vec<(Vec<u8>, &str)> = vec![
         (base().bytes(), "m.nii"),
         (gzip(&base().bytes()), "m.nii.gz"),
         (base().v2().bytes(), "m.nii"),
         (nrrd(&format!("{header}raw"), &data), "m.nrrd"),
         (nrrd(&format!("{header}gzip"), &gzip(&data)), "m.nrrd"),
+        (mgh_seed.clone(), "m.mgh"),
+        (gzip(&mgh_seed), "m.mgz"),
     ];
     let mut rng = XorShift(0x5eed_1abe1);
     for (seed, name) in seeds.iter_mut() {

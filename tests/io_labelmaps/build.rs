@@ -237,3 +237,24 @@ pub fn nrrd(header: &str, data: &[u8]) -> Vec<u8> {
     out.extend_from_slice(data);
     out
 }
+
+/// An MGH file: the header fields, zeros to byte 284, the voxels (`int16`), a footer.
+pub fn mgh(dims: [i32; 4], kind: i32, good_ras: i16, delta: [f32; 3], voxels: &[i16]) -> Vec<u8> {
+    let mut b = Vec::new();
+    b.extend(1i32.to_be_bytes());
+    dims.iter().for_each(|d| b.extend(d.to_be_bytes()));
+    b.extend(kind.to_be_bytes());
+    b.extend(0i32.to_be_bytes());
+    b.extend(good_ras.to_be_bytes());
+    delta.iter().for_each(|d| b.extend(d.to_be_bytes()));
+    let mdc_and_centre = [
+        1.0f32, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 10.0, 20.0, 30.0,
+    ];
+    mdc_and_centre
+        .iter()
+        .for_each(|v| b.extend(v.to_be_bytes()));
+    b.resize(284, 0);
+    voxels.iter().for_each(|v| b.extend(v.to_be_bytes()));
+    b.extend([0u8; 20]);
+    b
+}

@@ -1,0 +1,31 @@
+// End-to-end tests of the sources authors have, in the page: a FreeSurfer MGZ opens into the
+// structures the CLI extracts, named by FreeSurfer's colour table.
+//
+//   E2E_MODE=webgpu|cpu node --test tests/e2e/sources.test.mjs   (tests/e2e/run.sh runs both)
+import assert from "node:assert/strict";
+import { readFileSync } from "node:fs";
+import { join } from "node:path";
+
+import * as cli from "./lib/cli.mjs";
+import { E2E_OUT, ROOT } from "./lib/paths.mjs";
+import { EVERY_RUN, appSuite, testIn } from "./lib/suite.mjs";
+
+const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
+
+const ASEG_MGZ = join(ROOT, "tests/data/phantom_aseg.mgz");
+const TIMEOUT = 240_000;
+
+testIn(EVERY_RUN, "F1 a FreeSurfer MGZ opens with FreeSurfer's names, as the CLI extracts it", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(ASEG_MGZ), "phantom_aseg.mgz");
+        const page = (await app.call("structures")).structures;
+        const native = (await cli.cliJson("extract", ASEG_MGZ, "-o", join(E2E_OUT, `extract-mgz-${MODE}/`), "--json")).structures;
+        assert.deepEqual(page.map((s) => s.name), ["Left-Thalamus", "Left-Hippocampus", "Right-Hippocampus", "ctx-rh-insula"]);
+        assert.deepEqual(
+            page.map((s) => [s.label, s.name, s.voxels, s.vertices, s.triangles]),
+            native.map((s) => [s.label, s.name, s.voxels, s.vertices, s.triangles]),
+        );
+        page.forEach((s, i) => s.color.forEach((c, k) => assert.ok(Math.abs(c - native[i].color[k]) < 1e-6, `${s.name} colour`)));
+        await app.screenshot("F1-aseg-mgz-names");
+    });
+});
