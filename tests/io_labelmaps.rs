@@ -15,10 +15,10 @@ use std::time::{Duration, Instant};
 mod broken;
 #[path = "io_labelmaps/build.rs"]
 mod build;
-#[path = "io_labelmaps/mgh.rs"]
-mod mgh;
 #[path = "io_labelmaps/nrrd_and_tables.rs"]
 mod nrrd_and_tables;
+#[path = "io_labelmaps/sources.rs"]
+mod sources;
 
 use build::{f32s, gzip, i16s, i32s, nrrd, u16s, Nifti, FLOAT32, INT16, INT32, UINT16};
 

@@ -102,10 +102,10 @@ fn files_opened_together_make_the_case_the_cli_makes() {
     assert_eq!(
         names,
         [
-            "sphere r20 mask",
-            "ellipsoid 30 20 12 mask",
-            "torus R24 r8 mask",
-            "bent tube r3.5 mask"
+            "Sphere r20 mask",
+            "Ellipsoid 30 20 12 mask",
+            "Torus R24 r8 mask",
+            "Bent tube r3.5 mask"
         ]
     );
     let stages: Vec<&str> = (session.open_stages().iter())

@@ -265,7 +265,7 @@ fn several_mask_files_are_one_structure_each_named_by_the_file() {
     let s =
         segmentation::open(&named, None, &OpenOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let names: Vec<&str> = s.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(names, ["sphere r20 mask", "bent tube r3.5 mask"]);
+    assert_eq!(names, ["Sphere r20 mask", "Bent tube r3.5 mask"]);
     assert_ne!(s[0].color, s[1].color);
     for st in &s {
         assert_sound("masks", st);

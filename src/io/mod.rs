@@ -11,6 +11,7 @@ mod label_map;
 mod label_map_checks;
 mod mgh;
 mod nifti;
+mod nifti_names;
 mod nrrd;
 mod obj;
 mod ply;
@@ -26,6 +27,7 @@ pub use color_table::{is_color_table, parse_color_table, LabelEntry};
 pub use error::{LoadError, Location};
 pub use gltf::{GltfNode, GltfScene, Mat4};
 pub use label_map::{Affine, LabelLayer, LabelMap, LabelMapOptions, Segment, MAX_LABELS};
+pub use nifti_names::readable as readable_class_name;
 pub use read_label_map::{is_label_map, load_label_map};
 pub use weld::weld_exact;
 

@@ -2,12 +2,14 @@
 //! `.nii.gz`, in either byte order (told by `sizeof_hdr`).
 //!
 //! The grid goes to world RAS millimetres as nibabel places it: the sform when `sform_code > 0`,
-//! else the qform when `qform_code > 0`, else `diag(pixdim)` (the standard's "method 1").
+//! else the qform when `qform_code > 0`, else `diag(pixdim)` (the standard's "method 1"). Label
+//! names come from a label-table header extension where there is one ([`nifti_names`]).
 
 use super::gzip::{self, Inflater};
 use super::label_map::LabelMapOptions;
 use super::label_map::{Affine, LabelMap};
 use super::label_map_checks::{check_affine, check_raw, check_spacing, Sample, VoxelLayout};
+use super::nifti_names;
 use super::voxels::{self, VoxelSink};
 use super::{Format, LoadError, Location};
 
@@ -35,11 +37,16 @@ fn parse_raw(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadEr
     check_raw(data_bytes, data.len(), FORMAT)?;
     let mut sink = VoxelSink::new(&layout, options, FORMAT)?;
     sink.feed(&data[..data_bytes as usize])?;
+    let extensions = bytes.get(header.offsets.size..start).unwrap_or_default();
+    let names = match extensions.len() <= nifti_names::MAX_EXTENSION_BYTES {
+        true => nifti_names::label_names(extensions, header.big_endian),
+        false => Vec::new(),
+    };
     Ok(LabelMap {
         dims: layout.dims,
         affine,
         layers: sink.finish()?,
-        segments: Vec::new(),
+        segments: names,
         conventional: Vec::new(),
     })
 }
@@ -64,15 +71,24 @@ fn parse_gzip(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadE
     let mut sink = VoxelSink::new(&layout, options, FORMAT)?;
     let in_head = head.get(start..got).unwrap_or_default();
     sink.feed(in_head)?;
+    let size = header.offsets.size;
+    let mut extensions = head.get(size..start.min(got)).unwrap_or_default().to_vec();
     if start > got {
-        inflater.skip((start - got) as u64)?;
+        if start - size <= nifti_names::MAX_EXTENSION_BYTES {
+            let mut rest = vec![0; start - got];
+            inflater.read_exact(&mut rest)?;
+            extensions.extend(rest);
+        } else {
+            extensions.clear();
+            inflater.skip((start - got) as u64)?;
+        }
     }
     voxels::decode_gzip(inflater, &mut sink, data_bytes - in_head.len() as u64)?;
     Ok(LabelMap {
         dims: layout.dims,
         affine,
         layers: sink.finish()?,
-        segments: Vec::new(),
+        segments: nifti_names::label_names(&extensions, header.big_endian),
         conventional: Vec::new(),
     })
 }

@@ -145,8 +145,9 @@ fn as_mask(mut map: LabelMap) -> LabelMap {
     map
 }
 
-/// A structure's name from its file's: the folder and the label-map extensions dropped,
-/// underscores read as spaces (`portal_vein.nii.gz` is "portal vein").
+/// A structure's name from its file's, as TotalSegmentator names its masks: the folder and the
+/// label-map extensions dropped, read as words (`portal_vein.nii.gz` is "Portal vein",
+/// `kidney_left.nii.gz` "Left kidney").
 pub fn structure_name(file: &str) -> String {
     let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
     let lower = base.to_ascii_lowercase();
@@ -162,7 +163,7 @@ pub fn structure_name(file: &str) -> String {
     .iter()
     .find(|ext| lower.ends_with(*ext))
     .map_or(base.len(), |ext| base.len() - ext.len());
-    base[..stem_len].replace('_', " ").trim().to_string()
+    io::readable_class_name(base[..stem_len].trim())
 }
 
 #[cfg(test)]
@@ -171,9 +172,13 @@ mod tests {
 
     #[test]
     fn names_come_from_file_names() {
-        assert_eq!(structure_name("out/portal_vein.nii.gz"), "portal vein");
+        assert_eq!(structure_name("out/portal_vein.nii.gz"), "Portal vein");
+        assert_eq!(
+            structure_name("segmentations/kidney_left.nii.gz"),
+            "Left kidney"
+        );
         assert_eq!(structure_name("C:\\seg\\Liver.NII"), "Liver");
-        assert_eq!(structure_name("case.seg.nrrd"), "case");
-        assert_eq!(structure_name("tumour"), "tumour");
+        assert_eq!(structure_name("case.seg.nrrd"), "Case");
+        assert_eq!(structure_name("tumour"), "Tumour");
     }
 }

@@ -604,7 +604,7 @@ testIn(EVERY_RUN, "S9b a label map with its colour table, and four masks, droppe
         state = await dropAsOneCase(app, masks.map((name, i) => ({ bytes: readFileSync(paths[i]), name })), "sphere_r20_mask.nii.gz and 3 more files");
         const native = await cli.cliJson("extract", ...paths, "-o", join(E2E_OUT, `extract-masks-${MODE}/`), "--json");
         assertSameStructures(state.structures.structures, native.structures);
-        assert.deepEqual(state.structures.structures.map((s) => s.name), ["sphere r20 mask", "ellipsoid 30 20 12 mask", "torus R24 r8 mask", "bent tube r3.5 mask"]);
+        assert.deepEqual(state.structures.structures.map((s) => s.name), ["Sphere r20 mask", "Ellipsoid 30 20 12 mask", "Torus R24 r8 mask", "Bent tube r3.5 mask"]);
         assert.deepEqual(state.structures.structures.map((s) => s.source), masks);
         assert.equal(state.error, null);
         await app.metrics();

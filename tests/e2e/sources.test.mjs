@@ -1,5 +1,5 @@
-// End-to-end tests of the sources authors have, in the page: a FreeSurfer MGZ opens into the
-// structures the CLI extracts, named by FreeSurfer's colour table.
+// End-to-end tests of the sources authors have, in the page: a FreeSurfer MGZ and a
+// TotalSegmentator multilabel NIfTI open into the structures the CLI extracts, with their names.
 //
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/sources.test.mjs   (tests/e2e/run.sh runs both)
 import assert from "node:assert/strict";
@@ -27,5 +27,20 @@ testIn(EVERY_RUN, "F1 a FreeSurfer MGZ opens with FreeSurfer's names, as the CLI
         );
         page.forEach((s, i) => s.color.forEach((c, k) => assert.ok(Math.abs(c - native[i].color[k]) < 1e-6, `${s.name} colour`)));
         await app.screenshot("F1-aseg-mgz-names");
+    });
+});
+
+testIn(EVERY_RUN, "F2 a TotalSegmentator multilabel NIfTI opens with its class names, readable, as the CLI extracts it", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        const file = join(ROOT, "tests/data/totalseg_multilabel.nii.gz");
+        await app.loadMesh(readFileSync(file), "totalseg_multilabel.nii.gz");
+        const page = (await app.call("structures")).structures;
+        const native = (await cli.cliJson("extract", file, "-o", join(E2E_OUT, `extract-totalseg-${MODE}/`), "--json")).structures;
+        assert.deepEqual(page.map((s) => s.name), ["Right kidney", "Liver", "Portal vein and splenic vein"]);
+        assert.deepEqual(
+            page.map((s) => [s.label, s.name, s.voxels, s.vertices, s.triangles]),
+            native.map((s) => [s.label, s.name, s.voxels, s.vertices, s.triangles]),
+        );
+        await app.screenshot("F2-totalsegmentator-names");
     });
 });

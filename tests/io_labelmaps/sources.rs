@@ -1,5 +1,6 @@
-//! FreeSurfer MGH/MGZ: volumes nibabel wrote (tests/data, made by tests/data/make_mgz.py) against
-//! the NIfTI files they were made from, FreeSurfer's names, and broken headers.
+//! The label maps authors get from FreeSurfer and TotalSegmentator, written with nibabel (by
+//! tests/data/make_mgz.py and make_totalseg.py) from the shared NIfTI files: the same voxels,
+//! grids and surfaces, their names; broken MGH headers.
 
 use super::build::{gzip, mgh};
 use super::{assert_affine_near, error_of, load_named, read, voxel_values};
@@ -160,4 +161,36 @@ fn broken_mgh_files_are_errors() {
     let cut = gzip(&good);
     expect(&cut[..cut.len() / 2], "a.mgz", "truncated");
     expect(&gzip(&good[..200]), "a.mgz", "gzip stream is truncated");
+}
+
+#[test]
+fn a_totalsegmentator_multilabel_nifti_names_its_classes_from_its_extension() {
+    // tests/data/make_totalseg.py wrote it as TotalSegmentator does: an XML label table of its
+    // 117 classes in a header extension, the phantom renumbered (liver 5, portal vein 64,
+    // right kidney 2).
+    let gz = ours("totalseg_multilabel.nii.gz");
+    let map = load_named(&gz, "totalseg_multilabel.nii.gz");
+    assert_eq!(map.segments.len(), 117);
+    let phantom = load_named(&read("case_phantom_shared.nii.gz"), "phantom.nii.gz");
+    let renumbered: Vec<i64> = (voxel_values(&phantom, 0).iter())
+        .map(|v| [0, 5, 64, 5, 2][*v as usize])
+        .collect();
+    assert_eq!(voxel_values(&map, 0), renumbered);
+    // Uncompressed, the extension is read from the bytes in place.
+    assert_eq!(load_named(&inflate(&gz), "totalseg_multilabel.nii"), map);
+
+    let structures = open(&[("totalseg_multilabel.nii.gz", &gz)], None);
+    let named: Vec<(i64, &str)> = (structures.iter())
+        .map(|s| (s.label, s.name.as_str()))
+        .collect();
+    assert_eq!(
+        named,
+        [
+            (2, "Right kidney"),
+            (5, "Liver"),
+            (64, "Portal vein and splenic vein")
+        ]
+    );
+    // Its colours as the file states them (TotalSegmentator cycles twelve: 2 is blue).
+    assert_eq!(structures[0].color, [0.0, 0.0, 1.0]);
 }
