@@ -10,6 +10,7 @@ use super::structure_list::{
     filter_field, grouped_rows, measures, show_box, solo_button, StructureAction,
 };
 use crate::case::CaseStructure;
+use crate::io::StructureCodes;
 use crate::session::{Session, StructureChange};
 
 /// Shows the panel; `error_colours` is whether the selected structure is coloured by how far
@@ -125,6 +126,12 @@ fn record(
     if !s.description.is_empty() {
         ui.label(&s.description);
     }
+    if let Some(codes) = &s.codes {
+        ui.small(codes_line(codes)).on_hover_text(
+            "What the structure is in standard codes (coding scheme, code, meaning), as a \
+             learning platform or a DICOM segmentation names it",
+        );
+    }
     let mut about = format!(
         "{} vertices, {} triangles",
         s.original.vertex_count(),
@@ -145,4 +152,22 @@ fn record(
             "The local error: the distance from each point of the smooth surface to the \
              segmentation's surface",
         );
+}
+
+/// "SNOMED CT 64033007 Kidney, 24028007 Right (Anatomical Structure)".
+fn codes_line(codes: &StructureCodes) -> String {
+    let scheme = |s: &str| match s {
+        "SCT" => "SNOMED CT".to_string(),
+        other => other.to_string(),
+    };
+    let mut line = format!(
+        "{} {} {}",
+        scheme(&codes.kind.scheme),
+        codes.kind.value,
+        codes.kind.meaning
+    );
+    if let Some(m) = &codes.modifier {
+        line = format!("{line}, {} {}", m.value, m.meaning);
+    }
+    format!("{line} ({})", codes.category.meaning)
 }

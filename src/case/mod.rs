@@ -25,7 +25,7 @@ pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
 
 use serde::{Deserialize, Serialize};
 
-use crate::io::Affine;
+use crate::io::{Affine, StructureCodes};
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
 use crate::segmentation::Structure;
@@ -65,6 +65,8 @@ pub struct CaseStructure {
     /// The voxel grid it was extracted on, when it came from a label map: its original's
     /// vertices lie at the grid's edge midpoints, which a quantized file's reader snaps to.
     pub grid: Option<Affine>,
+    /// What it is in standard codes (SNOMED CT), when its source or its name says.
+    pub codes: Option<StructureCodes>,
     /// The surface as opened (the staircase of a label map), in world millimetres.
     pub original: Mesh,
     /// The structure's own filter and parameters, bound included.
@@ -109,6 +111,7 @@ impl PartialEq for CaseStructure {
             && (self.group == o.group && self.description == o.description)
             && (self.source == o.source && self.label == o.label)
             && (self.voxel_size == o.voxel_size && self.voxels == o.voxels && self.grid == o.grid)
+            && self.codes == o.codes
             && (self.original == o.original && self.params == o.params && self.tau == o.tau)
             && (self.weights == o.weights && self.smoothed == o.smoothed)
     }
@@ -153,6 +156,7 @@ impl CaseStructure {
             label: None,
             voxel_size: None,
             grid: None,
+            codes: None,
             voxels: None,
             original: mesh,
             params: Params::defaults(DEFAULT_FILTER),
@@ -174,6 +178,7 @@ impl CaseStructure {
         s.voxel_size = Some(structure.voxel_size);
         s.voxels = Some(structure.voxels);
         s.grid = Some(structure.grid);
+        s.codes = structure.codes;
         s.params.max_displacement = s.default_bound();
         s
     }

@@ -6,7 +6,7 @@
 use serde_json::{json, Value};
 
 use super::{voxel_grid, Case, CaseStructure, Smoothed};
-use crate::io::{Affine, GltfNode, GltfScene, Mat4};
+use crate::io::{Affine, GltfNode, GltfScene, Mat4, StructureCodes};
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
 use crate::segmentation::default_color;
@@ -37,6 +37,7 @@ pub fn structure_record(s: &CaseStructure) -> Value {
         "color": s.color,
         "voxel_size_mm": s.voxel_size,
         "voxel_to_world": s.grid.map(|g| g.0),
+        "codes": s.codes,
         "voxels": s.voxels,
         "voxel_diagonal_mm": diagonal,
         "filter": s.params.filter,
@@ -204,6 +205,8 @@ fn read_looks(s: &mut CaseStructure, record: &Value, node: &GltfNode, ours: bool
     s.label = record.get("label").and_then(Value::as_i64);
     s.voxel_size = floats::<3>(record.get("voxel_size_mm"));
     s.grid = record.get("voxel_to_world").and_then(grid);
+    s.codes = (record.get("codes").cloned())
+        .and_then(|c| serde_json::from_value::<StructureCodes>(c).ok());
     s.voxels = record
         .get("voxels")
         .and_then(Value::as_u64)

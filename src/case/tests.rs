@@ -26,6 +26,7 @@ fn a_surface_mesh_has_no_bound_and_a_label_map_structure_half_its_voxel_diagonal
             voxels: 1,
             voxel_size: [0.7, 0.7, 2.0],
             grid: crate::io::Affine::scaled([0.7, 0.7, 2.0], [0.0; 3]),
+            codes: None,
             mesh: tetra(),
         },
         Some("ct.nii.gz"),
@@ -48,6 +49,7 @@ fn a_label_maps_structure_wound_outward_is_closed_and_outward() {
             voxels: 1,
             voxel_size: [1.0; 3],
             grid: crate::io::Affine::scaled([1.0; 3], [0.0; 3]),
+            codes: None,
             mesh,
         };
         CaseStructure::from_label_map(structure, None)

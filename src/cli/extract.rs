@@ -194,6 +194,7 @@ fn structure_json(s: &Structure, file: &str) -> serde_json::Value {
         "volume": s.mesh.signed_volume(),
         "voxel_volume": s.voxel_volume(),
         "voxel_size": s.voxel_size,
+        "codes": s.codes,
         "file": file,
     })
 }

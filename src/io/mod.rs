@@ -2,6 +2,7 @@
 //! browser and the CLI share them. No input may panic; every failure is a [`LoadError`] naming
 //! what and where.
 
+mod codes;
 mod color_table;
 mod error;
 mod freesurfer_lut;
@@ -23,6 +24,7 @@ mod text;
 mod voxels;
 mod weld;
 
+pub use codes::{Code, StructureCodes};
 pub use color_table::{is_color_table, parse_color_table, LabelEntry};
 pub use error::{LoadError, Location};
 pub use gltf::{GltfNode, GltfScene, Mat4};

@@ -117,6 +117,7 @@ pub fn open_staged(
                 for mut s in extract_from(f, &map, &options.extract)? {
                     s.label = ordinal as i64 + 1;
                     s.name = structure_name(f.name);
+                    s.codes = super::codes_for_name(&s.name);
                     s.color = super::default_color(ordinal);
                     out.push(s);
                 }

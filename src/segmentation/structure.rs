@@ -4,7 +4,7 @@
 use super::extract::{surfaces_by_code, to_world};
 use super::palette::default_color;
 use super::specks::drop_small_components;
-use crate::io::{Affine, LabelMap, Segment};
+use crate::io::{Affine, LabelMap, Segment, StructureCodes};
 use crate::mesh::Mesh;
 
 /// Which labels to extract.
@@ -33,6 +33,9 @@ pub struct Structure {
     /// The voxel grid it was extracted on: its vertices lie at the world points of the grid's
     /// edge midpoints.
     pub grid: Affine,
+    /// What it is in standard codes, where its name is one the shipped table knows.
+    #[serde(default)]
+    pub codes: Option<StructureCodes>,
     /// Closed, outward-wound, manifold.
     pub mesh: Mesh,
 }
@@ -134,6 +137,7 @@ pub fn extract(
             out.push(Structure {
                 label: value,
                 layer: index,
+                codes: super::codes_for_name(&name),
                 name,
                 color,
                 voxels: counts[code],

@@ -1,5 +1,6 @@
 // End-to-end tests of the sources authors have, in the page: a FreeSurfer MGZ and a
-// TotalSegmentator multilabel NIfTI open into the structures the CLI extracts, with their names.
+// TotalSegmentator multilabel NIfTI open into the structures the CLI extracts, with their names;
+// the standard codes their names carry reach the viewer through a case glTF.
 //
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/sources.test.mjs   (tests/e2e/run.sh runs both)
 import assert from "node:assert/strict";
@@ -8,6 +9,7 @@ import { join } from "node:path";
 
 import * as cli from "./lib/cli.mjs";
 import { E2E_OUT, ROOT } from "./lib/paths.mjs";
+import { gltfValidator } from "./lib/deps.mjs";
 import { EVERY_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
@@ -43,4 +45,29 @@ testIn(EVERY_RUN, "F2 a TotalSegmentator multilabel NIfTI opens with its class n
         );
         await app.screenshot("F2-totalsegmentator-names");
     });
+});
+
+testIn(EVERY_RUN, "F3 standard codes survive case build and case info into the viewer's structures() and details", { timeout: TIMEOUT }, async () => {
+    const file = join(ROOT, "tests/data/totalseg_multilabel.nii.gz");
+    const glb = join(E2E_OUT, MODE, "totalseg-case.glb");
+    await cli.cliJson("case", "build", file, "--search", "local", "-o", glb, "--json");
+    const info = await cli.cliJson("case", "info", glb, "--json");
+    const kidney = {
+        category: { scheme: "SCT", value: "123037004", meaning: "Anatomical Structure" },
+        type: { scheme: "SCT", value: "64033007", meaning: "Kidney" },
+        modifier: { scheme: "SCT", value: "24028007", meaning: "Right" },
+    };
+    assert.deepEqual(info.structures[0].codes, kidney);
+    assert.equal(info.structures[1].codes.modifier, null);
+    const report = await gltfValidator.validateBytes(new Uint8Array(readFileSync(glb)), { uri: "totalseg-case.glb", format: "glb" });
+    const issues = report.issues.messages.filter((m) => m.severity <= 1).map((m) => `${m.code} ${m.pointer ?? ""}: ${m.message}`);
+    assert.deepEqual(issues, [], "the case GLB with codes has no validator errors or warnings");
+    await withApp(async (app) => {
+        const opened = await app.loadMesh(readFileSync(glb), "totalseg-case.glb", "loadCase");
+        assert.deepEqual(opened.structures.map((s) => s.codes), info.structures.map((s) => s.codes));
+        assert.deepEqual(opened.structures[0].codes, kidney);
+        assert.equal(opened.structures[1].codes.type.value, "10200004");
+        await app.stateWhen((s) => s.layout.structures.length === 3 && s.loading === null, "the case's three rows");
+        await app.screenshot("F3-viewer-codes");
+    }, { query: "?mode=viewer" });
 });

@@ -4,6 +4,7 @@
 
 use super::build::{gzip, mgh};
 use super::{assert_affine_near, error_of, load_named, read, voxel_values};
+use meshsmooth::io::Code;
 use meshsmooth::segmentation::{self, NamedBytes, OpenOptions, Structure};
 use std::io::Read;
 
@@ -193,4 +194,13 @@ fn a_totalsegmentator_multilabel_nifti_names_its_classes_from_its_extension() {
     );
     // Its colours as the file states them (TotalSegmentator cycles twelve: 2 is blue).
     assert_eq!(structures[0].color, [0.0, 0.0, 1.0]);
+    // Its SNOMED CT codes as TotalSegmentator publishes them for its classes.
+    let kidney = structures[0].codes.as_ref().expect("coded");
+    assert_eq!(kidney.kind, Code::new("SCT", "64033007", "Kidney"));
+    assert_eq!(kidney.modifier, Some(Code::new("SCT", "24028007", "Right")));
+    let portal = structures[2].codes.as_ref().expect("coded");
+    assert_eq!(
+        (portal.kind.value.as_str(), &portal.modifier),
+        ("110765007", &None)
+    );
 }

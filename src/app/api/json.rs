@@ -33,6 +33,7 @@ pub(crate) fn structures(case: &CaseDocument) -> Option<Value> {
                 "source": s.source,
                 "voxels": s.voxels,
                 "voxel_size": s.voxel_size,
+                "codes": s.codes,
                 "vertices": s.original.vertex_count(),
                 "triangles": s.original.triangle_count(),
                 "volume": s.original.signed_volume(),

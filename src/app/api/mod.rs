@@ -15,9 +15,10 @@
 //! - `addFile(bytes, name): Promise<structures>`: adds the file's structures to the open case
 //!   (after a file still opening); the model stays
 //! - `structures()`: `{file, current, title, description, structures: [{label, name, color,
-//!   opacity, visible, group, source, voxels, voxel_size, vertices, triangles, volume,
+//!   opacity, visible, group, source, voxels, voxel_size, codes, vertices, triangles, volume,
 //!   metrics}]}` of the open case, or null with nothing open (`metrics`: its last smoothing's
-//!   measures, or null; `label`, `voxels`, `voxel_size`: null where it came from no label map)
+//!   measures, or null; `label`, `voxels`, `voxel_size`: null where it came from no label map;
+//!   `codes`: `{category, type, modifier}` in standard codes, as the case glTF's record, or null)
 //! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`;
 //!   the structure left keeps its smoothing, one coming back gets its own back
 //! - `setStructure({index, name, color, opacity, visible, group})`: changes how a structure
