@@ -137,7 +137,11 @@ fn reply_handler(
                     );
                     inbox.borrow_mut().push((index, reply))
                 }
-                Err(why) => log::error!("engine worker {}: {why}", index + 1),
+                Err(why) => {
+                    // The worker's job cannot be answered: it fails instead of waiting forever.
+                    log::error!("engine worker {}: {why}", index + 1);
+                    inbox.borrow_mut().push((index, Reply::Broken { why }));
+                }
             }
         } else {
             let why = js_sys::JSON::stringify(&data).map_or_else(|_| "?".into(), String::from);
@@ -252,7 +256,7 @@ pub fn worker_handle(request: &[u8], tell: &js_sys::Function) -> Option<Vec<u8>>
         }),
         Err(why) => {
             log::error!("{why}");
-            None
+            Some(Reply::Broken { why })
         }
     };
     post(Reply::Memory {

@@ -33,17 +33,16 @@ impl Carrier for InThread {
 
     fn post(&mut self, worker: usize, request: &Request) {
         // Through the wire format, as the page's messages go.
-        let Ok(request) = super::decode::<Request>(&super::encode(request)) else {
-            return;
+        let request = match super::decode::<Request>(&super::encode(request)) {
+            Ok(request) => request,
+            Err(why) => return self.replies.push((worker, Reply::Broken { why })),
         };
         let mut told = Vec::new();
         let reply = self.workers[worker].handle(request, &super::clock_ms, &mut |r| told.push(r));
-        let wired = told
-            .iter()
-            .chain(&reply)
-            .map(|r| super::decode(&super::encode(r)));
-        self.replies
-            .extend(wired.filter_map(Result::ok).map(|r| (worker, r)));
+        // As the page does: a reply that does not decode breaks the worker's job.
+        let wired = (told.iter().chain(&reply))
+            .map(|r| super::decode(&super::encode(r)).unwrap_or_else(|why| Reply::Broken { why }));
+        self.replies.extend(wired.map(|r| (worker, r)));
     }
 
     fn take_replies(&mut self) -> Vec<(usize, Reply)> {

@@ -483,3 +483,12 @@ fn a_newer_opening_supersedes_an_older_and_a_bad_file_fails_its_job() {
     assert!(why.contains("PLY") || why.contains("ply"), "{why}");
     assert!(!pool.busy());
 }
+
+#[test]
+fn codes_without_a_modifier_cross_the_wire() {
+    // Postcard is not self-describing: a field left out when empty would not decode.
+    let codes = crate::segmentation::codes_for_name("liver").expect("coded");
+    assert_eq!(codes.modifier, None);
+    let back = decode::<crate::io::StructureCodes>(&encode(&codes));
+    assert_eq!(back, Ok(codes));
+}
