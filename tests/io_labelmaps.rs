@@ -15,6 +15,8 @@ use std::time::{Duration, Instant};
 mod broken;
 #[path = "io_labelmaps/build.rs"]
 mod build;
+#[path = "io_labelmaps/dicom_seg.rs"]
+mod dicom_seg;
 #[path = "io_labelmaps/nrrd_and_tables.rs"]
 mod nrrd_and_tables;
 #[path = "io_labelmaps/sources.rs"]

@@ -13,7 +13,7 @@ use wasm_bindgen::JsCast;
 
 /// The extensions `io::load` and `io::load_label_map` understand, for the picker's filter
 /// (`.gz` for `.nii.gz`, which the filter cannot name as one extension).
-const ACCEPT: &str = ".stl,.obj,.ply,.glb,.gltf,.nii,.gz,.nrrd,.mgh,.mgz,.txt,.ctbl";
+const ACCEPT: &str = ".stl,.obj,.ply,.glb,.gltf,.nii,.gz,.nrrd,.mgh,.mgz,.dcm,.txt,.ctbl";
 
 /// A file whose reading finished (or failed).
 pub struct ArrivedFile {

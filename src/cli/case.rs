@@ -30,7 +30,7 @@ pub(super) enum CaseCommand {
 
 #[derive(clap::Args)]
 pub(super) struct BuildArgs {
-    /// A label map (.nii, .nii.gz, .nrrd, .seg.nrrd, .mgz, .mgh) or several masks, surface meshes (.ply,
+    /// A label map (.nii, .nii.gz, .nrrd, .seg.nrrd, .mgz, .mgh, DICOM SEG .dcm) or several masks, surface meshes (.ply,
     /// .stl, .obj) and case glTFs (.glb, .gltf), in any mix.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,

@@ -11,7 +11,7 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 pub(super) struct ExtractArgs {
-    /// One label map (.nii, .nii.gz, .nrrd, .seg.nrrd, .mgz, .mgh), or several mask files (one structure each).
+    /// One label map (.nii, .nii.gz, .nrrd, .seg.nrrd, .mgz, .mgh, DICOM SEG .dcm), or several mask files (one structure each).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     /// A folder (OUT/, one PLY per structure) or a .glb (one node per structure).

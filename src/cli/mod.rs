@@ -46,7 +46,7 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// One closed surface per structure of a segmentation (NIfTI, NRRD, 3D Slicer .seg.nrrd, FreeSurfer .mgz).
+    /// One closed surface per structure of a segmentation (NIfTI, NRRD, 3D Slicer .seg.nrrd, FreeSurfer .mgz, DICOM SEG).
     Extract(extract::ExtractArgs),
     /// Cases: every structure of a segmentation smoothed and written as one glTF.
     #[command(subcommand)]

@@ -30,3 +30,50 @@ pub struct StructureCodes {
     #[serde(default)]
     pub modifier: Option<Code>,
 }
+
+/// The codes of 3D Slicer's terminology entry in a segment's tags
+/// (`SegmentN_Tags:=...|TerminologyEntry:context~category~type~modifier~...|`), where each code
+/// is `scheme^value^meaning`; `None` without an entry or with an empty category or type.
+pub(super) fn from_slicer_tags(tags: &str) -> Option<StructureCodes> {
+    let entry = (tags.split('|')).find_map(|tag| tag.strip_prefix("TerminologyEntry:"))?;
+    let mut fields = entry.split('~').skip(1);
+    let mut next = || fields.next().and_then(slicer_code);
+    let category = next()?;
+    let kind = next()?;
+    let modifier = next();
+    Some(StructureCodes {
+        category,
+        kind,
+        modifier,
+    })
+}
+
+/// `scheme^value^meaning`, or `None` when the value is empty (Slicer writes `^^` for none).
+fn slicer_code(text: &str) -> Option<Code> {
+    let mut parts = text.splitn(3, '^');
+    let (scheme, value, meaning) = (parts.next()?, parts.next()?, parts.next().unwrap_or(""));
+    (!value.trim().is_empty()).then(|| Code::new(scheme.trim(), value.trim(), meaning.trim()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slicer_terminology_entries_give_codes() {
+        let tags = "Segmentation.Status:inprogress|TerminologyEntry:Segmentation category and \
+                    type - 3D Slicer General Anatomy list~SCT^123037004^Anatomical Structure~\
+                    SCT^64033007^Kidney~SCT^24028007^Right~Anatomic codes - DICOM master list~^^~^^|";
+        let codes = from_slicer_tags(tags).unwrap();
+        assert_eq!(
+            codes.category,
+            Code::new("SCT", "123037004", "Anatomical Structure")
+        );
+        assert_eq!(codes.kind, Code::new("SCT", "64033007", "Kidney"));
+        assert_eq!(codes.modifier, Some(Code::new("SCT", "24028007", "Right")));
+        let plain = "TerminologyEntry:list~SCT^123037004^Anatomical Structure~SCT^10200004^Liver~^^~x~^^~^^";
+        assert_eq!(from_slicer_tags(plain).unwrap().modifier, None);
+        assert_eq!(from_slicer_tags("|"), None);
+        assert_eq!(from_slicer_tags("TerminologyEntry:list~^^~^^~^^"), None);
+    }
+}

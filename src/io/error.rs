@@ -10,7 +10,7 @@ pub enum LoadError {
     Empty { format: Format },
     #[error(
         "cannot tell the format of '{name}': use one of .stl .obj .ply .glb .gltf (meshes) or \
-         .nii .nii.gz .nrrd .mgz .mgh (label maps)"
+         .nii .nii.gz .nrrd .mgz .mgh .dcm (label maps)"
     )]
     UnknownFormat { name: String },
     #[error("{format}: not a {format} file ({detail})")]

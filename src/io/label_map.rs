@@ -1,6 +1,8 @@
 //! The label map as the parsers hand it over: a voxel grid of label codes, its affine into world
 //! millimetres (RAS), and the segment names and colours the file carried; and how to read one.
 
+use super::codes::StructureCodes;
+
 /// How to read a label map.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LabelMapOptions {
@@ -88,8 +90,8 @@ pub struct LabelLayer {
     pub values: Vec<i64>,
 }
 
-/// A named segment the file declares (3D Slicer's `SegmentN_*` keys): which layer and label
-/// value it occupies, its name and its display colour.
+/// A named segment the file declares (3D Slicer's `SegmentN_*` keys, a DICOM SEG's segments):
+/// which layer and label value it occupies, its name, display colour and codes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Segment {
     pub layer: usize,
@@ -97,6 +99,8 @@ pub struct Segment {
     pub name: String,
     /// Display (sRGB) colour, each channel in [0, 1].
     pub color: Option<[f32; 3]>,
+    /// What the segment is in standard codes, where the file says (DICOM SEG, Slicer's tags).
+    pub codes: Option<StructureCodes>,
 }
 
 /// A segmentation on one voxel grid: one layer (NIfTI, a plain NRRD) or several (a `.seg.nrrd`

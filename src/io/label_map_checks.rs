@@ -6,11 +6,11 @@ use super::label_map::Affine;
 use super::{Format, LoadError, Location};
 
 /// The most voxel data (and the most label codes) a label map may hold.
-const MAX_VOXEL_BYTES: u64 = 4 << 30;
+pub(super) const MAX_VOXEL_BYTES: u64 = 4 << 30;
 
 /// The most layers a label map may hold (3D Slicer writes one per group of overlapping segments;
 /// older files one per segment). Each layer costs a few small buffers beyond its codes.
-const MAX_LAYERS: usize = 1024;
+pub(super) const MAX_LAYERS: usize = 1024;
 
 /// Voxel sample types both formats share.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

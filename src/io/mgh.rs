@@ -75,6 +75,7 @@ fn finish(layout: VoxelLayout, affine: Affine, sink: VoxelSink) -> Result<LabelM
                 value,
                 name: name.to_string(),
                 color: Some(rgb.map(|c| f32::from(c) / 255.0)),
+                codes: None,
             })
         })
         .collect();

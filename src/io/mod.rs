@@ -4,6 +4,9 @@
 
 mod codes;
 mod color_table;
+mod dicom_lengths;
+mod dicom_seg;
+mod dicom_seg_grid;
 mod error;
 mod freesurfer_lut;
 mod gltf;
@@ -49,6 +52,8 @@ pub enum Format {
     Nrrd,
     /// FreeSurfer's MGH/MGZ volume: a label map, read by [`load_label_map`].
     Mgh,
+    /// A DICOM Segmentation object: a label map, read by [`load_label_map`].
+    DicomSeg,
     /// A label map's colour table, read by [`parse_color_table`].
     ColorTable,
 }
@@ -64,6 +69,7 @@ impl std::fmt::Display for Format {
             Format::Nifti => "NIfTI",
             Format::Nrrd => "NRRD",
             Format::Mgh => "MGH",
+            Format::DicomSeg => "DICOM SEG",
             Format::ColorTable => "colour table",
         })
     }
@@ -71,7 +77,7 @@ impl std::fmt::Display for Format {
 
 impl Format {
     /// The format named by a file name's extension (case-insensitive): a mesh format, or a
-    /// label-map one (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`, `.mgh`, `.mgz`).
+    /// label-map one (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`, `.mgh`, `.mgz`, `.dcm`).
     pub fn from_name(name: &str) -> Option<Format> {
         if let Some(format) = read_label_map::label_format_of(name) {
             return Some(format);
@@ -89,7 +95,10 @@ impl Format {
 
     /// Whether files of this format hold label maps (segmentations) rather than meshes.
     pub fn is_label_map(self) -> bool {
-        matches!(self, Format::Nifti | Format::Nrrd | Format::Mgh)
+        matches!(
+            self,
+            Format::Nifti | Format::Nrrd | Format::Mgh | Format::DicomSeg
+        )
     }
 }
 
@@ -134,7 +143,7 @@ pub fn load_as(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
         Format::Obj => obj::parse(bytes),
         Format::Ply => ply::parse(bytes),
         Format::Glb | Format::Gltf => gltf::parse(bytes, format),
-        Format::Nifti | Format::Nrrd | Format::Mgh | Format::ColorTable => {
+        Format::Nifti | Format::Nrrd | Format::Mgh | Format::DicomSeg | Format::ColorTable => {
             Err(LoadError::Unsupported {
                 format,
                 detail: "not a mesh format: open label maps as a segmentation (meshsmooth extract)"

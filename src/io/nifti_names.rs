@@ -82,6 +82,7 @@ fn label_table(content: &[u8]) -> Vec<Segment> {
                 value,
                 name: readable(name.trim()),
                 color,
+                codes: None,
             })
         })
         .collect();

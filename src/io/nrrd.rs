@@ -8,6 +8,7 @@
 
 use std::collections::BTreeMap;
 
+use super::codes::{self, StructureCodes};
 use super::gzip::Inflater;
 use super::label_map::LabelMapOptions;
 use super::label_map::{Affine, LabelMap, Segment};
@@ -80,6 +81,7 @@ struct SegmentFields {
     color: Option<[f32; 3]>,
     value: Option<i64>,
     layer: Option<Field<usize>>,
+    codes: Option<StructureCodes>,
 }
 
 #[derive(Debug, Default)]
@@ -229,7 +231,8 @@ impl Header {
         Ok(())
     }
 
-    /// 3D Slicer's `SegmentN_Name`, `_Color`, `_LabelValue`, `_Layer`; other keys are ignored.
+    /// 3D Slicer's `SegmentN_Name`, `_Color`, `_LabelValue`, `_Layer`, `_Tags` (its terminology
+    /// entry); other keys are ignored.
     fn key_value(&mut self, line: usize, key: &str, value: &str) -> Result<(), LoadError> {
         let Some((n, what)) = key.strip_prefix("Segment").and_then(|k| k.split_once('_')) else {
             return Ok(());
@@ -256,6 +259,7 @@ impl Header {
                     .map_err(|_| bad("not a layer number"))?;
                 segment.layer = Some(Field { value: v, line });
             }
+            "Tags" => segment.codes = codes::from_slicer_tags(value),
             _ => {}
         }
         Ok(())
@@ -425,6 +429,7 @@ impl Header {
                     .clone()
                     .unwrap_or_else(|| format!("Segment_{n}")),
                 color: fields.color,
+                codes: fields.codes.clone(),
             });
         }
         Ok(out)

@@ -1,5 +1,5 @@
 //! Label maps in: NIfTI-1 and NIfTI-2 (`.nii`, `.nii.gz`), NRRD (`.nrrd`, 3D Slicer's
-//! `.seg.nrrd`) and FreeSurfer's MGH (`.mgh`, `.mgz`) into a [`LabelMap`]; colour tables that
+//! `.seg.nrrd`), FreeSurfer's MGH (`.mgh`, `.mgz`) and DICOM SEG (`.dcm`) into a [`LabelMap`]; colour tables that
 //! name the labels are in `color_table`.
 //!
 //! Both formats are parsed here by hand rather than with the `nifti` crate: that crate reads
@@ -14,10 +14,10 @@
 //! where the voxel is at least the level, background elsewhere and at NaN.
 
 use super::label_map::{LabelMap, LabelMapOptions};
-use super::{mgh, nifti, nrrd, Format, LoadError};
+use super::{dicom_seg, mgh, nifti, nrrd, Format, LoadError};
 
 /// Whether a file name is a label map this module reads (`.nii`, `.nii.gz`, `.nrrd` including
-/// `.seg.nrrd`, `.mgh`, `.mgz`, and detached `.nhdr` headers, which are refused with a reason),
+/// `.seg.nrrd`, `.mgh`, `.mgz`, DICOM SEG's `.dcm`, and detached `.nhdr` headers, which are refused with a reason),
 /// ignoring case.
 pub fn is_label_map(name: &str) -> bool {
     label_format_of(name).is_some()
@@ -31,6 +31,8 @@ pub(super) fn label_format_of(name: &str) -> Option<Format> {
         Some(Format::Nrrd)
     } else if lower.ends_with(".mgh") || lower.ends_with(".mgz") {
         Some(Format::Mgh)
+    } else if lower.ends_with(".dcm") {
+        Some(Format::DicomSeg)
     } else {
         None
     }
@@ -59,6 +61,7 @@ pub fn load_label_map(
     match format {
         Format::Nrrd => nrrd::parse(bytes, options),
         Format::Mgh => mgh::parse(bytes, options),
+        Format::DicomSeg => dicom_seg::parse(bytes, options),
         _ => nifti::parse(bytes, options),
     }
 }
@@ -77,6 +80,8 @@ fn sniff(bytes: &[u8], name: &str) -> Result<Format, LoadError> {
     let nifti_size = |s: Option<i32>| matches!(s, Some(348 | 540));
     if bytes.starts_with(b"NRRD") {
         Ok(Format::Nrrd)
+    } else if dicom_seg::is_dicom(bytes) {
+        Ok(Format::DicomSeg)
     } else if bytes.starts_with(&[0, 0, 0, 1]) {
         Ok(Format::Mgh)
     } else if super::gzip::is_gzip(bytes) || nifti_size(size(false)) || nifti_size(size(true)) {

@@ -81,6 +81,7 @@ pub fn open_staged(
                 value: e.value,
                 name: e.name,
                 color: e.color,
+                codes: None,
             })
             .collect(),
         None => Vec::new(),
@@ -160,6 +161,7 @@ pub fn structure_name(file: &str) -> String {
         ".nhdr",
         ".mgz",
         ".mgh",
+        ".dcm",
     ]
     .iter()
     .find(|ext| lower.ends_with(*ext))

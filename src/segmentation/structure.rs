@@ -73,7 +73,7 @@ pub fn labels(map: &LabelMap, names: &[Segment]) -> Vec<LabelInfo> {
                 continue;
             }
             let label = layer.values[code];
-            let (name, color) = naming(map, names, index, label, out.len());
+            let (name, color, _) = naming(map, names, index, label, out.len());
             out.push(LabelInfo {
                 layer: index,
                 label,
@@ -133,11 +133,11 @@ pub fn extract(
             let Some(mut mesh) = mesh else { continue };
             to_world(&mut mesh, map);
             let value = layer.values[code];
-            let (name, color) = naming(map, names, index, value, out.len());
+            let (name, color, codes) = naming(map, names, index, value, out.len());
             out.push(Structure {
                 label: value,
                 layer: index,
-                codes: super::codes_for_name(&name),
+                codes: codes.or_else(|| super::codes_for_name(&name)),
                 name,
                 color,
                 voxels: counts[code],
@@ -194,14 +194,15 @@ fn code_counts(codes: &[u16], n: usize) -> Vec<usize> {
 }
 
 /// A structure's name and colour: the file's segment, else the table's entry, else the
-/// format's convention (FreeSurfer's table for MGH), else defaults.
+/// format's convention (FreeSurfer's table for MGH), else defaults; and the codes the file
+/// gives it.
 fn naming(
     map: &LabelMap,
     names: &[Segment],
     layer: usize,
     value: i64,
     ordinal: usize,
-) -> (String, [f32; 3]) {
+) -> (String, [f32; 3], Option<StructureCodes>) {
     let own = map
         .segments
         .iter()
@@ -216,5 +217,5 @@ fn naming(
     let color = (sources.iter().flatten())
         .find_map(|s| s.color)
         .unwrap_or_else(|| default_color(ordinal));
-    (name, color)
+    (name, color, own.and_then(|s| s.codes.clone()))
 }

@@ -188,6 +188,7 @@ fn chosen_labels_names_and_specks() {
         value: 3,
         name: "tumour".into(),
         color: Some([1.0, 0.0, 0.0]),
+        codes: None,
     }];
     let only = ExtractOptions {
         labels: vec![3],

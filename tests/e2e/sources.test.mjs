@@ -1,4 +1,4 @@
-// End-to-end tests of the sources authors have, in the page: a FreeSurfer MGZ and a
+// End-to-end tests of the sources authors have, in the page: a FreeSurfer MGZ, a DICOM SEG and a
 // TotalSegmentator multilabel NIfTI open into the structures the CLI extracts, with their names;
 // the standard codes their names carry reach the viewer through a case glTF.
 //
@@ -70,4 +70,26 @@ testIn(EVERY_RUN, "F3 standard codes survive case build and case info into the v
         await app.stateWhen((s) => s.layout.structures.length === 3 && s.loading === null, "the case's three rows");
         await app.screenshot("F3-viewer-codes");
     }, { query: "?mode=viewer" });
+});
+
+testIn(EVERY_RUN, "F4 a DICOM SEG opens with its segments' names, colours and codes, as the CLI extracts it and as the .seg.nrrd", { timeout: TIMEOUT }, async () => {
+    const file = join(ROOT, "tests/data/dicom_seg/phantom.dcm");
+    const nrrd = join(ROOT, "../shared/data/labelmaps/case_phantom_shared.seg.nrrd");
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(file), "phantom.dcm");
+        const page = (await app.call("structures")).structures;
+        const native = (await cli.cliJson("extract", file, "-o", join(E2E_OUT, `extract-dicom-seg-${MODE}/`), "--json")).structures;
+        const slicer = (await cli.cliJson("extract", nrrd, "-o", join(E2E_OUT, `extract-seg-nrrd-${MODE}/`), "--json")).structures;
+        assert.deepEqual(page.map((s) => s.name), ["liver", "portal_vein", "tumor", "right_kidney"]);
+        assert.deepEqual(
+            page.map((s) => [s.label, s.name, s.voxels, s.vertices, s.triangles]),
+            native.map((s) => [s.label, s.name, s.voxels, s.vertices, s.triangles]),
+        );
+        assert.deepEqual(page.map((s) => [s.name, s.voxels, s.triangles]), slicer.map((s) => [s.name, s.voxels, s.triangles]));
+        page.forEach((s, i) => s.color.forEach((c, k) => assert.ok(Math.abs(c - slicer[i].color[k]) * 255 <= 2, `${s.name} colour`)));
+        assert.deepEqual(page.map((s) => s.codes?.type.meaning), ["Liver", "Portal vein", "Neoplasm", "Kidney"]);
+        assert.equal(page[3].codes.modifier.meaning, "Right");
+        assert.equal(page[2].codes.category.meaning, "Morphologically Altered Structure");
+        await app.screenshot("F4-dicom-seg");
+    });
 });

@@ -19,7 +19,7 @@ mkdir -p "$work"
 
 corpus() {
     # A seed directory of small shared files with the given extensions, the tests' own files
-    # (tests/data: MGZ volumes) and this folder's seeds (tests/fuzz/seeds: a compressed case
+    # (tests/data: MGZ volumes, DICOM SEGs) and this folder's seeds (tests/fuzz/seeds: a compressed case
     # GLB), which the shared data has none of.
     local dir="$work/corpus-$1"
     shift
@@ -48,6 +48,8 @@ run() {
 run fuzz_nifti "$(corpus nifti '*.nii.gz')" 8192
 run fuzz_nrrd "$(corpus nrrd '*.nrrd')" 8192
 run fuzz_mgh "$(corpus mgh '*.mgz')" 8192
+# DICOM SEG: the seeds are up to 180 KB; longer inputs let the fuzzer keep whole frames.
+run fuzz_dicom_seg "$(corpus dicom_seg '*.dcm')" 32768
 run fuzz_stl "$(corpus stl '*.stl')"
 run fuzz_obj "$(corpus obj '*.obj')"
 run fuzz_ply "$(corpus ply '*.ply')"

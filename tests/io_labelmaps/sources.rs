@@ -10,7 +10,7 @@ use std::io::Read;
 
 const TESTS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
 
-fn ours(name: &str) -> Vec<u8> {
+pub(super) fn ours(name: &str) -> Vec<u8> {
     let path = format!("{TESTS}{name}");
     std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
@@ -23,7 +23,7 @@ fn inflate(bytes: &[u8]) -> Vec<u8> {
     out
 }
 
-fn open(files: &[(&str, &[u8])], table: Option<&[u8]>) -> Vec<Structure> {
+pub(super) fn open(files: &[(&str, &[u8])], table: Option<&[u8]>) -> Vec<Structure> {
     let files: Vec<NamedBytes> = (files.iter())
         .map(|&(name, bytes)| NamedBytes { name, bytes })
         .collect();
@@ -35,7 +35,7 @@ fn open(files: &[(&str, &[u8])], table: Option<&[u8]>) -> Vec<Structure> {
 }
 
 /// The largest distance between corresponding vertices of two structures' surfaces.
-fn largest_offset(a: &Structure, b: &Structure) -> f32 {
+pub(super) fn largest_offset(a: &Structure, b: &Structure) -> f32 {
     assert_eq!(a.mesh.triangles, b.mesh.triangles, "{}", a.name);
     (a.mesh.positions.iter().zip(&b.mesh.positions))
         .map(|(p, q)| (0..3).map(|i| (p[i] - q[i]).abs()).fold(0.0, f32::max))

@@ -7,7 +7,7 @@
 //!   file is open: a worker opens it (`state().loading` tells the stage), the current model
 //!   staying open until then; a later `loadMesh` before it is open replaces it (its promise
 //!   rejects). Every file opens as a case: a label map (`.nii`, `.nii.gz`, `.nrrd`,
-//!   `.seg.nrrd`, `.mgz`, `.mgh`) with its structures extracted, a case glTF with its structures, a surface as
+//!   `.seg.nrrd`, `.mgz`, `.mgh`, DICOM SEG `.dcm`) with its structures extracted, a case glTF with its structures, a surface as
 //!   a case of one; the first structure becomes the model
 //! - `loadCase(bytes, name): Promise<structures>`: `loadMesh` resolving with `structures()`,
 //!   for a case glTF written here (reopened as it was: names, colours, groups, parameters,

@@ -58,7 +58,7 @@ impl Shell {
                 self.help_open = !self.help_open;
             }
             ui.label(
-                "Drop meshes (STL, OBJ, PLY, glTF), a label map (NIfTI, NRRD, MGZ) or a case glTF on the page to open them as a case.",
+                "Drop meshes (STL, OBJ, PLY, glTF), a segmentation (NIfTI, NRRD, MGZ, DICOM SEG) or a case glTF on the page to open them as a case.",
             );
         });
     }

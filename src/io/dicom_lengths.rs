@@ -1,0 +1,300 @@
+//! A walk over a DICOM file's element headers that checks every declared length against the
+//! bytes left, before `dicom-object` parses it: that parser reserves each value's declared
+//! length (up to 4 GiB) before reading it, so a lying length in a small file would otherwise
+//! cost gigabytes. The walk also finds the transfer syntax and refuses the encodings the reader
+//! does not take (big-endian, deflated, encapsulated pixel data). The walk reads headers exactly
+//! as dicom-rs does (an unknown VR has a 32-bit length, as UN), so that every value it will
+//! allocate has been measured; what the two would read differently is refused.
+
+use super::{Format, LoadError};
+
+const FORMAT: Format = Format::DicomSeg;
+
+const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
+const IMPLICIT_LE: &str = "1.2.840.10008.1.2";
+const UNDEFINED: u32 = u32::MAX;
+
+const ITEM: (u16, u16) = (0xFFFE, 0xE000);
+const PIXEL_DATA: (u16, u16) = (0x7FE0, 0x0010);
+const TRANSFER_SYNTAX: (u16, u16) = (0x0002, 0x0010);
+
+/// Where the DICOM stream starts (after the 128-byte preamble, or at 0 when a file has none),
+/// once every element length has been checked.
+pub(super) fn check(bytes: &[u8]) -> Result<usize, LoadError> {
+    let start = if bytes.get(128..132) == Some(b"DICM") {
+        132
+    } else if bytes.starts_with(b"DICM") {
+        4
+    } else {
+        return Err(LoadError::BadMagic {
+            format: FORMAT,
+            detail: "no 'DICM' after a 128-byte preamble".into(),
+        });
+    };
+    let mut walk = Walk { bytes, at: start };
+    let syntax = walk.meta_group()?;
+    let implicit = match syntax.as_str() {
+        EXPLICIT_LE => false,
+        IMPLICIT_LE => true,
+        other => return Err(unsupported_syntax(other)),
+    };
+    walk.data_set(implicit)?;
+    Ok(start - 4)
+}
+
+fn unsupported_syntax(uid: &str) -> LoadError {
+    let what = match uid {
+        "1.2.840.10008.1.2.2" => "explicit VR big endian",
+        "1.2.840.10008.1.2.1.99" => "deflated explicit VR little endian",
+        "1.2.840.10008.1.2.5" => "RLE lossless",
+        _ => "a compressed or unknown encoding",
+    };
+    LoadError::Unsupported {
+        format: FORMAT,
+        detail: format!(
+            "transfer syntax {uid} ({what}): only uncompressed little-endian files are read"
+        ),
+    }
+}
+
+struct Walk<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+struct Header {
+    tag: (u16, u16),
+    len: u32,
+    /// Whether the value is a sequence (or an item) whose content is more elements.
+    nested: bool,
+}
+
+impl Walk<'_> {
+    fn u16_at(&self, at: usize) -> Result<u16, LoadError> {
+        let b = self.bytes.get(at..at + 2).ok_or_else(|| self.truncated())?;
+        Ok(u16::from_le_bytes([b[0], b[1]]))
+    }
+
+    fn u32_at(&self, at: usize) -> Result<u32, LoadError> {
+        let b = self.bytes.get(at..at + 4).ok_or_else(|| self.truncated())?;
+        Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    }
+
+    fn truncated(&self) -> LoadError {
+        LoadError::Truncated {
+            format: FORMAT,
+            offset: self.bytes.len(),
+            detail: format!("an element header at byte {} is cut off", self.at),
+        }
+    }
+
+    /// The file meta group (always explicit VR little endian); returns the transfer syntax.
+    fn meta_group(&mut self) -> Result<String, LoadError> {
+        let mut syntax = None;
+        while self.at < self.bytes.len() && self.u16_at(self.at)? == 0x0002 {
+            let header = self.header(false)?;
+            if header.nested {
+                return Err(self.bad("a sequence in the file meta group"));
+            }
+            let value = self.value(&header)?;
+            if header.tag == TRANSFER_SYNTAX {
+                let text = String::from_utf8_lossy(value);
+                syntax = Some(text.trim_end_matches(['\0', ' ']).to_string());
+            }
+        }
+        syntax.ok_or_else(|| self.bad("no transfer syntax (0002,0010) in the file meta group"))
+    }
+
+    fn data_set(&mut self, implicit: bool) -> Result<(), LoadError> {
+        while self.at < self.bytes.len() {
+            let header = self.header(implicit)?;
+            if header.tag == PIXEL_DATA && header.len == UNDEFINED {
+                return Err(LoadError::Unsupported {
+                    format: FORMAT,
+                    detail: "encapsulated (compressed) pixel data is not read".into(),
+                });
+            }
+            if !header.nested {
+                self.value(&header)?;
+            } else if header.len != UNDEFINED {
+                self.room_for(header.len)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads an element header at the cursor and steps past it (not past its value).
+    fn header(&mut self, implicit: bool) -> Result<Header, LoadError> {
+        let tag = (self.u16_at(self.at)?, self.u16_at(self.at + 2)?);
+        if tag.0 == 0xFFFE {
+            // Items and delimiters have no VR in any syntax; a delimiter has no value.
+            let len = self.u32_at(self.at + 4)?;
+            if !matches!(tag.1, 0xE000 | 0xE00D | 0xE0DD) {
+                return Err(self.bad(&format!(
+                    "(FFFE,{:04X}) is not an item or a delimiter",
+                    tag.1
+                )));
+            }
+            self.at += 8;
+            return Ok(Header {
+                tag,
+                len: if tag == ITEM { len } else { 0 },
+                nested: tag == ITEM,
+            });
+        }
+        if implicit {
+            let len = self.u32_at(self.at + 4)?;
+            self.at += 8;
+            let nested = len == UNDEFINED || is_sequence(tag);
+            return Ok(Header { tag, len, nested });
+        }
+        let vr = self.bytes.get(self.at + 4..self.at + 6).unwrap_or_default();
+        // PS3.5 7.1.2: these have a 16-bit length; every other VR, known or not, a 32-bit one.
+        const SHORT: [&[u8]; 21] = [
+            b"AE", b"AS", b"AT", b"CS", b"DA", b"DS", b"DT", b"FL", b"FD", b"IS", b"LO", b"LT",
+            b"PN", b"SH", b"SL", b"SS", b"ST", b"TM", b"UI", b"UL", b"US",
+        ];
+        let long = !SHORT.contains(&vr);
+        let len = if long {
+            let len = self.u32_at(self.at + 8)?;
+            self.at += 12;
+            len
+        } else {
+            let len = u32::from(self.u16_at(self.at + 6)?);
+            self.at += 8;
+            len
+        };
+        if vr != b"SQ" && len == UNDEFINED && tag != PIXEL_DATA {
+            // dicom-rs reads such a value as a sequence in implicit VR; this walk does not.
+            return Err(self.bad(&format!(
+                "({:04X},{:04X}) has an undefined length but is not a sequence",
+                tag.0, tag.1
+            )));
+        }
+        Ok(Header {
+            tag,
+            len,
+            nested: vr == b"SQ",
+        })
+    }
+
+    /// Steps past a value of defined length, returning it.
+    fn value(&mut self, header: &Header) -> Result<&[u8], LoadError> {
+        if header.len == UNDEFINED {
+            return Err(self.bad(&format!(
+                "element ({:04X},{:04X}) has an undefined length but is not a sequence",
+                header.tag.0, header.tag.1
+            )));
+        }
+        self.room_for(header.len)?;
+        let start = self.at;
+        self.at += header.len as usize;
+        Ok(&self.bytes[start..self.at])
+    }
+
+    fn room_for(&self, len: u32) -> Result<(), LoadError> {
+        let left = self.bytes.len() - self.at.min(self.bytes.len());
+        if len as usize > left {
+            return Err(LoadError::CountTooLarge {
+                format: FORMAT,
+                what: "bytes in an element",
+                claimed: u64::from(len),
+                possible: left as u64,
+            });
+        }
+        Ok(())
+    }
+
+    fn bad(&self, detail: &str) -> LoadError {
+        LoadError::Unsupported {
+            format: FORMAT,
+            detail: format!("byte {}: {detail}", self.at),
+        }
+    }
+}
+
+/// Whether the standard dictionary gives a tag the VR SQ (implicit VR files do not say).
+fn is_sequence(tag: (u16, u16)) -> bool {
+    use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
+    use dicom_core::{Tag, VR};
+    let entry = dicom_dictionary_std::StandardDataDictionary.by_tag(Tag(tag.0, tag.1));
+    entry.is_some_and(|e| e.vr().relaxed() == VR::SQ)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn element(tag: (u16, u16), vr: &[u8; 2], value: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        out.extend(tag.0.to_le_bytes());
+        out.extend(tag.1.to_le_bytes());
+        out.extend(vr);
+        if matches!(vr, b"OB" | b"SQ" | b"UN") {
+            out.extend([0, 0]);
+            out.extend((value.len() as u32).to_le_bytes());
+        } else {
+            out.extend((value.len() as u16).to_le_bytes());
+        }
+        out.extend(value);
+        out
+    }
+
+    fn file(syntax: &str, data_set: &[u8]) -> Vec<u8> {
+        let mut out = vec![0u8; 128];
+        out.extend(b"DICM");
+        let mut uid = syntax.as_bytes().to_vec();
+        if uid.len() % 2 == 1 {
+            uid.push(0);
+        }
+        out.extend(element(TRANSFER_SYNTAX, b"UI", &uid));
+        out.extend(data_set);
+        out
+    }
+
+    #[test]
+    fn a_length_past_the_end_is_refused_before_parsing() {
+        let good = element((0x0010, 0x0010), b"PN", b"Anon");
+        assert_eq!(check(&file(EXPLICIT_LE, &good)), Ok(128));
+        let mut lying = element((0x7FE0, 0x0010), b"OB", &[1, 2]);
+        lying[8..12].copy_from_slice(&0xF000_0000u32.to_le_bytes());
+        let error = check(&file(EXPLICIT_LE, &lying)).unwrap_err();
+        assert!(
+            matches!(error, LoadError::CountTooLarge { claimed, .. } if claimed == 0xF000_0000)
+        );
+    }
+
+    #[test]
+    fn a_lying_length_inside_a_sequence_item_is_found() {
+        let mut inner = element((0x0008, 0x0100), b"SH", b"T-D0050 ");
+        inner[6..8].copy_from_slice(&0xFFF0u16.to_le_bytes());
+        let mut item = Vec::new();
+        item.extend(0xFFFEu16.to_le_bytes());
+        item.extend(0xE000u16.to_le_bytes());
+        item.extend((inner.len() as u32).to_le_bytes());
+        item.extend(&inner);
+        let sequence = element((0x0062, 0x0002), b"SQ", &item);
+        assert!(matches!(
+            check(&file(EXPLICIT_LE, &sequence)),
+            Err(LoadError::CountTooLarge {
+                claimed: 0xFFF0,
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn other_encodings_are_named() {
+        let error = check(&file("1.2.840.10008.1.2.4.90", &[])).unwrap_err();
+        assert!(
+            error.to_string().contains("1.2.840.10008.1.2.4.90"),
+            "{error}"
+        );
+        let error = check(&file("1.2.840.10008.1.2.2", &[])).unwrap_err();
+        assert!(error.to_string().contains("big endian"), "{error}");
+        assert!(matches!(
+            check(b"not dicom"),
+            Err(LoadError::BadMagic { .. })
+        ));
+    }
+}
