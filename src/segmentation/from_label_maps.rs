@@ -1,6 +1,7 @@
-//! Opening a segmentation from files: one label map (each label a structure), or several binary
-//! masks (each file a structure, named by its file name, as TotalSegmentator writes them), with
-//! an optional colour table that names the labels. Shared by the CLI and the page.
+//! Opening a segmentation from files: one label map (each label a structure), or several files:
+//! binary masks (each file a structure, named by its file name, as TotalSegmentator writes them)
+//! and files that name their own segments (a folder of DICOM SEG objects), with an optional
+//! colour table that names the labels. Shared by the CLI and the page.
 
 use super::{extract, ExtractError, ExtractOptions, Structure};
 use crate::io::{self, LabelMap, LabelMapOptions, LoadError, Segment};
@@ -48,8 +49,9 @@ pub fn reading_stages(maps: usize) -> Vec<&'static str> {
 }
 
 /// Reads the files and extracts their structures. One file: a label map, its labels named by
-/// the file, else by `table`, else `label N`. Several: each a mask (every non-zero voxel), one
-/// structure per file named by it; each keeps its own grid.
+/// the file, else by `table`, else `label N`. Several: a file that names its segments (DICOM
+/// SEG, `.seg.nrrd`) gives each its structure, any other is a mask (every non-zero voxel), one
+/// structure named by the file; each keeps its own grid, and labels number the structures.
 pub fn open(
     files: &[NamedBytes],
     table: Option<NamedBytes>,
@@ -113,10 +115,19 @@ pub fn open_staged(
             let mut out = Vec::with_capacity(several.len());
             for (ordinal, f) in several.iter().enumerate() {
                 on_stage(EACH_MASK[0]);
-                let map = as_mask(read(f)?);
+                let map = read(f)?;
+                if !map.segments.is_empty() {
+                    on_stage(EACH_MASK[1]);
+                    for mut s in extract_from(f, &map, &options.extract)? {
+                        s.label = out.len() as i64 + 1;
+                        out.push(s);
+                    }
+                    continue;
+                }
+                let map = as_mask(map);
                 on_stage(EACH_MASK[1]);
                 for mut s in extract_from(f, &map, &options.extract)? {
-                    s.label = ordinal as i64 + 1;
+                    s.label = out.len() as i64 + 1;
                     s.name = structure_name(f.name);
                     s.codes = super::codes_for_name(&s.name);
                     s.color = super::default_color(ordinal);

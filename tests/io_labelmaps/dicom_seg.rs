@@ -474,3 +474,36 @@ fn slicer_terminology_tags_carry_the_same_codes_as_the_seg() {
     assert!(from_nrrd[2].codes.is_some());
     assert_eq!(from_nrrd[2].codes, from_dicom[2].codes);
 }
+
+#[test]
+fn a_folder_of_segs_keeps_every_segment_and_masks_beside_them_stay_masks() {
+    let phantom = seg("phantom.dcm");
+    let gap = seg("gap.dcm");
+    let mask = seg("fractional.nii.gz");
+    let structures = open(
+        &[
+            ("a/phantom.dcm", &phantom),
+            ("a/gap.dcm", &gap),
+            ("a/sphere_mask.nii.gz", &mask),
+        ],
+        None,
+    );
+    let named: Vec<(i64, &str)> = (structures.iter())
+        .map(|s| (s.label, s.name.as_str()))
+        .collect();
+    assert_eq!(
+        named,
+        [
+            (1, "liver"),
+            (2, "portal_vein"),
+            (3, "tumor"),
+            (4, "right_kidney"),
+            (5, "box"),
+            (6, "sphere"),
+            (7, "Sphere mask")
+        ]
+    );
+    let alone = open(&[("phantom.dcm", &phantom)], None);
+    assert_eq!(structures[3].codes, alone[3].codes);
+    assert_eq!(structures[3].mesh, alone[3].mesh);
+}
