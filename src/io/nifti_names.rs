@@ -4,7 +4,7 @@
 //! as text), which Connectome Workbench writes too (code 30). The XML is read with `roxmltree`.
 //!
 //! An extension that is not such a table, or not well-formed, names nothing: the label map reads
-//! as without it, as nibabel reads it.
+//! as without it, as nibabel reads it. Colours are taken from Workbench's tables only.
 
 use super::label_map::Segment;
 
@@ -37,7 +37,12 @@ pub(super) fn label_names(area: &[u8], big_endian: bool) -> Vec<Segment> {
             break;
         };
         if matches!(code, 0 | 30) {
-            let names = label_table(content);
+            let mut names = label_table(content);
+            if code == 0 {
+                // TotalSegmentator colours its table by cycling twelve colours that say nothing
+                // of the class: left unset, its classes take the colours it gives them in DICOM.
+                names.iter_mut().for_each(|s| s.color = None);
+            }
             if !names.is_empty() {
                 return names;
             }

@@ -130,7 +130,8 @@ pub fn open_staged(
                     s.label = out.len() as i64 + 1;
                     s.name = structure_name(f.name);
                     s.codes = super::codes_for_name(&s.name);
-                    s.color = super::default_color(ordinal);
+                    s.color = super::color_for_name(&s.name)
+                        .unwrap_or_else(|| super::default_color(ordinal));
                     out.push(s);
                 }
             }

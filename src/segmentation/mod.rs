@@ -17,7 +17,7 @@ pub use from_label_maps::{
     open, open_staged, reading_stages, structure_name, NamedBytes, OpenError, OpenOptions,
 };
 pub use palette::default_color;
-pub use standard_codes::codes_for_name;
+pub use standard_codes::{codes_for_name, color_for_name};
 pub use structure::{extract, labels, ExtractError, ExtractOptions, LabelInfo, Structure};
 
 #[cfg(test)]

@@ -2,9 +2,10 @@
 //! with the SNOMED CT codes TotalSegmentator publishes for them
 //! (`totalsegmentator/resources/totalsegmentator_snomed_mapping.csv` of
 //! github.com/wasserth/TotalSegmentator, last changed in d90ebaf4d8d5), so that a case built
-//! from its output carries codes without the author typing them. A structure matches a class by
-//! its name as TotalSegmentator writes it or as it reads ("kidney_right", "Right kidney"),
-//! ignoring case.
+//! from its output carries codes without the author typing them, and the display colour
+//! TotalSegmentator gives each class in its DICOM SEGs, for structures whose file gives none. A
+//! structure matches a class by its name as TotalSegmentator writes it or as it reads
+//! ("kidney_right", "Right kidney"), ignoring case.
 
 use std::collections::HashMap;
 use std::sync::OnceLock;
@@ -16,11 +17,11 @@ const TSV: &str = include_str!("standard_codes.tsv");
 
 const HEADER: &str = "class\tcategory_scheme\tcategory_value\tcategory_meaning\t\
                       type_scheme\ttype_value\ttype_meaning\t\
-                      modifier_scheme\tmodifier_value\tmodifier_meaning";
+                      modifier_scheme\tmodifier_value\tmodifier_meaning\tcolor";
 
 /// The parsed table: each class with its codes, and an index by both of its names.
 struct Table {
-    rows: Vec<(&'static str, StructureCodes)>,
+    rows: Vec<Row<'static>>,
     /// Normalised name (as written and as read) to its row in `rows`.
     by_name: HashMap<String, usize>,
 }
@@ -31,11 +32,19 @@ fn normalise(name: &str) -> String {
     name.trim().to_ascii_lowercase()
 }
 
-/// One data line of the table: the class and its codes, or what is wrong with it.
-fn parse_row(line: &str) -> Result<(&str, StructureCodes), String> {
+/// A class, its codes and its display colour (sRGB bytes).
+type Row<'a> = (&'a str, StructureCodes, [u8; 3]);
+
+/// One data line of the table, or what is wrong with it.
+fn parse_row(line: &str) -> Result<Row<'_>, String> {
     let fields: Vec<&str> = line.split('\t').collect();
-    let [class, fields @ ..] = <[&str; 10]>::try_from(fields.as_slice())
-        .map_err(|_| format!("{} fields, expected 10", fields.len()))?;
+    let [class, fields @ .., color] = <[&str; 11]>::try_from(fields.as_slice())
+        .map_err(|_| format!("{} fields, expected 11", fields.len()))?;
+    let color: Vec<u8> = (color.split(','))
+        .map(|c| c.trim().parse::<u8>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("colour '{color}' is not 'r,g,b' of bytes"))?;
+    let color = <[u8; 3]>::try_from(color).map_err(|_| "a colour of 3 bytes".to_string())?;
     let code = |f: &[&str]| Code::new(f[0], f[1], f[2]);
     if class.is_empty() || fields[..6].iter().any(|f| f.is_empty()) {
         return Err("an empty class, category or type field".to_string());
@@ -50,7 +59,7 @@ fn parse_row(line: &str) -> Result<(&str, StructureCodes), String> {
         kind: code(&fields[3..6]),
         modifier,
     };
-    Ok((class, codes))
+    Ok((class, codes, color))
 }
 
 impl Table {
@@ -66,7 +75,7 @@ impl Table {
             })
             .collect();
         let mut by_name = HashMap::with_capacity(2 * rows.len());
-        for (row, (class, _)) in rows.iter().enumerate() {
+        for (row, (class, ..)) in rows.iter().enumerate() {
             // Single-word classes ("liver") read as they are written: one key for both.
             for name in [normalise(class), normalise(&readable_class_name(class))] {
                 let before = by_name.insert(name.clone(), row);
@@ -90,6 +99,13 @@ pub fn codes_for_name(name: &str) -> Option<StructureCodes> {
     let table = Table::get();
     let row = *table.by_name.get(&normalise(name))?;
     Some(table.rows[row].1.clone())
+}
+
+/// The display colour (sRGB, channels in [0, 1]) TotalSegmentator gives the class named `name`.
+pub fn color_for_name(name: &str) -> Option<[f32; 3]> {
+    let table = Table::get();
+    let row = *table.by_name.get(&normalise(name))?;
+    Some(table.rows[row].2.map(|c| f32::from(c) / 255.0))
 }
 
 #[cfg(test)]
@@ -123,13 +139,19 @@ mod tests {
         );
         assert_eq!(codes_for_name("tumor"), None);
         assert_eq!(codes_for_name(""), None);
+        // TotalSegmentator's liver is green (40, 140, 40).
+        let green = color_for_name("Liver")
+            .unwrap()
+            .map(|c| (c * 255.0).round() as u8);
+        assert_eq!(green, [40, 140, 40]);
+        assert_eq!(color_for_name("tumor"), None);
     }
 
     #[test]
     fn every_row_is_whole_and_every_name_finds_its_own_row() {
         let table = Table::parse(TSV);
         assert_eq!(table.rows.len(), 117);
-        for (row, (class, codes)) in table.rows.iter().enumerate() {
+        for (row, (class, codes, _)) in table.rows.iter().enumerate() {
             assert!(!class.is_empty() && !codes.kind.meaning.is_empty());
             assert_eq!(table.by_name[&normalise(class)], row, "{class}");
             let readable = readable_class_name(class);
@@ -137,7 +159,7 @@ mod tests {
         }
         // Two keys a class, less one for each of the 16 single-word classes ("liver" reads
         // "Liver"): any fewer and two classes' names would collide.
-        let single_words = (table.rows.iter()).filter(|(c, _)| !c.contains('_'));
+        let single_words = (table.rows.iter()).filter(|(c, ..)| !c.contains('_'));
         assert_eq!(single_words.count(), 16);
         assert_eq!(table.by_name.len(), 2 * 117 - 16);
     }
@@ -145,11 +167,14 @@ mod tests {
     #[test]
     fn a_malformed_row_is_refused() {
         let row = "liver\tSCT\t123037004\tAnatomical Structure\tSCT\t10200004\tLiver";
-        assert!(parse_row(&format!("{row}\t\t\t")).is_ok());
-        assert!(parse_row(&format!("{row}\tSCT\t7771000\tLeft")).is_ok());
-        assert!(parse_row(&format!("{row}\tSCT\t\tLeft")).is_err());
+        assert!(parse_row(&format!("{row}\t\t\t\t1,2,3")).is_ok());
+        assert!(parse_row(&format!("{row}\tSCT\t7771000\tLeft\t1,2,3")).is_ok());
+        assert!(parse_row(&format!("{row}\tSCT\t\tLeft\t1,2,3")).is_err());
         assert!(parse_row(row).is_err());
-        assert!(parse_row(&format!("{row}\t\t\t\t")).is_err());
-        assert!(parse_row(&row.replace("SCT\t10200004", "\t10200004")).is_err());
+        assert!(parse_row(&format!("{row}\t\t\t\t1,2")).is_err());
+        assert!(parse_row(&format!("{row}\t\t\t\t1,2,300")).is_err());
+        assert!(parse_row(&format!("{row}\t\t\t\t\t1,2,3")).is_err());
+        let row = row.replace("SCT\t10200004", "\t10200004");
+        assert!(parse_row(&format!("{row}\t\t\t\t1,2,3")).is_err());
     }
 }

@@ -194,8 +194,8 @@ fn code_counts(codes: &[u16], n: usize) -> Vec<usize> {
 }
 
 /// A structure's name and colour: the file's segment, else the table's entry, else the
-/// format's convention (FreeSurfer's table for MGH), else defaults; and the codes the file
-/// gives it.
+/// format's convention (FreeSurfer's table for MGH), else (the colour) TotalSegmentator's for
+/// its classes, else defaults; and the codes the file gives it.
 fn naming(
     map: &LabelMap,
     names: &[Segment],
@@ -216,6 +216,7 @@ fn naming(
         .map_or_else(|| format!("label {value}"), str::to_string);
     let color = (sources.iter().flatten())
         .find_map(|s| s.color)
+        .or_else(|| super::color_for_name(&name))
         .unwrap_or_else(|| default_color(ordinal));
     (name, color, own.and_then(|s| s.codes.clone()))
 }

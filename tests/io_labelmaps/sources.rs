@@ -192,8 +192,11 @@ fn a_totalsegmentator_multilabel_nifti_names_its_classes_from_its_extension() {
             (64, "Portal vein and splenic vein")
         ]
     );
-    // Its colours as the file states them (TotalSegmentator cycles twelve: 2 is blue).
-    assert_eq!(structures[0].color, [0.0, 0.0, 1.0]);
+    // Not the colours its table cycles through (2 would be blue) but the ones TotalSegmentator
+    // gives its classes in DICOM: the right kidney (34, 102, 136), the liver (40, 140, 40).
+    let bytes = |s: &Structure| s.color.map(|c| (c * 255.0).round() as u8);
+    assert_eq!(bytes(&structures[0]), [34, 102, 136]);
+    assert_eq!(bytes(&structures[1]), [40, 140, 40]);
     // Its SNOMED CT codes as TotalSegmentator publishes them for its classes.
     let kidney = structures[0].codes.as_ref().expect("coded");
     assert_eq!(kidney.kind, Code::new("SCT", "64033007", "Kidney"));
