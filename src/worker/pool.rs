@@ -9,9 +9,10 @@ use std::collections::{HashMap, VecDeque};
 
 use super::{InThread, Input, Reply, Request};
 
+mod terms;
 mod view_worker;
 use crate::case::{Case, SuggestAllOptions};
-use crate::evaluate::{failed_terms, ModelRef, Offload, Request as TermsRequest, Terms};
+use crate::evaluate::{ModelRef, Request as TermsRequest, Terms};
 use crate::mesh::Mesh;
 use crate::smooth::Params;
 
@@ -381,36 +382,6 @@ impl Pool {
         self.next_job
     }
 
-    /// Sends the model and weights to every worker when they are not the ones sent last.
-    fn sync(&mut self, model: &ModelRef<'_>) {
-        let want = (model.id, model.weights_version);
-        if self.sent == Some(want) {
-            return;
-        }
-        if self.sent.map(|s| s.0) != Some(model.id) {
-            self.broadcast(&hold_request(model));
-            // Whatever waits is for another model (an opening stays: it makes the next one).
-            self.smooths.clear();
-            self.in_flight
-                .retain(|_, f| matches!(f, Flight::Load | Flight::Structure));
-            self.smoothed.clear();
-            self.terms.clear();
-        }
-        if self.sent.is_none_or(|s| s.1 != model.weights_version) {
-            self.broadcast(&weights_request(model));
-            self.terms.clear();
-            self.asked = None;
-            self.upcoming.clear();
-        }
-        self.sent = Some(want);
-    }
-
-    fn broadcast(&mut self, request: &Request) {
-        for worker in 0..self.busy.len() {
-            self.carrier.post(worker, request);
-        }
-    }
-
     /// Collects the replies and hands out work to the idle workers.
     pub fn pump(&mut self) {
         loop {
@@ -545,66 +516,5 @@ impl Pool {
         self.busy[worker] = Some(job);
         self.in_flight.insert(job, flight);
         self.carrier.post(worker, request);
-    }
-
-    fn key(model: &ModelRef<'_>, params: &Params, at: &[u32]) -> TermsKey {
-        let request: TermsRequest = (*params, at.to_vec());
-        (model.id, model.weights_version, super::encode(&request))
-    }
-}
-
-impl Offload for Pool {
-    fn measure(&mut self, model: &ModelRef<'_>, params: &Params, at: &[u32]) -> Option<Vec<Terms>> {
-        self.sync(model);
-        let key = Self::key(model, params, at);
-        self.asked = Some(key.clone());
-        self.pump();
-        let answer = self.terms.remove(&key);
-        self.waiting = answer.is_none();
-        match answer? {
-            Ok(terms) => Some(terms),
-            Err(why) => {
-                self.failure = Some(why);
-                Some(failed_terms(at.len()))
-            }
-        }
-    }
-
-    fn prefetch(&mut self, model: &ModelRef<'_>, requests: &[TermsRequest]) {
-        self.sync(model);
-        self.upcoming = requests
-            .iter()
-            .map(|(params, at)| Self::key(model, params, at))
-            .collect();
-        self.pump();
-    }
-
-    fn wants_prefetch(&self) -> bool {
-        true
-    }
-
-    fn waiting(&self) -> bool {
-        Pool::waiting(self)
-    }
-
-    fn failure(&self) -> Option<String> {
-        self.failure.clone()
-    }
-}
-
-/// The request that gives a worker the model to hold.
-fn hold_request(model: &ModelRef<'_>) -> Request {
-    Request::Hold {
-        model: model.id,
-        mesh: model.original.mesh().clone(),
-    }
-}
-
-/// The request that gives a worker the model's weights.
-fn weights_request(model: &ModelRef<'_>) -> Request {
-    Request::Weights {
-        model: model.id,
-        version: model.weights_version,
-        weights: model.weights.map(<[f32]>::to_vec),
     }
 }

@@ -53,7 +53,8 @@ impl Pool {
         let Some(view) = self.view_worker else {
             return;
         };
-        self.carrier.post(view, &super::hold_request(model));
-        self.carrier.post(view, &super::weights_request(model));
+        self.carrier.post(view, &super::terms::hold_request(model));
+        self.carrier
+            .post(view, &super::terms::weights_request(model));
     }
 }
