@@ -18,9 +18,17 @@ const ITEM: (u16, u16) = (0xFFFE, 0xE000);
 const PIXEL_DATA: (u16, u16) = (0x7FE0, 0x0010);
 const TRANSFER_SYNTAX: (u16, u16) = (0x0002, 0x0010);
 
-/// Where the DICOM stream starts (after the 128-byte preamble, or at 0 when a file has none),
-/// once every element length has been checked.
-pub(super) fn check(bytes: &[u8]) -> Result<usize, LoadError> {
+/// What the walk found: where the DICOM stream starts (after the 128-byte preamble, or at 0 when
+/// a file has none) and where the last Pixel Data value lies, so that the pixels are read from
+/// the file's bytes rather than copied into the parsed object.
+#[derive(Debug)]
+pub(super) struct Layout {
+    pub start: usize,
+    pub pixel_data: Option<std::ops::Range<usize>>,
+}
+
+/// The file's [`Layout`], once every element length has been checked.
+pub(super) fn check(bytes: &[u8]) -> Result<Layout, LoadError> {
     let start = if bytes.get(128..132) == Some(b"DICM") {
         132
     } else if bytes.starts_with(b"DICM") {
@@ -31,7 +39,11 @@ pub(super) fn check(bytes: &[u8]) -> Result<usize, LoadError> {
             detail: "no 'DICM' after a 128-byte preamble".into(),
         });
     };
-    let mut walk = Walk { bytes, at: start };
+    let mut walk = Walk {
+        bytes,
+        at: start,
+        pixel_data: None,
+    };
     let syntax = walk.meta_group()?;
     let implicit = match syntax.as_str() {
         EXPLICIT_LE => false,
@@ -39,7 +51,10 @@ pub(super) fn check(bytes: &[u8]) -> Result<usize, LoadError> {
         other => return Err(unsupported_syntax(other)),
     };
     walk.data_set(implicit)?;
-    Ok(start - 4)
+    Ok(Layout {
+        start: start - 4,
+        pixel_data: walk.pixel_data,
+    })
 }
 
 fn unsupported_syntax(uid: &str) -> LoadError {
@@ -60,6 +75,7 @@ fn unsupported_syntax(uid: &str) -> LoadError {
 struct Walk<'a> {
     bytes: &'a [u8],
     at: usize,
+    pixel_data: Option<std::ops::Range<usize>>,
 }
 
 struct Header {
@@ -115,7 +131,11 @@ impl Walk<'_> {
                 });
             }
             if !header.nested {
+                let start = self.at;
                 self.value(&header)?;
+                if header.tag == PIXEL_DATA {
+                    self.pixel_data = Some(start..self.at);
+                }
             } else if header.len != UNDEFINED {
                 self.room_for(header.len)?;
             }
@@ -255,7 +275,7 @@ mod tests {
     #[test]
     fn a_length_past_the_end_is_refused_before_parsing() {
         let good = element((0x0010, 0x0010), b"PN", b"Anon");
-        assert_eq!(check(&file(EXPLICIT_LE, &good)), Ok(128));
+        assert_eq!(check(&file(EXPLICIT_LE, &good)).map(|l| l.start), Ok(128));
         let mut lying = element((0x7FE0, 0x0010), b"OB", &[1, 2]);
         lying[8..12].copy_from_slice(&0xF000_0000u32.to_le_bytes());
         let error = check(&file(EXPLICIT_LE, &lying)).unwrap_err();

@@ -32,10 +32,12 @@ pub(super) enum Pixels {
 }
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
-    let start = dicom_lengths::check(bytes)?;
+    let layout = dicom_lengths::check(bytes)?;
+    // The pixels are read in place, not copied into the object.
     let object = OpenFileOptions::new()
         .read_preamble(ReadPreamble::Never)
-        .from_reader(&bytes[start..])
+        .read_until(tags::PIXEL_DATA)
+        .from_reader(&bytes[layout.start..])
         .map_err(|e| unsupported(format!("the DICOM object does not parse: {e}")))?;
     let sop_class = text(&object, tags::SOP_CLASS_UID).unwrap_or_default();
     if sop_class != SEGMENTATION_STORAGE {
@@ -54,10 +56,8 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     let per_frame = frame_geometry(&object, frames, &segments)?;
     let shared = first_item(&object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
     let grid = Grid::place([columns, rows], shared, &per_frame)?;
-    let data = object
-        .element(tags::PIXEL_DATA)
-        .ok()
-        .and_then(|e| e.to_bytes().ok())
+    let data = (layout.pixel_data)
+        .map(|range| &bytes[range])
         .ok_or_else(|| unsupported("no Pixel Data".into()))?;
     let frame_bytes = |pixels_in: usize| match pixels {
         Pixels::Binary => pixels_in.div_ceil(8),
@@ -73,7 +73,7 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
         });
     }
     let numbers: Vec<u16> = segments.iter().map(|s| s.0).collect();
-    let (layers, placed) = dicom_seg_grid::fill(&grid, &per_frame, &numbers, &data, pixels)?;
+    let (layers, placed) = dicom_seg_grid::fill(&grid, &per_frame, &numbers, data, pixels)?;
     Ok(LabelMap {
         dims: grid.dims,
         affine: grid.affine,

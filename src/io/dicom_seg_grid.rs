@@ -238,11 +238,12 @@ pub(super) fn fill(
         let mine: Vec<usize> = (0..frames.len())
             .filter(|&f| frames[f].segment == segment)
             .collect();
-        let set = |f: usize, p: usize| is_set(data, pixels, f * plane + p);
         let overlaps = |layer: &LabelLayer| {
             mine.iter().any(|&f| {
                 let base = grid.slices[f] * plane;
-                (0..plane).any(|p| layer.codes[base + p] != 0 && set(f, p))
+                in_segment(data, pixels, f * plane, plane, |p| {
+                    layer.codes[base + p] != 0
+                })
             })
         };
         let free = layers
@@ -260,9 +261,10 @@ pub(super) fn fill(
         layer.values.push(i64::from(segment));
         for &f in &mine {
             let base = grid.slices[f] * plane;
-            for p in (0..plane).filter(|&p| set(f, p)) {
+            in_segment(data, pixels, f * plane, plane, |p| {
                 layer.codes[base + p] = code;
-            }
+                false
+            });
         }
         placed.push(index);
     }
@@ -289,10 +291,36 @@ fn new_layer(voxels: usize, existing: usize, budget: usize) -> Result<LabelLayer
     })
 }
 
-fn is_set(data: &[u8], pixels: Pixels, pixel: usize) -> bool {
+/// Calls `visit` with each of `count` pixels from pixel `first` that is in the segment, until it
+/// returns true (then returns true). Binary frames skip zero bytes eight pixels at a time: most
+/// of a frame is outside its segment.
+fn in_segment(
+    data: &[u8],
+    pixels: Pixels,
+    first: usize,
+    count: usize,
+    mut visit: impl FnMut(usize) -> bool,
+) -> bool {
     match pixels {
-        Pixels::Binary => data[pixel / 8] & (1 << (pixel % 8)) != 0,
-        Pixels::Fractional { threshold } => data[pixel] >= threshold,
+        Pixels::Binary => {
+            let mut p = 0;
+            while p < count {
+                let bit = first + p;
+                let byte = data[bit / 8];
+                if bit.is_multiple_of(8) && byte == 0 && p + 8 <= count {
+                    p += 8;
+                    continue;
+                }
+                if byte & (1 << (bit % 8)) != 0 && visit(p) {
+                    return true;
+                }
+                p += 1;
+            }
+            false
+        }
+        Pixels::Fractional { threshold } => {
+            (0..count).any(|p| data[first + p] >= threshold && visit(p))
+        }
     }
 }
 
