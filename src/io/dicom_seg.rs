@@ -54,16 +54,17 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     let pixels = pixels(&object, options)?;
     let segments = segments(&object)?;
     let per_frame = frame_geometry(&object, frames, &segments)?;
-    let shared = first_item(&object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
-    let grid = Grid::place([columns, rows], shared, &per_frame)?;
     let data = (layout.pixel_data)
         .map(|range| &bytes[range])
         .ok_or_else(|| unsupported("no Pixel Data".into()))?;
-    let frame_bytes = |pixels_in: usize| match pixels {
-        Pixels::Binary => pixels_in.div_ceil(8),
-        Pixels::Fractional { .. } => pixels_in,
-    };
-    let needed = frame_bytes(frames * rows * columns);
+    // Checked: usize is 32 bits in the browser, and the sizes come from the file. Once the
+    // pixel data holds every frame, frame * plane + pixel fits below.
+    let pixels_in = (frames.checked_mul(rows)).and_then(|n| n.checked_mul(columns));
+    let needed = pixels_in.map(|n| match pixels {
+        Pixels::Binary => n.div_ceil(8),
+        Pixels::Fractional { .. } => n,
+    });
+    let needed = needed.unwrap_or(usize::MAX);
     if data.len() < needed {
         return Err(LoadError::CountTooLarge {
             format: FORMAT,
@@ -72,6 +73,8 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
             possible: data.len() as u64,
         });
     }
+    let shared = first_item(&object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
+    let grid = Grid::place([columns, rows], shared, &per_frame)?;
     let numbers: Vec<u16> = segments.iter().map(|s| s.0).collect();
     let (layers, placed) = dicom_seg_grid::fill(&grid, &per_frame, &numbers, data, pixels)?;
     Ok(LabelMap {
