@@ -7,6 +7,7 @@
 
 mod checks;
 mod from_files;
+mod image;
 mod pipeline;
 mod record;
 pub mod relations;
@@ -17,11 +18,14 @@ pub use from_files::{
     file_name, first_structure_file, open, open_staged, reading_stages, split_color_table,
     surface_structure, CaseOpenError,
 };
+pub use image::{check_frame, CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
 pub use pipeline::{
     smooth_structure, starts_from, suggest_all, suggest_structure, SuggestAllOptions,
     SuggestAllProgress, LEARNING_BATCH,
 };
 pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
+
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -40,6 +44,10 @@ pub struct Case {
     pub title: String,
     pub description: String,
     pub structures: Vec<CaseStructure>,
+    /// The image the segmentation was drawn on, shown under the surfaces; shared, not
+    /// copied, when the case is cloned.
+    #[serde(default)]
+    pub image: Option<Arc<CaseImage>>,
 }
 
 /// One structure of a case. Two are equal when they would be written the same: the memory of
@@ -296,6 +304,9 @@ impl Case {
         }
         if self.description.is_empty() {
             self.description = other.description;
+        }
+        if self.image.is_none() {
+            self.image = other.image;
         }
         self.structures.extend(other.structures);
     }

@@ -5,7 +5,9 @@
 
 use serde_json::{json, Value};
 
-use super::{voxel_grid, Case, CaseStructure, Smoothed};
+use std::sync::Arc;
+
+use super::{voxel_grid, Case, CaseImage, CaseStructure, Smoothed};
 use crate::io::{Affine, GltfNode, GltfScene, Mat4, StructureCodes};
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
@@ -23,6 +25,8 @@ pub enum CaseRecordError {
     Empty,
     #[error("structure '{name}': {detail}")]
     Structure { name: String, detail: String },
+    #[error("the case's image: {0}")]
+    Image(String),
 }
 
 /// A structure's record: what the platform shows beside it and what reopening restores.
@@ -82,6 +86,12 @@ pub fn from_gltf_scene(scene: GltfScene, source: &str) -> Result<Case, CaseRecor
     // conversion on the root alone: the stored positions are the case's, bit for bit (or, in a
     // compressed file, on a lattice the structure's own node scales to millimetres).
     let ours = record.is_some();
+    let image = match (record.and_then(|r| r.get("image")), scene.image_voxels) {
+        (Some(r), Some(voxels)) => Some(Arc::new(
+            CaseImage::from_record(r, voxels).map_err(CaseRecordError::Image)?,
+        )),
+        _ => None,
+    };
     let structures = scene
         .nodes
         .into_iter()
@@ -92,6 +102,7 @@ pub fn from_gltf_scene(scene: GltfScene, source: &str) -> Result<Case, CaseRecor
         title: text("title"),
         description: text("description"),
         structures,
+        image,
     })
 }
 

@@ -9,7 +9,7 @@ use super::inputs::Inputs;
 use super::params::filter as parse_filter;
 use super::progress::ProgressLine;
 use super::suggest::parse_search;
-use crate::case::{self, Case, SuggestAllOptions, SuggestAllProgress};
+use crate::case::{self, Case, SuggestAllOptions, SuggestAllProgress, WindowPreset};
 use crate::export::{self, CaseGltfOptions, Container, SceneFrame, Simplification};
 use crate::segmentation::{ExtractOptions, OpenOptions};
 use crate::smooth::Filter;
@@ -72,6 +72,18 @@ pub(super) struct BuildArgs {
     /// The level at which a float image becomes a mask.
     #[arg(long)]
     level: Option<f64>,
+    /// The image the segmentation was drawn on (CT or MRI, NIfTI), carried in the case for
+    /// the viewer to show under the surfaces; it must lie on the segmentation's voxel grid.
+    #[arg(long, value_name = "IMAGE")]
+    image: Option<PathBuf>,
+    /// The window the image's grey levels are made with: ct-soft-tissue, ct-bone, ct-lung,
+    /// ct-brain or mri-auto.
+    #[arg(long, default_value = "ct-soft-tissue", value_parser = parse_window, requires = "image")]
+    window: WindowPreset,
+    /// The most voxels the image keeps (one byte each in the case): a larger one is reduced
+    /// by the smallest whole factor that fits.
+    #[arg(long, default_value_t = case::DEFAULT_IMAGE_VOXELS, requires = "image")]
+    image_voxels: usize,
     /// Leave out the original surface (the morph target a viewer slides to, and what a
     /// reopened case smooths again from).
     #[arg(long)]
@@ -124,6 +136,15 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     super::check_destination(&args.output)?;
     let started = Instant::now();
     let mut case = open(args)?;
+    if let Some(path) = &args.image {
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        case.add_image(
+            &bytes,
+            &path.display().to_string(),
+            args.window,
+            args.image_voxels,
+        )?;
+    }
     if let Some(t) = &args.title {
         case.title = t.clone();
     }
@@ -176,6 +197,7 @@ fn build(args: &BuildArgs) -> Result<(), String> {
         outln!("{}", super::to_json(&out)?);
     } else {
         out!("{}", table(&case));
+        out!("{}", image_line(&case));
         out!("{}", case::checks_text(&case, &before, &after, &changes));
         outln!(
             "{} structures, {evaluations} parameter sets, suggested and smoothed in {:.2} s; \
@@ -234,6 +256,13 @@ fn gltf_options(args: &BuildArgs, container: Container) -> CaseGltfOptions {
             (None, None) => None,
         },
     }
+}
+
+fn parse_window(name: &str) -> Result<WindowPreset, String> {
+    WindowPreset::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = WindowPreset::ALL.iter().map(|p| p.name()).collect();
+        format!("'{name}' is not a window: {}", names.join(", "))
+    })
 }
 
 /// A percentage, or none.
@@ -320,6 +349,7 @@ fn info(file: &Path, json: bool) -> Result<(), String> {
             outln!("{}", case.description);
         }
         out!("{}", table(&case));
+        out!("{}", image_line(&case));
         let simplified: Vec<&serde_json::Value> = (written.iter())
             .map(|w| &w["simplification"])
             .filter(|r| r["simplified"] == true)
@@ -353,11 +383,40 @@ fn case_json(case: &Case) -> serde_json::Value {
             r
         })
         .collect();
+    let image = case.image.as_ref().map(|i| {
+        serde_json::json!({
+            "source": i.source,
+            "dims": i.dims,
+            "affine": i.affine.0,
+            "preset": i.preset,
+            "window": i.window,
+            "bytes": i.bytes(),
+        })
+    });
     serde_json::json!({
         "title": case.title,
         "description": case.description,
         "structures": structures,
+        "image": image,
     })
+}
+
+/// The image the case carries, in a line (empty when it has none).
+fn image_line(case: &Case) -> String {
+    let Some(i) = &case.image else {
+        return String::new();
+    };
+    format!(
+        "image: {}, {} x {} x {} voxels, window {} (centre {}, width {}), {} bytes\n",
+        i.source,
+        i.dims[0],
+        i.dims[1],
+        i.dims[2],
+        i.preset,
+        i.window.center,
+        i.window.width,
+        i.bytes()
+    )
 }
 
 fn table(case: &Case) -> String {

@@ -224,16 +224,20 @@ impl CaseWriter {
             root["matrix"] = json!(RAS_MM_TO_GLTF);
         }
         self.nodes[0] = root;
+        let mut record = json!({
+            "title": case.title,
+            "description": case.description,
+            "frame": self.options.frame.name(),
+            "units": "mm",
+            "structures": case.structures.len(),
+        });
+        if let Some(image) = &case.image {
+            record["image"] = image.record(self.b.push_blob(&image.voxels));
+        }
         let scene = json!({
             "name": title,
             "nodes": [0],
-            "extras": { CASE_KEY: {
-                "title": case.title,
-                "description": case.description,
-                "frame": self.options.frame.name(),
-                "units": "mm",
-                "structures": case.structures.len(),
-            }},
+            "extras": { CASE_KEY: record },
         });
         let document = json!({
             "asset": { "version": "2.0", "generator": concat!("meshsmooth ", env!("CARGO_PKG_VERSION")) },

@@ -48,6 +48,21 @@ impl Builder {
         self.accessors.push(accessor);
         self.accessors.len() - 1
     }
+
+    /// Appends `bytes` as a buffer view of its own, read by no accessor (a blob an extension
+    /// or `extras` names); returns the view's index.
+    pub(super) fn push_blob(&mut self, bytes: &[u8]) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": self.bin.len(),
+            "byteLength": bytes.len(),
+        }));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
 }
 
 impl Builder {

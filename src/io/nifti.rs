@@ -1,4 +1,4 @@
-//! NIfTI-1 (348-byte header) and NIfTI-2 (540-byte header) label maps, single-file `.nii` and
+//! NIfTI-1 (348-byte header) and NIfTI-2 (540-byte header) label maps and images, single-file `.nii` and
 //! `.nii.gz`, in either byte order (told by `sizeof_hdr`).
 //!
 //! The grid goes to world RAS millimetres as nibabel places it: the sform when `sform_code > 0`,
@@ -10,20 +10,53 @@ use super::label_map::LabelMapOptions;
 use super::label_map::{Affine, LabelMap};
 use super::label_map_checks::{check_affine, check_raw, check_spacing, Sample, VoxelLayout};
 use super::nifti_names;
-use super::voxels::{self, VoxelSink};
+use super::voxels::{self, Feed, VoxelSink};
 use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::Nifti;
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+    let volume = read(bytes, |layout| VoxelSink::new(layout, options, FORMAT))?;
+    let segments = match volume.extensions.len() <= nifti_names::MAX_EXTENSION_BYTES {
+        true => nifti_names::label_names(&volume.extensions, volume.big_endian),
+        false => Vec::new(),
+    };
+    Ok(LabelMap {
+        dims: volume.layout.dims,
+        affine: volume.affine,
+        layers: volume.sink.finish()?,
+        segments,
+        conventional: Vec::new(),
+    })
+}
+
+/// A file's grid and its voxels, fed into the sink the caller made for them.
+pub(super) struct Volume<S> {
+    pub layout: VoxelLayout,
+    pub affine: Affine,
+    pub sink: S,
+    /// The header extensions' bytes (empty when past [`nifti_names::MAX_EXTENSION_BYTES`]).
+    pub extensions: Vec<u8>,
+    pub big_endian: bool,
+}
+
+/// Reads a NIfTI file's header, then streams its voxels into the sink `make` builds for
+/// their layout (label codes, or an image's intensities).
+pub(super) fn read<S: Feed>(
+    bytes: &[u8],
+    make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
+) -> Result<Volume<S>, LoadError> {
     if gzip::is_gzip(bytes) {
-        parse_gzip(bytes, options)
+        read_gzip(bytes, make)
     } else {
-        parse_raw(bytes, options)
+        read_raw(bytes, make)
     }
 }
 
-fn parse_raw(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+fn read_raw<S: Feed>(
+    bytes: &[u8],
+    make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
+) -> Result<Volume<S>, LoadError> {
     let header = Header::parse(bytes)?;
     let layout = header.layout()?;
     let affine = header.affine()?;
@@ -35,25 +68,28 @@ fn parse_raw(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadEr
         detail: format!("the voxel data starts at byte {start} (vox_offset), past the end"),
     })?;
     check_raw(data_bytes, data.len(), FORMAT)?;
-    let mut sink = VoxelSink::new(&layout, options, FORMAT)?;
+    let mut sink = make(&layout)?;
     sink.feed(&data[..data_bytes as usize])?;
     let extensions = bytes.get(header.offsets.size..start).unwrap_or_default();
-    let names = match extensions.len() <= nifti_names::MAX_EXTENSION_BYTES {
-        true => nifti_names::label_names(extensions, header.big_endian),
-        false => Vec::new(),
-    };
-    Ok(LabelMap {
-        dims: layout.dims,
+    Ok(Volume {
+        layout,
         affine,
-        layers: sink.finish()?,
-        segments: names,
-        conventional: Vec::new(),
+        sink,
+        extensions: match extensions.len() <= nifti_names::MAX_EXTENSION_BYTES {
+            true => extensions.to_vec(),
+            false => Vec::new(),
+        },
+        big_endian: header.big_endian,
     })
 }
 
 /// `.nii.gz`: the header is inflated first, then the voxels stream from the same inflater
-/// straight into codes, never more than the header declares (plus one byte to notice excess).
-fn parse_gzip(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+/// straight into the sink, never more than the header declares (plus one byte to notice
+/// excess).
+fn read_gzip<S: Feed>(
+    bytes: &[u8],
+    make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
+) -> Result<Volume<S>, LoadError> {
     let mut inflater = Inflater::new(bytes, FORMAT);
     let mut head = [0u8; V2.size];
     let got = inflater.read_up_to(&mut head)?;
@@ -68,7 +104,7 @@ fn parse_gzip(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadE
     if got as u64 > total {
         return Err(inflater.too_long());
     }
-    let mut sink = VoxelSink::new(&layout, options, FORMAT)?;
+    let mut sink = make(&layout)?;
     let in_head = head.get(start..got).unwrap_or_default();
     sink.feed(in_head)?;
     let size = header.offsets.size;
@@ -84,12 +120,12 @@ fn parse_gzip(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadE
         }
     }
     voxels::decode_gzip(inflater, &mut sink, data_bytes - in_head.len() as u64)?;
-    Ok(LabelMap {
-        dims: layout.dims,
+    Ok(Volume {
+        layout,
         affine,
-        layers: sink.finish()?,
-        segments: nifti_names::label_names(&extensions, header.big_endian),
-        conventional: Vec::new(),
+        sink,
+        extensions,
+        big_endian: header.big_endian,
     })
 }
 

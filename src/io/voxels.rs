@@ -11,10 +11,22 @@ use super::label_map::{LabelLayer, LabelMapOptions, DEFAULT_LEVEL, MAX_LABELS};
 use super::label_map_checks::{Sample, VoxelLayout};
 use super::{Format, LoadError};
 
+/// What voxel bytes are decoded into: label codes ([`VoxelSink`]) or an image's intensities
+/// ([`super::intensity`]). Chunks come in file order, of any size.
+pub(super) trait Feed {
+    fn feed(&mut self, bytes: &[u8]) -> Result<(), LoadError>;
+}
+
+impl Feed for VoxelSink {
+    fn feed(&mut self, bytes: &[u8]) -> Result<(), LoadError> {
+        VoxelSink::feed(self, bytes)
+    }
+}
+
 /// Decodes the declared voxel bytes from a gzip stream into `sink`, then checks the stream ends.
 pub(super) fn decode_gzip(
     mut inflater: Inflater<'_>,
-    sink: &mut VoxelSink,
+    sink: &mut impl Feed,
     remaining: u64,
 ) -> Result<(), LoadError> {
     feed_from_gzip(&mut inflater, sink, remaining)?;
@@ -25,7 +37,7 @@ pub(super) fn decode_gzip(
 /// unread (for formats with a footer after the voxels).
 pub(super) fn feed_from_gzip(
     inflater: &mut Inflater<'_>,
-    sink: &mut VoxelSink,
+    sink: &mut impl Feed,
     mut remaining: u64,
 ) -> Result<(), LoadError> {
     let mut buf = vec![0u8; 1 << 18];

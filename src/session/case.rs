@@ -2,7 +2,9 @@
 //! structure as the author arranged and smoothed it (a mesh alone is a case of one).
 
 use super::CaseDocument;
-use crate::case::Case;
+use std::sync::Arc;
+
+use crate::case::{Case, CaseImage};
 use crate::export::{self, CaseGltfOptions};
 
 impl CaseDocument {
@@ -12,6 +14,11 @@ impl CaseDocument {
 
     pub fn case_description(&self) -> &str {
         &self.case.description
+    }
+
+    /// The image under the surfaces, where the case carries one.
+    pub fn case_image(&self) -> Option<&Arc<CaseImage>> {
+        self.case.image.as_ref()
     }
 
     /// Sets the case's title and description (`None` keeps one as it is).

@@ -234,7 +234,9 @@ impl Pool {
 
     /// Queues the checks between `case`'s structures, as opened and as shown (with the
     /// structures' jobs).
-    pub fn check_case(&mut self, case: Case) -> StructureJob {
+    pub fn check_case(&mut self, mut case: Case) -> StructureJob {
+        // The checks read the surfaces only: the image need not travel.
+        case.image = None;
         let job = self.new_job();
         let request = Request::CheckCase {
             job,

@@ -376,3 +376,27 @@ pub(super) fn read_indices(
     }
     Ok(out)
 }
+
+/// The bytes of buffer view `index` read as they are (a view holding a blob, not elements):
+/// checked to lie in its buffer, which must be loaded and not compressed.
+pub(super) fn view_bytes<'b>(
+    root: &Root,
+    compression: &Compression,
+    buffers: &'b [Option<Cow<'_, [u8]>>],
+    index: usize,
+    format: Format,
+) -> Result<&'b [u8], LoadError> {
+    let err = |detail: String| syntax(format, "buffer view", index, detail);
+    let view = (root.buffer_views.get(index)).ok_or_else(|| err("does not exist".into()))?;
+    if compression.source(index).is_some() {
+        return Err(err("is compressed, where a plain one was expected".into()));
+    }
+    let span = view_span(root, view, index, index, 1, format)?;
+    let buffer = (buffers.get(span.buffer_index))
+        .and_then(Option::as_deref)
+        .ok_or_else(|| err(format!("buffer {} holds no data", span.buffer_index)))?;
+    // The span lies within the buffer's declared length, which the loaded data holds.
+    let start = span.view_offset as usize;
+    (buffer.get(start..start + span.view_len as usize))
+        .ok_or_else(|| err("lies past the end of its buffer".into()))
+}

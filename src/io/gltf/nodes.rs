@@ -10,7 +10,7 @@ use ::gltf::json::validation::Checked;
 use ::gltf::json::Root;
 use serde_json::Value;
 
-use super::accessor::{layout, load_buffers, read_vectors, Layout};
+use super::accessor::{layout, load_buffers, read_vectors, view_bytes, Layout};
 use super::assemble::merge_loaded;
 use super::meshopt::Compression;
 use super::scene::{instances, Instance, Mat4, IDENTITY};
@@ -23,6 +23,8 @@ pub struct GltfScene {
     /// The scene's `extras`.
     pub extras: Option<Value>,
     pub nodes: Vec<GltfNode>,
+    /// The bytes of the buffer view a case's image names (`extras.meshsmooth.image.bufferView`).
+    pub image_voxels: Option<Vec<u8>>,
 }
 
 /// One node's mesh.
@@ -74,7 +76,24 @@ pub fn read_scene(bytes: &[u8], format: Format) -> Result<GltfScene, LoadError> 
         .scenes
         .get(scene)
         .and_then(|s| raw_json(s.extras.as_deref()));
-    Ok(GltfScene { extras, nodes })
+    let image_view = (extras.as_ref()).and_then(|e| {
+        e.get("meshsmooth")?
+            .get("image")?
+            .get("bufferView")?
+            .as_u64()
+    });
+    let image_voxels = match image_view {
+        Some(view) => {
+            let view = usize::try_from(view).unwrap_or(usize::MAX);
+            Some(view_bytes(&root, &compression, &buffers, view, format)?.to_vec())
+        }
+        None => None,
+    };
+    Ok(GltfScene {
+        extras,
+        nodes,
+        image_voxels,
+    })
 }
 
 /// One placed mesh of the scene as a node: its mesh in its own frame, its morph target and

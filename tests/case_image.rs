@@ -1,0 +1,219 @@
+//! The image under the surfaces: a CT on the segmentation's grid is added to the case, checked,
+//! windowed, carried through the case glTF, and its slice's edges lie where the surfaces cut.
+
+use std::sync::Arc;
+
+use meshsmooth::case::{self, from_gltf_scene, smooth_structure, Case, WindowPreset};
+use meshsmooth::export::{write_case, CaseGltfOptions};
+use meshsmooth::io::{load_gltf_scene, load_label_map, LabelMapOptions};
+
+#[path = "common/label_maps.rs"]
+mod label_maps;
+
+#[path = "common/nifti.rs"]
+mod nifti;
+
+const PHANTOM: &str = "labelmaps/case_phantom_shared.nii.gz";
+
+/// Hounsfield units by label: background, liver, portal vein, tumour, kidney. Far apart in the
+/// soft-tissue window, so every boundary is an edge in the image.
+const HU: [i16; 5] = [-150, 60, 220, -60, 150];
+
+/// A synthetic CT of the phantom: each voxel its label's HU, int16, on the label map's grid
+/// moved by `shift` mm.
+fn phantom_ct(shift: [f32; 3]) -> Vec<u8> {
+    let map = load_label_map(
+        &label_maps::read(PHANTOM),
+        PHANTOM,
+        &LabelMapOptions::default(),
+    )
+    .expect("the phantom opens");
+    let sform: [[f32; 4]; 3] = std::array::from_fn(|r| {
+        std::array::from_fn(|c| map.affine.0[r][c] as f32 + if c == 3 { shift[r] } else { 0.0 })
+    });
+    let mut bytes = nifti::nifti_header(map.dims, sform, map.spacing().map(|s| s as f32));
+    bytes[70..72].copy_from_slice(&4i16.to_le_bytes()); // int16
+    bytes[72..74].copy_from_slice(&16i16.to_le_bytes());
+    let layer = &map.layers[0];
+    for &code in &layer.codes {
+        let label = layer.values[code as usize] as usize;
+        bytes.extend_from_slice(&HU[label].to_le_bytes());
+    }
+    bytes
+}
+
+fn phantom_with_image() -> Case {
+    let mut case = label_maps::phantom_case();
+    let ct = phantom_ct([0.0; 3]);
+    case.add_image(
+        &ct,
+        "scans/ct.nii",
+        WindowPreset::CtSoftTissue,
+        case::DEFAULT_IMAGE_VOXELS,
+    )
+    .expect("the CT lies on the phantom's grid");
+    case
+}
+
+#[test]
+fn the_image_is_windowed_and_read_back_from_the_case_gltf_as_written() {
+    let case = phantom_with_image();
+    let image = case.image.as_ref().expect("added");
+    assert_eq!(image.source, "ct.nii", "the file's name only");
+    assert_eq!(image.dims, [160, 140, 48]);
+    // Soft tissue: -160 HU black, 240 HU white.
+    let grey = |hu: f32| ((hu + 160.0) / 400.0 * 255.0).round() as u8;
+    let mut levels: Vec<u8> = image.voxels.clone();
+    levels.sort_unstable();
+    levels.dedup();
+    assert_eq!(levels, {
+        let mut l: Vec<u8> = HU.iter().map(|&h| grey(f32::from(h))).collect();
+        l.sort_unstable();
+        l
+    });
+    let bytes = write_case(&case, &CaseGltfOptions::default()).expect("written");
+    let scene = load_gltf_scene(&bytes, "case.glb").expect("reads");
+    let back = from_gltf_scene(scene, "case.glb").expect("a case");
+    assert_eq!(back.image, case.image);
+    assert_eq!(back.structures.len(), case.structures.len());
+}
+
+#[test]
+fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept() {
+    let mut case = label_maps::phantom_case();
+    let before = case.clone();
+    let moved = phantom_ct([0.0, 0.0, 5.0]);
+    let error = (case.add_image(&moved, "ct.nii", WindowPreset::CtSoftTissue, 1 << 24))
+        .expect_err("moved 5 mm");
+    assert!(
+        error.contains("ct.nii") && error.contains("offset 0.000, 0.000, 5.000 mm"),
+        "{error}"
+    );
+    let error = (case.add_image(b"not a nifti", "ct.nii", WindowPreset::CtBone, 1 << 24))
+        .expect_err("garbage");
+    assert!(error.starts_with("ct.nii: NIfTI"), "{error}");
+    assert_eq!(case, before);
+    let mut surfaces = Case::default();
+    let error = (surfaces.add_image(
+        &phantom_ct([0.0; 3]),
+        "ct.nii",
+        WindowPreset::CtBone,
+        1 << 24,
+    ))
+    .expect_err("no grid");
+    assert!(error.contains("no structure from a label map"), "{error}");
+}
+
+#[test]
+fn a_large_image_is_reduced_to_the_voxels_asked_for_and_stays_in_place() {
+    let mut case = label_maps::phantom_case();
+    let ct = phantom_ct([0.0; 3]);
+    case.add_image(&ct, "ct.nii", WindowPreset::CtSoftTissue, 100_000)
+        .expect("added");
+    let image = case.image.clone().expect("added");
+    // 160 x 140 x 48 by 3: 54 x 47 x 16 = 40,608 voxels.
+    assert_eq!(image.dims, [54, 47, 16]);
+    let full = phantom_with_image().image.expect("added");
+    // The reduced grid's first cell is the mean of the full grid's first 3 x 3 x 3 voxels.
+    let centre = image.affine.apply([0.0; 3]);
+    let expected = full.affine.apply([1.0, 1.0, 1.0]);
+    assert!(
+        (0..3).all(|a| (centre[a] - expected[a]).abs() < 1e-9),
+        "{centre:?} {expected:?}"
+    );
+}
+
+/// Where each triangle of `positions` crosses the plane z = `z`: segments in the plane.
+fn cut(positions: &[[f32; 3]], triangles: &[[u32; 3]], z: f64) -> Vec<([f64; 3], [f64; 3])> {
+    let mut out = Vec::new();
+    for t in triangles {
+        let p = t.map(|v| positions[v as usize].map(f64::from));
+        let mut ends = Vec::new();
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            let (za, zb) = (p[a][2] - z, p[b][2] - z);
+            if (za < 0.0) != (zb < 0.0) {
+                let s = za / (za - zb);
+                ends.push(std::array::from_fn(|k| p[a][k] + s * (p[b][k] - p[a][k])));
+            }
+        }
+        if let [a, b] = ends[..] {
+            out.push((a, b));
+        }
+    }
+    out
+}
+
+/// For each cut segment's midpoint, how far along the outline's in-plane normal (either way)
+/// the image's grey level changes by at least `step`: the distance to the slice's edge.
+fn edge_distances(
+    image: &case::CaseImage,
+    segments: &[([f64; 3], [f64; 3])],
+    step: f32,
+) -> Vec<f64> {
+    segments
+        .iter()
+        .filter_map(|(a, b)| {
+            let mid: [f64; 3] = std::array::from_fn(|k| (a[k] + b[k]) / 2.0);
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let length = d[0].hypot(d[1]);
+            (length > 1e-6).then_some(())?;
+            let n = [-d[1] / length, d[0] / length];
+            let at = |t: f64| image.sample([mid[0] + n[0] * t, mid[1] + n[1] * t, mid[2]]);
+            (1..=40)
+                .map(|s| s as f64 * 0.05)
+                .find(|&t| match (at(t), at(-t)) {
+                    (Some(x), Some(y)) => (x - y).abs() >= step,
+                    _ => false,
+                })
+                .or(Some(f64::INFINITY))
+        })
+        .collect()
+}
+
+#[test]
+fn the_slice_edges_lie_on_the_surfaces_cut_outline_within_a_voxel() {
+    let mut case = phantom_with_image();
+    for s in &mut case.structures {
+        smooth_structure(s);
+    }
+    let image = Arc::clone(case.image.as_ref().expect("added"));
+    let voxel = 0.78;
+    // Planes through the organs at the phantom's slice centres (2.5 mm apart from -40 mm). Near
+    // a level between two slices a smoothed cap crosses the plane far (in the plane) from any
+    // edge of the interpolated image, though within a voxel of one in 3D.
+    for z in [0.0, 20.0, 37.5] {
+        for s in &case.structures {
+            let staircase = cut(&s.original.positions, &s.original.triangles, z);
+            let smoothed = cut(s.positions(), &s.original.triangles, z);
+            if staircase.is_empty() {
+                continue;
+            }
+            // The segmentation's own outline runs along the image's label boundaries: within a
+            // voxel of an edge (the trilinear slice blurs it over one), wherever it is.
+            let worst = edge_distances(&image, &staircase, 30.0)
+                .into_iter()
+                .fold(0.0, f64::max);
+            assert!(
+                worst <= voxel,
+                "{} at z = {z}: staircase {worst} mm from an edge",
+                s.name
+            );
+            // The smoothed surface's outline: within one voxel.
+            let d = edge_distances(&image, &smoothed, 30.0);
+            let within = d.iter().filter(|&&x| x <= voxel).count() as f64 / d.len() as f64;
+            let worst = d.iter().copied().fold(0.0, f64::max);
+            println!(
+                "{} z = {z}: {} cut points, {:.1}% within a voxel, worst {worst:.2} mm",
+                s.name,
+                d.len(),
+                100.0 * within
+            );
+            assert!(
+                within >= 0.99 && worst <= 1.5 * voxel,
+                "{} at z = {z}: {:.1}% of the outline within a voxel of an edge, worst {worst} mm",
+                s.name,
+                100.0 * within
+            );
+        }
+    }
+}
