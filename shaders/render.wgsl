@@ -95,6 +95,41 @@ fn fs_surface(f: SurfaceFragment, @builtin(front_facing) front: bool) -> @locati
     if dot(view.clip.xyz, f.world) > view.clip.w {
         discard;
     }
+    return shade(f, front);
+}
+
+// The surface where it meets the clipping plane, drawn over the image's slice there: within
+// this many pixels of the plane a fragment shows its structure's colour, unlit, as the cut
+// outline a radiology viewer draws on a slice.
+const CUT_LINE_PIXELS: f32 = 1.5;
+
+struct CutOutput {
+    @location(0) color: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+@fragment
+fn fs_surface_cut(f: SurfaceFragment, @builtin(front_facing) front: bool) -> CutOutput {
+    // Distance past the plane (negative on the kept side), and its change across a pixel.
+    let past = dot(view.clip.xyz, f.world) - view.clip.w;
+    let band = CUT_LINE_PIXELS * fwidth(past);
+    if past > 0.0 {
+        discard;
+    }
+    var out: CutOutput;
+    if -past <= band {
+        // Pulled towards the eye like the wireframe, to win against the slice it lies on.
+        let pulled = view.view_proj * vec4<f32>(mix(f.world, view.eye.xyz, WIRE_PULL), 1.0);
+        out.depth = pulled.z / pulled.w;
+        out.color = encode(f.albedo, 1.0);
+    } else {
+        out.depth = f.clip.z;
+        out.color = shade(f, front);
+    }
+    return out;
+}
+
+fn shade(f: SurfaceFragment, front: bool) -> vec4<f32> {
     let to_eye = normalize(view.eye.xyz - f.world);
     // Vertices without area have a zero normal: light them as if facing the eye.
     var n = to_eye;
@@ -144,6 +179,48 @@ fn fs_wire(f: WireFragment) -> @location(0) vec4<f32> {
         discard;
     }
     return encode(view.wire_color.rgb, view.wire_color.a);
+}
+
+// The image's slice on the clipping plane: a quad across the image's box, each fragment the
+// image's grey level there (trilinear), opaque. Group 1 as `slice_layout` in
+// src/app/viewer/pipelines.rs (bindings from 1: the composite's group has binding 0).
+
+// `SliceUniforms` in src/view/slice.rs, 128 bytes.
+struct Slice {
+    world_to_texture: mat4x4<f32>,
+    corners: array<vec4<f32>, 4>,
+}
+
+@group(1) @binding(1) var<uniform> slice: Slice;
+@group(1) @binding(2) var slice_image: texture_3d<f32>;
+@group(1) @binding(3) var slice_sampler: sampler;
+
+struct SliceFragment {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+}
+
+// Two triangles: corners 0, 1, 2 and 0, 2, 3.
+@vertex
+fn vs_slice(@builtin(vertex_index) index: u32) -> SliceFragment {
+    var corner = index;
+    if index >= 3u {
+        corner = select(index - 2u, 0u, index == 3u);
+    }
+    let p = slice.corners[corner].xyz;
+    return SliceFragment(view.view_proj * vec4<f32>(p, 1.0), p);
+}
+
+@fragment
+fn fs_slice(f: SliceFragment) -> @location(0) vec4<f32> {
+    let t = (slice.world_to_texture * vec4<f32>(f.world, 1.0)).xyz;
+    // Level 0 explicitly: no derivatives needed after the discard.
+    let grey = textureSampleLevel(slice_image, slice_sampler, t, 0.0).r;
+    if any(t < vec3<f32>(0.0)) || any(t > vec3<f32>(1.0)) {
+        discard;
+    }
+    // Grey levels are display values, as a radiology viewer shows them.
+    return encode(linear_from_srgb(vec3<f32>(grey)), 1.0);
 }
 
 // Composite: egui's render pass has no multisampling on the web, so the view is drawn with 4x

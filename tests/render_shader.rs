@@ -2,11 +2,14 @@
 //! struct laid out like the Rust record, and translatable to GLSL ES 3.00, as wgpu does when
 //! eframe falls back to WebGL2. No GPU needed.
 
-use meshsmooth::view::{ViewUniforms, RENDER_SHADER};
+use meshsmooth::view::{SliceUniforms, ViewUniforms, RENDER_SHADER};
 
-const ENTRY_POINTS: [(&str, naga::ShaderStage); 6] = [
+const ENTRY_POINTS: [(&str, naga::ShaderStage); 9] = [
     ("vs_surface", naga::ShaderStage::Vertex),
     ("fs_surface", naga::ShaderStage::Fragment),
+    ("fs_surface_cut", naga::ShaderStage::Fragment),
+    ("vs_slice", naga::ShaderStage::Vertex),
+    ("fs_slice", naga::ShaderStage::Fragment),
     ("vs_wire", naga::ShaderStage::Vertex),
     ("fs_wire", naga::ShaderStage::Fragment),
     ("vs_composite", naga::ShaderStage::Vertex),
@@ -70,6 +73,30 @@ fn the_view_struct_matches_the_rust_record() {
         ("background", std::mem::offset_of!(ViewUniforms, background)),
         ("clip", std::mem::offset_of!(ViewUniforms, clip)),
         ("flags", std::mem::offset_of!(ViewUniforms, flags)),
+    ];
+    let rust: Vec<(&str, u32)> = rust.iter().map(|&(n, o)| (n, o as u32)).collect();
+    assert_eq!(offsets, rust);
+}
+
+#[test]
+fn the_slice_struct_matches_the_rust_record() {
+    let (module, _) = parse_and_validate(RENDER_SHADER);
+    let (_, ty) = (module.types.iter())
+        .find(|(_, ty)| ty.name.as_deref() == Some("Slice"))
+        .expect("render.wgsl declares `struct Slice`");
+    let naga::TypeInner::Struct { members, span } = &ty.inner else {
+        panic!("Slice is not a struct");
+    };
+    assert_eq!(*span as usize, std::mem::size_of::<SliceUniforms>());
+    let offsets: Vec<(&str, u32)> = (members.iter())
+        .map(|m| (m.name.as_deref().unwrap_or(""), m.offset))
+        .collect();
+    let rust = [
+        (
+            "world_to_texture",
+            std::mem::offset_of!(SliceUniforms, world_to_texture),
+        ),
+        ("corners", std::mem::offset_of!(SliceUniforms, corners)),
     ];
     let rust: Vec<(&str, u32)> = rust.iter().map(|&(n, o)| (n, o as u32)).collect();
     assert_eq!(offsets, rust);

@@ -398,6 +398,7 @@ impl Document {
         state["brush"] = serde_json::json!({"on": v.brush_on, "pick_ms": v.pick_ms});
         state["view"] = v.rect.to_json();
         state["view"]["clip"] = serde_json::to_value(self.view_asks.clip).unwrap_or_default();
+        state["view"]["clip_plane"] = serde_json::json!(v.clip_plane);
         state["view"]["pointed"] = serde_json::json!(self.pointed);
         state["view"]["toward_segmentation"] =
             serde_json::json!(self.view_asks.toward_segmentation);

@@ -37,6 +37,8 @@ pub struct ViewReport {
     pub rect: PageRect,
     /// Where the camera is.
     pub pose: Option<CameraPose>,
+    /// The clipping plane `(n, d)` in world millimetres (`n . p > d` cut away), zero with none.
+    pub clip_plane: [f32; 4],
     pub brush_on: bool,
     pub pick_ms: Option<f64>,
 }

@@ -14,6 +14,7 @@ mod morph;
 mod orientation;
 mod param_drag;
 mod pick;
+mod slice;
 pub mod thumbnail;
 mod uniforms;
 
@@ -28,4 +29,5 @@ pub use param_drag::{
 pub use pick::{
     brush_falloff, brush_footprint, moller_trumbore, pick_triangle, pick_triangle_where, Hit, Ray,
 };
+pub use slice::{SlicePlacement, SliceTexture, SliceUniforms};
 pub use uniforms::{ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS};

@@ -9,7 +9,7 @@ import { readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 
 import * as cli from "./lib/cli.mjs";
-import { E2E_OUT, meshPath } from "./lib/paths.mjs";
+import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
 import { colourAt, decodePng } from "./lib/png.mjs";
 import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
@@ -311,4 +311,78 @@ testIn(WEBGPU_RUN, "V3 on a phone: the case under the view, one finger orbits, t
         await app.stateWhen((s) => s.structures.structures[3].visible === false, "the kidney hidden by a tap");
         await app.screenshot("V3-phone-kidney-hidden");
     }, { ...(await viewingThePhantom()), device: phone });
+});
+
+/** The phantom's case with its synthetic CT (tests/data/make_phantom_ct.py), as the CLI builds it. */
+async function phantomWithImage() {
+    const file = join(E2E_OUT, MODE, "phantom-case-ct.glb");
+    const ct = join(ROOT, "tests/data/phantom_ct.nii.gz");
+    await cli.cliJson("case", "build", PHANTOM_NRRD, "--image", ct, "--search", "local", "-o", file, "--json");
+    return readFileSync(file);
+}
+
+/** The CT's grey levels on screen (soft-tissue window): liver 60 HU, the rest of the phantom. */
+const LIVER_GREY = Math.round(((60 + 160) / 400) * 255);
+const neutral = (r, g, b) => Math.abs(r - g) <= 3 && Math.abs(g - b) <= 3;
+const liverGrey = (r, g, b) => neutral(r, g, b) && Math.abs(g - LIVER_GREY) <= 8;
+/** The liver's colour (221, 130, 101), unlit: its cut outline. */
+const liverOutline = (r, g, b) => Math.abs(r - 221) <= 24 && Math.abs(g - 130) <= 24 && Math.abs(b - 101) <= 24;
+
+testIn(EVERY_RUN, "V4 the clipping plane shows the case's CT slice, the liver's cut outline on its edges", { timeout: TIMEOUT }, async () => {
+    const bytes = await phantomWithImage();
+    await withApp(async (app) => {
+        const opened = await app.loadMesh(bytes, "V4-phantom-ct.glb", "loadCase");
+        assert.deepEqual(opened.image, { source: "phantom_ct.nii.gz", dims: [160, 140, 48], preset: "ct-soft-tissue", window: { center: 40, width: 400 } });
+        const { view } = await app.stateWhen((s) => s.layout.structures.length === 4 && s.loading === null, "the case's four rows");
+        await app.call("setView", { from: "S" });
+        const uncut = await app.screenshot("V4-from-above");
+        assert.ok(pixelsWhere(uncut, view, liverGrey).count < 50, "no slice without the plane");
+        // The plane through the middle of a slice of the CT: between two slices the image is
+        // interpolated, and where a boundary runs oblique to them (the vein) the grey changes
+        // over several voxels of the plane, though within one in 3D.
+        const planeAt = async (at, before = null) => {
+            await app.call("setView", { from: "S", clip: { axis: "axial", at } });
+            const drawn = (s) => Math.abs(s.view.clip?.at - at) < 1e-6 && s.view.clip_plane[2] === 1 && s.view.clip_plane[3] !== before;
+            return (await app.stateWhen(drawn, `the plane at ${at}`)).view.clip_plane[3];
+        };
+        const low = await planeAt(0);
+        const high = await planeAt(1, low);
+        const centre = -40 + 2.5 * Math.round(((low + high) / 2 + 40) / 2.5);
+        const middle = await planeAt((centre - low) / (high - low), high);
+        assert.ok(Math.abs(middle - centre) < 0.01, `the plane lies at z = ${middle} mm, a slice's centre ${centre}`);
+        const image = await app.screenshotWhen("V4-axial-slice", (i) => pixelsWhere(i, view, liverGrey).count > 2000, "the CT's liver on the slice");
+        const outline = pixelsWhere(image, view, liverOutline);
+        assert.ok(outline.count > 100, `the liver's outline is drawn: ${outline.count} pixels`);
+        // Each outline pixel lies on an intensity edge of the slice: within about one voxel
+        // (R pixels), its grey levels span at least EDGE (the liver's grey against the
+        // background's, the vein's or the tumour's, blurred where a boundary runs oblique to
+        // the 2.5 mm slices). The slice and the cut coincide.
+        const at = (x, y) => {
+            const i = (y * image.width + x) * 4;
+            return [image.rgba[i], image.rgba[i + 1], image.rgba[i + 2]];
+        };
+        const [R, EDGE] = [4, 40];
+        let [onEdge, all] = [0, 0];
+        for (let y = Math.round(view.y + 60); y < Math.round(view.y + view.height - 40); y++) {
+            for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) {
+                if (!liverOutline(...at(x, y))) continue;
+                all++;
+                let [low, high] = [255, 0];
+                for (let dy = -R; dy <= R; dy++) {
+                    for (let dx = -R; dx <= R; dx++) {
+                        const c = at(x + dx, y + dy);
+                        if (!neutral(...c)) continue;
+                        low = Math.min(low, c[1]);
+                        high = Math.max(high, c[1]);
+                    }
+                }
+                if (high - low >= EDGE) onEdge++;
+            }
+        }
+        console.log(JSON.stringify({ e2e: "slice-outline", mode: MODE, outline_pixels: all, on_an_edge: onEdge }));
+        assert.ok(onEdge >= 0.95 * all, `${onEdge} of ${all} outline pixels lie within ${R} pixels of an edge of the CT's slice`);
+        // A sagittal plane, seen from the side it cuts away (the patient's right).
+        await app.call("setView", { from: "R", clip: { axis: "sagittal", at: 0.6 } });
+        await app.screenshotWhen("V4-sagittal-slice", (i) => pixelsWhere(i, view, liverGrey).count > 500, "the liver on a sagittal slice");
+    }, { query: "?mode=viewer" });
 });

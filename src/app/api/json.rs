@@ -47,6 +47,12 @@ pub(crate) fn structures(case: &CaseDocument) -> Option<Value> {
         "title": case.case_title(),
         "description": case.case_description(),
         "structures": list,
+        "image": case.case_image().map(|i| json!({
+            "source": i.source,
+            "dims": i.dims,
+            "preset": i.preset,
+            "window": i.window,
+        })),
     }))
 }
 

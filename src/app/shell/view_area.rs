@@ -67,6 +67,7 @@ impl Shell {
                 doc.view = ViewReport {
                     rect: response.rect.into(),
                     pose: Some(viewer.pose()),
+                    clip_plane: viewer.clip_plane(),
                     brush_on: self.brush.active,
                     pick_ms: self.brush.pick_ms,
                 };

@@ -245,6 +245,7 @@ fn upload_looks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session
         })
         .collect();
     viewer.set_context(rs, &surfaces);
+    viewer.set_image(rs, session.case().case_image());
     let look = session.case().model_structure();
     viewer.set_model_look(
         look.map(|l| l.color),

@@ -12,8 +12,9 @@ use eframe::egui_wgpu::{self, wgpu, CallbackResources, CallbackTrait};
 use super::buffers::MeshBuffers;
 use super::context::{far_to_near, ContextMesh};
 use super::pipelines::Pipelines;
+use super::slice::SliceResources;
 use super::target::Target;
-use crate::view::ViewUniforms;
+use crate::view::{SliceUniforms, ViewUniforms};
 
 /// Everything the view keeps on the GPU, stored in egui-wgpu's type map: one view per app.
 pub struct ViewResources {
@@ -28,6 +29,9 @@ pub struct ViewResources {
     /// and a count of their changes.
     pub marks: Vec<ContextMesh>,
     pub marks_generation: u64,
+    /// The case's image, shown on the clipping plane, and a count of its changes.
+    pub slice: Option<SliceResources>,
+    pub slice_generation: u64,
     /// The per-frame record with vertex colours on, for the other structures.
     context_uniforms: wgpu::Buffer,
     context_group: wgpu::BindGroup,
@@ -44,6 +48,9 @@ struct Frame {
     mesh_generation: u64,
     context_generation: u64,
     marks_generation: u64,
+    slice_generation: u64,
+    /// Where the image's slice lies, when one is drawn.
+    slice: Option<SliceUniforms>,
     show_model: bool,
     model_closed: bool,
     size: [u32; 2],
@@ -79,6 +86,8 @@ impl ViewResources {
             context_generation: 0,
             marks: Vec::new(),
             marks_generation: 0,
+            slice: None,
+            slice_generation: 0,
             context_uniforms,
             context_group,
             target: None,
@@ -95,14 +104,22 @@ impl ViewResources {
         // A closed surface's back faces lie behind its front ones, unless a plane cuts it open:
         // not drawing them spares the rasteriser about half its work.
         let cut = frame.uniforms.clip[..3].iter().any(|&n| n != 0.0);
+        let slice = self.slice.as_ref().filter(|_| frame.slice.is_some());
         let opaque = |closed: bool| {
-            if closed && !cut {
+            if slice.is_some() {
+                &self.pipelines.surface_cut
+            } else if closed && !cut {
                 &self.pipelines.front_faces
             } else {
                 &self.pipelines.surface
             }
         };
         pass.set_bind_group(0, &self.view_group, &[]);
+        if let Some(slice) = slice {
+            pass.set_pipeline(&self.pipelines.slice);
+            pass.set_bind_group(1, &slice.group, &[]);
+            pass.draw(0..6, 0..1);
+        }
         if frame.show_model && !model_translucent {
             pass.set_pipeline(opaque(frame.model_closed));
             draw_surface(&mut pass, &self.mesh);
@@ -161,7 +178,13 @@ impl ViewResources {
         {
             let mut pass = view_pass(&mut encoder, &target);
             pass.set_bind_group(0, &self.view_group, &[]);
-            for pipeline in [&p.surface, &p.front_faces, &p.translucent, &p.over] {
+            for pipeline in [
+                &p.surface,
+                &p.front_faces,
+                &p.translucent,
+                &p.over,
+                &p.surface_cut,
+            ] {
                 pass.set_pipeline(pipeline);
                 draw_surface(&mut pass, &mesh);
             }
@@ -280,6 +303,8 @@ pub struct ViewCallback {
     pub show_model: bool,
     /// The model is closed and wound outward.
     pub model_closed: bool,
+    /// Where the image's slice lies, when the clipping plane shows one.
+    pub slice: Option<SliceUniforms>,
 }
 
 impl CallbackTrait for ViewCallback {
@@ -313,6 +338,8 @@ impl CallbackTrait for ViewCallback {
             mesh_generation: view.mesh.generation,
             context_generation: view.context_generation,
             marks_generation: view.marks_generation,
+            slice_generation: view.slice_generation,
+            slice: self.slice.filter(|_| view.slice.is_some()),
             show_model: self.show_model,
             model_closed: self.model_closed,
             size,
@@ -323,6 +350,9 @@ impl CallbackTrait for ViewCallback {
         queue.write_buffer(&view.uniforms, 0, bytemuck::bytes_of(&self.uniforms));
         let context = (self.uniforms.with_flags(crate::view::VERTEX_COLORS)).with_opacity(1.0);
         queue.write_buffer(&view.context_uniforms, 0, bytemuck::bytes_of(&context));
+        if let (Some(slice), Some(resources)) = (&frame.slice, &view.slice) {
+            queue.write_buffer(&resources.uniforms, 0, bytemuck::bytes_of(slice));
+        }
         if let Some(target) = &view.target {
             view.draw(encoder, target, &frame);
         }

@@ -16,6 +16,7 @@ mod callback;
 mod context;
 mod controls;
 mod pipelines;
+mod slice;
 mod target;
 
 pub use context::ContextSurface;
@@ -23,9 +24,12 @@ pub use context::ContextSurface;
 use eframe::egui;
 use eframe::egui_wgpu::{self, wgpu};
 
+use std::sync::Arc;
+
+use crate::case::CaseImage;
 use crate::view::{
-    first_view, CameraPose, Clip, OrbitCamera, StandardView, ViewUniforms, OUTPUT_LINEAR,
-    VERTEX_COLORS,
+    first_view, CameraPose, Clip, OrbitCamera, SlicePlacement, SliceTexture, StandardView,
+    ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS,
 };
 use callback::{ViewCallback, ViewResources};
 use glam::Vec3;
@@ -76,6 +80,8 @@ pub struct Viewer {
     scene: (Vec3, Vec3),
     /// The clipping plane, cutting every structure; `None` cuts nothing.
     pub clip: Option<Clip>,
+    /// Where the case's image lies (shown on the clipping plane), and which image it is.
+    image: Option<(usize, SlicePlacement)>,
 }
 
 /// The camera, the home view and the scene box, kept across a new model of the same scene.
@@ -132,6 +138,29 @@ impl Viewer {
             has_context: false,
             scene: (Vec3::ZERO, Vec3::ZERO),
             clip: None,
+            image: None,
+        }
+    }
+
+    /// The case's image, shown on the clipping plane (`None`: no image). Uploaded when it is
+    /// another image than the one shown, reduced to what the GPU takes along each side.
+    pub fn set_image(&mut self, rs: &egui_wgpu::RenderState, image: Option<&Arc<CaseImage>>) {
+        let key = image.map(|i| Arc::as_ptr(i) as usize);
+        if self.image.map(|(k, _)| k) == key {
+            return;
+        }
+        let max_side = rs.device.limits().max_texture_dimension_3d as usize;
+        let texture = image.map(|i| SliceTexture::new(i, max_side));
+        let result = with_resources(rs, |view| {
+            view.slice = (texture.as_ref()).map(|t| {
+                slice::SliceResources::new(&rs.device, &rs.queue, &view.pipelines.slice_layout, t)
+            });
+            view.slice_generation += 1;
+            Ok(())
+        });
+        match result {
+            Ok(()) => self.image = key.zip(texture.map(|t| t.placement)),
+            Err(e) => self.fail(e),
         }
     }
 
@@ -282,12 +311,15 @@ impl Viewer {
                 uniforms = uniforms.with_base_color([r, g, b]).with_opacity(a);
             }
             uniforms = uniforms.with_clip(self.clip_plane());
+            let slice = (self.clip.zip(self.image))
+                .and_then(|(_, (_, placement))| placement.uniforms(self.clip_plane()));
             let callback = ViewCallback {
                 rect,
                 uniforms,
                 wireframe: self.wireframe,
                 show_model: self.show_model,
                 model_closed: self.model_closed,
+                slice,
             };
             ui.painter()
                 .add(egui_wgpu::Callback::new_paint_callback(rect, callback));

@@ -11,7 +11,7 @@ use std::num::NonZeroU64;
 
 use eframe::egui_wgpu::wgpu;
 
-use crate::view::{ViewUniforms, RENDER_SHADER};
+use crate::view::{SliceUniforms, ViewUniforms, RENDER_SHADER};
 
 /// Bytes per vertex of the position and normal buffers: vec4<f32>, as the GPU engine stores
 /// positions (w ignored).
@@ -30,6 +30,8 @@ pub struct Pipelines {
     pub view_layout: wgpu::BindGroupLayout,
     /// Group 1 of the composite: the resolved image.
     pub composite_layout: wgpu::BindGroupLayout,
+    /// Group 1 of the slice: where it lies, the image and its sampler.
+    pub slice_layout: wgpu::BindGroupLayout,
     /// Lit, two-sided triangles; writes depth.
     pub surface: wgpu::RenderPipeline,
     /// The same, front faces only: for closed surfaces wound outward, none cut open.
@@ -39,6 +41,10 @@ pub struct Pipelines {
     /// The same, blended over everything whatever lies in front: marks that must show
     /// where they lie hidden (inside another structure).
     pub over: wgpu::RenderPipeline,
+    /// Two-sided surfaces over the image's slice: their cut outline drawn on it.
+    pub surface_cut: wgpu::RenderPipeline,
+    /// The image's slice on the clipping plane; opaque, writes depth.
+    pub slice: wgpu::RenderPipeline,
     /// Edges as a line list over the same positions; tests depth, writes none.
     pub wire: wgpu::RenderPipeline,
     /// The resolved image into egui's pass.
@@ -112,12 +118,15 @@ impl Pipelines {
                 wgpu::CompareFunction::Always,
                 blend,
             ),
+            surface_cut: build.surface_cut(),
+            slice: build.slice(),
             wire: build.wire(),
             composite: build.composite(egui_depth_format),
             samples,
             color_format: target_format,
             view_layout: build.view_layout,
             composite_layout: build.composite_layout,
+            slice_layout: build.slice_layout,
         }
     }
 }
@@ -129,8 +138,10 @@ struct Builder<'a> {
     module: wgpu::ShaderModule,
     view_layout: wgpu::BindGroupLayout,
     composite_layout: wgpu::BindGroupLayout,
+    slice_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
     composite_pipeline_layout: wgpu::PipelineLayout,
+    slice_pipeline_layout: wgpu::PipelineLayout,
     multisample: wgpu::MultisampleState,
     target_format: wgpu::TextureFormat,
 }
@@ -179,13 +190,22 @@ impl<'a> Builder<'a> {
                 bind_group_layouts: &[Some(&view_layout), Some(&composite_layout)],
                 immediate_size: 0,
             });
+        let slice_layout = slice_layout(device);
+        let slice_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("meshsmooth slice"),
+                bind_group_layouts: &[Some(&view_layout), Some(&slice_layout)],
+                immediate_size: 0,
+            });
         Self {
             device,
             module,
             view_layout,
             composite_layout,
+            slice_layout,
             layout,
             composite_pipeline_layout,
+            slice_pipeline_layout,
             multisample: wgpu::MultisampleState {
                 count: samples,
                 ..Default::default()
@@ -223,6 +243,35 @@ impl<'a> Builder<'a> {
         compare: wgpu::CompareFunction,
         blend: Option<wgpu::BlendState>,
     ) -> wgpu::RenderPipeline {
+        self.triangles(
+            label,
+            cull_mode,
+            Self::depth(write_depth, compare),
+            blend,
+            "fs_surface",
+        )
+    }
+
+    /// Two-sided, depth written: the surfaces beside the image's slice, outlined where cut.
+    fn surface_cut(&self) -> wgpu::RenderPipeline {
+        let depth = Self::depth(true, wgpu::CompareFunction::Less);
+        self.triangles(
+            "meshsmooth surface over a slice",
+            None,
+            depth,
+            None,
+            "fs_surface_cut",
+        )
+    }
+
+    fn triangles(
+        &self,
+        label: &str,
+        cull_mode: Option<wgpu::Face>,
+        depth_stencil: Option<wgpu::DepthStencilState>,
+        blend: Option<wgpu::BlendState>,
+        fragment: &str,
+    ) -> wgpu::RenderPipeline {
         let buffers = [
             per_vertex(VEC4_STRIDE, &POSITION),
             per_vertex(VEC4_STRIDE, &NORMAL),
@@ -243,13 +292,38 @@ impl<'a> Builder<'a> {
                 cull_mode,
                 ..Default::default()
             },
-            depth_stencil: Self::depth(write_depth, compare),
+            depth_stencil,
             multisample: self.multisample,
             fragment: Some(wgpu::FragmentState {
                 module: &self.module,
-                entry_point: Some("fs_surface"),
+                entry_point: Some(fragment),
                 compilation_options: Default::default(),
                 targets: &self.target(blend),
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    /// The image's slice: a quad from the slice record, no vertex buffers.
+    fn slice(&self) -> wgpu::RenderPipeline {
+        (self.device).create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("meshsmooth slice"),
+            layout: Some(&self.slice_pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &self.module,
+                entry_point: Some("vs_slice"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Self::depth(true, wgpu::CompareFunction::Less),
+            multisample: self.multisample,
+            fragment: Some(wgpu::FragmentState {
+                module: &self.module,
+                entry_point: Some("fs_slice"),
+                compilation_options: Default::default(),
+                targets: &self.target(None),
             }),
             multiview_mask: None,
             cache: None,
@@ -319,4 +393,40 @@ impl<'a> Builder<'a> {
             cache: None,
         })
     }
+}
+
+/// Group 1 of the slice: its record (binding 1), the image as a 3D texture of grey levels
+/// (filtered: trilinear between voxels) and its sampler.
+fn slice_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("meshsmooth slice"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: NonZeroU64::new(std::mem::size_of::<SliceUniforms>() as u64),
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D3,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    })
 }
