@@ -6,7 +6,7 @@
 
 use crate::session::{Session, Timings};
 use crate::suggest::Offload;
-use crate::view::{Clip, StandardView, ViewLink};
+use crate::view::{Clip, Planes, StandardView, ViewLink};
 use crate::worker::NamedFile;
 
 use super::layout::{PanelLayout, ViewReport};
@@ -86,6 +86,8 @@ pub enum Opening {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ViewAsks {
     pub clip: Option<Clip>,
+    /// The image's three planes, shown instead of a clip.
+    pub planes: Option<Planes>,
     pub look_from: Option<StandardView>,
     /// How far every structure is drawn back towards its segmentation (0 as smoothed).
     pub toward_segmentation: f32,
@@ -399,6 +401,7 @@ impl Document {
         state["view"] = v.rect.to_json();
         state["view"]["clip"] = serde_json::to_value(self.view_asks.clip).unwrap_or_default();
         state["view"]["clip_plane"] = serde_json::json!(v.clip_plane);
+        state["view"]["planes"] = serde_json::to_value(self.view_asks.planes).unwrap_or_default();
         state["view"]["pointed"] = serde_json::json!(self.pointed);
         state["view"]["toward_segmentation"] =
             serde_json::json!(self.view_asks.toward_segmentation);

@@ -1,5 +1,6 @@
 //! The view's own tools, over its bottom-left corner: the standard views (A P L R S I), the
-//! clipping plane (axial, coronal or sagittal, where along the scene, which side is kept) and
+//! clipping plane (axial, coronal or sagittal, where along the scene, which side is kept; or
+//! the case's image in its three planes) and
 //! the slide from the segmentation to the smoothed surfaces. The
 //! view takes them up from the document, where the API sets them too.
 
@@ -9,8 +10,9 @@ use super::document::ViewAsks;
 use crate::view::{Clip, ClipAxis, StandardView};
 
 /// Draws the tools along the bottom of `view` and records what was asked in `asks`: one row,
-/// or two on a narrow view (a phone).
-pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks) {
+/// or two on a narrow view (a phone). With the case's image, the image's three planes are one
+/// more choice.
+pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks, has_image: bool) {
     let narrow = view.width() < 560.0;
     let height = if narrow { 56.0 } else { 30.0 };
     let bar = egui::Rect::from_min_max(
@@ -26,7 +28,7 @@ pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks) {
             ui.horizontal(|ui| {
                 sides(ui, asks);
                 ui.separator();
-                clip(ui, asks);
+                clip(ui, asks, has_image);
             });
             ui.horizontal(|ui| slide(ui, asks));
         });
@@ -34,7 +36,7 @@ pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks) {
         ui.scope_builder(egui::UiBuilder::new().max_rect(bar).layout(row), |ui| {
             sides(ui, asks);
             ui.separator();
-            clip(ui, asks);
+            clip(ui, asks, has_image);
             ui.separator();
             slide(ui, asks);
         });
@@ -52,24 +54,50 @@ fn sides(ui: &mut egui::Ui, asks: &mut ViewAsks) {
     }
 }
 
-/// The clipping plane: its axis (or none), where it lies, which side is kept.
-fn clip(ui: &mut egui::Ui, asks: &mut ViewAsks) {
-    let mut axis = asks.clip.map(|c| c.axis);
+/// What the plane menu shows: nothing, a clip along an axis, or the image's three planes.
+#[derive(Clone, Copy, PartialEq)]
+enum Shown {
+    Nothing,
+    Clip(ClipAxis),
+    Planes,
+}
+
+/// The clipping plane: its axis (or none, or the image's three planes), where it lies, which
+/// side is kept.
+fn clip(ui: &mut egui::Ui, asks: &mut ViewAsks, has_image: bool) {
+    let mut shown = match (asks.planes, asks.clip) {
+        (Some(_), _) => Shown::Planes,
+        (None, Some(c)) => Shown::Clip(c.axis),
+        (None, None) => Shown::Nothing,
+    };
+    let name = |s: Shown| match s {
+        Shown::Nothing => "no clip",
+        Shown::Clip(axis) => axis.name(),
+        Shown::Planes => "3 planes",
+    };
     egui::ComboBox::from_id_salt("clip axis")
         .width(82.0)
-        .selected_text(axis.map_or("no clip", ClipAxis::name))
+        .selected_text(name(shown))
         .show_ui(ui, |ui| {
-            ui.selectable_value(&mut axis, None, "no clip");
+            ui.selectable_value(&mut shown, Shown::Nothing, "no clip");
             for a in ClipAxis::ALL {
-                ui.selectable_value(&mut axis, Some(a), a.name());
+                ui.selectable_value(&mut shown, Shown::Clip(a), a.name());
+            }
+            if has_image {
+                ui.selectable_value(&mut shown, Shown::Planes, "3 planes")
+                    .on_hover_text("The image's axial, coronal and sagittal planes together");
             }
         })
         .response
         .on_hover_text("A plane that cuts every structure, to see what lies inside");
-    asks.clip = match (axis, asks.clip) {
-        (None, _) => None,
-        (Some(a), Some(c)) => Some(Clip { axis: a, ..c }),
-        (Some(a), None) => Some(Clip {
+    asks.planes = match shown {
+        Shown::Planes => Some(asks.planes.unwrap_or_default()),
+        _ => None,
+    };
+    asks.clip = match (shown, asks.clip) {
+        (Shown::Nothing | Shown::Planes, _) => None,
+        (Shown::Clip(a), Some(c)) => Some(Clip { axis: a, ..c }),
+        (Shown::Clip(a), None) => Some(Clip {
             axis: a,
             at: 0.5,
             flip: false,

@@ -71,6 +71,41 @@ impl Clip {
     }
 }
 
+/// The image's three standard planes shown together, as radiology viewers show them: each
+/// at its place across the scene (0 at its low end, 1 at its high end) along x (sagittal),
+/// y (coronal) and z (axial). They cut nothing.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Planes {
+    pub sagittal: f32,
+    pub coronal: f32,
+    pub axial: f32,
+}
+
+impl Default for Planes {
+    fn default() -> Self {
+        Planes {
+            sagittal: 0.5,
+            coronal: 0.5,
+            axial: 0.5,
+        }
+    }
+}
+
+impl Planes {
+    /// Each plane `(n, d)` in a scene spanning `min..max`: sagittal, coronal, axial.
+    pub fn planes(&self, min: Vec3, max: Vec3) -> [[f32; 4]; 3] {
+        let at = [self.sagittal, self.coronal, self.axial];
+        std::array::from_fn(|k| {
+            let clip = Clip {
+                axis: [ClipAxis::Sagittal, ClipAxis::Coronal, ClipAxis::Axial][k],
+                at: at[k],
+                flip: false,
+            };
+            clip.plane(min, max)
+        })
+    }
+}
+
 /// The standard views: the side of the patient the eye looks from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StandardView {
@@ -138,6 +173,7 @@ impl StandardView {
 pub struct ViewRequest {
     pub from: Option<StandardView>,
     pub clip: Option<Option<Clip>>,
+    pub planes: Option<Option<Planes>>,
     /// How far every structure is drawn back towards its segmentation (0 smoothed, 1 the
     /// segmentation).
     pub toward_segmentation: Option<f32>,
@@ -171,9 +207,11 @@ impl ViewRequest {
                 },
                 "clip" if v.is_null() => out.clip = Some(None),
                 "clip" => out.clip = Some(Some(clip_from_json(v)?)),
+                "planes" if v.is_null() => out.planes = Some(None),
+                "planes" => out.planes = Some(Some(planes_from_json(v)?)),
                 other => {
                     return Err(format!(
-                        "setView: unknown key {other} (from, clip, toward_segmentation)"
+                        "setView: unknown key {other} (from, clip, planes, toward_segmentation)"
                     ))
                 }
             }
@@ -220,9 +258,60 @@ fn clip_from_json(v: &serde_json::Value) -> Result<Clip, String> {
     Ok(clip)
 }
 
+fn planes_from_json(v: &serde_json::Value) -> Result<Planes, String> {
+    let object =
+        (v.as_object()).ok_or("setView: planes takes {sagittal, coronal, axial} or null")?;
+    let mut planes = Planes::default();
+    for (key, v) in object {
+        let at = match v.as_f64() {
+            Some(at) if (0.0..=1.0).contains(&at) => at as f32,
+            _ => {
+                return Err(format!(
+                    "setView: planes {key} {v} must be a number in [0, 1]"
+                ))
+            }
+        };
+        match key.as_str() {
+            "sagittal" => planes.sagittal = at,
+            "coronal" => planes.coronal = at,
+            "axial" => planes.axial = at,
+            other => {
+                return Err(format!(
+                    "setView: unknown planes key {other} (sagittal, coronal, axial)"
+                ))
+            }
+        }
+    }
+    Ok(planes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn three_planes_lie_across_the_scene_each_along_its_axis() {
+        let (min, max) = (Vec3::new(0.0, 10.0, -50.0), Vec3::new(100.0, 30.0, 50.0));
+        let request = ViewRequest::from_json(&serde_json::json!({"planes": {"axial": 0.25}}))
+            .expect("planes");
+        let planes = request.planes.flatten().expect("set");
+        assert_eq!(
+            planes.planes(min, max),
+            [
+                [1.0, 0.0, 0.0, 50.0],
+                [0.0, 1.0, 0.0, 20.0],
+                [0.0, 0.0, 1.0, -25.0]
+            ]
+        );
+        let off = ViewRequest::from_json(&serde_json::json!({"planes": null})).expect("off");
+        assert_eq!(off.planes, Some(None));
+        for bad in [
+            serde_json::json!({"planes": {"axial": 2}}),
+            serde_json::json!({"planes": {"oblique": 0.5}}),
+        ] {
+            assert!(ViewRequest::from_json(&bad).is_err(), "{bad}");
+        }
+    }
 
     #[test]
     fn a_clip_cuts_above_its_place_along_its_axis_or_below_when_flipped() {

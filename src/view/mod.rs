@@ -19,7 +19,7 @@ pub mod thumbnail;
 mod uniforms;
 
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
-pub use clip::{Clip, ClipAxis, StandardView, ViewRequest};
+pub use clip::{Clip, ClipAxis, Planes, StandardView, ViewRequest};
 pub use link::{CameraPose, ViewLink, LINK_KEYS};
 pub use morph::toward_original;
 pub use orientation::{face_on_direction, first_view};

@@ -384,5 +384,20 @@ testIn(EVERY_RUN, "V4 the clipping plane shows the case's CT slice, the liver's 
         // A sagittal plane, seen from the side it cuts away (the patient's right).
         await app.call("setView", { from: "R", clip: { axis: "sagittal", at: 0.6 } });
         await app.screenshotWhen("V4-sagittal-slice", (i) => pixelsWhere(i, view, liverGrey).count > 500, "the liver on a sagittal slice");
+        // The three planes together, through the scene's middle; they replace the clip.
+        await app.call("setView", { from: "A", planes: { axial: 0.75 } });
+        let state = await app.stateWhen((s) => s.view.planes !== null, "the three planes");
+        assert.deepEqual(state.view.planes, { sagittal: 0.5, coronal: 0.5, axial: 0.75 });
+        assert.equal(state.view.clip, null, "no clip with the planes");
+        // They cut nothing: the liver hides its own grey on the coronal plane until hidden.
+        await app.screenshot("V4-three-planes");
+        const liverRow = state.layout.structures[0];
+        await app.page.mouse.click(liverRow.visible.x + liverRow.visible.width / 2, liverRow.visible.y + liverRow.visible.height / 2);
+        await app.stateWhen((s) => s.structures.structures[0].visible === false, "the liver hidden");
+        await app.screenshotWhen("V4-three-planes-liver-hidden", (i) => pixelsWhere(i, view, liverGrey).count > 2000, "the liver's grey on the coronal plane");
+        await app.call("setView", { clip: { axis: "axial" } });
+        state = await app.stateWhen((s) => s.view.clip !== null, "a clip again");
+        assert.equal(state.view.planes, null, "a clip replaces the planes");
+        await assert.rejects(app.call("setView", { planes: { oblique: 0.5 } }), /unknown planes key oblique/);
     }, { query: "?mode=viewer" });
 });

@@ -23,8 +23,18 @@ pub(super) fn set_view(
         if let Some(side) = request.from {
             doc.view_asks.look_from = Some(side);
         }
+        // A clip and the three planes are shown one at a time.
         if let Some(clip) = request.clip {
             doc.view_asks.clip = clip;
+            if clip.is_some() {
+                doc.view_asks.planes = None;
+            }
+        }
+        if let Some(planes) = request.planes {
+            doc.view_asks.planes = planes;
+            if planes.is_some() {
+                doc.view_asks.clip = None;
+            }
         }
         if let Some(t) = request.toward_segmentation {
             doc.view_asks.toward_segmentation = t;

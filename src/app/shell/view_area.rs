@@ -31,6 +31,7 @@ impl Shell {
                 let mut doc = self.doc.borrow_mut();
                 let doc = &mut *doc;
                 viewer.clip = doc.view_asks.clip;
+                viewer.planes = doc.view_asks.planes;
                 if let Some(side) = doc.view_asks.look_from.take() {
                     viewer.look_from(side);
                 }
@@ -50,7 +51,8 @@ impl Shell {
                 orientation_marker::paint(ui, response.rect, viewer.camera());
                 // A picture shows the view alone (and which way the patient lies).
                 if !self.picture.pending {
-                    view_tools::show(ui, response.rect, &mut doc.view_asks);
+                    let has_image = doc.case().case_image().is_some();
+                    view_tools::show(ui, response.rect, &mut doc.view_asks, has_image);
                 }
                 if doc.view_asks != asked {
                     ui.ctx().request_repaint();

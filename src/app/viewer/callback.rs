@@ -12,7 +12,7 @@ use eframe::egui_wgpu::{self, wgpu, CallbackResources, CallbackTrait};
 use super::buffers::MeshBuffers;
 use super::context::{far_to_near, ContextMesh};
 use super::pipelines::Pipelines;
-use super::slice::SliceResources;
+use super::slice::{SliceResources, SLICES};
 use super::target::Target;
 use crate::view::{SliceUniforms, ViewUniforms};
 
@@ -49,8 +49,10 @@ struct Frame {
     context_generation: u64,
     marks_generation: u64,
     slice_generation: u64,
-    /// Where the image's slice lies, when one is drawn.
-    slice: Option<SliceUniforms>,
+    /// Where the image's slices lie, those drawn.
+    slices: [Option<SliceUniforms>; SLICES],
+    /// The surfaces draw their cut outline on the clip's slice.
+    outlined: bool,
     show_model: bool,
     model_closed: bool,
     size: [u32; 2],
@@ -104,9 +106,8 @@ impl ViewResources {
         // A closed surface's back faces lie behind its front ones, unless a plane cuts it open:
         // not drawing them spares the rasteriser about half its work.
         let cut = frame.uniforms.clip[..3].iter().any(|&n| n != 0.0);
-        let slice = self.slice.as_ref().filter(|_| frame.slice.is_some());
         let opaque = |closed: bool| {
-            if slice.is_some() {
+            if frame.outlined {
                 &self.pipelines.surface_cut
             } else if closed && !cut {
                 &self.pipelines.front_faces
@@ -115,10 +116,15 @@ impl ViewResources {
             }
         };
         pass.set_bind_group(0, &self.view_group, &[]);
-        if let Some(slice) = slice {
+        if let Some(resources) = &self.slice {
             pass.set_pipeline(&self.pipelines.slice);
-            pass.set_bind_group(1, &slice.group, &[]);
-            pass.draw(0..6, 0..1);
+            for ((_, group), _) in (resources.slices.iter())
+                .zip(&frame.slices)
+                .filter(|(_, s)| s.is_some())
+            {
+                pass.set_bind_group(1, group, &[]);
+                pass.draw(0..6, 0..1);
+            }
         }
         if frame.show_model && !model_translucent {
             pass.set_pipeline(opaque(frame.model_closed));
@@ -303,8 +309,10 @@ pub struct ViewCallback {
     pub show_model: bool,
     /// The model is closed and wound outward.
     pub model_closed: bool,
-    /// Where the image's slice lies, when the clipping plane shows one.
-    pub slice: Option<SliceUniforms>,
+    /// Where the image's slices lie: the clipping plane's, or the three standard planes.
+    pub slices: [Option<SliceUniforms>; SLICES],
+    /// The surfaces draw their cut outline on the clip's slice.
+    pub outlined: bool,
 }
 
 impl CallbackTrait for ViewCallback {
@@ -339,7 +347,11 @@ impl CallbackTrait for ViewCallback {
             context_generation: view.context_generation,
             marks_generation: view.marks_generation,
             slice_generation: view.slice_generation,
-            slice: self.slice.filter(|_| view.slice.is_some()),
+            slices: match view.slice {
+                Some(_) => self.slices,
+                None => [None; SLICES],
+            },
+            outlined: self.outlined && view.slice.is_some(),
             show_model: self.show_model,
             model_closed: self.model_closed,
             size,
@@ -350,8 +362,12 @@ impl CallbackTrait for ViewCallback {
         queue.write_buffer(&view.uniforms, 0, bytemuck::bytes_of(&self.uniforms));
         let context = (self.uniforms.with_flags(crate::view::VERTEX_COLORS)).with_opacity(1.0);
         queue.write_buffer(&view.context_uniforms, 0, bytemuck::bytes_of(&context));
-        if let (Some(slice), Some(resources)) = (&frame.slice, &view.slice) {
-            queue.write_buffer(&resources.uniforms, 0, bytemuck::bytes_of(slice));
+        if let Some(resources) = &view.slice {
+            for ((buffer, _), slice) in resources.slices.iter().zip(&frame.slices) {
+                if let Some(slice) = slice {
+                    queue.write_buffer(buffer, 0, bytemuck::bytes_of(slice));
+                }
+            }
         }
         if let Some(target) = &view.target {
             view.draw(encoder, target, &frame);

@@ -28,8 +28,8 @@ use std::sync::Arc;
 
 use crate::case::CaseImage;
 use crate::view::{
-    first_view, CameraPose, Clip, OrbitCamera, SlicePlacement, SliceTexture, StandardView,
-    ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS,
+    first_view, CameraPose, Clip, OrbitCamera, Planes, SlicePlacement, SliceTexture, SliceUniforms,
+    StandardView, ViewUniforms, OUTPUT_LINEAR, VERTEX_COLORS,
 };
 use callback::{ViewCallback, ViewResources};
 use glam::Vec3;
@@ -80,6 +80,8 @@ pub struct Viewer {
     scene: (Vec3, Vec3),
     /// The clipping plane, cutting every structure; `None` cuts nothing.
     pub clip: Option<Clip>,
+    /// The image's three planes, shown (with no clip) where the case has an image.
+    pub planes: Option<Planes>,
     /// Where the case's image lies (shown on the clipping plane), and which image it is.
     image: Option<(usize, SlicePlacement)>,
 }
@@ -138,6 +140,7 @@ impl Viewer {
             has_context: false,
             scene: (Vec3::ZERO, Vec3::ZERO),
             clip: None,
+            planes: None,
             image: None,
         }
     }
@@ -311,15 +314,15 @@ impl Viewer {
                 uniforms = uniforms.with_base_color([r, g, b]).with_opacity(a);
             }
             uniforms = uniforms.with_clip(self.clip_plane());
-            let slice = (self.clip.zip(self.image))
-                .and_then(|(_, (_, placement))| placement.uniforms(self.clip_plane()));
+            let (slices, outlined) = self.slices();
             let callback = ViewCallback {
                 rect,
                 uniforms,
                 wireframe: self.wireframe,
                 show_model: self.show_model,
                 model_closed: self.model_closed,
-                slice,
+                slices,
+                outlined,
             };
             ui.painter()
                 .add(egui_wgpu::Callback::new_paint_callback(rect, callback));
@@ -328,6 +331,22 @@ impl Viewer {
             }
         }
         response
+    }
+
+    /// Where the image's slices lie this frame, and whether the surfaces outline their cut on
+    /// the clip's.
+    fn slices(&self) -> ([Option<SliceUniforms>; 3], bool) {
+        let Some((_, placement)) = self.image else {
+            return ([None; 3], false);
+        };
+        if let Some(planes) = self.planes.filter(|_| self.clip.is_none()) {
+            let planes = planes.planes(self.scene.0, self.scene.1);
+            return (planes.map(|p| placement.uniforms(p)), false);
+        }
+        let clipped = self
+            .clip
+            .and_then(|_| placement.uniforms(self.clip_plane()));
+        ([clipped, None, None], clipped.is_some())
     }
 
     /// The camera, the home view and the scene, to keep across a new model of the same scene.

@@ -5,9 +5,12 @@ use eframe::egui_wgpu::wgpu;
 
 use crate::view::{SliceTexture, SliceUniforms};
 
+/// Slices drawn at once: the clip's, or the three standard planes.
+pub const SLICES: usize = 3;
+
+/// The image's texture and, per slice, its record and bind group.
 pub struct SliceResources {
-    pub group: wgpu::BindGroup,
-    pub uniforms: wgpu::Buffer,
+    pub slices: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
 }
 
 impl SliceResources {
@@ -49,31 +52,36 @@ impl SliceResources {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("meshsmooth slice"),
-            size: std::mem::size_of::<SliceUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("meshsmooth slice"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: uniforms.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&sampler),
-                },
-            ],
-        });
-        Self { group, uniforms }
+        let slice = || {
+            let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("meshsmooth slice"),
+                size: std::mem::size_of::<SliceUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("meshsmooth slice"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: uniforms.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::Sampler(&sampler),
+                    },
+                ],
+            });
+            (uniforms, group)
+        };
+        Self {
+            slices: (0..SLICES).map(|_| slice()).collect(),
+        }
     }
 }
