@@ -19,6 +19,9 @@ fn check_case(data: &[u8]) {
     let Ok(case) = meshsmooth::case::from_gltf_scene(scene, "fuzz.glb") else {
         return;
     };
+    if let Some(image) = &case.image {
+        assert_eq!(image.voxels.len(), image.dims.iter().product::<usize>());
+    }
     for s in &case.structures {
         let n = s.original.positions.len();
         assert!(s
