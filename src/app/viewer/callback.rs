@@ -184,13 +184,8 @@ impl ViewResources {
         {
             let mut pass = view_pass(&mut encoder, &target);
             pass.set_bind_group(0, &self.view_group, &[]);
-            for pipeline in [
-                &p.surface,
-                &p.front_faces,
-                &p.translucent,
-                &p.over,
-                &p.surface_cut,
-            ] {
+            // Not the slice's pipelines: only a case with an image uses them.
+            for pipeline in [&p.surface, &p.front_faces, &p.translucent, &p.over] {
                 pass.set_pipeline(pipeline);
                 draw_surface(&mut pass, &mesh);
             }
