@@ -2,7 +2,9 @@
 //! (a whole factor along every axis) gathers the mean of the voxels it covers, so a whole-body
 //! CT never costs more memory than the reduced image a student is given.
 
-use super::label_map_checks::{Sample, VoxelLayout};
+use std::convert::Infallible;
+
+use super::label_map_checks::{for_each_sample, VoxelLayout};
 use super::voxels::Feed;
 use super::{Format, LoadError};
 
@@ -111,31 +113,18 @@ impl IntensitySink {
     }
 
     fn decode(&mut self, bytes: &[u8]) {
-        let big = self.layout.big_endian;
-        let (slope, inter) = (self.layout.slope, self.layout.inter);
-        macro_rules! run {
-            ($t:ty, $n:literal) => {{
-                let (samples, _) = bytes.as_chunks::<$n>();
-                for s in samples {
-                    let v = if big {
-                        <$t>::from_be_bytes(*s)
-                    } else {
-                        <$t>::from_le_bytes(*s)
-                    };
-                    self.push(v as f64 * slope + inter);
-                }
-            }};
-        }
-        match self.layout.sample {
-            Sample::U8 => run!(u8, 1),
-            Sample::I8 => run!(i8, 1),
-            Sample::U16 => run!(u16, 2),
-            Sample::I16 => run!(i16, 2),
-            Sample::U32 => run!(u32, 4),
-            Sample::I32 => run!(i32, 4),
-            Sample::F32 => run!(f32, 4),
-            Sample::F64 => run!(f64, 8),
-        }
+        let VoxelLayout {
+            sample,
+            big_endian,
+            slope,
+            inter,
+            ..
+        } = self.layout;
+        let decoded = for_each_sample(bytes, sample, big_endian, |v| {
+            self.push(v.scaled(slope, inter));
+            Ok::<(), Infallible>(())
+        });
+        let Ok(()) = decoded;
     }
 }
 
@@ -171,6 +160,7 @@ fn reduction_factor(dims: [usize; 3], max_voxels: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::label_map_checks::Sample;
 
     fn layout(dims: [usize; 3], sample: Sample) -> VoxelLayout {
         VoxelLayout {

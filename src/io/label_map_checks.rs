@@ -53,6 +53,59 @@ impl Sample {
     }
 }
 
+/// One voxel sample as stored: an integer exactly, or a real number.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Value {
+    Int(i64),
+    Real(f64),
+}
+
+impl Value {
+    /// The value after a file's scaling (`value * slope + inter`).
+    #[inline]
+    pub(super) fn scaled(self, slope: f64, inter: f64) -> f64 {
+        match self {
+            Value::Int(v) => v as f64 * slope + inter,
+            Value::Real(v) => v * slope + inter,
+        }
+    }
+}
+
+/// Calls `f` with each whole sample of `bytes` (a trailing part sample is left alone), the
+/// sample type and byte order chosen once per call rather than once per voxel.
+#[inline]
+pub(super) fn for_each_sample<E>(
+    bytes: &[u8],
+    sample: Sample,
+    big_endian: bool,
+    mut f: impl FnMut(Value) -> Result<(), E>,
+) -> Result<(), E> {
+    macro_rules! run {
+        ($t:ty, $n:literal, $wrap:expr) => {{
+            let (samples, _) = bytes.as_chunks::<$n>();
+            for s in samples {
+                let v = if big_endian {
+                    <$t>::from_be_bytes(*s)
+                } else {
+                    <$t>::from_le_bytes(*s)
+                };
+                f($wrap(v))?;
+            }
+        }};
+    }
+    match sample {
+        Sample::U8 => run!(u8, 1, |v| Value::Int(i64::from(v))),
+        Sample::I8 => run!(i8, 1, |v| Value::Int(i64::from(v))),
+        Sample::U16 => run!(u16, 2, |v| Value::Int(i64::from(v))),
+        Sample::I16 => run!(i16, 2, |v| Value::Int(i64::from(v))),
+        Sample::U32 => run!(u32, 4, |v| Value::Int(i64::from(v))),
+        Sample::I32 => run!(i32, 4, |v| Value::Int(i64::from(v))),
+        Sample::F32 => run!(f32, 4, |v| Value::Real(f64::from(v))),
+        Sample::F64 => run!(f64, 8, Value::Real),
+    }
+    Ok(())
+}
+
 /// How a file lays out its voxel values: the grid, the layers and the encoding of each value.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct VoxelLayout {

@@ -8,7 +8,7 @@ use std::collections::HashMap;
 
 use super::gzip::Inflater;
 use super::label_map::{LabelLayer, LabelMapOptions, DEFAULT_LEVEL, MAX_LABELS};
-use super::label_map_checks::{Sample, VoxelLayout};
+use super::label_map_checks::{for_each_sample, Value, VoxelLayout};
 use super::{Format, LoadError};
 
 /// What voxel bytes are decoded into: label codes ([`VoxelSink`]) or an image's intensities
@@ -362,46 +362,16 @@ fn too_many(format: Format, layer: usize) -> LoadError {
     }
 }
 
-/// Decodes whole samples of one layer, the sample type chosen once per run.
+/// Decodes whole samples of one layer: integers exactly where `exact`, else after scaling.
 fn decode_run(
     layer: &mut LayerCoder,
     bytes: &[u8],
     layout: &VoxelLayout,
     exact: bool,
 ) -> Result<(), TooManyLabels> {
-    let big = layout.big_endian;
     let (slope, inter) = (layout.slope, layout.inter);
-    macro_rules! run {
-        ($t:ty, $n:literal, $push:ident, $conv:expr) => {{
-            let (samples, _) = bytes.as_chunks::<$n>();
-            for s in samples {
-                let v = if big {
-                    <$t>::from_be_bytes(*s)
-                } else {
-                    <$t>::from_le_bytes(*s)
-                };
-                layer.$push($conv(v))?;
-            }
-        }};
-    }
-    macro_rules! int {
-        ($t:ty, $n:literal) => {
-            if exact {
-                run!($t, $n, push_label, |v: $t| v as i64)
-            } else {
-                run!($t, $n, push_real, |v: $t| v as f64 * slope + inter)
-            }
-        };
-    }
-    match layout.sample {
-        Sample::U8 => int!(u8, 1),
-        Sample::I8 => int!(i8, 1),
-        Sample::U16 => int!(u16, 2),
-        Sample::I16 => int!(i16, 2),
-        Sample::U32 => int!(u32, 4),
-        Sample::I32 => int!(i32, 4),
-        Sample::F32 => run!(f32, 4, push_real, |v: f32| v as f64 * slope + inter),
-        Sample::F64 => run!(f64, 8, push_real, |v: f64| v * slope + inter),
-    }
-    Ok(())
+    for_each_sample(bytes, layout.sample, layout.big_endian, |v| match v {
+        Value::Int(v) if exact => layer.push_label(v),
+        v => layer.push_real(v.scaled(slope, inter)),
+    })
 }
