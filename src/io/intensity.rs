@@ -8,14 +8,85 @@ use super::label_map_checks::{for_each_sample, VoxelLayout};
 use super::voxels::Feed;
 use super::{Format, LoadError};
 
-/// Decodes one volume's samples (after the file's scaling) and sums them into cells.
-pub(super) struct IntensitySink {
-    layout: VoxelLayout,
+/// A grid's values summed into the cells of a coarser grid, a whole `factor` along every axis,
+/// in the order a file stores them (`i` fastest); each cell ends as the mean of what it covers.
+pub struct BlockMeans {
+    dims: [usize; 3],
     factor: usize,
     reduced: [usize; 3],
     sums: Vec<f32>,
     /// The next voxel's `i, j, k`.
     at: [usize; 3],
+}
+
+impl BlockMeans {
+    /// `None` when the reduced grid's memory cannot be had.
+    pub fn new(dims: [usize; 3], factor: usize) -> Option<Self> {
+        let factor = factor.max(1);
+        let reduced = dims.map(|d| d.div_ceil(factor));
+        let cells = reduced.iter().product::<usize>();
+        let mut sums = Vec::new();
+        sums.try_reserve_exact(cells).ok()?;
+        sums.resize(cells, 0.0);
+        Some(Self {
+            dims,
+            factor,
+            reduced,
+            sums,
+            at: [0; 3],
+        })
+    }
+
+    /// Adds the next voxel's value; not-a-number voxels (outside a resampled field of view)
+    /// count as 0, and values past the grid's end are ignored.
+    #[inline]
+    pub fn push(&mut self, value: f32) {
+        let [i, j, k] = self.at;
+        let dims = self.dims;
+        if k >= dims[2] {
+            return;
+        }
+        let f = self.factor;
+        let cell = (k / f * self.reduced[1] + j / f) * self.reduced[0] + i / f;
+        self.sums[cell] += if value.is_finite() { value } else { 0.0 };
+        self.at = if i + 1 < dims[0] {
+            [i + 1, j, k]
+        } else if j + 1 < dims[1] {
+            [0, j + 1, k]
+        } else {
+            [0, 0, k + 1]
+        };
+    }
+
+    /// How many voxels have come.
+    pub fn pushed(&self) -> usize {
+        let [i, j, k] = self.at;
+        (k * self.dims[1] + j) * self.dims[0] + i
+    }
+
+    /// The reduced grid's size and its cells' means.
+    pub fn finish(self) -> ([usize; 3], Vec<f32>) {
+        let (f, dims, reduced) = (self.factor, self.dims, self.reduced);
+        // Cells at the far ends may cover fewer voxels than `factor` along an axis.
+        let covered = |axis: usize, cell: usize| (dims[axis] - cell * f).min(f) as f32;
+        let mut sums = self.sums;
+        for k in 0..reduced[2] {
+            for j in 0..reduced[1] {
+                let row = (k * reduced[1] + j) * reduced[0];
+                let jk = covered(1, j) * covered(2, k);
+                for i in 0..reduced[0] {
+                    sums[row + i] /= covered(0, i) * jk;
+                }
+            }
+        }
+        (reduced, sums)
+    }
+}
+
+/// Decodes one volume's samples (after the file's scaling) into [`BlockMeans`].
+pub(super) struct IntensitySink {
+    layout: VoxelLayout,
+    means: BlockMeans,
     /// The start of a sample split between two chunks.
     pending: Vec<u8>,
 }
@@ -39,77 +110,36 @@ impl IntensitySink {
             });
         }
         let factor = reduction_factor(layout.dims, max_voxels);
-        let reduced = layout.dims.map(|d| d.div_ceil(factor));
-        let cells = reduced.iter().product::<usize>();
-        let mut sums = Vec::new();
-        sums.try_reserve_exact(cells)
-            .map_err(|_| LoadError::Unsupported {
+        let means = BlockMeans::new(layout.dims, factor).ok_or_else(|| {
+            let cells: usize = layout.dims.map(|d| d.div_ceil(factor)).iter().product();
+            LoadError::Unsupported {
                 format,
                 detail: format!("cannot allocate {} bytes for the image", cells * 4),
-            })?;
-        sums.resize(cells, 0.0);
+            }
+        })?;
         Ok(Self {
             layout: *layout,
-            factor,
-            reduced,
-            sums,
-            at: [0; 3],
+            means,
             pending: Vec::new(),
         })
     }
 
     /// The factor the grid is reduced by along each axis.
     pub(super) fn factor(&self) -> usize {
-        self.factor
+        self.means.factor
     }
 
     /// The reduced grid's size and its cells' mean intensities, once every voxel has come.
     pub(super) fn finish(self, format: Format) -> Result<([usize; 3], Vec<f32>), LoadError> {
-        if self.at[2] < self.layout.dims[2] {
-            let plane = self.layout.dims[0] * self.layout.dims[1];
-            let read = self.at[2] * plane + self.at[1] * self.layout.dims[0] + self.at[0];
+        let (read, voxels) = (self.means.pushed(), self.layout.voxel_count());
+        if read < voxels {
             return Err(LoadError::Truncated {
                 format,
                 offset: 0,
-                detail: format!(
-                    "the voxel data ends after {read} of {} voxels",
-                    self.layout.voxel_count()
-                ),
+                detail: format!("the voxel data ends after {read} of {voxels} voxels"),
             });
         }
-        let (f, dims, reduced) = (self.factor, self.layout.dims, self.reduced);
-        // Cells at the far ends may cover fewer voxels than `factor` along an axis.
-        let covered = |axis: usize, cell: usize| (dims[axis] - cell * f).min(f) as f32;
-        let mut sums = self.sums;
-        for k in 0..reduced[2] {
-            for j in 0..reduced[1] {
-                let row = (k * reduced[1] + j) * reduced[0];
-                let jk = covered(1, j) * covered(2, k);
-                for i in 0..reduced[0] {
-                    sums[row + i] /= covered(0, i) * jk;
-                }
-            }
-        }
-        Ok((reduced, sums))
-    }
-
-    fn push(&mut self, value: f64) {
-        let [i, j, k] = self.at;
-        let dims = self.layout.dims;
-        if k >= dims[2] {
-            return;
-        }
-        let f = self.factor;
-        let cell = (k / f * self.reduced[1] + j / f) * self.reduced[0] + i / f;
-        // Not-a-number voxels (outside a resampled field of view) count as 0.
-        self.sums[cell] += if value.is_finite() { value as f32 } else { 0.0 };
-        self.at = if i + 1 < dims[0] {
-            [i + 1, j, k]
-        } else if j + 1 < dims[1] {
-            [0, j + 1, k]
-        } else {
-            [0, 0, k + 1]
-        };
+        Ok(self.means.finish())
     }
 
     fn decode(&mut self, bytes: &[u8]) {
@@ -121,7 +151,7 @@ impl IntensitySink {
             ..
         } = self.layout;
         let decoded = for_each_sample(bytes, sample, big_endian, |v| {
-            self.push(v.scaled(slope, inter));
+            self.means.push(v.scaled(slope, inter) as f32);
             Ok::<(), Infallible>(())
         });
         let Ok(()) = decoded;

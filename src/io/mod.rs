@@ -34,6 +34,7 @@ pub use color_table::{is_color_table, parse_color_table, LabelEntry};
 pub use error::{LoadError, Location};
 pub use gltf::{GltfNode, GltfScene, Mat4};
 pub use image::{load_image, reduced_affine, ImageVolume};
+pub use intensity::BlockMeans;
 pub use label_map::{Affine, LabelLayer, LabelMap, LabelMapOptions, Segment, MAX_LABELS};
 pub use nifti_names::readable as readable_class_name;
 pub use read_label_map::{is_label_map, load_label_map};

@@ -8,7 +8,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec4, Vec3};
 
 use crate::case::CaseImage;
-use crate::io::{reduced_affine, Affine};
+use crate::io::{reduced_affine, Affine, BlockMeans};
 
 /// `Slice` in shaders/render.wgsl, 128 bytes.
 #[repr(C)]
@@ -40,14 +40,15 @@ pub struct SlicePlacement {
 }
 
 impl<'a> SliceTexture<'a> {
-    /// `image`, reduced by the smallest whole factor that leaves no side past `max_side`.
-    pub fn new(image: &'a CaseImage, max_side: usize) -> Self {
+    /// `image`, reduced by the smallest whole factor that leaves no side past `max_side`;
+    /// `None` when the reduced texture's memory cannot be had.
+    pub fn new(image: &'a CaseImage, max_side: usize) -> Option<Self> {
         let longest = image.dims.iter().copied().max().unwrap_or(1);
         let factor = longest.div_ceil(max_side.max(1)).max(1);
         let (dims, voxels, affine) = if factor == 1 {
             (image.dims, Cow::Borrowed(&image.voxels[..]), image.affine)
         } else {
-            let (dims, voxels) = block_means(image.dims, &image.voxels, factor);
+            let (dims, voxels) = block_means(image.dims, &image.voxels, factor)?;
             (
                 dims,
                 Cow::Owned(voxels),
@@ -61,7 +62,7 @@ impl<'a> SliceTexture<'a> {
             DMat4::from_scale(1.0 / size) * DMat4::from_translation(glam::DVec3::splat(0.5));
         let world_to_texture = index_to_texture * index_to_world.inverse();
         let (min, max) = outer_box(&affine, dims);
-        SliceTexture {
+        Some(SliceTexture {
             dims,
             voxels,
             placement: SlicePlacement {
@@ -69,7 +70,7 @@ impl<'a> SliceTexture<'a> {
                 min,
                 max,
             },
-        }
+        })
     }
 }
 
@@ -132,25 +133,15 @@ fn outer_box(affine: &Affine, dims: [usize; 3]) -> (Vec3, Vec3) {
     (min, max)
 }
 
-/// Means of `factor`-sided blocks (fewer voxels at the far ends).
-fn block_means(dims: [usize; 3], voxels: &[u8], factor: usize) -> ([usize; 3], Vec<u8>) {
-    let out = dims.map(|d| d.div_ceil(factor));
-    let mut sums = vec![0u32; out.iter().product()];
-    let mut counts = vec![0u32; sums.len()];
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            let row = (k * dims[1] + j) * dims[0];
-            let cell_row = (k / factor * out[1] + j / factor) * out[0];
-            for i in 0..dims[0] {
-                sums[cell_row + i / factor] += u32::from(voxels[row + i]);
-                counts[cell_row + i / factor] += 1;
-            }
-        }
+/// Means of `factor`-sided blocks (fewer voxels at the far ends), rounded to grey levels; `None`
+/// when the memory cannot be had.
+fn block_means(dims: [usize; 3], voxels: &[u8], factor: usize) -> Option<([usize; 3], Vec<u8>)> {
+    let mut means = BlockMeans::new(dims, factor)?;
+    for &v in voxels {
+        means.push(f32::from(v));
     }
-    let means = (sums.iter().zip(&counts))
-        .map(|(&s, &c)| ((s + c / 2) / c.max(1)) as u8)
-        .collect();
-    (out, means)
+    let (out, means) = means.finish();
+    Some((out, means.iter().map(|m| m.round() as u8).collect()))
 }
 
 #[cfg(test)]
@@ -189,7 +180,7 @@ mod tests {
             [0.0, 0.0, 2.5, -40.0],
         ]);
         let grey = image([160, 140, 48], affine);
-        let texture = SliceTexture::new(&grey, 256);
+        let texture = SliceTexture::new(&grey, 256).expect("texture");
         assert_eq!(texture.dims, [160, 140, 48]);
         let u = texture
             .placement
@@ -218,14 +209,14 @@ mod tests {
     fn a_grid_past_the_gpu_limit_is_reduced_and_stays_where_it_was() {
         let affine = Affine::scaled([1.0, 1.0, 2.0], [-10.0, 5.0, 0.0]);
         let grey = image([300, 20, 10], affine);
-        let texture = SliceTexture::new(&grey, 256);
+        let texture = SliceTexture::new(&grey, 256).expect("texture");
         assert_eq!(texture.dims, [150, 10, 5]);
         let block: usize = [0, 1, 300, 301, 6000, 6001, 6300, 6301]
             .iter()
             .map(|v| v % 251)
             .sum();
         assert_eq!(usize::from(texture.voxels[0]), (block + 4) / 8);
-        let full = SliceTexture::new(&grey, 512);
+        let full = SliceTexture::new(&grey, 512).expect("texture");
         assert_eq!(
             (texture.placement.min, texture.placement.max),
             (full.placement.min, full.placement.max)

@@ -153,7 +153,7 @@ impl Viewer {
             return;
         }
         let max_side = rs.device.limits().max_texture_dimension_3d as usize;
-        let texture = image.map(|i| SliceTexture::new(i, max_side));
+        let texture = image.and_then(|i| SliceTexture::new(i, max_side));
         let result = with_resources(rs, |view| {
             view.slice = (texture.as_ref()).map(|t| {
                 slice::SliceResources::new(&rs.device, &rs.queue, &view.pipelines.slice_layout, t)
