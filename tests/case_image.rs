@@ -105,6 +105,28 @@ fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept(
 }
 
 #[test]
+fn every_grid_of_a_case_is_checked_not_only_the_first() {
+    let mut case = label_maps::phantom_case();
+    let last = case.structures.last_mut().expect("structures");
+    let grid = last.grid.as_mut().expect("from a label map");
+    grid.0[2][3] += 5.0;
+    let name = last.name.clone();
+    let before = case.clone();
+    let error = (case.add_image(
+        &phantom_ct([0.0; 3]),
+        "ct.nii",
+        WindowPreset::CtSoftTissue,
+        1 << 24,
+    ))
+    .expect_err("off the last structure's grid");
+    assert!(
+        error.contains("5.000 mm") && error.ends_with(&format!("the grid is {name}'s")),
+        "{error}"
+    );
+    assert_eq!(case, before);
+}
+
+#[test]
 fn a_large_image_is_reduced_to_the_voxels_asked_for_and_stays_in_place() {
     let mut case = label_maps::phantom_case();
     let ct = phantom_ct([0.0; 3]);

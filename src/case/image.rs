@@ -204,16 +204,26 @@ impl super::Case {
         preset: WindowPreset,
         max_voxels: usize,
     ) -> Result<(), String> {
-        let grid = (self.structures.iter())
-            .find_map(|s| s.grid)
-            .ok_or_else(|| {
-                format!(
-                    "{name}: the case has no structure from a label map, so there is no \
-                     segmentation grid to place the image on"
-                )
-            })?;
+        // A case may join label maps on different grids: the image must lie on each.
+        let mut grids: Vec<(&str, Affine)> = Vec::new();
+        for s in &self.structures {
+            if let Some(grid) = s.grid.filter(|g| grids.iter().all(|(_, seen)| seen != g)) {
+                grids.push((&s.name, grid));
+            }
+        }
+        if grids.is_empty() {
+            return Err(format!(
+                "{name}: the case has no structure from a label map, so there is no \
+                 segmentation grid to place the image on"
+            ));
+        }
         let image = load_image(bytes, name, max_voxels).map_err(|e| format!("{name}: {e}"))?;
-        check_frame(&image, &grid, name)?;
+        for (structure, grid) in &grids {
+            check_frame(&image, grid, name).map_err(|e| match grids.len() {
+                1 => e,
+                _ => format!("{e}; the grid is {structure}'s"),
+            })?;
+        }
         self.image = Some(Arc::new(CaseImage::new(&image, file_name(name), preset)));
         Ok(())
     }
