@@ -75,21 +75,25 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     }
     let shared = first_item(&object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
     let grid = Grid::place([columns, rows], shared, &per_frame)?;
-    let numbers: Vec<u16> = segments.iter().map(|s| s.0).collect();
+    let numbers: Vec<u16> = segments.iter().map(segment_number).collect();
     let (layers, placed) = dicom_seg_grid::fill(&grid, &per_frame, &numbers, data, pixels)?;
     Ok(LabelMap {
         dims: grid.dims,
         affine: grid.affine,
         layers,
         segments: (segments.into_iter().zip(placed))
-            .map(|((number, mut segment), layer)| {
+            .map(|(mut segment, layer)| {
                 segment.layer = layer;
-                segment.value = i64::from(number);
                 segment
             })
             .collect(),
         conventional: Vec::new(),
     })
+}
+
+/// A segment's number, which [`segments`] keeps as its value.
+fn segment_number(segment: &Segment) -> u16 {
+    u16::try_from(segment.value).unwrap_or(0)
 }
 
 fn unsupported(detail: String) -> LoadError {
@@ -163,10 +167,10 @@ fn pixels(object: &InMemDicomObject, options: &LabelMapOptions) -> Result<Pixels
     }
 }
 
-/// The segments the Segment Sequence declares: number, then name, colour and codes (layer and
-/// value are set once the voxels are placed).
-fn segments(object: &InMemDicomObject) -> Result<Vec<(u16, Segment)>, LoadError> {
-    let mut out: Vec<(u16, Segment)> = Vec::new();
+/// The segments the Segment Sequence declares, by number (the value): name, colour and codes
+/// (the layer is set once the voxels are placed).
+fn segments(object: &InMemDicomObject) -> Result<Vec<Segment>, LoadError> {
+    let mut out: Vec<Segment> = Vec::new();
     for (index, item) in items(object, tags::SEGMENT_SEQUENCE).iter().enumerate() {
         let number = (item.element(tags::SEGMENT_NUMBER).ok())
             .and_then(|e| e.to_int::<u16>().ok())
@@ -176,7 +180,7 @@ fn segments(object: &InMemDicomObject) -> Result<Vec<(u16, Segment)>, LoadError>
                 location: Location::Item("segment", index + 1),
                 detail: "no Segment Number from 1 to 65535".into(),
             })?;
-        if out.iter().any(|(n, _)| *n == number) {
+        if out.iter().any(|s| segment_number(s) == number) {
             return Err(unsupported(format!(
                 "segment number {number} is declared twice"
             )));
@@ -193,14 +197,14 @@ fn segments(object: &InMemDicomObject) -> Result<Vec<(u16, Segment)>, LoadError>
             color,
             codes: segment_codes(item),
         };
-        out.push((number, segment));
+        out.push(segment);
     }
     if out.is_empty() {
         return Err(unsupported(
             "the Segment Sequence declares no segment".into(),
         ));
     }
-    out.sort_by_key(|(n, _)| *n);
+    out.sort_by_key(|s| s.value);
     Ok(out)
 }
 
@@ -238,7 +242,7 @@ fn code(item: &InMemDicomObject) -> Option<Code> {
 fn frame_geometry(
     object: &InMemDicomObject,
     frames: usize,
-    segments: &[(u16, Segment)],
+    segments: &[Segment],
 ) -> Result<Vec<FrameGeometry>, LoadError> {
     let groups = items(object, tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE);
     if groups.len() != frames {
@@ -250,7 +254,7 @@ fn frame_geometry(
     // A file of one segment may name it once, in the shared groups.
     let shared = first_item(object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
     let only = shared.and_then(segment_of).or(match segments {
-        [(number, _)] => Some(*number),
+        [only] => Some(segment_number(only)),
         _ => None,
     });
     (groups.iter().enumerate())
@@ -270,7 +274,7 @@ fn frame_geometry(
             let segment = segment_of(group)
                 .or(only)
                 .ok_or_else(|| at("no Referenced Segment Number"))?;
-            if !segments.iter().any(|(n, _)| *n == segment) {
+            if !segments.iter().any(|s| segment_number(s) == segment) {
                 return Err(at(&format!("segment {segment} is not declared")));
             }
             let orientation = dicom_seg_grid::orientation_of(group);
