@@ -129,9 +129,10 @@ pub fn open_staged(
                 for mut s in extract_from(f, &map, &options.extract)? {
                     s.label = out.len() as i64 + 1;
                     s.name = structure_name(f.name);
-                    s.codes = super::codes_for_name(&s.name);
-                    s.color = super::color_for_name(&s.name)
-                        .unwrap_or_else(|| super::default_color(ordinal));
+                    let standard = super::standard_class(&s.name);
+                    s.color = (standard.as_ref())
+                        .map_or_else(|| super::default_color(ordinal), |c| c.color);
+                    s.codes = standard.map(|c| c.codes);
                     out.push(s);
                 }
             }

@@ -3,7 +3,7 @@
 //!
 //! Bytes -> [`crate::io`] (NIfTI, NRRD, colour tables) -> [`crate::io::LabelMap`] -> [`extract`] -> one
 //! closed [`crate::mesh::Mesh`] per label, in world millimetres (RAS), coded where its name is
-//! a standard one ([`codes_for_name`]).
+//! a standard one ([`standard_class`]).
 
 mod cube_table;
 mod extract;
@@ -17,7 +17,7 @@ pub use from_label_maps::{
     open, open_staged, reading_stages, structure_name, NamedBytes, OpenError, OpenOptions,
 };
 pub use palette::default_color;
-pub use standard_codes::{codes_for_name, color_for_name};
+pub use standard_codes::{standard_class, StandardClass};
 pub use structure::{extract, labels, ExtractError, ExtractOptions, LabelInfo, Structure};
 
 #[cfg(test)]

@@ -94,23 +94,34 @@ impl Table {
     }
 }
 
-/// The codes of a structure named `name`, when it is one of TotalSegmentator's classes.
-pub fn codes_for_name(name: &str) -> Option<StructureCodes> {
-    let table = Table::get();
-    let row = *table.by_name.get(&normalise(name))?;
-    Some(table.rows[row].1.clone())
+/// One of TotalSegmentator's classes: its codes and display colour (sRGB, channels in [0, 1]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StandardClass {
+    pub codes: StructureCodes,
+    pub color: [f32; 3],
 }
 
-/// The display colour (sRGB, channels in [0, 1]) TotalSegmentator gives the class named `name`.
-pub fn color_for_name(name: &str) -> Option<[f32; 3]> {
+/// The class a structure named `name` is, when it is one of TotalSegmentator's.
+pub fn standard_class(name: &str) -> Option<StandardClass> {
     let table = Table::get();
-    let row = *table.by_name.get(&normalise(name))?;
-    Some(table.rows[row].2.map(|c| f32::from(c) / 255.0))
+    let (_, codes, color) = &table.rows[*table.by_name.get(&normalise(name))?];
+    Some(StandardClass {
+        codes: codes.clone(),
+        color: color.map(|c| f32::from(c) / 255.0),
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn codes_for_name(name: &str) -> Option<StructureCodes> {
+        standard_class(name).map(|c| c.codes)
+    }
+
+    fn color_for_name(name: &str) -> Option<[f32; 3]> {
+        standard_class(name).map(|c| c.color)
+    }
 
     #[test]
     fn totalsegmentator_classes_have_their_published_codes() {

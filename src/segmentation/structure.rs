@@ -137,7 +137,7 @@ pub fn extract(
             out.push(Structure {
                 label: value,
                 layer: index,
-                codes: codes.or_else(|| super::codes_for_name(&name)),
+                codes,
                 name,
                 color,
                 voxels: counts[code],
@@ -195,7 +195,7 @@ fn code_counts(codes: &[u16], n: usize) -> Vec<usize> {
 
 /// A structure's name and colour: the file's segment, else the table's entry, else the
 /// format's convention (FreeSurfer's table for MGH), else (the colour) TotalSegmentator's for
-/// its classes, else defaults; and the codes the file gives it.
+/// its classes, else defaults; and the codes the file gives it, else the standard class's.
 fn naming(
     map: &LabelMap,
     names: &[Segment],
@@ -214,9 +214,11 @@ fn naming(
         .map(|s| s.name.trim())
         .find(|n| !n.is_empty())
         .map_or_else(|| format!("label {value}"), str::to_string);
+    let standard = super::standard_class(&name);
     let color = (sources.iter().flatten())
         .find_map(|s| s.color)
-        .or_else(|| super::color_for_name(&name))
+        .or(standard.as_ref().map(|c| c.color))
         .unwrap_or_else(|| default_color(ordinal));
-    (name, color, own.and_then(|s| s.codes.clone()))
+    let codes = (own.and_then(|s| s.codes.clone())).or(standard.map(|c| c.codes));
+    (name, color, codes)
 }

@@ -487,7 +487,7 @@ fn a_newer_opening_supersedes_an_older_and_a_bad_file_fails_its_job() {
 #[test]
 fn codes_without_a_modifier_cross_the_wire() {
     // Postcard is not self-describing: a field left out when empty would not decode.
-    let codes = crate::segmentation::codes_for_name("liver").expect("coded");
+    let codes = (crate::segmentation::standard_class("liver").expect("coded")).codes;
     assert_eq!(codes.modifier, None);
     let back = decode::<crate::io::StructureCodes>(&encode(&codes));
     assert_eq!(back, Ok(codes));
