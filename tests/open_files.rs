@@ -111,7 +111,7 @@ fn files_opened_together_make_the_case_the_cli_makes() {
     let stages: Vec<&str> = (session.open_stages().iter())
         .map(|(d, _)| d.as_str())
         .collect();
-    let mut expected = ["reading a mask", "extracting its surface"].repeat(4);
+    let mut expected = ["reading a file", "extracting its structures"].repeat(4);
     expected.extend([
         "building the topology",
         "checking the mesh",

@@ -36,15 +36,16 @@ pub enum OpenError {
 
 /// The stages of reading one label map.
 const ONE_MAP: [&str; 2] = ["reading the label map", "extracting the structures"];
-/// The stages of reading each of several masks, one after another.
-const EACH_MASK: [&str; 2] = ["reading a mask", "extracting its surface"];
+/// The stages of reading each of several files (masks, or SEGs that name their segments), one
+/// after another: announced before a file is read, so they name no kind of file.
+const EACH_FILE: [&str; 2] = ["reading a file", "extracting its structures"];
 
 /// The stages [`open_staged`] announces for `maps` label-map files, in order.
 pub fn reading_stages(maps: usize) -> Vec<&'static str> {
     match maps {
         0 => Vec::new(),
         1 => ONE_MAP.to_vec(),
-        n => EACH_MASK.repeat(n),
+        n => EACH_FILE.repeat(n),
     }
 }
 
@@ -114,10 +115,10 @@ pub fn open_staged(
             }
             let mut out = Vec::with_capacity(several.len());
             for (ordinal, f) in several.iter().enumerate() {
-                on_stage(EACH_MASK[0]);
+                on_stage(EACH_FILE[0]);
                 let map = read(f)?;
                 if !map.segments.is_empty() {
-                    on_stage(EACH_MASK[1]);
+                    on_stage(EACH_FILE[1]);
                     for mut s in extract_from(f, &map, &options.extract)? {
                         s.label = out.len() as i64 + 1;
                         out.push(s);
@@ -125,7 +126,7 @@ pub fn open_staged(
                     continue;
                 }
                 let map = as_mask(map);
-                on_stage(EACH_MASK[1]);
+                on_stage(EACH_FILE[1]);
                 for mut s in extract_from(f, &map, &options.extract)? {
                     s.label = out.len() as i64 + 1;
                     s.name = structure_name(f.name);
