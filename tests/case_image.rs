@@ -5,7 +5,10 @@ use std::sync::Arc;
 
 use meshsmooth::case::{self, from_gltf_scene, smooth_structure, Case, WindowPreset};
 use meshsmooth::export::{write_case, CaseGltfOptions};
-use meshsmooth::io::{load_gltf_scene, load_label_map, LabelMapOptions};
+use std::io::Write;
+
+use flate2::{write::GzEncoder, Compression};
+use meshsmooth::io::{load_gltf_scene, load_label_map, LabelMap, LabelMapOptions};
 
 #[path = "common/label_maps.rs"]
 mod label_maps;
@@ -19,27 +22,55 @@ const PHANTOM: &str = "labelmaps/case_phantom_shared.nii.gz";
 /// soft-tissue window, so every boundary is an edge in the image.
 const HU: [i16; 5] = [-150, 60, 220, -60, 150];
 
-/// A synthetic CT of the phantom: each voxel its label's HU, int16, on the label map's grid
-/// moved by `shift` mm.
-fn phantom_ct(shift: [f32; 3]) -> Vec<u8> {
-    let map = load_label_map(
+fn phantom_map() -> LabelMap {
+    load_label_map(
         &label_maps::read(PHANTOM),
         PHANTOM,
         &LabelMapOptions::default(),
     )
-    .expect("the phantom opens");
+    .expect("the phantom opens")
+}
+
+/// Each voxel of the phantom its label's HU, int16 little-endian.
+fn phantom_hu(map: &LabelMap) -> Vec<u8> {
+    let layer = &map.layers[0];
+    (layer.codes.iter())
+        .flat_map(|&code| HU[layer.values[code as usize] as usize].to_le_bytes())
+        .collect()
+}
+
+/// A synthetic CT of the phantom as NIfTI on the label map's grid moved by `shift` mm.
+fn phantom_ct(shift: [f32; 3]) -> Vec<u8> {
+    let map = phantom_map();
     let sform: [[f32; 4]; 3] = std::array::from_fn(|r| {
         std::array::from_fn(|c| map.affine.0[r][c] as f32 + if c == 3 { shift[r] } else { 0.0 })
     });
     let mut bytes = nifti::nifti_header(map.dims, sform, map.spacing().map(|s| s as f32));
     bytes[70..72].copy_from_slice(&4i16.to_le_bytes()); // int16
     bytes[72..74].copy_from_slice(&16i16.to_le_bytes());
-    let layer = &map.layers[0];
-    for &code in &layer.codes {
-        let label = layer.values[code as usize] as usize;
-        bytes.extend_from_slice(&HU[label].to_le_bytes());
-    }
+    bytes.extend(phantom_hu(&map));
     bytes
+}
+
+/// The same CT as 3D Slicer saves a volume: NRRD, gzip, in LPS.
+fn phantom_ct_nrrd() -> Vec<u8> {
+    let map = phantom_map();
+    let lps = |v: [f64; 3]| format!("({},{},{})", -v[0], -v[1], v[2]);
+    let column = |c: usize| std::array::from_fn(|r| map.affine.0[r][c]);
+    let [i, j, k] = map.dims;
+    let header = format!(
+        "NRRD0004\n# made by tests/case_image.rs\ntype: short\ndimension: 3\n\
+         space: left-posterior-superior\nsizes: {i} {j} {k}\n\
+         space directions: {} {} {}\nkinds: domain domain domain\nendian: little\n\
+         encoding: gzip\nspace origin: {}\n\n",
+        lps(column(0)),
+        lps(column(1)),
+        lps(column(2)),
+        lps(column(3)),
+    );
+    let mut gz = GzEncoder::new(header.into_bytes(), Compression::fast());
+    gz.write_all(&phantom_hu(&map)).expect("gzip");
+    gz.finish().expect("gzip")
 }
 
 fn phantom_with_image() -> Case {
@@ -76,6 +107,27 @@ fn the_image_is_windowed_and_read_back_from_the_case_gltf_as_written() {
     let back = from_gltf_scene(scene, "case.glb").expect("a case");
     assert_eq!(back.image, case.image);
     assert_eq!(back.structures.len(), case.structures.len());
+}
+
+#[test]
+fn a_slicer_nrrd_volume_reads_as_the_same_image_as_the_nifti() {
+    let nifti = phantom_with_image().image.expect("added");
+    let mut case = label_maps::phantom_case();
+    (case.add_image(
+        &phantom_ct_nrrd(),
+        "scans/ct.nrrd",
+        WindowPreset::CtSoftTissue,
+        case::DEFAULT_IMAGE_VOXELS,
+    ))
+    .expect("the NRRD lies on the phantom's grid");
+    let nrrd = case.image.expect("added");
+    assert_eq!(nrrd.source, "ct.nrrd");
+    assert_eq!((nrrd.dims, &nrrd.voxels), (nifti.dims, &nifti.voxels));
+    let (a, b) = (nrrd.affine.0.as_flattened(), nifti.affine.0.as_flattened());
+    assert!(
+        a.iter().zip(b).all(|(a, b)| (a - b).abs() < 1e-6),
+        "{a:?} {b:?}"
+    );
 }
 
 #[test]

@@ -3,7 +3,7 @@
 
 use super::intensity::IntensitySink;
 use super::label_map::Affine;
-use super::{nifti, Format, LoadError};
+use super::{nifti, nrrd, Format, LoadError};
 
 /// An intensity volume on its (possibly reduced) grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,28 +20,31 @@ pub struct ImageVolume {
     pub source_affine: Affine,
 }
 
-/// Reads `name`'s image (NIfTI, `.nii` or `.nii.gz`), reduced by the smallest whole factor
-/// that leaves at most `max_voxels` voxels.
+/// Reads `name`'s image (NIfTI `.nii`/`.nii.gz`, or NRRD `.nrrd` with its data attached),
+/// reduced by the smallest whole factor that leaves at most `max_voxels` voxels.
 pub fn load_image(bytes: &[u8], name: &str, max_voxels: usize) -> Result<ImageVolume, LoadError> {
     let lower = name.to_ascii_lowercase();
-    if !(lower.ends_with(".nii") || lower.ends_with(".nii.gz")) {
+    let sink = |format| move |layout: &_| IntensitySink::new(layout, format, max_voxels);
+    let (format, layout, affine, sink) = if lower.ends_with(".nrrd") {
+        let v = nrrd::read(bytes, sink(Format::Nrrd))?;
+        (Format::Nrrd, v.layout, v.affine, v.sink)
+    } else if lower.ends_with(".nii") || lower.ends_with(".nii.gz") {
+        let v = nifti::read(bytes, sink(Format::Nifti))?;
+        (Format::Nifti, v.layout, v.affine, v.sink)
+    } else {
         return Err(LoadError::Unsupported {
             format: Format::Nifti,
-            detail: format!("{name}: an image is read from NIfTI (.nii, .nii.gz)"),
+            detail: format!("{name}: an image is read from NIfTI (.nii, .nii.gz) or NRRD (.nrrd)"),
         });
-    }
-    let format = Format::Nifti;
-    let volume = nifti::read(bytes, |layout| {
-        IntensitySink::new(layout, format, max_voxels)
-    })?;
-    let factor = volume.sink.factor();
-    let (dims, values) = volume.sink.finish(format)?;
+    };
+    let factor = sink.factor();
+    let (dims, values) = sink.finish(format)?;
     Ok(ImageVolume {
         dims,
-        affine: reduced_affine(&volume.affine, factor),
+        affine: reduced_affine(&affine, factor),
         values,
-        source_dims: volume.layout.dims,
-        source_affine: volume.affine,
+        source_dims: layout.dims,
+        source_affine: affine,
     })
 }
 

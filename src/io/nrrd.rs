@@ -14,40 +14,63 @@ use super::label_map::LabelMapOptions;
 use super::label_map::{Affine, LabelMap, Segment};
 use super::label_map_checks::{check_affine, check_raw, check_spacing, Sample, VoxelLayout};
 use super::text::Lines;
-use super::voxels::{self, VoxelSink};
+use super::voxels::{self, Feed, VoxelSink};
 use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::Nrrd;
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+    let volume = read(bytes, |layout| VoxelSink::new(layout, options, FORMAT))?;
+    let segments = volume.header.segments(volume.layout.layers)?;
+    Ok(LabelMap {
+        dims: volume.layout.dims,
+        affine: volume.affine,
+        layers: volume.sink.finish()?,
+        segments,
+        conventional: Vec::new(),
+    })
+}
+
+/// A file's grid and its voxels, fed into the sink the caller made for them.
+pub(super) struct Volume<S> {
+    pub layout: VoxelLayout,
+    pub affine: Affine,
+    pub sink: S,
+    header: Header,
+}
+
+/// Reads a NRRD file's header, then streams its voxels into the sink `make` builds for their
+/// layout (label codes, or an image's intensities).
+pub(super) fn read<S: Feed>(
+    bytes: &[u8],
+    make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
+) -> Result<Volume<S>, LoadError> {
     let header = Header::parse(bytes)?;
     let (layout, spatial) = header.layout()?;
     let affine = header.affine(spatial)?;
-    let segments = header.segments(layout.layers)?;
     let data_bytes = layout.data_bytes(FORMAT)?;
     let data = bytes.get(header.data_start..).unwrap_or_default();
     let mut sink;
     match header.encoding {
         Some(Encoding::Raw) => {
             check_raw(data_bytes, data.len(), FORMAT)?;
-            sink = VoxelSink::new(&layout, options, FORMAT)?;
+            sink = make(&layout)?;
             sink.feed(&data[..data_bytes as usize])?;
         }
         Some(Encoding::Gzip) => {
             let mut inflater = Inflater::new(data, FORMAT);
             inflater.check_ratio(data_bytes, "bytes of inflated voxel data")?;
             inflater.expect_total(data_bytes);
-            sink = VoxelSink::new(&layout, options, FORMAT)?;
+            sink = make(&layout)?;
             voxels::decode_gzip(inflater, &mut sink, data_bytes)?;
         }
         None => return Err(missing("encoding", header.end_line)),
     }
-    Ok(LabelMap {
-        dims: layout.dims,
+    Ok(Volume {
+        layout,
         affine,
-        layers: sink.finish()?,
-        segments,
-        conventional: Vec::new(),
+        sink,
+        header,
     })
 }
 

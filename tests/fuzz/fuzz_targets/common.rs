@@ -59,3 +59,14 @@ pub fn check_label_map(map: &meshsmooth::io::LabelMap) {
         }
     }
 }
+
+/// Reads `data` as the image `name`: refused, or one value per voxel of a grid no larger than
+/// asked.
+#[allow(dead_code)]
+pub fn check_image(data: &[u8], name: &str) {
+    if let Ok(image) = meshsmooth::io::load_image(data, name, 4096) {
+        let voxels: usize = image.dims.iter().product();
+        assert!(voxels <= 4096 && voxels > 0, "{:?}", image.dims);
+        assert_eq!(image.values.len(), voxels);
+    }
+}
