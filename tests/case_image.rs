@@ -131,6 +131,37 @@ fn a_slicer_nrrd_volume_reads_as_the_same_image_as_the_nifti() {
 }
 
 #[test]
+fn a_freesurfer_volume_reads_as_an_image_on_the_grid_of_its_segmentation() {
+    // FreeSurfer's T1.mgz lies on its aseg.mgz's grid; the aseg itself stands in for it here.
+    let aseg = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/phantom_aseg.mgz"
+    ))
+    .expect("the aseg MGZ");
+    let mut case = label_maps::phantom_case();
+    (case.add_image(&aseg, "T1.mgz", WindowPreset::MriAuto, 1 << 24)).expect("on the grid");
+    let image = case.image.expect("added");
+    assert_eq!(
+        (image.source.as_str(), image.dims),
+        ("T1.mgz", [160, 140, 48])
+    );
+    let grid = phantom_map().affine;
+    let (a, b) = (image.affine.0.as_flattened(), grid.0.as_flattened());
+    assert!(
+        a.iter().zip(b).all(|(a, b)| (a - b).abs() < 1e-4),
+        "{a:?} {b:?}"
+    );
+    assert!(image.voxels.contains(&255) && image.voxels.contains(&0));
+    let mut case = label_maps::phantom_case();
+    let error = (case.add_image(&aseg, "T1.stl", WindowPreset::MriAuto, 1 << 24))
+        .expect_err("no image format");
+    assert!(
+        error.contains("cannot tell the image format of 'T1.stl'"),
+        "{error}"
+    );
+}
+
+#[test]
 fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept() {
     let mut case = label_maps::phantom_case();
     let before = case.clone();

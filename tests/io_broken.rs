@@ -71,6 +71,7 @@ fn shape(e: &LoadError) -> (&'static str, Option<Location>) {
     match e {
         LoadError::Empty { .. } => ("Empty", None),
         LoadError::UnknownFormat { .. } => ("UnknownFormat", None),
+        LoadError::UnknownImageFormat { .. } => ("UnknownImageFormat", None),
         LoadError::BadMagic { .. } => ("BadMagic", None),
         LoadError::Truncated { .. } => ("Truncated", None),
         LoadError::CountTooLarge { .. } => ("CountTooLarge", None),

@@ -72,9 +72,9 @@ pub(super) struct BuildArgs {
     /// The level at which a float image becomes a mask.
     #[arg(long)]
     level: Option<f64>,
-    /// The image the segmentation was drawn on (CT or MRI: NIfTI, or NRRD as 3D Slicer saves a
-    /// volume), carried in the case for the viewer to show under the surfaces; it must lie on
-    /// the segmentation's voxel grid.
+    /// The image the segmentation was drawn on (CT or MRI: NIfTI, NRRD as 3D Slicer saves a
+    /// volume, or FreeSurfer's MGH/MGZ), carried in the case for the viewer to show under the
+    /// surfaces; it must lie on the segmentation's voxel grid.
     #[arg(long, value_name = "IMAGE")]
     image: Option<PathBuf>,
     /// The window the image's grey levels are made with: ct-soft-tissue, ct-bone, ct-lung,

@@ -13,6 +13,8 @@ pub enum LoadError {
          .nii .nii.gz .nrrd .mgz .mgh .dcm (label maps)"
     )]
     UnknownFormat { name: String },
+    #[error("cannot tell the image format of '{name}': use one of .nii .nii.gz .nrrd .mgz .mgh")]
+    UnknownImageFormat { name: String },
     #[error("{format}: not a {format} file ({detail})")]
     BadMagic { format: Format, detail: String },
     #[error("{format}: file ends early at byte {offset}: {detail}")]

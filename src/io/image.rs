@@ -3,7 +3,7 @@
 
 use super::intensity::IntensitySink;
 use super::label_map::Affine;
-use super::{nifti, nrrd, Format, LoadError};
+use super::{mgh, nifti, nrrd, Format, LoadError};
 
 /// An intensity volume on its (possibly reduced) grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,8 +20,9 @@ pub struct ImageVolume {
     pub source_affine: Affine,
 }
 
-/// Reads `name`'s image (NIfTI `.nii`/`.nii.gz`, or NRRD `.nrrd` with its data attached),
-/// reduced by the smallest whole factor that leaves at most `max_voxels` voxels.
+/// Reads `name`'s image (NIfTI `.nii`/`.nii.gz`, NRRD `.nrrd` with its data attached, or
+/// FreeSurfer `.mgz`/`.mgh`), reduced by the smallest whole factor that leaves at most
+/// `max_voxels` voxels.
 pub fn load_image(bytes: &[u8], name: &str, max_voxels: usize) -> Result<ImageVolume, LoadError> {
     let lower = name.to_ascii_lowercase();
     let sink = |format| move |layout: &_| IntensitySink::new(layout, format, max_voxels);
@@ -31,10 +32,12 @@ pub fn load_image(bytes: &[u8], name: &str, max_voxels: usize) -> Result<ImageVo
     } else if lower.ends_with(".nii") || lower.ends_with(".nii.gz") {
         let v = nifti::read(bytes, sink(Format::Nifti))?;
         (Format::Nifti, v.layout, v.affine, v.sink)
+    } else if lower.ends_with(".mgz") || lower.ends_with(".mgh") {
+        let (layout, affine, sink) = mgh::read(bytes, sink(Format::Mgh))?;
+        (Format::Mgh, layout, affine, sink)
     } else {
-        return Err(LoadError::Unsupported {
-            format: Format::Nifti,
-            detail: format!("{name}: an image is read from NIfTI (.nii, .nii.gz) or NRRD (.nrrd)"),
+        return Err(LoadError::UnknownImageFormat {
+            name: name.to_string(),
         });
     };
     let factor = sink.factor();

@@ -1,5 +1,5 @@
 //! FreeSurfer MGH (`.mgh`) and its gzip form MGZ (`.mgz`) label volumes (`aseg.mgz`,
-//! `aparc+aseg.mgz`), read as nibabel reads them: a big-endian header of fixed fields, the voxels
+//! `aparc+aseg.mgz`) and images (`T1.mgz`), read as nibabel reads them: a big-endian header of fixed fields, the voxels
 //! from byte 284 with the first index fastest, then a footer (scan parameters, tags) that a label
 //! map does not need and is not read.
 //!
@@ -12,7 +12,7 @@ use super::freesurfer_lut;
 use super::gzip::{self, Inflater};
 use super::label_map::{Affine, LabelMap, LabelMapOptions, Segment};
 use super::label_map_checks::{check_affine, check_raw, Sample, VoxelLayout};
-use super::voxels::{self, VoxelSink};
+use super::voxels::{self, Feed, VoxelSink};
 use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::Mgh;
@@ -23,29 +23,46 @@ const DATA_OFFSET: usize = 284;
 const FIELDS_END: usize = 90;
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+    let (layout, affine, sink) = read(bytes, |layout| VoxelSink::new(layout, options, FORMAT))?;
+    finish(layout, affine, sink)
+}
+
+/// Reads an MGH/MGZ file's header, then streams its voxels into the sink `make` builds for
+/// their layout (label codes, or an image's intensities: FreeSurfer's `T1.mgz` lies on the
+/// grid of its `aseg.mgz`).
+pub(super) fn read<S: Feed>(
+    bytes: &[u8],
+    make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
+) -> Result<(VoxelLayout, Affine, S), LoadError> {
     if gzip::is_gzip(bytes) {
-        parse_gzip(bytes, options)
+        read_gzip(bytes, make)
     } else {
-        parse_raw(bytes, options)
+        read_raw(bytes, make)
     }
 }
 
-fn parse_raw(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+fn read_raw<S: Feed>(
+    bytes: &[u8],
+    make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
+) -> Result<(VoxelLayout, Affine, S), LoadError> {
     let header = Header::parse(bytes)?;
     let layout = header.layout()?;
     let affine = header.affine()?;
     let data_bytes = layout.data_bytes(FORMAT)?;
     let data = bytes.get(DATA_OFFSET..).unwrap_or_default();
     check_raw(data_bytes, data.len(), FORMAT)?;
-    let mut sink = VoxelSink::new(&layout, options, FORMAT)?;
+    let mut sink = make(&layout)?;
     // What follows the voxels is the footer.
     sink.feed(&data[..data_bytes as usize])?;
-    finish(layout, affine, sink)
+    Ok((layout, affine, sink))
 }
 
-/// `.mgz`: the header inflated first, then the voxels stream from the same inflater into codes;
-/// the stream is read no further than the voxels (the footer is not needed).
-fn parse_gzip(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+/// `.mgz`: the header inflated first, then the voxels stream from the same inflater into the
+/// sink; the stream is read no further than the voxels (the footer is not needed).
+fn read_gzip<S: Feed>(
+    bytes: &[u8],
+    make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
+) -> Result<(VoxelLayout, Affine, S), LoadError> {
     let mut inflater = Inflater::new(bytes, FORMAT);
     let mut head = [0u8; DATA_OFFSET];
     let got = inflater.read_up_to(&mut head)?;
@@ -59,9 +76,9 @@ fn parse_gzip(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadE
         return Err(inflater.truncated());
     }
     inflater.expect_total(total);
-    let mut sink = VoxelSink::new(&layout, options, FORMAT)?;
+    let mut sink = make(&layout)?;
     voxels::feed_from_gzip(&mut inflater, &mut sink, data_bytes)?;
-    finish(layout, affine, sink)
+    Ok((layout, affine, sink))
 }
 
 fn finish(layout: VoxelLayout, affine: Affine, sink: VoxelSink) -> Result<LabelMap, LoadError> {
