@@ -9,6 +9,7 @@ use std::io::Write;
 
 use flate2::{write::GzEncoder, Compression};
 use meshsmooth::io::{load_gltf_scene, load_label_map, LabelMap, LabelMapOptions};
+use meshsmooth::session::Session;
 
 #[path = "common/label_maps.rs"]
 mod label_maps;
@@ -159,6 +160,45 @@ fn a_freesurfer_volume_reads_as_an_image_on_the_grid_of_its_segmentation() {
         error.contains("cannot tell the image format of 'T1.stl'"),
         "{error}"
     );
+}
+
+/// The page's session reads the image in a worker against the open case's grids; a refusal
+/// keeps the image it had.
+#[test]
+fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
+    let mut session = Session::default();
+    let refused = session.begin_image("ct.nrrd", phantom_ct_nrrd(), WindowPreset::CtBone);
+    assert!(refused
+        .expect_err("nothing open")
+        .contains("open the segmentation first"));
+    session.begin_open(
+        "case_phantom_shared.seg.nrrd",
+        label_maps::read("labelmaps/case_phantom_shared.seg.nrrd"),
+    );
+    session.poll_opening().expect("done").expect("opens");
+    assert!(session.case().case_image().is_none());
+    let nrrd = phantom_ct_nrrd();
+    (session.begin_image("scans/ct.nrrd", nrrd.clone(), WindowPreset::CtSoftTissue))
+        .expect("asked");
+    session.poll_opening().expect("done").expect("read");
+    let image = session.case().case_image().expect("added").clone();
+    let mut case = label_maps::phantom_case();
+    case.add_image(&nrrd, "ct.nrrd", WindowPreset::CtSoftTissue, 1 << 24)
+        .expect("added");
+    assert_eq!(Some(&image), case.image.as_ref());
+    let moved = phantom_ct([0.0, 0.0, 5.0]);
+    (session.begin_image("moved.nii", moved, WindowPreset::CtSoftTissue)).expect("asked");
+    let error = session
+        .poll_opening()
+        .expect("done")
+        .expect_err("moved 5 mm");
+    assert!(
+        error.contains("moved.nii") && error.contains("5.000 mm"),
+        "{error}"
+    );
+    assert_eq!(session.case().case_image(), Some(&image), "kept");
+    session.remove_image();
+    assert!(session.case().case_image().is_none());
 }
 
 #[test]

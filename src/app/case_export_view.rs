@@ -4,6 +4,7 @@
 use eframe::egui;
 
 use super::structure_list::StructureAction;
+use crate::case::WindowPreset;
 use crate::export::{CaseGltfOptions, Simplification};
 use crate::session::Session;
 
@@ -13,6 +14,8 @@ pub struct ExportChoice {
     /// The simplified surface's largest distance from the smoothed one, in each structure's
     /// voxel diagonals.
     voxel_diagonals: f64,
+    /// The window an image chosen next is read with.
+    preset: WindowPreset,
 }
 
 impl Default for ExportChoice {
@@ -20,6 +23,7 @@ impl Default for ExportChoice {
         Self {
             simplify: false,
             voxel_diagonals: 0.1,
+            preset: WindowPreset::CtSoftTissue,
         }
     }
 }
@@ -41,6 +45,7 @@ impl ExportChoice {
         session: &Session,
         actions: &mut Vec<StructureAction>,
     ) {
+        self.image_row(ui, session, actions);
         ui.horizontal(|ui| {
             ui.checkbox(&mut self.simplify, "Simplify within")
                 .on_hover_text("Fewer triangles for the download: each surface stays closed, within this many of its voxel diagonals of the smoothed one");
@@ -91,6 +96,45 @@ impl ExportChoice {
         if let Some(e) = session.case_export_error() {
             ui.colored_label(ui.visuals().warn_fg_color, format!("Not written: {e}"));
         }
+    }
+}
+
+impl ExportChoice {
+    /// The image under the surfaces: the one the case carries, with what it adds to the case
+    /// glTF; else the window and the button to choose one.
+    fn image_row(
+        &mut self,
+        ui: &mut egui::Ui,
+        session: &Session,
+        actions: &mut Vec<StructureAction>,
+    ) {
+        ui.horizontal_wrapped(|ui| match session.case().case_image() {
+            Some(image) => {
+                let [i, j, k] = image.dims;
+                let size = megabytes(image.voxels.len());
+                ui.label(format!("Image {}: {i} x {j} x {k}, {}, {size}", image.source, image.preset))
+                    .on_hover_text("Shown on the clipping plane and carried in the case glTF (this many bytes of it)");
+                if ui.small_button("Remove").clicked() {
+                    actions.push(StructureAction::RemoveImage);
+                }
+            }
+            None => {
+                egui::ComboBox::from_id_salt("image window")
+                    .selected_text(self.preset.name())
+                    .show_ui(ui, |ui| {
+                        for preset in WindowPreset::ALL {
+                            ui.selectable_value(&mut self.preset, preset, preset.name());
+                        }
+                    });
+                if ui
+                    .button("Add image...")
+                    .on_hover_text("The CT or MRI the segmentation was drawn on (NIfTI, NRRD or MGH/MGZ, on the segmentation's voxel grid), windowed to grey levels: shown on the clipping plane and carried in the case glTF")
+                    .clicked()
+                {
+                    actions.push(StructureAction::AddImage(self.preset));
+                }
+            }
+        });
     }
 }
 

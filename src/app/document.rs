@@ -235,6 +235,26 @@ impl Document {
         self.waiting_for_load.extend(waiter);
     }
 
+    /// Starts reading the image under the open case's surfaces in a worker. `waiter`, when
+    /// given, hears once it is read (or at once, when it cannot be asked).
+    pub fn begin_image(
+        &mut self,
+        name: &str,
+        bytes: Vec<u8>,
+        preset: crate::case::WindowPreset,
+        waiter: Option<LoadWaiter>,
+    ) {
+        match self.session.begin_image(name, bytes, preset) {
+            Ok(()) => self.waiting_for_load.extend(waiter),
+            Err(why) => {
+                log::warn!("{why}");
+                if let Some(w) = waiter {
+                    w(Err(why));
+                }
+            }
+        }
+    }
+
     /// Whether nothing is being opened, a worker is still opening it, or it opened (or failed)
     /// in this frame. The last takes the frame: the engines take up a new model from the next
     /// frame on, before the view does. The waiters hear once nothing more is to open, of the

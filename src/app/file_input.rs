@@ -21,12 +21,22 @@ pub struct ArrivedFile {
     pub bytes: Result<Vec<u8>, String>,
 }
 
+/// What files chosen or dropped together are for.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum FilesFor {
+    /// Opened together as a new case.
+    #[default]
+    NewCase,
+    /// Their structures join the open case (the Add button).
+    OpenCase,
+    /// The image under the open case's surfaces, windowed by the preset.
+    Image(crate::case::WindowPreset),
+}
+
 /// Files chosen or dropped together, once every one of them was read.
 pub struct Arrived {
     pub files: Vec<ArrivedFile>,
-    /// Whether their structures join the open case (the Add button) instead of opening
-    /// together as a new one.
-    pub add: bool,
+    pub purpose: FilesFor,
 }
 
 /// A file to read: its name and the read, which starts when awaited.
@@ -78,8 +88,8 @@ struct Inbox {
     /// The reads in flight, by number.
     reading: Rc<RefCell<Vec<(u64, Reading)>>>,
     next: Rc<Cell<u64>>,
-    /// Whether the picker was opened to add files to the open case.
-    adding: Rc<Cell<bool>>,
+    /// What the picker was opened for.
+    picking_for: Rc<Cell<FilesFor>>,
     /// Takes files up as they arrive, between frames (see [`FileInput::on_arrival`]).
     on_arrival: Rc<RefCell<Option<ArrivalHook>>>,
 }
@@ -123,9 +133,9 @@ impl Inbox {
         super::wake(ctx);
     }
 
-    /// Reads `files` one after another and delivers them together once all are read: they
-    /// open as one case, or (`add`) each joins the open one.
-    fn read_together(&self, files: Vec<PendingRead>, add: bool, ctx: &egui::Context) {
+    /// Reads `files` one after another and delivers them together once all are read, for
+    /// `purpose`.
+    fn read_together(&self, files: Vec<PendingRead>, purpose: FilesFor, ctx: &egui::Context) {
         let reads: Vec<_> = (files.into_iter())
             .map(|(name, read)| {
                 let (id, progress) = self.begin(&name, ctx);
@@ -140,7 +150,7 @@ impl Inbox {
                 inbox.reading.borrow_mut().retain(|(i, _)| *i != id);
                 files.push(ArrivedFile { name, bytes });
             }
-            inbox.deliver(Arrived { files, add }, &ctx);
+            inbox.deliver(Arrived { files, purpose }, &ctx);
         });
     }
 }
@@ -177,10 +187,10 @@ impl FileInput {
     }
 
     /// Opens the browser's file dialog; the chosen files arrive later through
-    /// [`Self::take_arrived`], to open as a case or (`add`) to join the open one.
-    pub fn open_picker(&self, add: bool) -> Result<(), String> {
+    /// [`Self::take_arrived`], for `purpose`.
+    pub fn open_picker(&self, purpose: FilesFor) -> Result<(), String> {
         let input = self.picker.as_ref().map_err(String::clone)?;
-        self.inbox.adding.set(add);
+        self.inbox.picking_for.set(purpose);
         // Clearing the value lets the same file be chosen twice in a row.
         input.set_value("");
         input.click();
@@ -211,7 +221,7 @@ impl FileInput {
             })
             .collect();
         if !files.is_empty() {
-            self.inbox.read_together(files, false, ctx);
+            self.inbox.read_together(files, FilesFor::NewCase, ctx);
         }
     }
 
@@ -222,10 +232,10 @@ impl FileInput {
         let (id, progress) = inbox.begin(&name, &ctx);
         wasm_bindgen_futures::spawn_local(async move {
             let bytes = read_bytes::fetch(&url, progress).await;
-            let add = false;
             inbox.reading.borrow_mut().retain(|(i, _)| *i != id);
             let files = vec![ArrivedFile { name, bytes }];
-            inbox.deliver(Arrived { files, add }, &ctx);
+            let purpose = FilesFor::NewCase;
+            inbox.deliver(Arrived { files, purpose }, &ctx);
         });
     }
 
@@ -291,7 +301,7 @@ fn create_picker(
                 })
                 .collect();
             if !files.is_empty() {
-                inbox.read_together(files, inbox.adding.get(), &ctx);
+                inbox.read_together(files, inbox.picking_for.get(), &ctx);
             }
         })
     };

@@ -19,6 +19,10 @@ pub enum StructureAction {
     CaseText(String, String),
     /// Choose files whose structures join the case.
     AddFiles,
+    /// Choose the image under the case's surfaces, windowed by the preset.
+    AddImage(crate::case::WindowPreset),
+    /// Take the image from under the surfaces.
+    RemoveImage,
     /// Check the structures against each other (what lies inside what, what crosses).
     Check,
     /// Write the case glTF with these options (its size shows before it is saved).

@@ -193,24 +193,17 @@ impl CaseImage {
     }
 }
 
-impl super::Case {
-    /// Adds the image `name` (NIfTI bytes), reduced to at most `max_voxels` and windowed by
-    /// `preset`, after checking that it lies on the grid the structures were extracted on.
-    /// The case is unchanged when it is refused.
-    pub fn add_image(
-        &mut self,
+impl CaseImage {
+    /// Reads the image `name` (NIfTI, NRRD or MGH bytes), reduced to at most `max_voxels` and
+    /// windowed by `preset`, after checking that it lies on each of `grids`: the grids a case's
+    /// structures were extracted on, each with a structure's name ([`super::Case::image_grids`]).
+    pub fn read(
         bytes: &[u8],
         name: &str,
         preset: WindowPreset,
         max_voxels: usize,
-    ) -> Result<(), String> {
-        // A case may join label maps on different grids: the image must lie on each.
-        let mut grids: Vec<(&str, Affine)> = Vec::new();
-        for s in &self.structures {
-            if let Some(grid) = s.grid.filter(|g| grids.iter().all(|(_, seen)| seen != g)) {
-                grids.push((&s.name, grid));
-            }
-        }
+        grids: &[(String, Affine)],
+    ) -> Result<Self, String> {
         if grids.is_empty() {
             return Err(format!(
                 "{name}: the case has no structure from a label map, so there is no \
@@ -218,13 +211,41 @@ impl super::Case {
             ));
         }
         let image = load_image(bytes, name, max_voxels).map_err(|e| format!("{name}: {e}"))?;
-        for (structure, grid) in &grids {
+        for (structure, grid) in grids {
             check_frame(&image, grid, name).map_err(|e| match grids.len() {
                 1 => e,
                 _ => format!("{e}; the grid is {structure}'s"),
             })?;
         }
-        self.image = Some(Arc::new(CaseImage::new(&image, file_name(name), preset)));
+        Ok(CaseImage::new(&image, file_name(name), preset))
+    }
+}
+
+impl super::Case {
+    /// Each distinct grid the structures were extracted on, with the first structure on it (a
+    /// case may join label maps on different grids: an image must lie on each).
+    pub fn image_grids(&self) -> Vec<(String, Affine)> {
+        let mut grids: Vec<(String, Affine)> = Vec::new();
+        for s in &self.structures {
+            if let Some(grid) = s.grid.filter(|g| grids.iter().all(|(_, seen)| seen != g)) {
+                grids.push((s.name.clone(), grid));
+            }
+        }
+        grids
+    }
+
+    /// Adds the image `name` ([`CaseImage::read`] on the case's grids). The case is unchanged
+    /// when it is refused.
+    pub fn add_image(
+        &mut self,
+        bytes: &[u8],
+        name: &str,
+        preset: WindowPreset,
+        max_voxels: usize,
+    ) -> Result<(), String> {
+        let grids = self.image_grids();
+        let image = CaseImage::read(bytes, name, preset, max_voxels, &grids)?;
+        self.image = Some(Arc::new(image));
         Ok(())
     }
 }

@@ -28,6 +28,8 @@ enum Purpose {
     File,
     /// A file's structures join the open case.
     Addition,
+    /// A file is the image under the open case's surfaces.
+    Image,
 }
 
 /// An opening asked of the workers.
@@ -106,6 +108,34 @@ impl Session {
         }
     }
 
+    /// Starts reading the image the open case's segmentation was drawn on, windowed by
+    /// `preset`, in a worker; it replaces the case's image once read and checked against the
+    /// structures' grids. Refused at once when nothing is open, or while a file opens (the
+    /// grids to check are not known yet).
+    pub fn begin_image(
+        &mut self,
+        name: &str,
+        bytes: Vec<u8>,
+        preset: case::WindowPreset,
+    ) -> Result<(), String> {
+        if self.opening.is_some() || !self.additions.is_empty() || self.doc.model().is_none() {
+            let why = "open the segmentation first, and wait until it is open";
+            return Err(self.fail(name, why));
+        }
+        let input = Input::Image {
+            bytes,
+            preset: preset.name().to_string(),
+            grids: self.doc.case.image_grids(),
+        };
+        self.begin(name.to_string(), name.to_string(), input, Purpose::Image);
+        Ok(())
+    }
+
+    /// Takes the image from under the case's surfaces.
+    pub fn remove_image(&mut self) {
+        self.doc.set_image(None);
+    }
+
     /// Starts the next file waiting to be added, once nothing is being opened.
     fn next_addition(&mut self) {
         if self.opening.is_none() {
@@ -169,6 +199,10 @@ impl Session {
                 stages,
                 ..
             } => (model, case, stages),
+            // The image's reasons name its file already.
+            Reply::Failed { why, .. } if purpose == Purpose::Image => {
+                return Err(self.fail("the image", &why))
+            }
             Reply::Failed { why, .. } => return Err(self.fail(name, &why)),
             _ => return Err(self.fail(name, "a worker answered something else")),
         };
@@ -178,6 +212,10 @@ impl Session {
             (Purpose::Addition, _, case) => {
                 self.error = None;
                 self.doc.add(*case);
+            }
+            (Purpose::Image, _, case) => {
+                self.error = None;
+                self.doc.set_image(case.image);
             }
             _ => return Err(self.fail(name, "a worker answered something else")),
         }

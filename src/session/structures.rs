@@ -219,6 +219,12 @@ impl CaseDocument {
         self.case_version += 1;
     }
 
+    /// The image under the surfaces from now on (`None`: none).
+    pub(super) fn set_image(&mut self, image: Option<std::sync::Arc<crate::case::CaseImage>>) {
+        self.case.image = image;
+        self.case_version += 1;
+    }
+
     /// Structure `index`'s measures as shown: the model's current result's, another's kept
     /// ones; `None` where it is not smoothed (or the model's result is still to come).
     pub fn structure_metrics(&self, index: usize) -> Option<&Metrics> {

@@ -38,6 +38,15 @@ pub enum Input {
     Files(Vec<NamedFile>),
     /// A file's bytes read as a case only, to add its structures to the open one.
     Addition(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
+    /// The image the segmentation was drawn on, read as a case holding only it
+    /// ([`crate::case::CaseImage::read`]): windowed by the preset so named, checked against
+    /// the open case's grids.
+    Image {
+        #[serde(with = "crate::mesh::flat_bytes")]
+        bytes: Vec<u8>,
+        preset: String,
+        grids: Vec<(String, crate::io::Affine)>,
+    },
 }
 
 /// A message to a worker.
@@ -271,10 +280,24 @@ impl Worker {
                         bytes: &f.bytes,
                     })
                     .collect();
-                model::open_files(&named, &mut on_stage).map(|o| (Some(o.model), o.case))
+                (model::open_files(&named, &mut on_stage))
+                    .map(|o| (Some(o.model), o.case))
+                    .map_err(|e| e.reason())
             }
-            Input::Addition(bytes) => {
-                model::open_case(name, &bytes, &mut on_stage).map(|case| (None, case))
+            Input::Addition(bytes) => (model::open_case(name, &bytes, &mut on_stage))
+                .map(|case| (None, case))
+                .map_err(|e| e.reason()),
+            Input::Image {
+                bytes,
+                preset,
+                grids,
+            } => {
+                on_stage(model::Stage {
+                    index: 0,
+                    total: 1,
+                    doing: "reading the image",
+                });
+                read_image(name, &bytes, &preset, &grids).map(|case| (None, case))
             }
         };
         let ended = clock();
@@ -293,10 +316,7 @@ impl Worker {
                     stages,
                 }
             }
-            Err(e) => Reply::Failed {
-                job,
-                why: e.reason(),
-            },
+            Err(why) => Reply::Failed { job, why },
         }
     }
 
@@ -424,6 +444,22 @@ pub fn clock_ms() -> f64 {
 /// [`Reply::Smoothed`]'s metrics back from JSON.
 pub fn metrics_of(json: &str) -> Result<Metrics, String> {
     serde_json::from_str(json).map_err(|e| format!("a worker's measures did not decode: {e}"))
+}
+
+/// A case holding only the image `name` ([`Input::Image`]).
+fn read_image(
+    name: &str,
+    bytes: &[u8],
+    preset: &str,
+    grids: &[(String, crate::io::Affine)],
+) -> Result<Case, String> {
+    let preset = (case::WindowPreset::from_name(preset))
+        .ok_or_else(|| format!("{name}: no window preset named {preset:?}"))?;
+    let image = case::CaseImage::read(bytes, name, preset, case::DEFAULT_IMAGE_VOXELS, grids)?;
+    Ok(Case {
+        image: Some(std::sync::Arc::new(image)),
+        ..Case::default()
+    })
 }
 
 #[cfg(test)]

@@ -401,3 +401,35 @@ testIn(EVERY_RUN, "V4 the clipping plane shows the case's CT slice, the liver's 
         await assert.rejects(app.call("setView", { planes: { oblique: 0.5 } }), /unknown planes key oblique/);
     }, { query: "?mode=viewer" });
 });
+
+testIn(EVERY_RUN, "V5 the author adds the CT under the page's case, the case glTF carries it, the viewer shows its slice", { timeout: TIMEOUT }, async () => {
+    const ct = readFileSync(join(ROOT, "tests/data/phantom_ct.nii.gz"));
+    const bone = { source: "phantom_ct.nii.gz", dims: [160, 140, 48], preset: "ct-bone", window: { center: 400, width: 1800 } };
+    /** The liver (60 HU) in the bone window, unlit. */
+    const boneLiver = (r, g, b) => neutral(r, g, b) && Math.abs(g - Math.round(((60 - 400 + 900) / 1800) * 255)) <= 6;
+    let exported;
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd", "loadCase");
+        const unknown = await app.attemptLoad(ct, "phantom_ct.nii.gz", "addImage", "soft");
+        assert.match(unknown.message, /preset must be one of ct-soft-tissue, ct-bone/);
+        const stl = await app.attemptLoad(ct, "phantom_ct.stl", "addImage");
+        assert.match(stl.message, /cannot tell the image format of 'phantom_ct\.stl': use one of \.nii \.nii\.gz \.nrrd \.mgz \.mgh/);
+        const jhu = await app.attemptLoad(readFileSync(join(ROOT, "tests/data/jhu_labels.mgz")), "jhu_labels.mgz", "addImage");
+        assert.match(jhu.message, /jhu_labels\.mgz does not lie on the segmentation's voxel grid: its voxel \(\d+, \d+, \d+\) is [0-9.]+ mm from the segmentation's \(offset/);
+        const added = await app.loadMesh(ct, "phantom_ct.nii.gz", "addImage", "ct-bone");
+        assert.deepEqual(added.image, bone);
+        const { view } = await app.stateWhen((s) => s.loading === null && s.layout.structures.length === 4, "the case open, the image read");
+        await app.call("setView", { from: "S", clip: { axis: "axial", at: 0.5 } });
+        await app.screenshotWhen("V5-author-bone-window", (i) => pixelsWhere(i, view, boneLiver).count > 2000, "the CT's liver on the author's slice");
+        exported = Buffer.from(await app.call("exportCase", "glb"));
+        await app.call("removeImage");
+        assert.equal((await app.call("structures")).image, null, "removed");
+    });
+    await withApp(async (app) => {
+        const opened = await app.loadMesh(exported, "V5-author-case.glb", "loadCase");
+        assert.deepEqual(opened.image, bone, "the author's image, carried in the case glTF");
+        const { view } = await app.stateWhen((s) => s.layout.structures.length === 4 && s.loading === null, "the case's four rows");
+        await app.call("setView", { from: "S", clip: { axis: "axial", at: 0.5 } });
+        await app.screenshotWhen("V5-viewer-bone-window", (i) => pixelsWhere(i, view, boneLiver).count > 2000, "the CT's liver on the viewer's slice");
+    }, { query: "?mode=viewer" });
+});

@@ -1,8 +1,9 @@
-//! The API's calls that hand the page a file: `loadMesh`, `loadCase` and `addFile`, each
-//! opened by a worker and settled once it is open.
+//! The API's calls that hand the page a file: `loadMesh`, `loadCase`, `addFile` and
+//! `addImage`, each opened by a worker and settled once it is open.
 
 use super::{error, settled, to_js};
 use crate::app::document::{LoadWaiter, SharedDocument};
+use crate::case::WindowPreset;
 use eframe::egui;
 use js_sys::{Function, Promise, Uint8Array};
 use wasm_bindgen::closure::Closure;
@@ -87,6 +88,46 @@ pub(super) fn file_call(
                     doc.begin_add(&name, bytes, Some(waiter))
                 }
             }
+            crate::app::wake(&c);
+        })
+    })
+}
+
+/// `addImage(bytes: Uint8Array, name, preset)`: the image under the open case's surfaces, read
+/// by a worker with the window `preset` names (`ct-soft-tissue` when left out); the promise
+/// settles with the structures (their `image`) once it is read, or with why not.
+pub(super) fn image_call(
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+) -> Closure<dyn FnMut(JsValue, JsValue, JsValue) -> Promise> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    Closure::new(move |bytes: JsValue, name: JsValue, preset: JsValue| {
+        let Some(bytes) = bytes.dyn_ref::<Uint8Array>() else {
+            return settled(Err(
+                "addImage(bytes, name): bytes must be a Uint8Array".into()
+            ));
+        };
+        let Some(name) = name.as_string().filter(|n| !n.is_empty()) else {
+            return settled(Err("addImage(bytes, name): name must name the file".into()));
+        };
+        let preset = match preset.as_string() {
+            Some(name) => WindowPreset::from_name(&name),
+            None if preset.is_undefined() || preset.is_null() => Some(WindowPreset::CtSoftTissue),
+            None => None,
+        };
+        let Some(preset) = preset else {
+            let names: Vec<&str> = WindowPreset::ALL.iter().map(|p| p.name()).collect();
+            let why = format!("addImage: preset must be one of {}", names.join(", "));
+            return settled(Err(why));
+        };
+        let mut bytes = Some(bytes.to_vec());
+        let (d, c) = (d.clone(), c.clone());
+        Promise::new(&mut |resolve: Function, reject: Function| {
+            let Some(bytes) = bytes.take() else { return };
+            let structures = |s: &crate::session::Session| super::json::structures(s.case());
+            let waiter = load_waiter(resolve, reject, structures);
+            d.borrow_mut()
+                .begin_image(&name, bytes, preset, Some(waiter));
             crate::app::wake(&c);
         })
     })

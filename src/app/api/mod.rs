@@ -14,6 +14,11 @@
 //!   smoothed surfaces) or any file above
 //! - `addFile(bytes, name): Promise<structures>`: adds the file's structures to the open case
 //!   (after a file still opening); the model stays
+//! - `addImage(bytes, name, preset): Promise<structures>`: the image the segmentation was drawn
+//!   on (NIfTI, NRRD or MGH/MGZ, on the voxel grid of every label map the structures came from),
+//!   windowed by `preset` (`ct-soft-tissue`, the default, `ct-bone`, `ct-lung`, `ct-brain`,
+//!   `mri-auto`), read by a worker; replaces the case's image; rejects with the offset found
+//!   when it lies elsewhere, the image the case had staying. `removeImage()` takes it away
 //! - `structures()`: `{file, current, title, description, structures: [{label, name, color,
 //!   opacity, visible, group, source, voxels, voxel_size, codes, vertices, triangles, volume,
 //!   metrics}]}` of the open case, or null with nothing open (`metrics`: its last smoothing's
@@ -276,6 +281,13 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
     for call in [FileCall::Mesh, FileCall::Case, FileCall::Add] {
         api.define(call.name(), file_call(doc, ctx, call))?;
     }
+    api.define("addImage", files::image_call(doc, ctx))?;
+    let (d, c) = (doc.clone(), ctx.clone());
+    let remove_image = Closure::<dyn FnMut()>::new(move || {
+        d.borrow_mut().session_mut().remove_image();
+        crate::app::wake(&c);
+    });
+    api.define("removeImage", remove_image)?;
 
     api.define("setView", view::set_view(doc, ctx))?;
     view::define_screenshot(&api, doc, ctx)?;

@@ -17,7 +17,7 @@ impl Shell {
             ui.heading("meshsmooth");
             ui.separator();
             if ui.button("Open…").on_hover_text("O").clicked() {
-                self.open_picker(false);
+                self.open_picker(super::FilesFor::NewCase);
             }
             ui.menu_button("Export", |ui| {
                 for (label, format) in [

@@ -8,7 +8,7 @@ use super::case_text::CaseText;
 use super::controls::{self, Controls};
 use super::document::{now_ms, Backend, Document, Opening, SharedDocument};
 use super::drag_params::DragParams;
-use super::file_input::{Arrived, FileInput};
+use super::file_input::{Arrived, FileInput, FilesFor};
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
 use super::picture::Picture;
@@ -108,12 +108,20 @@ fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
                 }
             }
         }
-        if group.add {
-            for f in files {
-                doc.begin_add(&f.name, f.bytes, None);
+        match group.purpose {
+            FilesFor::OpenCase => {
+                for f in files {
+                    doc.begin_add(&f.name, f.bytes, None);
+                }
             }
-        } else if !files.is_empty() {
-            doc.begin_open_files(files, None);
+            // One image: the first file chosen.
+            FilesFor::Image(preset) => {
+                if let Some(f) = files.into_iter().next() {
+                    doc.begin_image(&f.name, f.bytes, preset, None);
+                }
+            }
+            FilesFor::NewCase if !files.is_empty() => doc.begin_open_files(files, None),
+            FilesFor::NewCase => {}
         }
     }
 }
@@ -229,9 +237,9 @@ impl Shell {
         open_arrived(self.files.take_arrived(), &mut self.doc.borrow_mut());
     }
 
-    /// The file dialog, to open files as a case or (`add`) to add them to the open one.
-    fn open_picker(&mut self, add: bool) {
-        if let Err(e) = self.files.open_picker(add) {
+    /// The file dialog, for files to open as a case, to add to the open one, or an image.
+    fn open_picker(&mut self, purpose: FilesFor) {
+        if let Err(e) = self.files.open_picker(purpose) {
             self.doc.borrow_mut().session_mut().fail("a file", &e);
         }
     }
@@ -261,7 +269,7 @@ impl Shell {
 
     fn apply(&mut self, action: Action) {
         match action {
-            Action::Open => self.open_picker(false),
+            Action::Open => self.open_picker(FilesFor::NewCase),
             Action::ToggleWireframe => {
                 if let Some((viewer, _)) = &mut self.view {
                     viewer.wireframe = !viewer.wireframe;
@@ -312,12 +320,20 @@ impl Shell {
         let mut guard = self.doc.borrow_mut();
         let doc = &mut *guard;
         let timings = doc.timings;
-        let mut add_files = false;
+        let mut picker = None;
         let (session, panel) = doc.session_and_panel();
         for action in self.structures.show(ui, session, panel) {
             let done = match action {
                 StructureAction::AddFiles => {
-                    add_files = true;
+                    picker = Some(FilesFor::OpenCase);
+                    Ok(())
+                }
+                StructureAction::AddImage(preset) => {
+                    picker = Some(FilesFor::Image(preset));
+                    Ok(())
+                }
+                StructureAction::RemoveImage => {
+                    doc.session_mut().remove_image();
                     Ok(())
                 }
                 StructureAction::Select(i) => doc.select_structure(i),
@@ -377,8 +393,8 @@ impl Shell {
         ui.heading("Colours");
         controls::coloring(ui, &mut self.coloring, doc.case_mut());
         drop(guard);
-        if add_files {
-            self.open_picker(true);
+        if let Some(purpose) = picker {
+            self.open_picker(purpose);
         }
     }
 }

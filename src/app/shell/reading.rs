@@ -18,7 +18,7 @@ impl Shell {
             ui.heading("meshsmooth viewer");
             ui.separator();
             if ui.button("Open…").on_hover_text("O").clicked() {
-                self.open_picker(false);
+                self.open_picker(super::FilesFor::NewCase);
             }
             if let Some((viewer, _)) = &mut self.view {
                 if ui.button("Reset view").on_hover_text("R").clicked() {

@@ -276,9 +276,13 @@ export class AppPage {
         return this.call("metrics");
     }
 
-    /** `loadMesh(bytes, name)` with the bytes of a Node Buffer; resolves with the info object. */
-    async loadMesh(bytes, name, method = "loadMesh") {
-        const result = await this.attemptLoad(bytes, name, method);
+    /**
+     * `loadMesh(bytes, name)` with the bytes of a Node Buffer; resolves with the info object.
+     * `method` may be another call taking bytes and a name (`loadCase`, `addFile`, `addImage`),
+     * `extra` its further arguments.
+     */
+    async loadMesh(bytes, name, method = "loadMesh", ...extra) {
+        const result = await this.attemptLoad(bytes, name, method, ...extra);
         if (!result.ok) {
             throw new Error(`${method}(${name}) rejected: ${result.message}`);
         }
@@ -289,22 +293,22 @@ export class AppPage {
      * `loadMesh` (or `method`: `loadCase`, `addFile`, which take the same arguments) without
      * throwing: `{ok, value}` or `{ok: false, isError, message}`.
      */
-    async attemptLoad(bytes, name, method = "loadMesh") {
+    async attemptLoad(bytes, name, method = "loadMesh", ...extra) {
         await this.api();
         return this.page.evaluate(
-            async ([base64, name, method]) => {
+            async ([base64, name, method, extra]) => {
                 const text = atob(base64);
                 const bytes = new Uint8Array(text.length);
                 for (let i = 0; i < text.length; i++) {
                     bytes[i] = text.charCodeAt(i);
                 }
                 try {
-                    return { ok: true, value: await window.meshsmooth[method](bytes, name) };
+                    return { ok: true, value: await window.meshsmooth[method](bytes, name, ...extra) };
                 } catch (e) {
                     return { ok: false, isError: e instanceof Error, message: e instanceof Error ? e.message : String(e) };
                 }
             },
-            [Buffer.from(bytes).toString("base64"), name, method],
+            [Buffer.from(bytes).toString("base64"), name, method, extra],
         );
     }
 
