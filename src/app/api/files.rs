@@ -63,15 +63,11 @@ pub(super) fn file_call(
 ) -> Closure<dyn FnMut(JsValue, JsValue) -> Promise> {
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move |bytes: JsValue, name: JsValue| {
-        let Some(bytes) = bytes.dyn_ref::<Uint8Array>() else {
-            let why = format!("{}(bytes, name): bytes must be a Uint8Array", call.name());
-            return settled(Err(why));
+        let (bytes, name) = match file_arguments(call.name(), &bytes, &name) {
+            Ok(file) => file,
+            Err(why) => return settled(Err(why)),
         };
-        let Some(name) = name.as_string().filter(|n| !n.is_empty()) else {
-            let why = format!("{}(bytes, name): name must name the file", call.name());
-            return settled(Err(why));
-        };
-        let mut bytes = Some(bytes.to_vec());
+        let mut bytes = Some(bytes);
         let (d, c) = (d.clone(), c.clone());
         Promise::new(&mut |resolve: Function, reject: Function| {
             let Some(bytes) = bytes.take() else { return };
@@ -102,13 +98,9 @@ pub(super) fn image_call(
 ) -> Closure<dyn FnMut(JsValue, JsValue, JsValue) -> Promise> {
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move |bytes: JsValue, name: JsValue, preset: JsValue| {
-        let Some(bytes) = bytes.dyn_ref::<Uint8Array>() else {
-            return settled(Err(
-                "addImage(bytes, name): bytes must be a Uint8Array".into()
-            ));
-        };
-        let Some(name) = name.as_string().filter(|n| !n.is_empty()) else {
-            return settled(Err("addImage(bytes, name): name must name the file".into()));
+        let (bytes, name) = match file_arguments("addImage", &bytes, &name) {
+            Ok(file) => file,
+            Err(why) => return settled(Err(why)),
         };
         let preset = match preset.as_string() {
             Some(name) => WindowPreset::from_name(&name),
@@ -120,7 +112,7 @@ pub(super) fn image_call(
             let why = format!("addImage: preset must be one of {}", names.join(", "));
             return settled(Err(why));
         };
-        let mut bytes = Some(bytes.to_vec());
+        let mut bytes = Some(bytes);
         let (d, c) = (d.clone(), c.clone());
         Promise::new(&mut |resolve: Function, reject: Function| {
             let Some(bytes) = bytes.take() else { return };
@@ -131,4 +123,17 @@ pub(super) fn image_call(
             crate::app::wake(&c);
         })
     })
+}
+
+/// A call's `(bytes: Uint8Array, name)` arguments, or why they are not.
+fn file_arguments(
+    call: &str,
+    bytes: &JsValue,
+    name: &JsValue,
+) -> Result<(Vec<u8>, String), String> {
+    let bytes = (bytes.dyn_ref::<Uint8Array>())
+        .ok_or_else(|| format!("{call}(bytes, name): bytes must be a Uint8Array"))?;
+    let name = (name.as_string().filter(|n| !n.is_empty()))
+        .ok_or_else(|| format!("{call}(bytes, name): name must name the file"))?;
+    Ok((bytes.to_vec(), name))
 }
