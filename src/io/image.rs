@@ -26,28 +26,28 @@ pub struct ImageVolume {
 pub fn load_image(bytes: &[u8], name: &str, max_voxels: usize) -> Result<ImageVolume, LoadError> {
     let lower = name.to_ascii_lowercase();
     let sink = |format| move |layout: &_| IntensitySink::new(layout, format, max_voxels);
-    let (format, layout, affine, sink) = if lower.ends_with(".nrrd") {
-        let v = nrrd::read(bytes, sink(Format::Nrrd))?;
-        (Format::Nrrd, v.layout, v.affine, v.sink)
+    let (format, volume) = if lower.ends_with(".nrrd") {
+        (Format::Nrrd, nrrd::read(bytes, sink(Format::Nrrd))?.plain())
     } else if lower.ends_with(".nii") || lower.ends_with(".nii.gz") {
-        let v = nifti::read(bytes, sink(Format::Nifti))?;
-        (Format::Nifti, v.layout, v.affine, v.sink)
+        (
+            Format::Nifti,
+            nifti::read(bytes, sink(Format::Nifti))?.plain(),
+        )
     } else if lower.ends_with(".mgz") || lower.ends_with(".mgh") {
-        let (layout, affine, sink) = mgh::read(bytes, sink(Format::Mgh))?;
-        (Format::Mgh, layout, affine, sink)
+        (Format::Mgh, mgh::read(bytes, sink(Format::Mgh))?)
     } else {
         return Err(LoadError::UnknownImageFormat {
             name: name.to_string(),
         });
     };
-    let factor = sink.factor();
-    let (dims, values) = sink.finish(format)?;
+    let factor = volume.sink.factor();
+    let (dims, values) = volume.sink.finish(format)?;
     Ok(ImageVolume {
         dims,
-        affine: reduced_affine(&affine, factor),
+        affine: reduced_affine(&volume.affine, factor),
         values,
-        source_dims: layout.dims,
-        source_affine: affine,
+        source_dims: volume.layout.dims,
+        source_affine: volume.affine,
     })
 }
 

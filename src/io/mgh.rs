@@ -12,7 +12,7 @@ use super::freesurfer_lut;
 use super::gzip::{self, Inflater};
 use super::label_map::{Affine, LabelMap, LabelMapOptions, Segment};
 use super::label_map_checks::{check_affine, check_raw, Sample, VoxelLayout};
-use super::voxels::{self, Feed, VoxelSink};
+use super::voxels::{self, Feed, Streamed, VoxelSink};
 use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::Mgh;
@@ -23,8 +23,9 @@ const DATA_OFFSET: usize = 284;
 const FIELDS_END: usize = 90;
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
-    let (layout, affine, sink) = read(bytes, |layout| VoxelSink::new(layout, options, FORMAT))?;
-    finish(layout, affine, sink)
+    finish(read(bytes, |layout| {
+        VoxelSink::new(layout, options, FORMAT)
+    })?)
 }
 
 /// Reads an MGH/MGZ file's header, then streams its voxels into the sink `make` builds for
@@ -33,7 +34,7 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
 pub(super) fn read<S: Feed>(
     bytes: &[u8],
     make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
-) -> Result<(VoxelLayout, Affine, S), LoadError> {
+) -> Result<Streamed<S>, LoadError> {
     if gzip::is_gzip(bytes) {
         read_gzip(bytes, make)
     } else {
@@ -44,7 +45,7 @@ pub(super) fn read<S: Feed>(
 fn read_raw<S: Feed>(
     bytes: &[u8],
     make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
-) -> Result<(VoxelLayout, Affine, S), LoadError> {
+) -> Result<Streamed<S>, LoadError> {
     let header = Header::parse(bytes)?;
     let layout = header.layout()?;
     let affine = header.affine()?;
@@ -54,7 +55,12 @@ fn read_raw<S: Feed>(
     let mut sink = make(&layout)?;
     // What follows the voxels is the footer.
     sink.feed(&data[..data_bytes as usize])?;
-    Ok((layout, affine, sink))
+    Ok(Streamed {
+        layout,
+        affine,
+        sink,
+        meta: (),
+    })
 }
 
 /// `.mgz`: the header inflated first, then the voxels stream from the same inflater into the
@@ -62,7 +68,7 @@ fn read_raw<S: Feed>(
 fn read_gzip<S: Feed>(
     bytes: &[u8],
     make: impl FnOnce(&VoxelLayout) -> Result<S, LoadError>,
-) -> Result<(VoxelLayout, Affine, S), LoadError> {
+) -> Result<Streamed<S>, LoadError> {
     let mut inflater = Inflater::new(bytes, FORMAT);
     let mut head = [0u8; DATA_OFFSET];
     let got = inflater.read_up_to(&mut head)?;
@@ -78,10 +84,21 @@ fn read_gzip<S: Feed>(
     inflater.expect_total(total);
     let mut sink = make(&layout)?;
     voxels::feed_from_gzip(&mut inflater, &mut sink, data_bytes)?;
-    Ok((layout, affine, sink))
+    Ok(Streamed {
+        layout,
+        affine,
+        sink,
+        meta: (),
+    })
 }
 
-fn finish(layout: VoxelLayout, affine: Affine, sink: VoxelSink) -> Result<LabelMap, LoadError> {
+fn finish(volume: Streamed<VoxelSink>) -> Result<LabelMap, LoadError> {
+    let Streamed {
+        layout,
+        affine,
+        sink,
+        ..
+    } = volume;
     let layers = sink.finish()?;
     let values = layers.first().map_or(&[][..], |l| &l.values[..]);
     let conventional = (values.iter().skip(1))

@@ -10,15 +10,15 @@ use super::label_map::LabelMapOptions;
 use super::label_map::{Affine, LabelMap};
 use super::label_map_checks::{check_affine, check_raw, check_spacing, Sample, VoxelLayout};
 use super::nifti_names;
-use super::voxels::{self, Feed, VoxelSink};
+use super::voxels::{self, Feed, Streamed, VoxelSink};
 use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::Nifti;
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
     let volume = read(bytes, |layout| VoxelSink::new(layout, options, FORMAT))?;
-    let segments = match volume.extensions.len() <= nifti_names::MAX_EXTENSION_BYTES {
-        true => nifti_names::label_names(&volume.extensions, volume.big_endian),
+    let segments = match volume.meta.bytes.len() <= nifti_names::MAX_EXTENSION_BYTES {
+        true => nifti_names::label_names(&volume.meta.bytes, volume.meta.big_endian),
         false => Vec::new(),
     };
     Ok(LabelMap {
@@ -30,15 +30,14 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     })
 }
 
-/// A file's grid and its voxels, fed into the sink the caller made for them.
-pub(super) struct Volume<S> {
-    pub layout: VoxelLayout,
-    pub affine: Affine,
-    pub sink: S,
+/// What a NIfTI file carries beside its voxels.
+pub(super) struct Extensions {
     /// The header extensions' bytes (empty when past [`nifti_names::MAX_EXTENSION_BYTES`]).
-    pub extensions: Vec<u8>,
+    pub bytes: Vec<u8>,
     pub big_endian: bool,
 }
+
+type Volume<S> = Streamed<S, Extensions>;
 
 /// Reads a NIfTI file's header, then streams its voxels into the sink `make` builds for
 /// their layout (label codes, or an image's intensities).
@@ -71,15 +70,17 @@ fn read_raw<S: Feed>(
     let mut sink = make(&layout)?;
     sink.feed(&data[..data_bytes as usize])?;
     let extensions = bytes.get(header.offsets.size..start).unwrap_or_default();
-    Ok(Volume {
+    Ok(Streamed {
         layout,
         affine,
         sink,
-        extensions: match extensions.len() <= nifti_names::MAX_EXTENSION_BYTES {
-            true => extensions.to_vec(),
-            false => Vec::new(),
+        meta: Extensions {
+            bytes: match extensions.len() <= nifti_names::MAX_EXTENSION_BYTES {
+                true => extensions.to_vec(),
+                false => Vec::new(),
+            },
+            big_endian: header.big_endian,
         },
-        big_endian: header.big_endian,
     })
 }
 
@@ -120,12 +121,14 @@ fn read_gzip<S: Feed>(
         }
     }
     voxels::decode_gzip(inflater, &mut sink, data_bytes - in_head.len() as u64)?;
-    Ok(Volume {
+    Ok(Streamed {
         layout,
         affine,
         sink,
-        extensions,
-        big_endian: header.big_endian,
+        meta: Extensions {
+            bytes: extensions,
+            big_endian: header.big_endian,
+        },
     })
 }
 

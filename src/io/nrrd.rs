@@ -14,14 +14,14 @@ use super::label_map::LabelMapOptions;
 use super::label_map::{Affine, LabelMap, Segment};
 use super::label_map_checks::{check_affine, check_raw, check_spacing, Sample, VoxelLayout};
 use super::text::Lines;
-use super::voxels::{self, Feed, VoxelSink};
+use super::voxels::{self, Feed, Streamed, VoxelSink};
 use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::Nrrd;
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
     let volume = read(bytes, |layout| VoxelSink::new(layout, options, FORMAT))?;
-    let segments = volume.header.segments(volume.layout.layers)?;
+    let segments = volume.meta.segments(volume.layout.layers)?;
     Ok(LabelMap {
         dims: volume.layout.dims,
         affine: volume.affine,
@@ -31,13 +31,7 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     })
 }
 
-/// A file's grid and its voxels, fed into the sink the caller made for them.
-pub(super) struct Volume<S> {
-    pub layout: VoxelLayout,
-    pub affine: Affine,
-    pub sink: S,
-    header: Header,
-}
+type Volume<S> = Streamed<S, Header>;
 
 /// Reads a NRRD file's header, then streams its voxels into the sink `make` builds for their
 /// layout (label codes, or an image's intensities).
@@ -66,11 +60,11 @@ pub(super) fn read<S: Feed>(
         }
         None => return Err(missing("encoding", header.end_line)),
     }
-    Ok(Volume {
+    Ok(Streamed {
         layout,
         affine,
         sink,
-        header,
+        meta: header,
     })
 }
 
@@ -108,7 +102,7 @@ struct SegmentFields {
 }
 
 #[derive(Debug, Default)]
-struct Header {
+pub(super) struct Header {
     data_start: usize,
     /// The blank line that ends the header (where missing fields are reported).
     end_line: usize,

@@ -7,9 +7,36 @@
 use std::collections::HashMap;
 
 use super::gzip::Inflater;
-use super::label_map::{LabelLayer, LabelMapOptions, DEFAULT_LEVEL, MAX_LABELS};
+use super::label_map::{Affine, LabelLayer, LabelMapOptions, DEFAULT_LEVEL, MAX_LABELS};
 use super::label_map_checks::{for_each_sample, Value, VoxelLayout};
 use super::{Format, LoadError};
+
+/// A file's grid and its voxels, fed into the sink the caller made for them, with what else
+/// the format's reader found on the way (`meta`: NIfTI's extensions, NRRD's header).
+pub(super) struct Streamed<S, M = ()> {
+    pub layout: VoxelLayout,
+    pub affine: Affine,
+    pub sink: S,
+    pub meta: M,
+}
+
+impl<S, M> Streamed<S, M> {
+    /// The grid and voxels alone, for readers that need nothing else of the format.
+    pub fn plain(self) -> Streamed<S> {
+        let Streamed {
+            layout,
+            affine,
+            sink,
+            ..
+        } = self;
+        Streamed {
+            layout,
+            affine,
+            sink,
+            meta: (),
+        }
+    }
+}
 
 /// What voxel bytes are decoded into: label codes ([`VoxelSink`]) or an image's intensities
 /// ([`super::intensity`]). Chunks come in file order, of any size.
