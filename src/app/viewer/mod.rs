@@ -82,8 +82,9 @@ pub struct Viewer {
     pub clip: Option<Clip>,
     /// The image's three planes, shown (with no clip) where the case has an image.
     pub planes: Option<Planes>,
-    /// Where the case's image lies (shown on the clipping plane), and which image it is.
-    image: Option<(usize, SlicePlacement)>,
+    /// Which image was last set (its key, remembered even when its texture could not be made,
+    /// so a refusal is not retried every frame) and where it lies when shown.
+    image: Option<(usize, Option<SlicePlacement>)>,
 }
 
 /// The camera, the home view and the scene box, kept across a new model of the same scene.
@@ -162,7 +163,7 @@ impl Viewer {
             Ok(())
         });
         match result {
-            Ok(()) => self.image = key.zip(texture.map(|t| t.placement)),
+            Ok(()) => self.image = key.map(|k| (k, texture.map(|t| t.placement))),
             Err(e) => self.fail(e),
         }
     }
@@ -336,7 +337,7 @@ impl Viewer {
     /// Where the image's slices lie this frame, and whether the surfaces outline their cut on
     /// the clip's.
     fn slices(&self) -> ([Option<SliceUniforms>; 3], bool) {
-        let Some((_, placement)) = self.image else {
+        let Some((_, Some(placement))) = self.image else {
             return ([None; 3], false);
         };
         if let Some(planes) = self.planes.filter(|_| self.clip.is_none()) {
