@@ -193,7 +193,8 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
         .expect("done")
         .expect_err("moved 5 mm");
     assert!(
-        error.contains("moved.nii") && error.contains("5.000 mm"),
+        error.starts_with("Cannot open the image moved.nii: the image does not lie")
+            && error.contains("5.000 mm"),
         "{error}"
     );
     assert_eq!(session.case().case_image(), Some(&image), "kept");
@@ -209,12 +210,13 @@ fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept(
     let error = (case.add_image(&moved, "ct.nii", WindowPreset::CtSoftTissue, 1 << 24))
         .expect_err("moved 5 mm");
     assert!(
-        error.contains("ct.nii") && error.contains("offset 0.000, 0.000, 5.000 mm"),
+        error.starts_with("the image does not lie")
+            && error.contains("offset 0.000, 0.000, 5.000 mm"),
         "{error}"
     );
     let error = (case.add_image(b"not a nifti", "ct.nii", WindowPreset::CtBone, 1 << 24))
         .expect_err("garbage");
-    assert!(error.starts_with("ct.nii: NIfTI"), "{error}");
+    assert!(error.starts_with("NIfTI"), "{error}");
     assert_eq!(case, before);
     let mut surfaces = Case::default();
     let error = (surfaces.add_image(

@@ -197,6 +197,7 @@ impl CaseImage {
     /// Reads the image `name` (NIfTI, NRRD or MGH bytes), reduced to at most `max_voxels` and
     /// windowed by `preset`, after checking that it lies on each of `grids`: the grids a case's
     /// structures were extracted on, each with a structure's name ([`super::Case::image_grids`]).
+    /// A refusal's reason leaves the file to be named by the caller.
     pub fn read(
         bytes: &[u8],
         name: &str,
@@ -205,14 +206,15 @@ impl CaseImage {
         grids: &[(String, Affine)],
     ) -> Result<Self, String> {
         if grids.is_empty() {
-            return Err(format!(
-                "{name}: the case has no structure from a label map, so there is no \
-                 segmentation grid to place the image on"
-            ));
+            return Err(
+                "the case has no structure from a label map, so there is no \
+                        segmentation grid to place the image on"
+                    .to_string(),
+            );
         }
-        let image = load_image(bytes, name, max_voxels).map_err(|e| format!("{name}: {e}"))?;
+        let image = load_image(bytes, name, max_voxels).map_err(|e| e.to_string())?;
         for (structure, grid) in grids {
-            check_frame(&image, grid, name).map_err(|e| match grids.len() {
+            check_frame(&image, grid).map_err(|e| match grids.len() {
                 1 => e,
                 _ => format!("{e}; the grid is {structure}'s"),
             })?;
@@ -253,7 +255,7 @@ impl super::Case {
 /// Refuses an image whose grid is not the segmentation's: `grid` is the voxel grid the case's
 /// structures were extracted on. Names the largest offset between the two at the image's
 /// corners.
-pub fn check_frame(image: &ImageVolume, grid: &Affine, name: &str) -> Result<(), String> {
+pub fn check_frame(image: &ImageVolume, grid: &Affine) -> Result<(), String> {
     let [di, dj, dk] = image.source_dims.map(|d| d.saturating_sub(1) as f64);
     let corners = [
         [0.0, 0.0, 0.0],
@@ -284,7 +286,7 @@ pub fn check_frame(image: &ImageVolume, grid: &Affine, name: &str) -> Result<(),
         return Ok(());
     }
     Err(format!(
-        "{name} does not lie on the segmentation's voxel grid: its voxel ({}, {}, {}) is \
+        "the image does not lie on the segmentation's voxel grid: its voxel ({}, {}, {}) is \
          {worst:.3} mm from the segmentation's (offset {:.3}, {:.3}, {:.3} mm, RAS)",
         corner[0], corner[1], corner[2], offset[0], offset[1], offset[2]
     ))
@@ -362,15 +364,15 @@ mod tests {
     fn an_image_off_the_segmentation_grid_is_refused_with_its_offset() {
         let grid = Affine::scaled([1.5, 1.5, 3.0], [-100.0, -80.0, 20.0]);
         let same = volume([10, 10, 5], grid, vec![0.0; 500]);
-        assert_eq!(check_frame(&same, &grid, "ct.nii.gz"), Ok(()));
+        assert_eq!(check_frame(&same, &grid), Ok(()));
         let moved = volume(
             [10, 10, 5],
             Affine::scaled([1.5, 1.5, 3.0], [-100.0, -67.5, 20.0]),
             vec![0.0; 500],
         );
-        let error = check_frame(&moved, &grid, "ct.nii.gz").expect_err("moved");
+        let error = check_frame(&moved, &grid).expect_err("moved");
         assert!(
-            error.contains("ct.nii.gz") && error.contains("12.500 mm"),
+            error.starts_with("the image does not lie on") && error.contains("12.500 mm"),
             "{error}"
         );
         assert!(error.contains("offset 0.000, 12.500, 0.000 mm"), "{error}");

@@ -139,12 +139,9 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     let mut case = open(args)?;
     if let Some(path) = &args.image {
         let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        case.add_image(
-            &bytes,
-            &path.display().to_string(),
-            args.window,
-            args.image_voxels,
-        )?;
+        let name = path.display().to_string();
+        (case.add_image(&bytes, &name, args.window, args.image_voxels))
+            .map_err(|e| format!("{name}: {e}"))?;
     }
     if let Some(t) = &args.title {
         case.title = t.clone();

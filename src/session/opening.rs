@@ -32,6 +32,16 @@ enum Purpose {
     Image,
 }
 
+impl Purpose {
+    /// How a failure names the file: an image is told apart from the case it goes under.
+    fn shown(self, name: &str) -> String {
+        match self {
+            Purpose::Image => format!("the image {name}"),
+            Purpose::File | Purpose::Addition => name.to_string(),
+        }
+    }
+}
+
 /// An opening asked of the workers.
 pub(super) struct WorkerOpening {
     name: String,
@@ -199,11 +209,7 @@ impl Session {
                 stages,
                 ..
             } => (model, case, stages),
-            // The image's reasons name its file already.
-            Reply::Failed { why, .. } if purpose == Purpose::Image => {
-                return Err(self.fail("the image", &why))
-            }
-            Reply::Failed { why, .. } => return Err(self.fail(name, &why)),
+            Reply::Failed { why, .. } => return Err(self.fail(&purpose.shown(name), &why)),
             _ => return Err(self.fail(name, "a worker answered something else")),
         };
         self.open_stages = stages;
