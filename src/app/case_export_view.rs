@@ -97,9 +97,7 @@ impl ExportChoice {
             ui.colored_label(ui.visuals().warn_fg_color, format!("Not written: {e}"));
         }
     }
-}
 
-impl ExportChoice {
     /// The image under the surfaces: the one the case carries, with what it adds to the case
     /// glTF; else the window and the button to choose one.
     fn image_row(
