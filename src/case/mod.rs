@@ -3,11 +3,13 @@
 //! and measures, smoothed independently and written as one glTF.
 //!
 //! Layout: the document here; opening files as a case in `from_files`; smoothing and "Suggest all" in `pipeline`; the quality record
-//! the glTF carries (and reads back) in `record`; checks between structures in `relations`.
+//! the glTF carries (and reads back) in `record`; checks between structures in `relations`; the
+//! tour, labels and quiz in `lesson`.
 
 mod checks;
 mod from_files;
 mod image;
+mod lesson;
 mod pipeline;
 mod record;
 pub mod relations;
@@ -19,6 +21,7 @@ pub use from_files::{
     surface_structure, CaseOpenError,
 };
 pub use image::{check_frame, CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
+pub use lesson::{Camera, Label, Lesson, Quiz, QuizMode, Step};
 pub use pipeline::{
     smooth_structure, starts_from, suggest_all, suggest_structure, SuggestAllOptions,
     SuggestAllProgress, LEARNING_BATCH,
@@ -48,6 +51,9 @@ pub struct Case {
     /// copied, when the case is cloned.
     #[serde(default)]
     pub image: Option<Arc<CaseImage>>,
+    /// The tour, labels and quiz a student goes through.
+    #[serde(default)]
+    pub lesson: Lesson,
 }
 
 /// One structure of a case. Two are equal when they would be written the same: the memory of
@@ -307,6 +313,9 @@ impl Case {
         }
         if self.image.is_none() {
             self.image = other.image;
+        }
+        if self.lesson.is_empty() {
+            self.lesson = other.lesson;
         }
         self.structures.extend(other.structures);
     }

@@ -7,7 +7,7 @@ use serde_json::{json, Value};
 
 use std::sync::Arc;
 
-use super::{voxel_grid, Case, CaseImage, CaseStructure, Smoothed};
+use super::{voxel_grid, Case, CaseImage, CaseStructure, Lesson, Smoothed};
 use crate::io::{Affine, GltfNode, GltfScene, Mat4, StructureCodes};
 use crate::mesh::Mesh;
 use crate::metrics::Metrics;
@@ -27,6 +27,8 @@ pub enum CaseRecordError {
     Structure { name: String, detail: String },
     #[error("the case's image: {0}")]
     Image(String),
+    #[error("the case's lesson: {0}")]
+    Lesson(String),
 }
 
 /// A structure's record: what the platform shows beside it and what reopening restores.
@@ -92,17 +94,43 @@ pub fn from_gltf_scene(scene: GltfScene, source: &str) -> Result<Case, CaseRecor
         )),
         _ => None,
     };
+    let lesson = lesson(record, &scene.marked).map_err(CaseRecordError::Lesson)?;
     let structures = scene
         .nodes
         .into_iter()
         .enumerate()
         .map(|(i, node)| structure(node, i, source, ours))
         .collect::<Result<_, _>>()?;
-    Ok(Case {
+    let case = Case {
         title: text("title"),
         description: text("description"),
         structures,
         image,
+        lesson,
+    };
+    case.lesson.check(&case).map_err(CaseRecordError::Lesson)?;
+    Ok(case)
+}
+
+/// The lesson of a case written here: the steps and labels from their nodes' records (in the
+/// nodes' order), the quiz from the scene's.
+fn lesson(record: Option<&Value>, marked: &[Value]) -> Result<Lesson, String> {
+    fn each<T: serde::de::DeserializeOwned>(marked: &[Value], key: &str) -> Result<Vec<T>, String> {
+        (marked.iter().filter_map(|m| m.get(key)))
+            .enumerate()
+            .map(|(i, v)| {
+                serde_json::from_value(v.clone()).map_err(|e| format!("{key} {}: {e}", i + 1))
+            })
+            .collect()
+    }
+    let quiz = match record.and_then(|r| r.get("quiz")) {
+        Some(q) => Some(serde_json::from_value(q.clone()).map_err(|e| format!("quiz: {e}"))?),
+        None => None,
+    };
+    Ok(Lesson {
+        steps: each(marked, "step")?,
+        labels: each(marked, "text_label")?,
+        quiz,
     })
 }
 

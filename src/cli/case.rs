@@ -85,6 +85,10 @@ pub(super) struct BuildArgs {
     /// by the smallest whole factor that fits.
     #[arg(long, default_value_t = case::DEFAULT_IMAGE_VOXELS, requires = "image")]
     image_voxels: usize,
+    /// The lesson the case carries (JSON: tour steps, labels on the structures, a quiz), its
+    /// structures named as the case names them.
+    #[arg(long, value_name = "LESSON")]
+    lesson: Option<PathBuf>,
     /// Leave out the original surface (the morph target a viewer slides to, and what a
     /// reopened case smooths again from).
     #[arg(long)]
@@ -149,6 +153,14 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     if let Some(d) = &args.description {
         case.description = d.clone();
     }
+    if let Some(path) = &args.lesson {
+        let name = path.display();
+        let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
+        case.lesson = case::Lesson::from_json(&bytes).map_err(|e| format!("{name}: {e}"))?;
+        case.lesson
+            .check(&case)
+            .map_err(|e| format!("{name}: {e}"))?;
+    }
     if args.no_bound {
         for s in &mut case.structures {
             s.params.max_displacement = None;
@@ -196,6 +208,7 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     } else {
         out!("{}", table(&case));
         out!("{}", image_line(&case));
+        out!("{}", lesson_line(&case));
         out!("{}", case::checks_text(&case, &before, &after, &changes));
         outln!(
             "{} structures, {evaluations} parameter sets, suggested and smoothed in {:.2} s; \
@@ -348,6 +361,7 @@ fn info(file: &Path, json: bool) -> Result<(), String> {
         }
         out!("{}", table(&case));
         out!("{}", image_line(&case));
+        out!("{}", lesson_line(&case));
         let simplified: Vec<&serde_json::Value> = (written.iter())
             .map(|w| &w["simplification"])
             .filter(|r| r["simplified"] == true)
@@ -396,7 +410,41 @@ fn case_json(case: &Case) -> serde_json::Value {
         "description": case.description,
         "structures": structures,
         "image": image,
+        "lesson": case.lesson,
     })
+}
+
+/// What the case's lesson holds, in a line (empty when it has none).
+fn lesson_line(case: &Case) -> String {
+    let lesson = &case.lesson;
+    if lesson.is_empty() {
+        return String::new();
+    }
+    let quiz = match &lesson.quiz {
+        Some(q) => {
+            let modes: Vec<&str> = (q.modes.iter())
+                .map(|m| match m {
+                    case::QuizMode::FindIt => "find it",
+                    case::QuizMode::NameIt => "name it",
+                })
+                .collect();
+            let asked = match q.structures.len() {
+                0 => "every structure shown".to_string(),
+                n => format!("{n} structures"),
+            };
+            format!(
+                ", a quiz ({}) on {asked}, passed at {:.0}%",
+                modes.join(", "),
+                q.pass_mark * 100.0
+            )
+        }
+        None => String::new(),
+    };
+    format!(
+        "lesson: {} tour steps, {} labels{quiz}\n",
+        lesson.steps.len(),
+        lesson.labels.len()
+    )
 }
 
 /// The image the case carries, in a line (empty when it has none).

@@ -16,7 +16,8 @@
 use base64::Engine as _;
 use serde_json::{json, Value};
 
-use super::compressed::{self, Placement, Surfaces};
+use super::case_lesson::{label_node, step_camera};
+use super::compressed::{self, Lattice, Placement, Surfaces};
 use super::glb::{
     container, floats, geometry, index_bytes, Builder, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT,
     MESHOPT, TRIANGLES, UNSIGNED_INT,
@@ -110,6 +111,8 @@ pub struct CaseWriter {
     materials: Vec<Value>,
     root_children: Vec<usize>,
     group_nodes: Vec<(String, usize)>,
+    /// Each structure's node and the lattice it scales (where compressed): its labels' frame.
+    structure_nodes: Vec<(usize, Option<Lattice>)>,
     /// Triangles in the case before simplification (a triangle budget's share of each).
     case_triangles: usize,
     triangles: usize,
@@ -129,6 +132,7 @@ impl CaseWriter {
         if estimate > u64::from(u32::MAX) {
             return Err(too_large());
         }
+        case.lesson.check(case).map_err(ExportError::Lesson)?;
         Ok(Self {
             options: *options,
             b: Builder::default(),
@@ -137,6 +141,7 @@ impl CaseWriter {
             materials: Vec::new(),
             root_children: Vec::new(),
             group_nodes: Vec::new(),
+            structure_nodes: Vec::new(),
             case_triangles: (case.structures.iter())
                 .map(|s| s.original.triangle_count())
                 .sum(),
@@ -187,6 +192,7 @@ impl CaseWriter {
             record["color"] = json!([color[0], color[1], color[2], s.color[3]]);
         }
         let mut node = json!({ "name": s.name, "mesh": index });
+        let lattice = placement.as_ref().map(|p| p.lattice);
         if let Some(Placement { lattice, record: q }) = placement {
             // The lattice's stored integers to millimetres, under the root's frame.
             node["translation"] = json!(lattice.offset);
@@ -196,6 +202,7 @@ impl CaseWriter {
         node["extras"] = json!({ CASE_KEY: record });
         self.nodes.push(node);
         let node = self.nodes.len() - 1;
+        self.structure_nodes.push((node, lattice));
         match s.group.as_deref() {
             None => self.root_children.push(node),
             Some(group) => match self.group_nodes.iter().find(|(g, _)| g == group) {
@@ -224,6 +231,8 @@ impl CaseWriter {
             root["matrix"] = json!(RAS_MM_TO_GLTF);
         }
         self.nodes[0] = root;
+        self.add_labels(case);
+        let (cameras, camera_nodes) = self.add_steps(case);
         let mut record = json!({
             "title": case.title,
             "description": case.description,
@@ -234,12 +243,15 @@ impl CaseWriter {
         if let Some(image) = &case.image {
             record["image"] = image.record(self.b.push_blob(&image.voxels));
         }
+        if let Some(quiz) = &case.lesson.quiz {
+            record["quiz"] = json!(quiz);
+        }
         let scene = json!({
             "name": title,
-            "nodes": [0],
+            "nodes": std::iter::once(0).chain(camera_nodes).collect::<Vec<_>>(),
             "extras": { CASE_KEY: record },
         });
-        let document = json!({
+        let mut document = json!({
             "asset": { "version": "2.0", "generator": concat!("meshsmooth ", env!("CARGO_PKG_VERSION")) },
             "scene": 0,
             "scenes": [scene],
@@ -249,7 +261,40 @@ impl CaseWriter {
             "accessors": self.b.accessors,
             "bufferViews": self.b.views,
         });
+        if !cameras.is_empty() {
+            document["cameras"] = json!(cameras);
+        }
         finish(document, self.b, &self.options)
+    }
+
+    /// Each label's node under its structure's node.
+    fn add_labels(&mut self, case: &Case) {
+        for label in &case.lesson.labels {
+            let structure = (case.structures.iter()).position(|s| s.name == label.structure);
+            let Some(&(parent, lattice)) = structure.and_then(|i| self.structure_nodes.get(i))
+            else {
+                continue;
+            };
+            self.nodes.push(label_node(label, lattice));
+            let node = self.nodes.len() - 1;
+            if self.nodes[parent].get("children").is_none() {
+                self.nodes[parent]["children"] = json!([]);
+            }
+            push_child(&mut self.nodes[parent], node);
+        }
+    }
+
+    /// Each tour step's camera, and its node (for the scene's top level).
+    fn add_steps(&mut self, case: &Case) -> (Vec<Value>, Vec<usize>) {
+        let mut cameras = Vec::new();
+        let mut nodes = Vec::new();
+        for step in &case.lesson.steps {
+            let (camera, node) = step_camera(step, cameras.len(), self.options.frame);
+            cameras.push(camera);
+            self.nodes.push(node);
+            nodes.push(self.nodes.len() - 1);
+        }
+        (cameras, nodes)
     }
 }
 

@@ -3,6 +3,7 @@
 //! Nothing from an input file's header is ever written (STL headers often carry patient names).
 
 mod case_gltf;
+mod case_lesson;
 mod compressed;
 mod glb;
 mod meshopt;
@@ -107,6 +108,8 @@ pub enum ExportError {
     },
     #[error("{what} of vertex {vertex} is not finite")]
     NonFinite { what: &'static str, vertex: usize },
+    #[error("the lesson: {0}")]
+    Lesson(String),
 }
 
 /// The GLB `extras` of a smoothed mesh: which filter made it, with which parameters, and its

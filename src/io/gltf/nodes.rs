@@ -25,6 +25,9 @@ pub struct GltfScene {
     pub nodes: Vec<GltfNode>,
     /// The bytes of the buffer view a case's image names (`extras.meshsmooth.image.bufferView`).
     pub image_voxels: Option<Vec<u8>>,
+    /// What meshsmooth's own nodes without a mesh hold (`extras.meshsmooth`: a tour step's
+    /// camera, a label), in the nodes' order.
+    pub marked: Vec<Value>,
 }
 
 /// One node's mesh.
@@ -89,10 +92,19 @@ pub fn read_scene(bytes: &[u8], format: Format) -> Result<GltfScene, LoadError> 
         }
         None => None,
     };
+    let marked = (root.nodes.iter())
+        .filter(|n| n.mesh.is_none())
+        .filter_map(|n| {
+            raw_json(n.extras.as_deref())?
+                .get_mut("meshsmooth")
+                .map(Value::take)
+        })
+        .collect();
     Ok(GltfScene {
         extras,
         nodes,
         image_voxels,
+        marked,
     })
 }
 
