@@ -16,7 +16,7 @@ import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
 import { meshNodes, readGlb } from "./lib/glb.mjs";
-import { meshPath, outputDir } from "./lib/paths.mjs";
+import { ROOT, meshPath, outputDir } from "./lib/paths.mjs";
 import { assertNotBlank, colourHistogram, decodePng } from "./lib/png.mjs";
 import { WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 import { openThreePage, serveThreePage, threeVersion } from "./lib/three.mjs";
@@ -30,11 +30,12 @@ const VIEWPORT = { width: 960, height: 720 };
  * The one command under test: writes the case GLB of `input` (a label map) to `output`, its
  * labels named by the colour table `colors` when given.
  */
-function writeCaseGlb(input, output, { colors } = {}) {
+function writeCaseGlb(input, output, { colors, lesson } = {}) {
     // The local search keeps the 48 structures of the atlas to seconds; the file is the same
     // kind (smoothed surfaces, originals as morph targets, records) either way.
     const table = colors ? ["--colors", colors] : [];
-    return cli.cli("case", "build", input, ...table, "--search", "local", "--local-error", "-o", output);
+    const taught = lesson ? ["--lesson", lesson] : [];
+    return cli.cli("case", "build", input, ...table, ...taught, "--search", "local", "--local-error", "-o", output);
 }
 
 const CASES = [
@@ -43,6 +44,7 @@ const CASES = [
         what: "the phantom's",
         input: meshPath("labelmaps/case_phantom_shared.nii.gz"),
         colors: meshPath("labelmaps/case_phantom_shared_labels.txt"),
+        lesson: join(ROOT, "tests/data/phantom_lesson.json"),
         structures: 4,
     },
     {
@@ -175,7 +177,7 @@ const written = new Map();
 function caseGlb(c) {
     if (!written.has(c.key)) {
         const file = join(OUT, `case-${c.key}.glb`);
-        const writing = c.fromPage ? writePageCaseGlb(c.input, file) : writeCaseGlb(c.input, file, { colors: c.colors });
+        const writing = c.fromPage ? writePageCaseGlb(c.input, file) : writeCaseGlb(c.input, file, { colors: c.colors, lesson: c.lesson });
         written.set(
             c.key,
             writing.then((listed) => ({ file, bytes: readFileSync(file), listed })),
@@ -215,6 +217,49 @@ after(async () => {
 });
 
 const SEVERITIES = ["error", "warning", "info", "hint"];
+
+/** RAS millimetres in glTF metres: right -> -X, superior -> +Y, anterior -> +Z. */
+const metres = ([r, a, s]) => [-r / 1000, s / 1000, a / 1000];
+const distance = (p, q) => Math.hypot(...p.map((x, k) => x - q[k]));
+
+/**
+ * The lesson as three sees it: each tour step a camera, named by its title, at the step's eye
+ * and looking at its target; each label a node named by its text under its structure, within
+ * 0.01 mm of its point. The first step's view is drawn through three's camera.
+ */
+async function checkLesson(t, c, seen, opened) {
+    const lesson = JSON.parse(readFileSync(c.lesson, "utf8"));
+    assert.deepEqual(seen.views.map((v) => [v.name, v.type]), lesson.steps.map((s) => [s.title, "PerspectiveCamera"]), "a camera per step, in order");
+    lesson.steps.forEach((step, i) => {
+        const { target, yaw, pitch, distance: d } = step.camera;
+        const towardEye = [-Math.sin(yaw) * Math.cos(pitch), Math.cos(yaw) * Math.cos(pitch), Math.sin(pitch)];
+        const eye = metres(target.map((x, k) => x + d * towardEye[k]));
+        const view = seen.views[i];
+        assert.ok(distance(view.world, eye) < 1e-5, `${step.title}: three's camera at ${view.world}, the step's eye at ${eye}`);
+        const look = metres(towardEye.map((x) => -x * 1000));
+        assert.ok(distance(view.looking, look) < 1e-4, `${step.title}: looks along ${view.looking}, expected ${look}`);
+    });
+    const problems = [];
+    for (const label of lesson.labels) {
+        const node = seen.marked.find((m) => m.name === label.text);
+        if (!node) {
+            problems.push(`${label.text}: no node of that name`);
+            continue;
+        }
+        const off = distance(node.world, metres(label.point)) * 1000;
+        if (node.parent !== label.structure || off > 0.01) {
+            problems.push(`${label.text}: under ${node.parent}, ${off.toFixed(4)} mm from its point`);
+        }
+    }
+    assert.deepEqual(problems, [], "labels as named nodes at their points");
+    await opened.page.evaluate(([w, h]) => window.gltfCheck.renderFrom(0, w, h), [VIEWPORT.width, VIEWPORT.height]);
+    await opened.page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    const shot = join(OUT, `case-${c.key}-step1.png`);
+    const png = await opened.page.screenshot();
+    writeFileSync(shot, png);
+    assertNotBlank(decodePng(png), shot);
+    t.diagnostic(`the first step through three's camera: ${shot}`);
+}
 
 CASES.forEach((c, n) => {
     testIn(WEBGPU_RUN, `GLB${2 * n + 1} ${c.what} scene GLB passes the Khronos glTF-Validator with no error or warning`, { timeout: TIMEOUT }, async (t) => {
@@ -338,6 +383,8 @@ CASES.forEach((c, n) => {
                 const off = Math.max(...want.map((w, k) => Math.abs(m.meanWorld[k] * 1000 - w)));
                 assert.ok(off <= tolerance, `${names[i]}: centre in three's world ${m.meanWorld.map((x) => (x * 1000).toFixed(2))} mm, expected (-R, S, A) = ${want.map((x) => x.toFixed(2))} mm`);
             });
+
+            if (c.lesson) await checkLesson(t, c, seen, opened);
 
             // One rendering, seen from the front (+Z, anterior) with superior up.
             const rendered = await opened.page.evaluate(([w, h]) => window.gltfCheck.render(w, h), [VIEWPORT.width, VIEWPORT.height]);

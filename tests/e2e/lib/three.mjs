@@ -51,6 +51,7 @@ import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
 import { MeshoptDecoder } from "three/addons/libs/meshopt_decoder.module.js";
 
 let loaded = null;
+let cameras = [];
 
 window.gltfCheck = {
     revision: THREE.REVISION,
@@ -65,9 +66,22 @@ window.gltfCheck = {
         // Case glTFs are EXT_meshopt_compression'ed: three decodes them with its MeshoptDecoder.
         const gltf = await new GLTFLoader().setMeshoptDecoder(MeshoptDecoder).parseAsync(bytes, "");
         loaded = gltf.scene;
+        cameras = gltf.cameras;
         loaded.updateMatrixWorld(true);
         const meshes = [];
+        const marked = [];
         const v = new THREE.Vector3();
+        // Nodes without a mesh that carry a name and extras (a case's labels): where they are.
+        loaded.traverse((object) => {
+            if (object.isMesh || object.isCamera || !object.userData.meshsmooth) return;
+            marked.push({ name: object.userData.name, world: object.getWorldPosition(new THREE.Vector3()).toArray(), parent: object.parent?.userData.name ?? null });
+        });
+        const views = cameras.map((c) => ({
+            name: c.userData.name ?? c.name,
+            type: c.type,
+            world: c.getWorldPosition(new THREE.Vector3()).toArray(),
+            looking: c.getWorldDirection(new THREE.Vector3()).toArray(),
+        }));
         loaded.traverse((object) => {
             if (!object.isMesh) return;
             // The glTF node's own name is kept in userData.name; the mesh is that node unless
@@ -98,7 +112,24 @@ window.gltfCheck = {
         });
         // precise: from the vertices themselves (morph targets would widen the quick box).
         const box = new THREE.Box3().setFromObject(loaded, true);
-        return { revision: THREE.REVISION, meshes, box: { min: box.min.toArray(), max: box.max.toArray() } };
+        return { revision: THREE.REVISION, meshes, marked, views, box: { min: box.min.toArray(), max: box.max.toArray() } };
+    },
+
+    /** Draws the loaded scene through the file's camera number index (a case's tour step). */
+    renderFrom(index, width, height) {
+        const canvas = document.getElementById("view");
+        const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+        renderer.setPixelRatio(1);
+        renderer.setSize(width, height);
+        const scene = new THREE.Scene();
+        scene.background = new THREE.Color(0x202428);
+        scene.add(loaded);
+        scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2.5));
+        const camera = cameras[index];
+        camera.aspect = width / height;
+        camera.updateProjectionMatrix();
+        renderer.render(scene, camera);
+        return { name: camera.name };
     },
 
     render(width, height) {
