@@ -555,3 +555,38 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     assert!(session.loading().is_none(), "nothing left to add");
     assert_eq!(session.case().case_structures().len(), 5, "the case stays");
 }
+
+/// The viewer shows a structure the file holds no smoothing of as the file holds it: nothing
+/// is computed for it and its surface is the file's; the authoring page smooths it as before.
+#[test]
+fn a_viewer_shows_a_structure_without_a_smoothing_record_as_the_file_holds_it() {
+    let unsmoothed = meshsmooth::export::write_case(&label_maps::phantom_case(), &page_export())
+        .expect("writes");
+    let mut viewer = Session::default();
+    viewer.case_mut().show_as_read(true);
+    open_in_session(&mut viewer, "case.glb", unsmoothed.clone());
+    assert!(viewer.case().shown_as_read(0));
+    assert!(!viewer.case().needs_smoothing(), "nothing to compute");
+    assert!(viewer.smooth_cpu().is_none());
+    assert!(viewer.case().result().is_none());
+    let held = &viewer.case().case_structures()[0];
+    assert!(held.smoothed.is_none());
+    assert_eq!(viewer.case().model().expect("open").mesh(), &held.original);
+
+    let mut author = Session::default();
+    open_in_session(&mut author, "case.glb", unsmoothed);
+    assert!(!author.case().shown_as_read(0));
+    assert!(
+        author.case().needs_smoothing(),
+        "the author's page smooths it"
+    );
+
+    // A structure the file holds a smoothing of is measured in the viewer too.
+    author.smooth_cpu();
+    let smoothed = author.case().export_case(&page_export()).expect("writes");
+    let mut viewer = Session::default();
+    viewer.case_mut().show_as_read(true);
+    open_in_session(&mut viewer, "case.glb", smoothed);
+    assert!(!viewer.case().shown_as_read(0));
+    assert!(viewer.case().needs_smoothing());
+}

@@ -145,8 +145,12 @@ fn record(
     }
     ui.small(about);
     let [how, what] = measures(s, session, index);
-    ui.label(format!("Smoothed with {how}"));
-    ui.label(what);
+    if session.case().shown_as_read(index) {
+        ui.label(format!("No smoothing record: {what}"));
+    } else {
+        ui.label(format!("Smoothed with {how}"));
+        ui.label(what);
+    }
     ui.checkbox(error_colours, "Colour by how far it moved")
         .on_hover_text(
             "The local error: the distance from each point of the smooth surface to the \

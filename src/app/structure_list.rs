@@ -279,6 +279,12 @@ fn checks_report(ui: &mut egui::Ui, session: &Session) {
 /// the volume change and the local error, mean and maximum (mm, and in voxel diagonals where
 /// the voxel size is known).
 pub fn measures(s: &CaseStructure, session: &Session, i: usize) -> [String; 2] {
+    if session.case().shown_as_read(i) {
+        return [
+            "no smoothing record".into(),
+            "shown as the file holds it".into(),
+        ];
+    }
     let params = session.case().structure_params(i).unwrap_or(s.params);
     let how = format!("{}: {}", params.filter.name(), params.describe());
     let what = match session.case().structure_metrics(i) {

@@ -33,6 +33,9 @@ pub struct CaseDocument {
     pub(super) model_id: u64,
     /// Counts changes of the model's weights (the GPU engine uploads them once per change).
     pub(super) weights_version: u64,
+    /// A structure the file holds no smoothing of is shown as the file holds it (the viewer:
+    /// a student sees only what the file holds), not smoothed with its default settings.
+    pub(super) as_read: bool,
 }
 
 impl CaseDocument {
@@ -102,7 +105,18 @@ impl CaseDocument {
 
     /// Whether a model is open whose result for the current parameters is still to compute.
     pub fn needs_smoothing(&self) -> bool {
-        self.model().is_some() && self.result().is_none()
+        self.model().is_some() && self.result().is_none() && !self.shown_as_read(self.current)
+    }
+
+    /// Shows structures the file holds no smoothing of as it holds them, from now on.
+    pub fn show_as_read(&mut self, on: bool) {
+        self.as_read = on;
+    }
+
+    /// Whether structure `index` is shown as its file holds it: no smoothing of its own, in a
+    /// document that does not smooth such structures.
+    pub fn shown_as_read(&self, index: usize) -> bool {
+        self.as_read && (self.case.structures.get(index)).is_some_and(|s| s.smoothed.is_none())
     }
 
     /// Makes `filter` active (with the values it had when last active).

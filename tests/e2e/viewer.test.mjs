@@ -433,3 +433,22 @@ testIn(EVERY_RUN, "V5 the author adds the CT under the page's case, the case glT
         await app.screenshotWhen("V5-viewer-bone-window", (i) => pixelsWhere(i, view, boneLiver).count > 2000, "the CT's liver on the viewer's slice");
     }, { query: "?mode=viewer" });
 });
+
+testIn(EVERY_RUN, "V6 a glTF meshsmooth did not smooth is shown as the file holds it, with no smoothing record", { timeout: TIMEOUT }, async () => {
+    const file = join(E2E_OUT, MODE, "V6-converted.glb");
+    await cli.cli("convert", meshPath("synthetic/synthetic_ellipsoid_30_20_12.ply"), file);
+    const bytes = readFileSync(file);
+    await withApp(async (app) => {
+        const read = (s) => s.structures?.structures.length === 1 && s.loading === null && s.layout.structures.length === 1;
+        const state = await app.stateWhen(read, "the converted surface");
+        const [s] = state.structures.structures;
+        assert.equal(s.shown_as_read, true, "no smoothing record");
+        // Nothing is computed for it: a while later it is still unmeasured and nothing runs.
+        await app.page.waitForTimeout(1500);
+        const later = await app.state();
+        assert.equal(later.busy, false, "nothing to compute");
+        assert.equal(later.structures.structures[0].metrics, null, "no measures made up");
+        const shot = await app.screenshot("V6-as-read");
+        assert.ok(drawn(shot, later.view).count > 2000, "the surface is drawn");
+    }, { query: "?mode=viewer&case=cases/converted.glb", routes: { "cases/converted.glb": bytes } });
+});

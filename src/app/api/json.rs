@@ -38,6 +38,7 @@ pub(crate) fn structures(case: &CaseDocument) -> Option<Value> {
                 "triangles": s.original.triangle_count(),
                 "volume": s.original.signed_volume(),
                 "metrics": case.structure_metrics(i),
+                "shown_as_read": case.shown_as_read(i),
             })
         })
         .collect();

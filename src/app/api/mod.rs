@@ -21,8 +21,10 @@
 //!   when it lies elsewhere, the image the case had staying. `removeImage()` takes it away
 //! - `structures()`: `{file, current, title, description, structures: [{label, name, color,
 //!   opacity, visible, group, source, voxels, voxel_size, codes, vertices, triangles, volume,
-//!   metrics}]}` of the open case, or null with nothing open (`metrics`: its last smoothing's
-//!   measures, or null; `label`, `voxels`, `voxel_size`: null where it came from no label map;
+//!   metrics, shown_as_read}]}` of the open case, or null with nothing open (`metrics`: its last
+//!   smoothing's measures, or null; `shown_as_read`: the viewer shows it as its file holds it,
+//!   the file holding no smoothing of it; `label`, `voxels`, `voxel_size`: null where it came
+//!   from no label map;
 //!   `codes`: `{category, type, modifier}` in standard codes, as the case glTF's record, or null)
 //! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`;
 //!   the structure left keeps its smoothing, one coming back gets its own back

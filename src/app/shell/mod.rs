@@ -161,6 +161,7 @@ impl Shell {
             doc.reading = reading;
             doc.session_mut().set_graphs_wanted(!reading);
             doc.session_mut().set_suggest_on_open(!reading);
+            doc.session_mut().case_mut().show_as_read(reading);
         }
         doc.borrow_mut().shortcuts = query::param("shortcuts").as_deref() != Some("off");
         // A link's view is of the case it names.
