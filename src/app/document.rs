@@ -91,6 +91,8 @@ pub struct ViewAsks {
     pub look_from: Option<StandardView>,
     /// How far every structure is drawn back towards its segmentation (0 as smoothed).
     pub toward_segmentation: f32,
+    /// The tour step to show next (the shell takes it up).
+    pub step: Option<usize>,
 }
 
 pub struct Document {
@@ -113,6 +115,8 @@ pub struct Document {
     pub finished_opening: Option<Result<(), String>>,
     /// Where the graphs and gallery cards are, for `state()`.
     pub panel: PanelLayout,
+    /// The tour step shown, while the student follows the case's tour.
+    pub tour: Option<usize>,
     waiting: Vec<Waiter>,
     /// Calls waiting for background work (a suggestion, the graphs).
     waiting_for: Vec<(Ready, Waiter)>,
@@ -172,6 +176,7 @@ impl Document {
             shortcuts: true,
             finished_opening: None,
             panel: PanelLayout::default(),
+            tour: None,
             waiting: Vec::new(),
             waiting_for: Vec::new(),
             show_gallery: false,
@@ -432,6 +437,7 @@ impl Document {
             None => serde_json::Value::Null,
         };
         state["layout"] = self.panel.to_json();
+        state["tour"] = self.tour_json();
         // WebAssembly memory only grows: its size is the page's peak.
         state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state

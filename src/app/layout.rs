@@ -55,6 +55,8 @@ pub struct PanelLayout {
     pub structures: Vec<StructureRow>,
     pub structure_name: Option<PageRect>,
     pub structure_filter: Option<PageRect>,
+    /// The tour's buttons as drawn, by what they do (`start`, `back`, `next`, `leave`).
+    pub tour: Vec<(&'static str, PageRect)>,
 }
 
 /// One row of the Structures list: its visibility box, show-alone button and name (which
@@ -97,6 +99,8 @@ impl PanelLayout {
             })).collect::<Vec<_>>(),
             "structure_name": self.structure_name.map(PageRect::to_json),
             "structure_filter": self.structure_filter.map(PageRect::to_json),
+            "tour": self.tour.iter().map(|(k, r)| (k.to_string(), r.to_json()))
+                .collect::<serde_json::Map<_, _>>(),
         })
     }
 }

@@ -49,6 +49,7 @@ mod shell;
 mod shortcuts;
 mod status;
 mod structure_list;
+mod tour;
 mod view_tools;
 pub mod viewer;
 mod workers;

@@ -4,7 +4,8 @@
 //!
 //! Layout: the document here; opening files as a case in `from_files`; smoothing and "Suggest all" in `pipeline`; the quality record
 //! the glTF carries (and reads back) in `record`; checks between structures in `relations`; the
-//! tour, labels and quiz in `lesson`.
+//! tour, labels and quiz in `lesson`, and what a student did with them as xAPI statements in
+//! `xapi`.
 
 mod checks;
 mod from_files;
@@ -14,6 +15,7 @@ mod pipeline;
 mod record;
 pub mod relations;
 mod voxel_grid;
+pub mod xapi;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
 pub use from_files::{

@@ -4,7 +4,7 @@
 use super::CaseDocument;
 use std::sync::Arc;
 
-use crate::case::{Case, CaseImage};
+use crate::case::{xapi, Case, CaseImage, Lesson};
 use crate::export::{self, CaseGltfOptions};
 
 impl CaseDocument {
@@ -14,6 +14,17 @@ impl CaseDocument {
 
     pub fn case_description(&self) -> &str {
         &self.case.description
+    }
+
+    /// The tour, labels and quiz the case carries.
+    pub fn lesson(&self) -> &Lesson {
+        &self.case.lesson
+    }
+
+    /// What the platform records when tour step `index` is shown (an xAPI statement).
+    pub fn step_statement(&self, index: usize) -> Option<serde_json::Value> {
+        let step = self.case.lesson.steps.get(index)?;
+        Some(xapi::step_shown(&self.case, index, step))
     }
 
     /// The image under the surfaces, where the case carries one.

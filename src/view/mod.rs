@@ -2,7 +2,7 @@
 //! is first shown from, the per-frame record the render shader reads, thumbnails drawn on
 //! the CPU with the same camera and lights, picking (the triangle under the cursor and the
 //! vertices under the brush), the window/level-style parameter drag, and the clipping plane
-//! and standard views of a case, and the link that restores a view.
+//! and standard views of a case, the link that restores a view, and a tour's steps.
 //!
 //! Free of egui and wgpu so that it builds and is unit-tested natively; the web app's
 //! renderer (`app::viewer`, wasm32) uploads what this module computes.
@@ -16,6 +16,7 @@ mod param_drag;
 mod pick;
 mod slice;
 pub mod thumbnail;
+mod tour;
 mod uniforms;
 
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
@@ -30,4 +31,5 @@ pub use pick::{
     brush_falloff, brush_footprint, moller_trumbore, pick_triangle, pick_triangle_where, Hit, Ray,
 };
 pub use slice::{SlicePlacement, SliceTexture, SliceUniforms};
+pub use tour::{flight, step_view, FLIGHT_SECONDS};
 pub use uniforms::{ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS};

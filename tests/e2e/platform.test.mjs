@@ -6,11 +6,12 @@
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/platform.test.mjs   (tests/e2e/run.sh runs both)
 import { after } from "node:test";
 import assert from "node:assert/strict";
-import { mkdtempSync, writeFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
 import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
+import * as cli from "./lib/cli.mjs";
 import { DIST, ROOT, meshPath, outputDir } from "./lib/paths.mjs";
 import { decodePng, assertNotBlank } from "./lib/png.mjs";
 import { serveDirectory } from "./lib/server.mjs";
@@ -129,6 +130,19 @@ testIn(EVERY_RUN, "P1 a platform on another origin authors a case in the embedde
         const after = await call(pane, "structures");
         assert.equal(after.structures[0].visible, true, `the ${pane}'s liver stays shown`);
     }
+
+    // A case with a tour: the platform steps the student through it from its own buttons and
+    // hears each step shown, with the xAPI statement to record.
+    const lessonCase = join(OUT, "P1-lesson-case.glb");
+    await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "--lesson", join(ROOT, "tests/data/phantom_lesson.json"), "-o", lessonCase, "--json");
+    await page.evaluate((b) => window.platform.viewer.call("loadCase", new Uint8Array(b), "lesson.glb"), Array.from(readFileSync(lessonCase)));
+    since = await lines();
+    await call("viewer", "showStep", 1);
+    await logged(/^student at step 2 of 3: The tumour inside the liver$/, "the step shown, heard", since);
+    const [statement] = await page.evaluate(() => window.platform.statements);
+    assert.equal(statement.verb.id, "http://adlnet.gov/expapi/verbs/experienced");
+    assert.equal(statement.object.definition.name["en-US"], "The tumour inside the liver");
+    assert.match(statement.object.id, /#step-2$/);
 
     // Frames open only the three sites, and every other request stays within the origin of the
     // frame that made it.

@@ -452,3 +452,62 @@ testIn(EVERY_RUN, "V6 a glTF meshsmooth did not smooth is shown as the file hold
         assert.ok(drawn(shot, later.view).count > 2000, "the surface is drawn");
     }, { query: "?mode=viewer&case=cases/converted.glb", routes: { "cases/converted.glb": bytes } });
 });
+
+testIn(EVERY_RUN, "V7 the viewer plays the case's tour: each step's structures, clip, caption and camera, by button and by call", { timeout: TIMEOUT }, async () => {
+    const lessonFile = join(ROOT, "tests/data/phantom_lesson.json");
+    const lesson = JSON.parse(readFileSync(lessonFile, "utf8"));
+    const file = join(E2E_OUT, MODE, "V7-lesson-case.glb");
+    await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "--lesson", lessonFile, "-o", file, "--json");
+    const bytes = readFileSync(file);
+    await withApp(async (app) => {
+        const state = await phantomShown(app);
+        assert.deepEqual(state.tour, { step: null, steps: 3, title: null, caption: null });
+        const press = async (button) => {
+            const s = await app.stateWhen((s) => s.layout.tour?.[button], `the tour's ${button} button`);
+            const r = s.layout.tour[button];
+            await app.page.mouse.click(r.x + r.width / 2, r.y + r.height / 2);
+        };
+        // At a step: its title and caption, and the camera arrived at its view.
+        const atStep = (i) =>
+            app.stateWhen((s) => {
+                const c = s.view.camera;
+                const want = lesson.steps[i].camera;
+                const close = (a, b) => Math.abs(a - b) <= 1e-3 * Math.max(1, Math.abs(b));
+                return s.tour?.step === i && c && close(c.yaw, want.yaw) && close(c.pitch, want.pitch) && close(c.distance, want.distance) && c.target.every((x, k) => close(x, want.target[k]));
+            }, `step ${i + 1} shown, its camera arrived`);
+        const shown = (s) => s.structures.structures.map((x) => [x.name, x.visible, Number(x.opacity.toFixed(3))]);
+
+        await press("start");
+        let s = await atStep(0);
+        assert.equal(s.tour.title, lesson.steps[0].title);
+        assert.equal(s.tour.caption, lesson.steps[0].caption);
+        assert.deepEqual(shown(s), [["liver", true, 1], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", true, 1]]);
+        const first = drawn(await app.screenshot("V7-step-1"), s.view);
+
+        await press("next");
+        s = await atStep(1);
+        assert.deepEqual(shown(s), [["liver", true, 0.3], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", false, 1]], "the kidney hidden, the liver see-through");
+        assert.equal(s.structures.current, 2, "the tumour selected");
+        assert.equal(s.view.clip, null);
+        const second = drawn(await app.screenshot("V7-step-2"), s.view);
+        assert.ok(second.count > 500 && first.count > 500, `both views draw the case: ${first.count}, ${second.count} pixels`);
+
+        // The platform's call, as its own buttons would make it.
+        await app.call("showStep", 2);
+        s = await atStep(2);
+        const clip = lesson.steps[2].clip;
+        assert.deepEqual({ ...s.view.clip, at: Math.fround(s.view.clip.at) }, { ...clip, at: Math.fround(clip.at) }, "the step's clip (f32)");
+        assert.equal(s.view.toward_segmentation, 0.25);
+        assert.deepEqual(shown(s).map((x) => x.slice(1)), [[true, 1], [true, 1], [true, 1], [true, 1]], "the step shows every structure again, opaque");
+        await app.screenshot("V7-step-3");
+
+        await press("back");
+        s = await atStep(1);
+        await press("leave");
+        s = await app.stateWhen((s) => s.tour.step === null, "the tour left");
+        assert.equal(Math.fround(s.view.camera.yaw), Math.fround(lesson.steps[1].camera.yaw), "the view stays where the tour left it");
+        const refused = await app.attempt("showStep", 3);
+        assert.equal(refused.ok, false);
+        assert.match(refused.message, /the case's tour has steps 0 to 2: no step 3/);
+    }, { query: "?mode=viewer&case=cases/lesson.glb", routes: { "cases/lesson.glb": bytes } });
+});

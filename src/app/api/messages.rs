@@ -10,7 +10,10 @@
 //! - events: `{meshsmooth: "event", event, detail}`: `ready` (`{mode, backend, calls}`) once
 //!   the page answers; `loaded` (`structures()`) when files handed over are open, or `failed`
 //!   (`{error}`); `changed` (`structures()`) when the case changed (a structure shown,
-//!   hidden, renamed, selected or smoothed anew) and its results are computed.
+//!   hidden, renamed, selected or smoothed anew) and its results are computed; `step`
+//!   (`{step, steps, title, caption, statement}`) when a tour step is shown, `statement` the
+//!   xAPI statement a learning record store keeps (verb "experienced", the step as the object;
+//!   the actor is the platform's to add).
 
 use js_sys::{Array, Function, Object, Promise, Reflect};
 use wasm_bindgen::closure::Closure;
@@ -26,6 +29,8 @@ pub struct Embedding {
     parent: String,
     /// What the case was when the parent last heard (see [`case_key`]).
     heard: Option<CaseKey>,
+    /// The tour step the parent last heard was shown.
+    heard_step: Option<usize>,
 }
 
 impl Embedding {
@@ -36,6 +41,7 @@ impl Embedding {
         Some(parent_origin(&wanted).map(|parent| Self {
             parent,
             heard: None,
+            heard_step: None,
         }))
     }
 
@@ -64,6 +70,12 @@ impl Embedding {
 
     /// Tells the parent what changed since the last frame: files opened, or the case edited.
     pub fn after_frame(&mut self, doc: &mut Document) {
+        if doc.tour != self.heard_step {
+            self.heard_step = doc.tour;
+            if let Some(step) = doc.tour {
+                self.post_event("step", &doc.step_event(step));
+            }
+        }
         if let Some(outcome) = doc.finished_opening.take() {
             match outcome {
                 Ok(()) => {

@@ -95,6 +95,10 @@
 //!   the clipping plane that cuts every structure (`{axis: "axial" | "coronal" | "sagittal",
 //!   at: 0..1 across the scene, flip}`, or null for none) and `toward_segmentation` (0: the
 //!   smoothed surfaces, 1: the segmentation's); `state().view` reads them back
+//! - `showStep(index)`: shows the case's tour step (from 0: its structures, clip, slide and
+//!   selection at once, the camera flying to its view); `leaveTour()` leaves the tour, the view
+//!   staying; `state().tour` is `{step, steps, title, caption}` (`step` null outside the
+//!   tour), or null when the case has no tour; `state().layout.tour` where its buttons are
 //!
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.
@@ -235,7 +239,7 @@ fn setter(
 }
 
 /// The calls the viewer offers: those that read a case and change only how it is shown.
-const READING_CALLS: [&str; 10] = [
+const READING_CALLS: [&str; 12] = [
     "loadCase",
     "screenshot",
     "structures",
@@ -243,6 +247,8 @@ const READING_CALLS: [&str; 10] = [
     "setStructure",
     "soloStructure",
     "setView",
+    "showStep",
+    "leaveTour",
     "setShortcuts",
     "backend",
     "state",
@@ -293,6 +299,7 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
 
     api.define("setView", view::set_view(doc, ctx))?;
     view::define_screenshot(&api, doc, ctx)?;
+    view::define_tour(&api, doc, ctx)?;
     case::define(&api, doc, ctx)?;
     guidance::define(&api, doc, ctx)?;
     define_smoothing(&api, doc, ctx)?;

@@ -1,5 +1,6 @@
 //! The API's calls on the view: `setView` (its standard sides, clipping plane and slide towards
-//! the segmentation, as its tools set them) and `screenshot` (a PNG of it).
+//! the segmentation, as its tools set them), `screenshot` (a PNG of it), and `showStep` and
+//! `leaveTour` (the case's tour).
 
 use eframe::egui;
 use js_sys::{Function, Promise, Uint8Array};
@@ -67,4 +68,34 @@ pub(super) fn define_screenshot(
         }),
     )?;
     Ok(())
+}
+
+/// `showStep(index)` (the tour's step, from 0; the camera flies there) and `leaveTour()`.
+pub(super) fn define_tour(
+    api: &Api,
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+) -> Result<(), String> {
+    let (d, c) = (doc.clone(), ctx.clone());
+    api.define(
+        "showStep",
+        Closure::<dyn FnMut(JsValue) -> Result<(), JsValue>>::new(move |index: JsValue| {
+            let index = (index.as_f64())
+                .filter(|i| i.fract() == 0.0 && *i >= 0.0)
+                .ok_or_else(|| error("showStep(index): index must be a whole number >= 0"))?;
+            d.borrow_mut()
+                .ask_step(index as usize)
+                .map_err(|e| error(&e))?;
+            crate::app::wake(&c);
+            Ok(())
+        }),
+    )?;
+    let (d, c) = (doc.clone(), ctx.clone());
+    api.define(
+        "leaveTour",
+        Closure::<dyn FnMut()>::new(move || {
+            d.borrow_mut().leave_tour();
+            crate::app::wake(&c);
+        }),
+    )
 }

@@ -32,6 +32,7 @@ mod first_paint;
 mod reading;
 mod sharing;
 mod start;
+mod tour;
 mod view_area;
 mod view_sync;
 
@@ -84,6 +85,8 @@ pub struct Shell {
     link: Option<Result<ViewLink, String>>,
     /// The link's camera, until the view has framed that case.
     pending_pose: Option<CameraPose>,
+    /// The camera on its way to a tour step's view.
+    flight: Option<tour::Flight>,
     /// "Copy link" was clicked (and is still hovered).
     link_copied: bool,
     /// The case in words for screen readers.
@@ -196,6 +199,7 @@ impl Shell {
             picture: Picture::default(),
             link,
             pending_pose: None,
+            flight: None,
             link_copied: false,
             case_text: CaseText::default(),
             repainting: false,
@@ -429,6 +433,10 @@ impl eframe::App for Shell {
         if let Some(link) = self.link.take_if(|_| opened) {
             self.take_up_link(link);
         }
+        if opening == Opening::Idle {
+            self.take_up_step();
+        }
+        self.fly(&ctx);
         {
             let mut doc = self.doc.borrow_mut();
             let session = doc.session_mut();

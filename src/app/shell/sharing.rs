@@ -4,6 +4,7 @@
 use eframe::egui;
 
 use super::Shell;
+use crate::app::document::Document;
 use crate::app::download;
 use crate::session::StructureChange;
 use crate::view::ViewLink;
@@ -80,37 +81,44 @@ impl Shell {
                 return;
             }
         };
-        let count = doc.case().case_structures().len();
-        let mut problems = Vec::new();
-        for &i in link
-            .hidden
-            .iter()
-            .chain(link.opacity.iter().map(|(i, _)| i))
-        {
-            if i >= count {
-                problems.push(format!("the case has no structure {i}"));
-            }
-        }
-        for i in 0..count {
-            let change = StructureChange {
-                visible: Some(!link.hidden.contains(&i)),
-                opacity: (link.opacity.iter().find(|(j, _)| *j == i)).map(|(_, a)| *a),
-                ..Default::default()
-            };
-            if let Err(e) = doc.case_mut().set_structure(i, change) {
-                problems.push(e);
-            }
-        }
-        doc.view_asks.clip = link.clip;
-        doc.view_asks.toward_segmentation = link.toward_segmentation;
-        if let Some(i) = link.selected {
-            if let Err(e) = doc.select_structure(i) {
-                problems.push(e);
-            }
-        }
+        let problems = show_view(&mut doc, &link);
         self.pending_pose = link.camera;
         if !problems.is_empty() {
             doc.session_mut().fail("the link", &problems.join("; "));
         }
     }
+}
+
+/// Shows the structures, selection, clip and slide `link` asks for (not its camera); what
+/// could not be shown, in words.
+pub(super) fn show_view(doc: &mut Document, link: &ViewLink) -> Vec<String> {
+    let count = doc.case().case_structures().len();
+    let mut problems = Vec::new();
+    for &i in link
+        .hidden
+        .iter()
+        .chain(link.opacity.iter().map(|(i, _)| i))
+    {
+        if i >= count {
+            problems.push(format!("the case has no structure {i}"));
+        }
+    }
+    for i in 0..count {
+        let change = StructureChange {
+            visible: Some(!link.hidden.contains(&i)),
+            opacity: (link.opacity.iter().find(|(j, _)| *j == i)).map(|(_, a)| *a),
+            ..Default::default()
+        };
+        if let Err(e) = doc.case_mut().set_structure(i, change) {
+            problems.push(e);
+        }
+    }
+    doc.view_asks.clip = link.clip;
+    doc.view_asks.toward_segmentation = link.toward_segmentation;
+    if let Some(i) = link.selected {
+        if let Err(e) = doc.select_structure(i) {
+            problems.push(e);
+        }
+    }
+    problems
 }

@@ -18,7 +18,7 @@ function log(line) {
     $("log").append(item);
 }
 /** For whoever drives this page (its end-to-end test): the log, both pages, the case received. */
-window.platform = { log: events, author, viewer, published: null };
+window.platform = { log: events, author, viewer, published: null, statements: [] };
 
 /** Runs `work`, logging why it failed instead of leaving the button dead. */
 function action(button, work) {
@@ -52,6 +52,13 @@ viewer.on("loaded", (c) => {
         if (s.description) item.append(`: ${s.description}`);
         return item;
     }));
+});
+
+// What the student did, as xAPI statements a learning record store keeps (with the actor,
+// which only the platform knows).
+viewer.on("step", (s) => {
+    log(`student at step ${s.step + 1} of ${s.steps}: ${s.title}`);
+    window.platform.statements.push({ actor: { name: "the signed-in student" }, ...s.statement });
 });
 
 $("segmentation").addEventListener("change", async (event) => {

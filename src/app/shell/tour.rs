@@ -1,0 +1,100 @@
+//! The viewer's tour: the step asked for shown (structures, clip, slide, selection) with the
+//! camera flying to its view, and the panel that steps through it with the step's caption.
+
+use eframe::egui;
+
+use super::sharing::show_view;
+use super::Shell;
+use crate::app::document::now_ms;
+use crate::view::{flight, step_view, CameraPose, FLIGHT_SECONDS};
+
+/// The camera's way to a step's view: from, to, and when it set out (ms).
+pub(super) type Flight = (CameraPose, CameraPose, f64);
+
+impl Shell {
+    /// Shows the tour step asked for, if one was: its view now, its camera on the way.
+    pub(super) fn take_up_step(&mut self) {
+        let mut doc = self.doc.borrow_mut();
+        let Some(index) = doc.view_asks.step.take() else {
+            return;
+        };
+        let Some(step) = doc.case().lesson().steps.get(index).cloned() else {
+            return;
+        };
+        let names: Vec<String> = (doc.case().case_structures().iter())
+            .map(|s| s.name.clone())
+            .collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let link = step_view(&step, &names);
+        let problems = show_view(&mut doc, &link);
+        if !problems.is_empty() {
+            log::warn!("tour step {}: {}", index + 1, problems.join("; "));
+        }
+        doc.tour = Some(index);
+        if let (Some(to), Some((viewer, _))) = (link.camera, &self.view) {
+            self.flight = Some((viewer.pose(), to, now_ms()));
+        }
+    }
+
+    /// Moves the camera along its flight to a step's view, asking for frames until it is there.
+    pub(super) fn fly(&mut self, ctx: &egui::Context) {
+        let (Some((from, to, started)), Some((viewer, _))) = (self.flight, &mut self.view) else {
+            return;
+        };
+        let t = (now_ms() - started) / (1000.0 * FLIGHT_SECONDS);
+        viewer.set_pose(flight(from, to, t));
+        if t >= 1.0 {
+            self.flight = None;
+        } else {
+            ctx.request_repaint();
+        }
+    }
+
+    /// The tour's controls and the step's caption, when the case has a tour.
+    pub(super) fn tour_panel(&mut self, ui: &mut egui::Ui) {
+        let mut doc = self.doc.borrow_mut();
+        doc.panel.tour.clear();
+        let steps = &doc.case().lesson().steps;
+        if steps.is_empty() {
+            return;
+        }
+        let count = steps.len();
+        let Some(index) = doc.tour else {
+            let start = ui.button(format!("▶ Take the tour ({count} steps)"));
+            doc.panel.tour.push(("start", start.rect.into()));
+            if start.clicked() {
+                let _ = doc.ask_step(0);
+            }
+            ui.separator();
+            return;
+        };
+        let step = steps[index.min(count - 1)].clone();
+        ui.strong(format!("Step {} of {count}: {}", index + 1, step.title));
+        if !step.caption.is_empty() {
+            ui.label(&step.caption);
+        }
+        let mut asked = None;
+        let mut leave = false;
+        let mut drawn = Vec::new();
+        ui.horizontal_wrapped(|ui| {
+            let back = ui.add_enabled(index > 0, egui::Button::new("◀ Back"));
+            let next = ui.add_enabled(index + 1 < count, egui::Button::new("Next ▶"));
+            let out = ui.button("Leave the tour");
+            asked = (back.clicked().then(|| index - 1)).or(next.clicked().then_some(index + 1));
+            leave = out.clicked();
+            drawn = vec![
+                ("back", back.rect),
+                ("next", next.rect),
+                ("leave", out.rect),
+            ];
+        });
+        doc.panel.tour = drawn.into_iter().map(|(k, r)| (k, r.into())).collect();
+        if let Some(i) = asked {
+            let _ = doc.ask_step(i);
+        }
+        if leave {
+            doc.leave_tour();
+        }
+        ui.separator();
+    }
+}

@@ -1,0 +1,49 @@
+//! The case's tour as the page follows it: which step is shown, asked by the student's
+//! buttons or the platform's calls, and what `state()` and the platform hear of it.
+
+use serde_json::{json, Value};
+
+use super::document::Document;
+
+impl Document {
+    /// Shows tour step `index` from the next frame on (the camera flies there).
+    pub fn ask_step(&mut self, index: usize) -> Result<(), String> {
+        let steps = self.case().lesson().steps.len();
+        if index >= steps {
+            return Err(match steps {
+                0 => "the case has no tour".to_string(),
+                n => format!("the case's tour has steps 0 to {}: no step {index}", n - 1),
+            });
+        }
+        self.view_asks.step = Some(index);
+        Ok(())
+    }
+
+    /// Leaves the tour, the view staying as it is.
+    pub fn leave_tour(&mut self) {
+        self.tour = None;
+        self.view_asks.step = None;
+    }
+
+    /// `{step, steps, title, caption}` (`step` null outside the tour), or null without a tour.
+    pub fn tour_json(&self) -> Value {
+        let steps = &self.case().lesson().steps;
+        if steps.is_empty() {
+            return Value::Null;
+        }
+        let shown = self.tour.and_then(|i| steps.get(i));
+        json!({
+            "step": self.tour,
+            "steps": steps.len(),
+            "title": shown.map(|s| &s.title),
+            "caption": shown.map(|s| &s.caption),
+        })
+    }
+
+    /// The platform's `step` event: the step shown and its xAPI statement.
+    pub fn step_event(&self, index: usize) -> Value {
+        let mut detail = self.tour_json();
+        detail["statement"] = self.case().step_statement(index).unwrap_or_default();
+        detail
+    }
+}

@@ -1,0 +1,132 @@
+//! Playing a case's tour: a step as the view it shows (the same view a link restores), and the
+//! camera's flight from where the student left it to the step's view.
+
+use glam::Vec3;
+
+use super::{CameraPose, ViewLink};
+use crate::case::Step;
+
+/// How long the camera takes to reach a step's view (seconds): long enough to see where it
+/// goes, short enough not to wait.
+pub const FLIGHT_SECONDS: f64 = 0.8;
+
+/// The view step shows, its structures found by name in `names` (the case's, in order); a
+/// name the case lacks shows nothing (a lesson is checked against its case when read). Every
+/// structure's opacity is set: those the step does not name are opaque, whatever the step
+/// before made them.
+pub fn step_view(step: &Step, names: &[&str]) -> ViewLink {
+    let index = |name: &str| names.iter().position(|n| *n == name);
+    let c = step.camera;
+    ViewLink {
+        camera: Some(CameraPose {
+            yaw: c.yaw,
+            pitch: c.pitch,
+            distance: c.distance,
+            target: Vec3::from(c.target),
+        }),
+        hidden: step.hidden.iter().filter_map(|n| index(n)).collect(),
+        opacity: (names.iter().enumerate())
+            .map(|(i, n)| (i, step.opacity.get(*n).copied().unwrap_or(1.0)))
+            .collect(),
+        selected: step.selected.as_deref().and_then(index),
+        clip: step.clip,
+        toward_segmentation: step.toward_segmentation,
+    }
+}
+
+/// The camera `t` of the way (0 to 1, eased in and out) from `from` to `to`: turning the short
+/// way round, and zooming at a steady rate (the distance geometrically).
+pub fn flight(from: CameraPose, to: CameraPose, t: f64) -> CameraPose {
+    let t = t.clamp(0.0, 1.0) as f32;
+    let s = t * t * (3.0 - 2.0 * t);
+    let tau = std::f32::consts::TAU;
+    let turn = (to.yaw - from.yaw + std::f32::consts::PI).rem_euclid(tau) - std::f32::consts::PI;
+    let ratio = to.distance / from.distance;
+    let distance = match ratio.is_finite() && ratio > 0.0 {
+        true => from.distance * ratio.powf(s),
+        false => to.distance,
+    };
+    if s >= 1.0 {
+        return to;
+    }
+    CameraPose {
+        yaw: from.yaw + s * turn,
+        pitch: from.pitch + s * (to.pitch - from.pitch),
+        distance,
+        target: from.target.lerp(to.target, s),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::case::Camera;
+    use crate::view::{Clip, ClipAxis};
+
+    fn pose(yaw: f32, distance: f32) -> CameraPose {
+        CameraPose {
+            yaw,
+            pitch: 0.2,
+            distance,
+            target: Vec3::new(1.0, 2.0, 3.0),
+        }
+    }
+
+    #[test]
+    fn a_step_shows_its_structures_by_their_places_in_the_case() {
+        let step = Step {
+            title: "cut".into(),
+            caption: String::new(),
+            camera: Camera {
+                target: [1.0, 2.0, 3.0],
+                yaw: 0.5,
+                pitch: -0.1,
+                distance: 90.0,
+            },
+            hidden: vec!["kidney".into()],
+            opacity: [("liver".to_string(), 0.25)].into_iter().collect(),
+            selected: Some("tumour".into()),
+            clip: Some(Clip {
+                axis: ClipAxis::Coronal,
+                at: 0.4,
+                flip: true,
+            }),
+            toward_segmentation: 0.5,
+        };
+        let view = step_view(&step, &["liver", "tumour", "kidney"]);
+        assert_eq!(view.hidden, [2]);
+        assert_eq!(view.opacity, [(0, 0.25), (1, 1.0), (2, 1.0)]);
+        assert_eq!(view.selected, Some(1));
+        assert_eq!(view.clip, step.clip);
+        assert_eq!(view.toward_segmentation, 0.5);
+        let camera = view.camera.expect("a camera");
+        assert_eq!(
+            (camera.yaw, camera.pitch, camera.distance),
+            (0.5, -0.1, 90.0)
+        );
+        assert_eq!(camera.target, Vec3::new(1.0, 2.0, 3.0));
+    }
+
+    #[test]
+    fn the_flight_starts_and_ends_at_its_poses_turning_the_short_way() {
+        let (from, to) = (pose(3.0, 100.0), pose(-3.0, 400.0));
+        assert_eq!(flight(from, to, 0.0), from);
+        assert_eq!(flight(from, to, 1.0), to);
+        assert_eq!(flight(from, to, 7.0), to);
+        // From 3 to -3 radians the short way passes pi (0.28 rad), not 0 (6 rad).
+        let half = flight(from, to, 0.5);
+        assert!(
+            (half.yaw - std::f32::consts::PI).abs() < 1e-5,
+            "{}",
+            half.yaw
+        );
+        // Half way in time, half way in zoom ratio: 100 -> 200 -> 400.
+        assert!((half.distance - 200.0).abs() < 1e-3, "{}", half.distance);
+        let early = flight(from, to, 0.1);
+        assert!(
+            early.yaw > 3.0 && early.yaw - 3.0 < 0.1 * 0.29,
+            "eased in: {}",
+            early.yaw
+        );
+    }
+}
