@@ -71,7 +71,8 @@ impl Shell {
                     "{}: {} vertices, {} faces",
                     model.name, model.report.vertices, model.report.faces
                 ));
-                if !model.warnings.is_empty() {
+                // The mesh report, the engine and its timings are the author's business.
+                if !model.warnings.is_empty() && !self.reading {
                     ui.colored_label(
                         ui.visuals().warn_fg_color,
                         format!("{} warning(s): see the report", model.warnings.len()),
@@ -79,13 +80,15 @@ impl Shell {
                 }
                 ui.separator();
             }
-            ui.label(format!("engine: {}", doc.backend.name()));
-            if let Some(t) = doc.timings {
-                ui.label(t.describe());
-            }
-            if let Some(why) = &self.gpu_fallback {
-                ui.colored_label(ui.visuals().warn_fg_color, "CPU fallback")
-                    .on_hover_text(why);
+            if !self.reading {
+                ui.label(format!("engine: {}", doc.backend.name()));
+                if let Some(t) = doc.timings {
+                    ui.label(t.describe());
+                }
+                if let Some(why) = &self.gpu_fallback {
+                    ui.colored_label(ui.visuals().warn_fg_color, "CPU fallback")
+                        .on_hover_text(why);
+                }
             }
             status::progress(ui, &doc, &self.files.reading());
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
