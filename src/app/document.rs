@@ -93,6 +93,8 @@ pub struct ViewAsks {
     pub toward_segmentation: f32,
     /// The tour step to show next (the shell takes it up).
     pub step: Option<usize>,
+    /// The case's labels are not drawn.
+    pub hide_labels: bool,
 }
 
 pub struct Document {
@@ -428,6 +430,9 @@ impl Document {
         state["view"]["clip_plane"] = serde_json::json!(v.clip_plane);
         state["view"]["planes"] = serde_json::to_value(self.view_asks.planes).unwrap_or_default();
         state["view"]["pointed"] = serde_json::json!(self.pointed);
+        state["view"]["labels"] = (v.labels.iter())
+            .map(|(text, [x, y])| serde_json::json!({"text": text, "x": x, "y": y}))
+            .collect();
         state["view"]["toward_segmentation"] =
             serde_json::json!(self.view_asks.toward_segmentation);
         state["view"]["link"] = serde_json::json!(self.view_link_url());

@@ -31,8 +31,8 @@ impl From<eframe::egui::Rect> for PageRect {
 }
 
 /// The 3D view's part of `state()`: where it is on the page, whether the weight brush is on
-/// and how long its latest pick took.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// and how long its latest pick took, and the labels drawn.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ViewReport {
     pub rect: PageRect,
     /// Where the camera is.
@@ -41,6 +41,8 @@ pub struct ViewReport {
     pub clip_plane: [f32; 4],
     pub brush_on: bool,
     pub pick_ms: Option<f64>,
+    /// Each label drawn: its text and where its point is on the page.
+    pub labels: Vec<(String, [f32; 2])>,
 }
 
 /// Where the bottom panel's clickable parts were drawn in the latest frame (points), for
@@ -55,7 +57,8 @@ pub struct PanelLayout {
     pub structures: Vec<StructureRow>,
     pub structure_name: Option<PageRect>,
     pub structure_filter: Option<PageRect>,
-    /// The tour's buttons as drawn, by what they do (`start`, `back`, `next`, `leave`).
+    /// The lesson's controls as drawn, by what they do (`labels`, the tour's `start`, `back`,
+    /// `next`, `leave`).
     pub tour: Vec<(&'static str, PageRect)>,
 }
 

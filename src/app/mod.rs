@@ -36,6 +36,7 @@ mod gallery_view;
 mod gpu_engine;
 mod graphs;
 mod guide;
+mod labels;
 mod layout;
 mod legend;
 mod orientation_marker;

@@ -2,13 +2,14 @@
 //! is first shown from, the per-frame record the render shader reads, thumbnails drawn on
 //! the CPU with the same camera and lights, picking (the triangle under the cursor and the
 //! vertices under the brush), the window/level-style parameter drag, and the clipping plane
-//! and standard views of a case, the link that restores a view, and a tour's steps.
+//! and standard views of a case, the link that restores a view, a tour's steps and where labels go.
 //!
 //! Free of egui and wgpu so that it builds and is unit-tested natively; the web app's
 //! renderer (`app::viewer`, wasm32) uploads what this module computes.
 
 mod camera;
 mod clip;
+mod labels;
 mod link;
 mod morph;
 mod orientation;
@@ -21,6 +22,7 @@ mod uniforms;
 
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
 pub use clip::{Clip, ClipAxis, Planes, StandardView, ViewRequest};
+pub use labels::{label_spots, LabelSpot};
 pub use link::{CameraPose, ViewLink, LINK_KEYS};
 pub use morph::toward_original;
 pub use orientation::{face_on_direction, first_view};

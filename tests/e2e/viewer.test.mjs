@@ -482,7 +482,15 @@ testIn(EVERY_RUN, "V7 the viewer plays the case's tour: each step's structures, 
         assert.equal(s.tour.title, lesson.steps[0].title);
         assert.equal(s.tour.caption, lesson.steps[0].caption);
         assert.deepEqual(shown(s), [["liver", true, 1], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", true, 1]]);
+        const inView = (l) => l.x > s.view.x && l.x < s.view.x + s.view.width && l.y > s.view.y && l.y < s.view.y + s.view.height;
+        assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver", "Tumour"], "both labels drawn");
+        assert.ok(s.view.labels.every(inView), `the labels' points lie in the view: ${JSON.stringify(s.view.labels)}`);
         const first = drawn(await app.screenshot("V7-step-1"), s.view);
+        // The labels' switch takes them away and brings them back.
+        await press("labels");
+        await app.stateWhen((s) => s.view.labels.length === 0, "the labels off");
+        await press("labels");
+        await app.stateWhen((s) => s.view.labels.length === 2, "the labels on again");
 
         await press("next");
         s = await atStep(1);
@@ -498,6 +506,9 @@ testIn(EVERY_RUN, "V7 the viewer plays the case's tour: each step's structures, 
         const clip = lesson.steps[2].clip;
         assert.deepEqual({ ...s.view.clip, at: Math.fround(s.view.clip.at) }, { ...clip, at: Math.fround(clip.at) }, "the step's clip (f32)");
         assert.equal(s.view.toward_segmentation, 0.25);
+        // The cut takes away the tumour's label (above it); the liver's lies below the plane.
+        s = await app.stateWhen((s) => s.view.labels.length === 1, "one label left by the cut");
+        assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver"]);
         assert.deepEqual(shown(s).map((x) => x.slice(1)), [[true, 1], [true, 1], [true, 1], [true, 1]], "the step shows every structure again, opaque");
         await app.screenshot("V7-step-3");
 

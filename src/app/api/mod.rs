@@ -98,7 +98,9 @@
 //! - `showStep(index)`: shows the case's tour step (from 0: its structures, clip, slide and
 //!   selection at once, the camera flying to its view); `leaveTour()` leaves the tour, the view
 //!   staying; `state().tour` is `{step, steps, title, caption}` (`step` null outside the
-//!   tour), or null when the case has no tour; `state().layout.tour` where its buttons are
+//!   tour), or null when the case has no tour; `state().layout.tour` where its buttons and
+//!   the labels' switch are; `state().view.labels` the labels drawn (`[{text, x, y}]`, their
+//!   points on the page)
 //!
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.

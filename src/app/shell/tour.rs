@@ -50,10 +50,17 @@ impl Shell {
         }
     }
 
-    /// The tour's controls and the step's caption, when the case has a tour.
+    /// The labels' switch and the tour's controls with the step's caption, where the case has
+    /// them.
     pub(super) fn tour_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
         doc.panel.tour.clear();
+        if !doc.case().lesson().labels.is_empty() {
+            let mut shown = !doc.view_asks.hide_labels;
+            let toggle = ui.checkbox(&mut shown, "Labels");
+            doc.panel.tour.push(("labels", toggle.rect.into()));
+            doc.view_asks.hide_labels = !shown;
+        }
         let steps = &doc.case().lesson().steps;
         if steps.is_empty() {
             return;
@@ -88,7 +95,7 @@ impl Shell {
                 ("leave", out.rect),
             ];
         });
-        doc.panel.tour = drawn.into_iter().map(|(k, r)| (k, r.into())).collect();
+        (doc.panel.tour).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
         if let Some(i) = asked {
             let _ = doc.ask_step(i);
         }

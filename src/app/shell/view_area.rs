@@ -8,7 +8,7 @@ use super::Shell;
 use crate::app::document::Document;
 use crate::app::layout::ViewReport;
 use crate::app::pointing::Pointing;
-use crate::app::{legend, orientation_marker, status, view_tools, viewer};
+use crate::app::{labels, legend, orientation_marker, status, view_tools, viewer};
 
 impl Shell {
     /// The 3D view with its legend, its tools and the messages over it; the structure under
@@ -49,6 +49,10 @@ impl Shell {
                 doc.pointed = self.pointing.named.as_ref().map(|(_, name)| name.clone());
                 let asked = doc.view_asks;
                 orientation_marker::paint(ui, response.rect, viewer.camera());
+                let labels = match doc.view_asks.hide_labels || self.picture.pending {
+                    true => Vec::new(),
+                    false => labels::paint(ui, response.rect, viewer, doc),
+                };
                 // A picture shows the view alone (and which way the patient lies).
                 if !self.picture.pending {
                     let has_image = doc.case().case_image().is_some();
@@ -72,6 +76,7 @@ impl Shell {
                     clip_plane: viewer.clip_plane(),
                     brush_on: self.brush.active,
                     pick_ms: self.brush.pick_ms,
+                    labels,
                 };
                 response.rect
             }

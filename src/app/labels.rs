@@ -1,0 +1,51 @@
+//! The case's labels over the 3D view: a dot on the point, a leader line out to the text, the
+//! text on a dark plate so it reads over any surface; a label goes with its structure.
+
+use eframe::egui;
+use glam::Vec2;
+
+use super::document::Document;
+use super::viewer::Viewer;
+use crate::view::label_spots;
+
+/// Draws the labels of the open case that the view shows; returns each drawn label's text and
+/// its point on the page.
+pub fn paint(
+    ui: &egui::Ui,
+    rect: egui::Rect,
+    viewer: &Viewer,
+    doc: &Document,
+) -> Vec<(String, [f32; 2])> {
+    let labels = &doc.case().lesson().labels;
+    if labels.is_empty() {
+        return Vec::new();
+    }
+    let structures = doc.case().case_structures();
+    let shown = |name: &str| structures.iter().any(|s| s.name == name && s.visible);
+    let size = Vec2::new(rect.width(), rect.height());
+    let spots = label_spots(labels, shown, viewer.camera(), size, viewer.clip_plane());
+    let painter = ui.painter_at(rect);
+    let font = egui::FontId::proportional(14.0);
+    let ink = egui::Color32::from_gray(240);
+    let mut drawn = Vec::with_capacity(spots.len());
+    for spot in spots {
+        let label = &labels[spot.index];
+        let at = |v: Vec2| rect.min + egui::vec2(v.x, v.y);
+        let (point, text) = (at(spot.point), at(spot.text));
+        painter.line_segment([point, text], egui::Stroke::new(1.5, ink));
+        painter.circle_filled(point, 3.0, ink);
+        let galley = painter.layout_no_wrap(label.text.clone(), font.clone(), ink);
+        // The text on the side of its end away from the point.
+        let left = if spot.text.x < spot.point.x {
+            text.x - galley.size().x - 6.0
+        } else {
+            text.x + 6.0
+        };
+        let corner = egui::pos2(left, text.y - galley.size().y / 2.0);
+        let plate = egui::Rect::from_min_size(corner, galley.size()).expand(3.0);
+        painter.rect_filled(plate, 3.0, egui::Color32::from_black_alpha(170));
+        painter.galley(corner, galley, ink);
+        drawn.push((label.text.clone(), [point.x, point.y]));
+    }
+    drawn
+}
