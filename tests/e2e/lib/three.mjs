@@ -53,6 +53,18 @@ import { MeshoptDecoder } from "three/addons/libs/meshopt_decoder.module.js";
 let loaded = null;
 let cameras = [];
 
+/** The page's canvas as a renderer of width x height, and a scene holding the loaded file. */
+function stage(width, height) {
+    const canvas = document.getElementById("view");
+    const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+    renderer.setPixelRatio(1);
+    renderer.setSize(width, height);
+    const scene = new THREE.Scene();
+    scene.background = new THREE.Color(0x202428);
+    scene.add(loaded);
+    return { renderer, scene };
+}
+
 window.gltfCheck = {
     revision: THREE.REVISION,
 
@@ -117,13 +129,7 @@ window.gltfCheck = {
 
     /** Draws the loaded scene through the file's camera number index (a case's tour step). */
     renderFrom(index, width, height) {
-        const canvas = document.getElementById("view");
-        const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
-        renderer.setPixelRatio(1);
-        renderer.setSize(width, height);
-        const scene = new THREE.Scene();
-        scene.background = new THREE.Color(0x202428);
-        scene.add(loaded);
+        const { renderer, scene } = stage(width, height);
         scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2.5));
         const camera = cameras[index];
         camera.aspect = width / height;
@@ -133,13 +139,7 @@ window.gltfCheck = {
     },
 
     render(width, height) {
-        const canvas = document.getElementById("view");
-        const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
-        renderer.setPixelRatio(1);
-        renderer.setSize(width, height);
-        const scene = new THREE.Scene();
-        scene.background = new THREE.Color(0x202428);
-        scene.add(loaded);
+        const { renderer, scene } = stage(width, height);
         const box = new THREE.Box3().setFromObject(loaded, true);
         const centre = box.getCenter(new THREE.Vector3());
         const size = box.getSize(new THREE.Vector3());
