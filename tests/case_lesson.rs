@@ -408,3 +408,44 @@ fn case_build_takes_a_lesson_file_and_case_info_reads_it_back() {
         "{stderr}"
     );
 }
+
+/// The page's session: the lesson set there is checked against the case, follows a structure
+/// renamed, and travels in the case glTF the page writes.
+#[test]
+fn the_session_keeps_the_lesson_through_a_rename_and_its_export() {
+    use meshsmooth::session::{Session, StructureChange};
+    let mut session = Session::default();
+    let bytes = std::fs::read(common_cli::data("labelmaps/case_phantom_shared.seg.nrrd"))
+        .expect("the phantom");
+    session.begin_open("case_phantom_shared.seg.nrrd", bytes);
+    session.poll_opening().expect("done").expect("opens");
+    let lesson = phantom_with_lesson().lesson;
+    let mut wrong = lesson.clone();
+    wrong.labels[0].structure = "spleen".into();
+    assert!(session.case_mut().set_lesson(wrong).is_err());
+    assert!(session.case().lesson().is_empty(), "kept as it was");
+    session.case_mut().set_lesson(lesson.clone()).expect("set");
+    let rename = StructureChange {
+        name: Some("Tumour".into()),
+        ..Default::default()
+    };
+    session
+        .case_mut()
+        .set_structure(2, rename)
+        .expect("renamed");
+    let now = session.case().lesson().clone();
+    assert_eq!(now.steps[1].selected.as_deref(), Some("Tumour"));
+    assert_eq!(now.labels[1].structure, "Tumour");
+    assert!(now
+        .quiz
+        .as_ref()
+        .expect("quiz")
+        .structures
+        .contains(&"Tumour".to_string()));
+    session.smooth_cpu();
+    let glb = session
+        .case()
+        .export_case(&CaseGltfOptions::default())
+        .expect("writes");
+    assert_eq!(read_back(&glb, "page.glb").lesson, now);
+}

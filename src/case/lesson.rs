@@ -118,6 +118,28 @@ impl Lesson {
         self.steps.is_empty() && self.labels.is_empty() && self.quiz.is_none()
     }
 
+    /// Names structure `old` `new` wherever the lesson names it (the author renamed it).
+    pub fn rename(&mut self, old: &str, new: &str) {
+        let rename = |name: &mut String| {
+            if name == old {
+                *name = new.to_string();
+            }
+        };
+        for step in &mut self.steps {
+            step.hidden.iter_mut().for_each(rename);
+            step.selected.iter_mut().for_each(rename);
+            if let Some(a) = step.opacity.remove(old) {
+                step.opacity.insert(new.to_string(), a);
+            }
+        }
+        self.labels
+            .iter_mut()
+            .for_each(|l| rename(&mut l.structure));
+        if let Some(quiz) = &mut self.quiz {
+            quiz.structures.iter_mut().for_each(rename);
+        }
+    }
+
     /// Reads a lesson from JSON (a pipeline's file, or what a case glTF's `extras` hold).
     pub fn from_json(text: &[u8]) -> Result<Self, String> {
         serde_json::from_slice(text).map_err(|e| format!("not a lesson: {e}"))

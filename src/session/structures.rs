@@ -137,8 +137,12 @@ impl CaseDocument {
             .map_or_else(|| s.description.clone(), |d| d.trim().to_string());
         let was = (&s.name, s.color, s.visible, &s.group, &s.description);
         if was != (&name, color, visible, &group, &description) {
-            (s.name, s.color, s.visible, s.group) = (name, color, visible, group);
+            let old = std::mem::replace(&mut s.name, name);
+            (s.color, s.visible, s.group) = (color, visible, group);
             s.description = description;
+            // The lesson names structures: it follows a rename.
+            let new = &self.case.structures[index].name;
+            self.case.lesson.rename(&old, new);
             self.case_version += 1;
         }
         Ok(())

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use super::{CameraPose, ViewLink};
-use crate::case::Step;
+use crate::case::{Camera, Step};
 
 /// How long the camera takes to reach a step's view (seconds): long enough to see where it
 /// goes, short enough not to wait.
@@ -34,6 +34,43 @@ pub fn step_view(step: &Step, names: &[&str]) -> ViewLink {
     }
 }
 
+/// The view `link` shows (its camera required) as a tour step named `title`, its structures
+/// named from `names` (the case's, in order); only structures less than opaque keep an
+/// opacity.
+pub fn recorded_step(
+    link: &ViewLink,
+    names: &[&str],
+    title: &str,
+    caption: &str,
+) -> Result<Step, String> {
+    let c = link.camera.ok_or("the view has no camera yet")?;
+    let name = |i: usize| {
+        (names.get(i).map(|n| n.to_string())).ok_or(format!("the case has no structure {i}"))
+    };
+    Ok(Step {
+        title: title.to_string(),
+        caption: caption.to_string(),
+        camera: Camera {
+            target: c.target.to_array(),
+            yaw: c.yaw,
+            pitch: c.pitch,
+            distance: c.distance,
+        },
+        hidden: link
+            .hidden
+            .iter()
+            .map(|&i| name(i))
+            .collect::<Result<_, _>>()?,
+        opacity: (link.opacity.iter())
+            .filter(|(_, a)| *a < 1.0)
+            .map(|&(i, a)| Ok((name(i)?, a)))
+            .collect::<Result<_, String>>()?,
+        selected: link.selected.map(name).transpose()?,
+        clip: link.clip,
+        toward_segmentation: link.toward_segmentation,
+    })
+}
+
 /// The camera `t` of the way (0 to 1, eased in and out) from `from` to `to`: turning the short
 /// way round, and zooming at a steady rate (the distance geometrically).
 pub fn flight(from: CameraPose, to: CameraPose, t: f64) -> CameraPose {
@@ -60,7 +97,6 @@ pub fn flight(from: CameraPose, to: CameraPose, t: f64) -> CameraPose {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::case::Camera;
     use crate::view::{Clip, ClipAxis};
 
     fn pose(yaw: f32, distance: f32) -> CameraPose {
@@ -105,6 +141,45 @@ mod tests {
             (0.5, -0.1, 90.0)
         );
         assert_eq!(camera.target, Vec3::new(1.0, 2.0, 3.0));
+    }
+
+    #[test]
+    fn a_recorded_view_plays_back_as_the_same_view() {
+        let names = ["liver", "tumour", "kidney"];
+        let link = ViewLink {
+            camera: Some(pose(1.0, 250.0)),
+            hidden: vec![2],
+            opacity: vec![(0, 0.4)],
+            selected: Some(1),
+            clip: Some(Clip {
+                axis: ClipAxis::Sagittal,
+                at: 0.3,
+                flip: false,
+            }),
+            toward_segmentation: 0.1,
+        };
+        let step = recorded_step(&link, &names, "inside", "The tumour.").expect("recorded");
+        assert_eq!(step.hidden, ["kidney"]);
+        assert_eq!(step.selected.as_deref(), Some("tumour"));
+        let back = step_view(&step, &names);
+        assert_eq!(back.opacity, [(0, 0.4), (1, 1.0), (2, 1.0)]);
+        assert_eq!(
+            ViewLink {
+                opacity: link.opacity.clone(),
+                ..back
+            },
+            link
+        );
+        let nowhere = ViewLink::default();
+        assert!(recorded_step(&nowhere, &names, "x", "").is_err());
+        let stale = ViewLink {
+            hidden: vec![7],
+            ..link
+        };
+        assert_eq!(
+            recorded_step(&stale, &names, "x", "").expect_err("no structure 7"),
+            "the case has no structure 7"
+        );
     }
 
     #[test]

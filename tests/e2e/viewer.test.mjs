@@ -522,3 +522,40 @@ testIn(EVERY_RUN, "V7 the viewer plays the case's tour: each step's structures, 
         assert.match(refused.message, /the case's tour has steps 0 to 2: no step 3/);
     }, { query: "?mode=viewer&case=cases/lesson.glb", routes: { "cases/lesson.glb": bytes } });
 });
+
+testIn(EVERY_RUN, "V8 the author records tour steps in the page; the case glTF carries them to the viewer and back", { timeout: TIMEOUT }, async () => {
+    let exported;
+    let authored;
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd", "loadCase");
+        await app.stateWhen((s) => s.loading === null && s.view.camera, "the case open and framed");
+        assert.equal(await app.call("recordStep", { title: "All four", caption: "The whole case." }), 1);
+        await app.call("setStructure", { index: 0, opacity: 0.4 });
+        await app.call("setView", { from: "S", clip: { axis: "axial", at: 0.5, flip: false } });
+        await app.stateWhen((s) => s.view.clip?.axis === "axial", "the clip set");
+        assert.equal(await app.call("recordStep", { title: "From above, cut" }), 2);
+        const refused = await app.attempt("setLesson", { labels: [{ structure: "spleen", point: [0, 0, 0], text: "Spleen" }] });
+        assert.match(refused.message, /setLesson: label 1 \('Spleen'\) names 'spleen', which the case does not have/);
+        const lesson = await app.call("lesson");
+        assert.deepEqual(lesson.steps.map((s) => s.title), ["All four", "From above, cut"]);
+        assert.deepEqual(Object.keys(lesson.steps[1].opacity), ["liver"]);
+        assert.equal(Math.fround(lesson.steps[1].opacity.liver), Math.fround(0.4));
+        assert.equal(lesson.steps[1].clip.axis, "axial");
+        lesson.labels = [{ structure: "tumor", point: [45.12, 38.06, 38.75], text: "Tumour" }];
+        lesson.quiz = { structures: [], modes: ["find-it"], pass_mark: 0.5 };
+        await app.call("setLesson", lesson);
+        authored = await app.call("lesson");
+        exported = Buffer.from(await app.call("exportCase", "glb"));
+    });
+    await withApp(async (app) => {
+        const s = await app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null, "the case in the viewer");
+        assert.equal(s.tour.steps, 2);
+        await app.call("showStep", 1);
+        const at = await app.stateWhen((s) => s.tour.step === 1 && s.view.clip?.axis === "axial", "the second step");
+        assert.equal(at.structures.structures[0].opacity.toFixed(3), "0.400");
+    }, { query: "?mode=viewer&case=cases/authored.glb", routes: { "cases/authored.glb": exported } });
+    await withApp(async (app) => {
+        await app.loadMesh(exported, "authored.glb", "loadCase");
+        assert.deepEqual(await app.call("lesson"), authored, "reopened in the page, the same lesson");
+    });
+});

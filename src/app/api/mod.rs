@@ -101,6 +101,9 @@
 //!   tour), or null when the case has no tour; `state().layout.tour` where its buttons and
 //!   the labels' switch are; `state().view.labels` the labels drawn (`[{text, x, y}]`, their
 //!   points on the page)
+//! - `lesson()`, `setLesson(lesson)` and `recordStep({title, caption})` (the authoring page):
+//!   the case's lesson as `case build --lesson` reads it; setting one checks it against the
+//!   case; recording adds the view as it stands as the tour's last step
 //!
 //! Every call goes through the same [`crate::session::Session`] the UI edits, so the page shows
 //! what the API did and the numbers equal the CLI's for the same mesh and parameters.

@@ -1,15 +1,15 @@
 //! The API's calls on the view: `setView` (its standard sides, clipping plane and slide towards
-//! the segmentation, as its tools set them), `screenshot` (a PNG of it), and `showStep` and
-//! `leaveTour` (the case's tour).
+//! the segmentation, as its tools set them), `screenshot` (a PNG of it), `showStep` and
+//! `leaveTour` (the case's tour), and the author's `lesson`, `setLesson` and `recordStep`.
 
 use eframe::egui;
 use js_sys::{Function, Promise, Uint8Array};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsValue;
 
-use super::{error, from_js, Api};
-use crate::app::document::SharedDocument;
-use crate::view::ViewRequest;
+use super::{error, from_js, to_js, Api};
+use crate::app::document::{Document, SharedDocument};
+use crate::view::{recorded_step, ViewRequest};
 
 pub(super) fn set_view(
     doc: &SharedDocument,
@@ -97,5 +97,61 @@ pub(super) fn define_tour(
             d.borrow_mut().leave_tour();
             crate::app::wake(&c);
         }),
+    )?;
+    define_lesson(api, doc, ctx)
+}
+
+/// `lesson()`, `setLesson(lesson)` and `recordStep({title, caption})`: the author's lesson.
+fn define_lesson(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
+    let d = doc.clone();
+    api.define(
+        "lesson",
+        Closure::<dyn FnMut() -> JsValue>::new(move || {
+            to_js(&serde_json::json!(d.borrow().case().lesson()))
+        }),
+    )?;
+    let (d, c) = (doc.clone(), ctx.clone());
+    api.define(
+        "setLesson",
+        Closure::<dyn FnMut(JsValue) -> Result<(), JsValue>>::new(move |value: JsValue| {
+            let lesson = from_js(&value)
+                .and_then(|v| serde_json::from_value(v).map_err(|e| format!("not a lesson: {e}")))
+                .map_err(|e| error(&format!("setLesson: {e}")))?;
+            let set = d.borrow_mut().case_mut().set_lesson(lesson);
+            crate::app::wake(&c);
+            set.map_err(|e| error(&format!("setLesson: {e}")))
+        }),
+    )?;
+    let (d, c) = (doc.clone(), ctx.clone());
+    api.define(
+        "recordStep",
+        Closure::<dyn FnMut(JsValue) -> Result<JsValue, JsValue>>::new(move |value: JsValue| {
+            let recorded = record_step(&mut d.borrow_mut(), &value);
+            crate::app::wake(&c);
+            recorded
+                .map(|n| JsValue::from(n as f64))
+                .map_err(|e| error(&format!("recordStep: {e}")))
+        }),
     )
+}
+
+/// Adds the view as it stands as the tour's last step; returns the number of steps.
+fn record_step(doc: &mut Document, value: &JsValue) -> Result<usize, String> {
+    let v = from_js(value)?;
+    let text = |key: &str| {
+        v.get(key)
+            .and_then(|t| t.as_str())
+            .unwrap_or_default()
+            .to_string()
+    };
+    let names: Vec<String> = (doc.case().case_structures().iter())
+        .map(|s| s.name.clone())
+        .collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let step = recorded_step(&doc.view_link(), &names, &text("title"), &text("caption"))?;
+    let mut lesson = doc.case().lesson().clone();
+    lesson.steps.push(step);
+    let steps = lesson.steps.len();
+    doc.case_mut().set_lesson(lesson)?;
+    Ok(steps)
 }
