@@ -148,7 +148,7 @@ impl Lesson {
     /// Refuses a lesson that names a structure `case` does not have, or holds a number or a
     /// text no viewer could show; the reason names the step, label or quiz entry.
     pub fn check(&self, case: &Case) -> Result<(), String> {
-        let names: Vec<&str> = case.structures.iter().map(|s| s.name.as_str()).collect();
+        let names = case.names();
         let known = |what: &str, name: &str| match names.contains(&name) {
             true => Ok(()),
             false => Err(format!(

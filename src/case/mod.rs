@@ -322,6 +322,11 @@ impl Case {
         self.structures.extend(other.structures);
     }
 
+    /// The structures' names, in the case's order.
+    pub fn names(&self) -> Vec<&str> {
+        self.structures.iter().map(|s| s.name.as_str()).collect()
+    }
+
     /// The structures' groups in the order they first appear.
     pub fn groups(&self) -> Vec<&str> {
         let mut out: Vec<&str> = Vec::new();

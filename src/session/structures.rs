@@ -41,6 +41,11 @@ impl CaseDocument {
         &self.case.structures
     }
 
+    /// The structures' names, in the case's order (as a lesson names them).
+    pub fn structure_names(&self) -> Vec<&str> {
+        self.case.names()
+    }
+
     /// Which structure the model is, while one is open.
     pub fn current_structure(&self) -> Option<usize> {
         self.model().map(|_| self.current)

@@ -144,10 +144,7 @@ fn record_step(doc: &mut Document, value: &JsValue) -> Result<usize, String> {
             .unwrap_or_default()
             .to_string()
     };
-    let names: Vec<String> = (doc.case().case_structures().iter())
-        .map(|s| s.name.clone())
-        .collect();
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let names = doc.case().structure_names();
     let step = recorded_step(&doc.view_link(), &names, &text("title"), &text("caption"))?;
     let mut lesson = doc.case().lesson().clone();
     lesson.steps.push(step);

@@ -21,11 +21,7 @@ impl Shell {
         let Some(step) = doc.case().lesson().steps.get(index).cloned() else {
             return;
         };
-        let names: Vec<String> = (doc.case().case_structures().iter())
-            .map(|s| s.name.clone())
-            .collect();
-        let names: Vec<&str> = names.iter().map(String::as_str).collect();
-        let link = step_view(&step, &names);
+        let link = step_view(&step, &doc.case().structure_names());
         let problems = show_view(&mut doc, &link);
         if !problems.is_empty() {
             log::warn!("tour step {}: {}", index + 1, problems.join("; "));
