@@ -1,6 +1,8 @@
 //! The case's labels over the 3D view: a dot on the point, a leader line out to the text, the
 //! text on a dark plate so it reads over any surface; a label goes with its structure.
 
+use std::collections::HashSet;
+
 use eframe::egui;
 use glam::Vec2;
 
@@ -20,8 +22,11 @@ pub fn paint(
     if labels.is_empty() {
         return Vec::new();
     }
-    let structures = doc.case().case_structures();
-    let shown = |name: &str| structures.iter().any(|s| s.name == name && s.visible);
+    let visible: HashSet<&str> = (doc.case().case_structures().iter())
+        .filter(|s| s.visible)
+        .map(|s| s.name.as_str())
+        .collect();
+    let shown = |name: &str| visible.contains(name);
     let size = Vec2::new(rect.width(), rect.height());
     let spots = label_spots(labels, shown, viewer.camera(), size, viewer.clip_plane());
     let painter = ui.painter_at(rect);
