@@ -33,5 +33,5 @@ pub use pick::{
     brush_falloff, brush_footprint, moller_trumbore, pick_triangle, pick_triangle_where, Hit, Ray,
 };
 pub use slice::{SlicePlacement, SliceTexture, SliceUniforms};
-pub use tour::{flight, recorded_step, step_view, FLIGHT_SECONDS};
+pub use tour::{recorded_step, step_view, Flight, FLIGHT_SECONDS};
 pub use uniforms::{ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS};

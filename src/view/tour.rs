@@ -71,9 +71,56 @@ pub fn recorded_step(
     })
 }
 
+/// The camera's way to a step's view, which gives way to the student's hand: once the camera
+/// is not where the flight last put it (dragged, zoomed, turned to a standard side), the flight
+/// is over.
+#[derive(Clone, Copy, Debug)]
+pub struct Flight {
+    from: CameraPose,
+    to: CameraPose,
+    started_ms: f64,
+    /// Where the flight last put the camera, as the view holds it.
+    left: CameraPose,
+    arrived: bool,
+}
+
+impl Flight {
+    pub fn new(from: CameraPose, to: CameraPose, now_ms: f64) -> Self {
+        Self {
+            from,
+            to,
+            started_ms: now_ms,
+            left: from,
+            arrived: false,
+        }
+    }
+
+    /// Where the camera, now at `at`, goes at `now_ms`; `None` once the flight has arrived or
+    /// the camera was moved by another hand. The caller reports where it put it with
+    /// [`Flight::left_at`].
+    pub fn advance(&mut self, at: CameraPose, now_ms: f64) -> Option<CameraPose> {
+        if self.arrived || at != self.left {
+            return None;
+        }
+        let t = (now_ms - self.started_ms) / (1000.0 * FLIGHT_SECONDS);
+        self.arrived = t >= 1.0;
+        Some(flight(self.from, self.to, t))
+    }
+
+    /// The camera as the view holds it after being put where [`Flight::advance`] said.
+    pub fn left_at(&mut self, pose: CameraPose) {
+        self.left = pose;
+    }
+
+    /// Whether the last pose given was the step's view.
+    pub fn arrived(&self) -> bool {
+        self.arrived
+    }
+}
+
 /// The camera `t` of the way (0 to 1, eased in and out) from `from` to `to`: turning the short
 /// way round, and zooming at a steady rate (the distance geometrically).
-pub fn flight(from: CameraPose, to: CameraPose, t: f64) -> CameraPose {
+fn flight(from: CameraPose, to: CameraPose, t: f64) -> CameraPose {
     let t = t.clamp(0.0, 1.0) as f32;
     let s = t * t * (3.0 - 2.0 * t);
     let tau = std::f32::consts::TAU;
@@ -179,6 +226,38 @@ mod tests {
         assert_eq!(
             recorded_step(&stale, &names, "x", "").expect_err("no structure 7"),
             "the case has no structure 7"
+        );
+    }
+
+    #[test]
+    fn a_flight_arrives_once_and_gives_way_to_the_students_hand() {
+        let (from, to) = (pose(0.0, 100.0), pose(1.0, 50.0));
+        let ms = 1000.0 * FLIGHT_SECONDS;
+        let mut f = Flight::new(from, to, 10.0);
+        let half = f.advance(from, 10.0 + ms / 2.0).unwrap();
+        assert!(half.yaw > 0.0 && half.yaw < 1.0 && !f.arrived());
+        f.left_at(half);
+        let end = f.advance(half, 10.0 + ms).unwrap();
+        assert_eq!(end, to);
+        assert!(f.arrived());
+        f.left_at(end);
+        assert_eq!(
+            f.advance(end, 10.0 + 2.0 * ms),
+            None,
+            "arrived: nothing more"
+        );
+
+        let mut f = Flight::new(from, to, 0.0);
+        let first = f.advance(from, ms / 4.0).unwrap();
+        f.left_at(first);
+        let dragged = CameraPose {
+            yaw: first.yaw + 0.3,
+            ..first
+        };
+        assert_eq!(
+            f.advance(dragged, ms / 2.0),
+            None,
+            "the student's drag ends it"
         );
     }
 

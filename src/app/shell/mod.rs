@@ -86,7 +86,7 @@ pub struct Shell {
     /// The link's camera, until the view has framed that case.
     pending_pose: Option<CameraPose>,
     /// The camera on its way to a tour step's view.
-    flight: Option<tour::Flight>,
+    flight: Option<crate::view::Flight>,
     /// "Copy link" was clicked (and is still hovered).
     link_copied: bool,
     /// The case in words for screen readers.

@@ -6,10 +6,7 @@ use eframe::egui;
 use super::sharing::show_view;
 use super::Shell;
 use crate::app::document::now_ms;
-use crate::view::{flight, step_view, CameraPose, FLIGHT_SECONDS};
-
-/// The camera's way to a step's view: from, to, and when it set out (ms).
-pub(super) type Flight = (CameraPose, CameraPose, f64);
+use crate::view::{step_view, Flight};
 
 impl Shell {
     /// Shows the tour step asked for, if one was: its view now, its camera on the way.
@@ -28,18 +25,23 @@ impl Shell {
         }
         doc.tour = Some(index);
         if let (Some(to), Some((viewer, _))) = (link.camera, &self.view) {
-            self.flight = Some((viewer.pose(), to, now_ms()));
+            self.flight = Some(Flight::new(viewer.pose(), to, now_ms()));
         }
     }
 
-    /// Moves the camera along its flight to a step's view, asking for frames until it is there.
+    /// Moves the camera along its flight to a step's view, asking for frames until it is
+    /// there or the student takes the camera.
     pub(super) fn fly(&mut self, ctx: &egui::Context) {
-        let (Some((from, to, started)), Some((viewer, _))) = (self.flight, &mut self.view) else {
+        let (Some(f), Some((viewer, _))) = (&mut self.flight, &mut self.view) else {
             return;
         };
-        let t = (now_ms() - started) / (1000.0 * FLIGHT_SECONDS);
-        viewer.set_pose(flight(from, to, t));
-        if t >= 1.0 {
+        let Some(pose) = f.advance(viewer.pose(), now_ms()) else {
+            self.flight = None;
+            return;
+        };
+        viewer.set_pose(pose);
+        f.left_at(viewer.pose());
+        if f.arrived() {
             self.flight = None;
         } else {
             ctx.request_repaint();
