@@ -119,6 +119,10 @@ pub struct Document {
     pub panel: PanelLayout,
     /// The tour step shown, while the student follows the case's tour.
     pub tour: Option<usize>,
+    /// The quiz the student is taking.
+    pub quiz: Option<crate::view::QuizRun>,
+    /// What the lesson's player tells the embedding page (event, detail), in order.
+    pub lesson_events: Vec<(&'static str, serde_json::Value)>,
     waiting: Vec<Waiter>,
     /// Calls waiting for background work (a suggestion, the graphs).
     waiting_for: Vec<(Ready, Waiter)>,
@@ -179,6 +183,8 @@ impl Document {
             finished_opening: None,
             panel: PanelLayout::default(),
             tour: None,
+            quiz: None,
+            lesson_events: Vec::new(),
             waiting: Vec::new(),
             waiting_for: Vec::new(),
             show_gallery: false,
@@ -304,6 +310,9 @@ impl Document {
             );
         }
         self.timings = None;
+        // Another case: another lesson.
+        self.tour = None;
+        self.quiz = None;
     }
 
     /// Whether work for the current parameters is still to do.
@@ -443,6 +452,7 @@ impl Document {
         };
         state["layout"] = self.panel.to_json();
         state["tour"] = self.tour_json();
+        state["quiz"] = self.quiz_json();
         // WebAssembly memory only grows: its size is the page's peak.
         state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state

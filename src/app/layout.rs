@@ -58,8 +58,9 @@ pub struct PanelLayout {
     pub structure_name: Option<PageRect>,
     pub structure_filter: Option<PageRect>,
     /// The lesson's controls as drawn, by what they do (`labels`, the tour's `start`, `back`,
-    /// `next`, `leave`).
-    pub tour: Vec<(&'static str, PageRect)>,
+    /// `next`, `leave`, the quiz's `quiz`, `choice-0` to `choice-3`, `next-question`,
+    /// `again`, `end-quiz`).
+    pub lesson: Vec<(&'static str, PageRect)>,
 }
 
 /// One row of the Structures list: its visibility box, show-alone button and name (which
@@ -102,7 +103,7 @@ impl PanelLayout {
             })).collect::<Vec<_>>(),
             "structure_name": self.structure_name.map(PageRect::to_json),
             "structure_filter": self.structure_filter.map(PageRect::to_json),
-            "tour": self.tour.iter().map(|(k, r)| (k.to_string(), r.to_json()))
+            "lesson": self.lesson.iter().map(|(k, r)| (k.to_string(), r.to_json()))
                 .collect::<serde_json::Map<_, _>>(),
         })
     }

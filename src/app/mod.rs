@@ -44,6 +44,7 @@ mod page;
 mod picture;
 mod pointing;
 mod query;
+mod quiz;
 mod read_bytes;
 mod report_view;
 mod shell;

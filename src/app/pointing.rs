@@ -26,13 +26,15 @@ struct Asked {
 
 impl Pointing {
     /// Finds the structure under the pointer over the view (`response`), names it beside the
-    /// pointer, and returns it when it was clicked. `plane` is the view's clipping plane.
+    /// pointer unless `quiet` (a quiz asks for it), and returns it when it was clicked.
+    /// `plane` is the view's clipping plane.
     pub fn update(
         &mut self,
         ui: &egui::Ui,
         response: &egui::Response,
         (camera, plane): (&OrbitCamera, [f32; 4]),
         session: &Session,
+        quiet: bool,
     ) -> Option<usize> {
         let pointer = response.hover_pos().filter(|_| !response.dragged());
         let Some(pointer) = pointer else {
@@ -62,6 +64,9 @@ impl Pointing {
             self.asked = Some(asked);
         }
         let (index, name) = self.named.as_ref()?;
+        if quiet {
+            return response.clicked().then_some(*index);
+        }
         let font = egui::TextStyle::Body.resolve(ui.style());
         let place = pointer + egui::vec2(14.0, -6.0);
         let painter = ui.painter_at(response.rect);

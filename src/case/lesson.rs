@@ -113,6 +113,13 @@ pub enum QuizMode {
     NameIt,
 }
 
+impl Quiz {
+    /// Whether `right` of `questions` answers reach the pass mark.
+    pub fn passes(&self, right: usize, questions: usize) -> bool {
+        right as f32 / questions.max(1) as f32 >= self.pass_mark
+    }
+}
+
 impl Lesson {
     pub fn is_empty(&self) -> bool {
         self.steps.is_empty() && self.labels.is_empty() && self.quiz.is_none()

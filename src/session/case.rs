@@ -16,6 +16,11 @@ impl CaseDocument {
         &self.case.description
     }
 
+    /// The case itself, read-only (its edits go through this document).
+    pub fn as_case(&self) -> &Case {
+        &self.case
+    }
+
     /// The tour, labels and quiz the case carries.
     pub fn lesson(&self) -> &Lesson {
         &self.case.lesson

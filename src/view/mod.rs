@@ -15,6 +15,7 @@ mod morph;
 mod orientation;
 mod param_drag;
 mod pick;
+mod quiz;
 mod slice;
 pub mod thumbnail;
 mod tour;
@@ -32,6 +33,7 @@ pub use param_drag::{
 pub use pick::{
     brush_falloff, brush_footprint, moller_trumbore, pick_triangle, pick_triangle_where, Hit, Ray,
 };
+pub use quiz::{Answer, Question, QuizRun, CHOICES};
 pub use slice::{SlicePlacement, SliceTexture, SliceUniforms};
 pub use tour::{recorded_step, step_view, Flight, FLIGHT_SECONDS};
 pub use uniforms::{ViewUniforms, BASE_COLOR_SRGB, OUTPUT_LINEAR, RENDER_SHADER, VERTEX_COLORS};

@@ -144,6 +144,46 @@ testIn(EVERY_RUN, "P1 a platform on another origin authors a case in the embedde
     assert.equal(statement.object.definition.name["en-US"], "The tumour inside the liver");
     assert.match(statement.object.id, /#step-2$/);
 
+    // The platform starts the quiz from its own button; the student answers in the viewer (the
+    // liver clicked for every "Find it", the first name for every "Name it") and the platform
+    // hears each answer and the score, each with its xAPI statement.
+    const viewerState = async (test, what) => {
+        for (let tries = 0; tries < 300; tries++) {
+            const s = await call("viewer", "state");
+            if (test(s)) return s;
+            await new Promise((r) => setTimeout(r, 100));
+        }
+        throw new Error(`the viewer: ${what} not reached`);
+    };
+    const frame = await page.locator("#viewer").boundingBox();
+    const tap = (x, y) => page.mouse.click(frame.x + x, frame.y + y);
+    await call("viewer", "showStep", 0);
+    const front = JSON.parse(readFileSync(join(ROOT, "tests/data/phantom_lesson.json"), "utf8")).steps[0].camera;
+    const arrived = (s) => Math.abs(s.view.camera.distance - front.distance) < 1e-3 && Math.abs(s.view.camera.yaw - front.yaw) < 1e-3;
+    const atFront = await viewerState((s) => s.tour.step === 0 && arrived(s) && s.view.labels.length === 2, "the first step's view with its labels");
+    const liver = atFront.view.labels.find((l) => l.text === "Liver");
+    since = await lines();
+    await call("viewer", "startQuiz");
+    for (let q = 0; q < 8; q++) {
+        const s = await viewerState((s) => s.quiz.question === q && !s.layout.lesson["next-question"], `question ${q + 1} drawn`);
+        if (s.quiz.mode === "find-it") await tap(liver.x, liver.y);
+        else await tap(s.layout.lesson["choice-0"].x + 10, s.layout.lesson["choice-0"].y + 8);
+        const answered = await viewerState((s) => s.quiz.answer !== null && s.layout.lesson["next-question"], `question ${q + 1} answered`);
+        const next = answered.layout.lesson["next-question"];
+        await tap(next.x + next.width / 2, next.y + next.height / 2);
+    }
+    await logged(/^student finished the quiz: \d of 8, (passed|not passed)$/, "the score heard", since);
+    const heard = (await page.evaluate(() => window.platform.log)).slice(since);
+    const answers = heard.filter((l) => l.startsWith("student answered "));
+    assert.equal(answers.length, 8, `every answer heard: ${answers.join(" | ")}`);
+    assert.ok(answers.some((l) => /^student answered find-it on liver: right in/.test(l)), "the liver found");
+    const statements = (await page.evaluate(() => window.platform.statements)).filter((s) => s.verb.display["en-US"] !== "experienced");
+    assert.deepEqual(statements.map((s) => s.verb.display["en-US"]).slice(0, 8), Array(8).fill("answered"));
+    const final = statements[8];
+    assert.match(final.verb.id, /\/(passed|failed)$/);
+    assert.equal(final.result.score.max, 8);
+    assert.equal(final.actor.name, "the signed-in student", "the platform adds the student");
+
     // Frames open only the three sites, and every other request stays within the origin of the
     // frame that made it.
     const sites = [app.origin, platform.origin, third.origin];

@@ -11,6 +11,7 @@ import { join } from "node:path";
 import * as cli from "./lib/cli.mjs";
 import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
 import { colourAt, decodePng } from "./lib/png.mjs";
+import { changedPixels, drawn } from "./lib/view.mjs";
 import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
@@ -18,47 +19,6 @@ const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 const PHANTOM_NRRD = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
 const TIMEOUT = 240_000;
 
-/** Whether (x, y) lies on the orientation marker, in the view's top-right corner. */
-const onMarker = (x, y, view) => x > view.x + view.width - 100 && y < view.y + 100;
-
-/**
- * The pixels of the 3D view that show a surface: unlike the background (read at the view's
- * top-right corner), away from the messages at its top, the orientation marker and its tools
- * at its bottom. Returns their count and mean x (CSS pixels).
- */
-function drawn(image, view) {
-    const at = (x, y) => {
-        const i = (Math.round(y) * image.width + Math.round(x)) * 4;
-        return [image.rgba[i], image.rgba[i + 1], image.rgba[i + 2]];
-    };
-    const background = at(view.x + view.width - 4, view.y + 4);
-    let count = 0;
-    let sumX = 0;
-    for (let y = Math.round(view.y + 60); y < Math.round(view.y + view.height - 40); y++) {
-        for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) {
-            const c = at(x, y);
-            if (onMarker(x, y, view)) continue;
-            if (c.some((v, k) => Math.abs(v - background[k]) > 24)) {
-                count++;
-                sumX += x;
-            }
-        }
-    }
-    return { count, meanX: count ? sumX / count : NaN };
-}
-
-/** Pixels of the view (away from its messages, marker and tools) that differ between two images. */
-function changedPixels(a, b, view) {
-    let count = 0;
-    for (let y = Math.round(view.y + 60); y < Math.round(view.y + view.height - 40); y++) {
-        for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) {
-            const i = (y * a.width + x) * 4;
-            if (onMarker(x, y, view)) continue;
-            if ([0, 1, 2].some((k) => Math.abs(a.rgba[i + k] - b.rgba[i + k]) > 16)) count++;
-        }
-    }
-    return count;
-}
 
 /** Pixels of the view whose colour passes `test(r, g, b)`: their count and mean position. */
 function pixelsWhere(image, view, test) {
@@ -451,111 +411,4 @@ testIn(EVERY_RUN, "V6 a glTF meshsmooth did not smooth is shown as the file hold
         const shot = await app.screenshot("V6-as-read");
         assert.ok(drawn(shot, later.view).count > 2000, "the surface is drawn");
     }, { query: "?mode=viewer&case=cases/converted.glb", routes: { "cases/converted.glb": bytes } });
-});
-
-testIn(EVERY_RUN, "V7 the viewer plays the case's tour: each step's structures, clip, caption and camera, by button and by call", { timeout: TIMEOUT }, async () => {
-    const lessonFile = join(ROOT, "tests/data/phantom_lesson.json");
-    const lesson = JSON.parse(readFileSync(lessonFile, "utf8"));
-    const file = join(E2E_OUT, MODE, "V7-lesson-case.glb");
-    await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "--lesson", lessonFile, "-o", file, "--json");
-    const bytes = readFileSync(file);
-    await withApp(async (app) => {
-        const state = await phantomShown(app);
-        assert.deepEqual(state.tour, { step: null, steps: 3, title: null, caption: null });
-        const press = async (button) => {
-            const s = await app.stateWhen((s) => s.layout.tour?.[button], `the tour's ${button} button`);
-            const r = s.layout.tour[button];
-            await app.page.mouse.click(r.x + r.width / 2, r.y + r.height / 2);
-        };
-        // At a step: its title and caption, and the camera arrived at its view.
-        const atStep = (i) =>
-            app.stateWhen((s) => {
-                const c = s.view.camera;
-                const want = lesson.steps[i].camera;
-                const close = (a, b) => Math.abs(a - b) <= 1e-3 * Math.max(1, Math.abs(b));
-                return s.tour?.step === i && c && close(c.yaw, want.yaw) && close(c.pitch, want.pitch) && close(c.distance, want.distance) && c.target.every((x, k) => close(x, want.target[k]));
-            }, `step ${i + 1} shown, its camera arrived`);
-        const shown = (s) => s.structures.structures.map((x) => [x.name, x.visible, Number(x.opacity.toFixed(3))]);
-
-        await press("start");
-        let s = await atStep(0);
-        assert.equal(s.tour.title, lesson.steps[0].title);
-        assert.equal(s.tour.caption, lesson.steps[0].caption);
-        assert.deepEqual(shown(s), [["liver", true, 1], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", true, 1]]);
-        const inView = (l) => l.x > s.view.x && l.x < s.view.x + s.view.width && l.y > s.view.y && l.y < s.view.y + s.view.height;
-        assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver", "Tumour"], "both labels drawn");
-        assert.ok(s.view.labels.every(inView), `the labels' points lie in the view: ${JSON.stringify(s.view.labels)}`);
-        const first = drawn(await app.screenshot("V7-step-1"), s.view);
-        // The labels' switch takes them away and brings them back.
-        await press("labels");
-        await app.stateWhen((s) => s.view.labels.length === 0, "the labels off");
-        await press("labels");
-        await app.stateWhen((s) => s.view.labels.length === 2, "the labels on again");
-
-        await press("next");
-        s = await atStep(1);
-        assert.deepEqual(shown(s), [["liver", true, 0.3], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", false, 1]], "the kidney hidden, the liver see-through");
-        assert.equal(s.structures.current, 2, "the tumour selected");
-        assert.equal(s.view.clip, null);
-        const second = drawn(await app.screenshot("V7-step-2"), s.view);
-        assert.ok(second.count > 500 && first.count > 500, `both views draw the case: ${first.count}, ${second.count} pixels`);
-
-        // The platform's call, as its own buttons would make it.
-        await app.call("showStep", 2);
-        s = await atStep(2);
-        const clip = lesson.steps[2].clip;
-        assert.deepEqual({ ...s.view.clip, at: Math.fround(s.view.clip.at) }, { ...clip, at: Math.fround(clip.at) }, "the step's clip (f32)");
-        assert.equal(s.view.toward_segmentation, 0.25);
-        // The cut takes away the tumour's label (above it); the liver's lies below the plane.
-        s = await app.stateWhen((s) => s.view.labels.length === 1, "one label left by the cut");
-        assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver"]);
-        assert.deepEqual(shown(s).map((x) => x.slice(1)), [[true, 1], [true, 1], [true, 1], [true, 1]], "the step shows every structure again, opaque");
-        await app.screenshot("V7-step-3");
-
-        await press("back");
-        s = await atStep(1);
-        await press("leave");
-        s = await app.stateWhen((s) => s.tour.step === null, "the tour left");
-        assert.equal(Math.fround(s.view.camera.yaw), Math.fround(lesson.steps[1].camera.yaw), "the view stays where the tour left it");
-        const refused = await app.attempt("showStep", 3);
-        assert.equal(refused.ok, false);
-        assert.match(refused.message, /the case's tour has steps 0 to 2: no step 3/);
-    }, { query: "?mode=viewer&case=cases/lesson.glb", routes: { "cases/lesson.glb": bytes } });
-});
-
-testIn(EVERY_RUN, "V8 the author records tour steps in the page; the case glTF carries them to the viewer and back", { timeout: TIMEOUT }, async () => {
-    let exported;
-    let authored;
-    await withApp(async (app) => {
-        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd", "loadCase");
-        await app.stateWhen((s) => s.loading === null && s.view.camera, "the case open and framed");
-        assert.equal(await app.call("recordStep", { title: "All four", caption: "The whole case." }), 1);
-        await app.call("setStructure", { index: 0, opacity: 0.4 });
-        await app.call("setView", { from: "S", clip: { axis: "axial", at: 0.5, flip: false } });
-        await app.stateWhen((s) => s.view.clip?.axis === "axial", "the clip set");
-        assert.equal(await app.call("recordStep", { title: "From above, cut" }), 2);
-        const refused = await app.attempt("setLesson", { labels: [{ structure: "spleen", point: [0, 0, 0], text: "Spleen" }] });
-        assert.match(refused.message, /setLesson: label 1 \('Spleen'\) names 'spleen', which the case does not have/);
-        const lesson = await app.call("lesson");
-        assert.deepEqual(lesson.steps.map((s) => s.title), ["All four", "From above, cut"]);
-        assert.deepEqual(Object.keys(lesson.steps[1].opacity), ["liver"]);
-        assert.equal(Math.fround(lesson.steps[1].opacity.liver), Math.fround(0.4));
-        assert.equal(lesson.steps[1].clip.axis, "axial");
-        lesson.labels = [{ structure: "tumor", point: [45.12, 38.06, 38.75], text: "Tumour" }];
-        lesson.quiz = { structures: [], modes: ["find-it"], pass_mark: 0.5 };
-        await app.call("setLesson", lesson);
-        authored = await app.call("lesson");
-        exported = Buffer.from(await app.call("exportCase", "glb"));
-    });
-    await withApp(async (app) => {
-        const s = await app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null, "the case in the viewer");
-        assert.equal(s.tour.steps, 2);
-        await app.call("showStep", 1);
-        const at = await app.stateWhen((s) => s.tour.step === 1 && s.view.clip?.axis === "axial", "the second step");
-        assert.equal(at.structures.structures[0].opacity.toFixed(3), "0.400");
-    }, { query: "?mode=viewer&case=cases/authored.glb", routes: { "cases/authored.glb": exported } });
-    await withApp(async (app) => {
-        await app.loadMesh(exported, "authored.glb", "loadCase");
-        assert.deepEqual(await app.call("lesson"), authored, "reopened in the page, the same lesson");
-    });
 });

@@ -13,7 +13,10 @@
 //!   hidden, renamed, selected or smoothed anew) and its results are computed; `step`
 //!   (`{step, steps, title, caption, statement}`) when a tour step is shown, `statement` the
 //!   xAPI statement a learning record store keeps (verb "experienced", the step as the object;
-//!   the actor is the platform's to add).
+//!   the actor is the platform's to add); `quizAnswered` (`{structure, mode, given, right, ms,
+//!   statement}`, verb "answered", the question a `cmi.interaction` with its right response)
+//!   on each answer; `quizFinished` (`{right, questions, score, passed, statement}`, verb
+//!   "passed" or "failed", the scaled score) after the last question.
 
 use js_sys::{Array, Function, Object, Promise, Reflect};
 use wasm_bindgen::closure::Closure;
@@ -70,6 +73,9 @@ impl Embedding {
 
     /// Tells the parent what changed since the last frame: files opened, or the case edited.
     pub fn after_frame(&mut self, doc: &mut Document) {
+        for (event, detail) in std::mem::take(&mut doc.lesson_events) {
+            self.post_event(event, &detail);
+        }
         if doc.tour != self.heard_step {
             self.heard_step = doc.tour;
             if let Some(step) = doc.tour {

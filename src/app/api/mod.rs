@@ -98,9 +98,16 @@
 //! - `showStep(index)`: shows the case's tour step (from 0: its structures, clip, slide and
 //!   selection at once, the camera flying to its view); `leaveTour()` leaves the tour, the view
 //!   staying; `state().tour` is `{step, steps, title, caption}` (`step` null outside the
-//!   tour), or null when the case has no tour; `state().layout.tour` where its buttons and
-//!   the labels' switch are; `state().view.labels` the labels drawn (`[{text, x, y}]`, their
-//!   points on the page)
+//!   tour), or null when the case has no tour; `state().layout.lesson` where its buttons, the
+//!   quiz's and the labels' switch are; `state().view.labels` the labels drawn (`[{text, x,
+//!   y}]`, their points on the page)
+//! - `startQuiz()` starts the case's quiz (again; the tour left, the structures it asks shown):
+//!   "Find it" questions are answered by clicking the structure in the view, "Name it" ones
+//!   by one of the offered names; `nextQuestion()` moves on once the question is answered;
+//!   `endQuiz()` ends it. `state().quiz` is null without a quiz in the case, else `{running,
+//!   modes, pass_mark}` and, while it runs, `{question, questions, mode, asked, choices,
+//!   answer: {given, right} | null, right, answered, finished, score, passed}` (`question`
+//!   null once finished)
 //! - `lesson()`, `setLesson(lesson)` and `recordStep({title, caption})` (the authoring page):
 //!   the case's lesson as `case build --lesson` reads it; setting one checks it against the
 //!   case; recording adds the view as it stands as the tour's last step
@@ -244,7 +251,7 @@ fn setter(
 }
 
 /// The calls the viewer offers: those that read a case and change only how it is shown.
-const READING_CALLS: [&str; 12] = [
+const READING_CALLS: [&str; 15] = [
     "loadCase",
     "screenshot",
     "structures",
@@ -254,6 +261,9 @@ const READING_CALLS: [&str; 12] = [
     "setView",
     "showStep",
     "leaveTour",
+    "startQuiz",
+    "nextQuestion",
+    "endQuiz",
     "setShortcuts",
     "backend",
     "state",

@@ -1,6 +1,7 @@
 //! The API's calls on the view: `setView` (its standard sides, clipping plane and slide towards
 //! the segmentation, as its tools set them), `screenshot` (a PNG of it), `showStep` and
-//! `leaveTour` (the case's tour), and the author's `lesson`, `setLesson` and `recordStep`.
+//! `leaveTour` (the case's tour), `startQuiz`, `nextQuestion` and `endQuiz` (its quiz), and the
+//! author's `lesson`, `setLesson` and `recordStep`.
 
 use eframe::egui;
 use js_sys::{Function, Promise, Uint8Array};
@@ -98,7 +99,33 @@ pub(super) fn define_tour(
             crate::app::wake(&c);
         }),
     )?;
+    define_quiz(api, doc, ctx)?;
     define_lesson(api, doc, ctx)
+}
+
+/// `startQuiz()`, `nextQuestion()` (the question asked being answered) and `endQuiz()`.
+fn define_quiz(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result<(), String> {
+    type Call = fn(&mut Document) -> Result<(), String>;
+    let calls: [(&str, Call); 3] = [
+        ("startQuiz", Document::start_quiz),
+        ("nextQuestion", Document::next_question),
+        ("endQuiz", |d| {
+            d.end_quiz();
+            Ok(())
+        }),
+    ];
+    for (name, call) in calls {
+        let (d, c) = (doc.clone(), ctx.clone());
+        api.define(
+            name,
+            Closure::<dyn FnMut() -> Result<(), JsValue>>::new(move || {
+                let done = call(&mut d.borrow_mut());
+                crate::app::wake(&c);
+                done.map_err(|e| error(&format!("{name}: {e}")))
+            }),
+        )?;
+    }
+    Ok(())
 }
 
 /// `lesson()`, `setLesson(lesson)` and `recordStep({title, caption})`: the author's lesson.

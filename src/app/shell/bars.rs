@@ -66,7 +66,8 @@ impl Shell {
     pub(super) fn status_bar(&self, ui: &mut egui::Ui) {
         let doc = self.doc.borrow();
         ui.horizontal(|ui| {
-            if let Some(model) = doc.case().model() {
+            // A quiz names no structure but in its questions.
+            if let Some(model) = doc.case().model().filter(|_| doc.quiz.is_none()) {
                 ui.label(format!(
                     "{}: {} vertices, {} faces",
                     model.name, model.report.vertices, model.report.faces

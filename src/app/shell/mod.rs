@@ -29,6 +29,7 @@ use std::rc::Rc;
 
 mod bars;
 mod first_paint;
+mod quiz;
 mod reading;
 mod sharing;
 mod start;
@@ -471,6 +472,7 @@ impl eframe::App for Shell {
             if let Some(embedding) = &mut self.embedding {
                 embedding.after_frame(&mut doc);
             }
+            doc.lesson_events.clear();
             self.case_text.update(doc.session());
             self.repainting = doc.working();
             if self.repainting && doc.working_elsewhere() {

@@ -53,7 +53,11 @@ impl Shell {
             // Filling the panel: under the view it would otherwise shrink to its first lines.
             let scroll = egui::ScrollArea::vertical().auto_shrink([false, false]);
             scroll.show(ui, |ui| {
+                if self.quiz_panel(ui) {
+                    return;
+                }
                 self.tour_panel(ui);
+                self.quiz_start(ui);
                 let mut guard = self.doc.borrow_mut();
                 let doc = &mut *guard;
                 let was = self.coloring == Some(ColorField::LocalError);

@@ -52,11 +52,11 @@ impl Shell {
     /// them.
     pub(super) fn tour_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
-        doc.panel.tour.clear();
+        doc.panel.lesson.clear();
         if !doc.case().lesson().labels.is_empty() {
             let mut shown = !doc.view_asks.hide_labels;
             let toggle = ui.checkbox(&mut shown, "Labels");
-            doc.panel.tour.push(("labels", toggle.rect.into()));
+            doc.panel.lesson.push(("labels", toggle.rect.into()));
             doc.view_asks.hide_labels = !shown;
         }
         let steps = &doc.case().lesson().steps;
@@ -66,7 +66,7 @@ impl Shell {
         let count = steps.len();
         let Some(index) = doc.tour else {
             let start = ui.button(format!("▶ Take the tour ({count} steps)"));
-            doc.panel.tour.push(("start", start.rect.into()));
+            doc.panel.lesson.push(("start", start.rect.into()));
             if start.clicked() {
                 let _ = doc.ask_step(0);
             }
@@ -93,7 +93,7 @@ impl Shell {
                 ("leave", out.rect),
             ];
         });
-        (doc.panel.tour).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
+        (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
         if let Some(i) = asked {
             let _ = doc.ask_step(i);
         }

@@ -49,7 +49,8 @@ impl Shell {
                 doc.pointed = self.pointing.named.as_ref().map(|(_, name)| name.clone());
                 let asked = doc.view_asks;
                 orientation_marker::paint(ui, response.rect, viewer.camera());
-                let labels = match doc.view_asks.hide_labels || self.picture.pending {
+                let quiet = doc.view_asks.hide_labels || doc.quiz.is_some();
+                let labels = match quiet || self.picture.pending {
                     true => Vec::new(),
                     false => labels::paint(ui, response.rect, viewer, doc),
                 };
@@ -98,6 +99,7 @@ impl Shell {
 }
 
 /// Names the structure under the pointer; in the viewer (`reading`) a click selects it.
+/// While a quiz runs nothing is named, and a click answers "Find it".
 fn point(
     pointing: &mut Pointing,
     reading: bool,
@@ -106,7 +108,17 @@ fn point(
     at: (&crate::view::OrbitCamera, [f32; 4]),
     doc: &mut Document,
 ) {
-    let clicked = pointing.update(ui, response, at, doc.session());
+    let quiz = doc.quiz.is_some();
+    let clicked = pointing.update(ui, response, at, doc.session(), quiz);
+    if quiz {
+        if let Some(i) = clicked.filter(|_| doc.quiz_wants_click()) {
+            if let Err(e) = doc.answer_quiz(i) {
+                log::warn!("{e}");
+            }
+            ui.ctx().request_repaint();
+        }
+        return;
+    }
     let current = doc.case().current_structure();
     if let (true, Some(i)) = (reading, clicked.filter(|&i| Some(i) != current)) {
         if let Err(e) = doc.select_structure(i) {

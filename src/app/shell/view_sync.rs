@@ -36,7 +36,7 @@ pub(super) struct Shown {
     pub(super) legend: Option<Legend>,
     /// The version of the structures' looks and the slide towards the segmentation the other
     /// structures were uploaded for.
-    pub(super) looks: Option<(u64, u32)>,
+    pub(super) looks: Option<(u64, u32, Option<usize>)>,
     /// The checks' marks and the looks' version they were uploaded for.
     pub(super) marks: (Option<u64>, u64),
 }
@@ -88,9 +88,10 @@ impl Shell {
             shown.legend = computed.map(|(_, l)| l);
             shown.colors = colors;
         }
-        let looks = (session.case().case_version(), toward.to_bits());
+        let highlight = doc.quiz_highlight();
+        let looks = (session.case().case_version(), toward.to_bits(), highlight);
         if shown.looks != Some(looks) {
-            upload_looks(viewer, rs, session, toward);
+            upload_looks(viewer, rs, session, (toward, highlight));
             shown.looks = Some(looks);
         }
         let marks = (
@@ -223,9 +224,23 @@ fn upload_positions(
     true
 }
 
+/// How much of its opacity a structure keeps while another is singled out.
+const FADED: f32 = 0.15;
+
 /// The case's other structures with their looks (drawn back towards the segmentation by
-/// `toward`), and the model's look.
-fn upload_looks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session, toward: f32) {
+/// `toward`; all but `highlight`, where one is singled out, faded), and the model's look.
+fn upload_looks(
+    viewer: &mut viewer::Viewer,
+    rs: &RenderState,
+    session: &Session,
+    (toward, highlight): (f32, Option<usize>),
+) {
+    let look = |index: usize, mut color: [f32; 4]| {
+        if highlight.is_some_and(|h| h != index) {
+            color[3] *= FADED;
+        }
+        color
+    };
     let others = session.case().other_structures();
     let list = session.case().case_structures();
     let moved: Vec<Option<Vec<[f32; 3]>>> = (others.iter())
@@ -240,17 +255,18 @@ fn upload_looks(viewer: &mut viewer::Viewer, rs: &RenderState, session: &Session
         .map(|(o, moved)| viewer::ContextSurface {
             positions: moved.as_deref().unwrap_or(o.positions),
             triangles: o.triangles,
-            color: o.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
+            color: look(o.index, o.color).map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
             closed: o.closed,
         })
         .collect();
     viewer.set_context(rs, &surfaces);
     viewer.set_image(rs, session.case().case_image());
-    let look = session.case().model_structure();
+    let model = session.case().model_structure();
+    let current = session.case().current_structure().unwrap_or_default();
     viewer.set_model_look(
-        look.map(|l| l.color),
-        look.is_none_or(|l| l.visible),
-        look.is_some_and(|l| l.closed_outward()),
+        model.map(|l| look(current, l.color)),
+        model.is_none_or(|l| l.visible),
+        model.is_some_and(|l| l.closed_outward()),
     );
 }
 

@@ -1,6 +1,7 @@
 // Talks to a meshsmooth page (the authoring page or the viewer) in an iframe, by its
 // postMessage protocol: `call(name, ...args)` runs `window.meshsmooth[name]` there and resolves
-// with its value; `on(event, listener)` hears `ready`, `loaded`, `failed`, `changed` and `step`.
+// with its value; `on(event, listener)` hears `ready`, `loaded`, `failed`, `changed`, `step`,
+// `quizAnswered` and `quizFinished`.
 // Messages from anywhere but that iframe's window at `origin` are ignored.
 //
 // The page must be opened with `?parent=<this page's origin>`; `open(path)` does that.

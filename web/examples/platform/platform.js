@@ -56,9 +56,18 @@ viewer.on("loaded", (c) => {
 
 // What the student did, as xAPI statements a learning record store keeps (with the actor,
 // which only the platform knows).
+const record = (statement) => window.platform.statements.push({ actor: { name: "the signed-in student" }, ...statement });
 viewer.on("step", (s) => {
     log(`student at step ${s.step + 1} of ${s.steps}: ${s.title}`);
-    window.platform.statements.push({ actor: { name: "the signed-in student" }, ...s.statement });
+    record(s.statement);
+});
+viewer.on("quizAnswered", (a) => {
+    log(`student answered ${a.mode} on ${a.structure}: ${a.right ? "right" : `wrong (${a.given})`} in ${(a.ms / 1000).toFixed(1)} s`);
+    record(a.statement);
+});
+viewer.on("quizFinished", (f) => {
+    log(`student finished the quiz: ${f.right} of ${f.questions}, ${f.passed ? "passed" : "not passed"}`);
+    record(f.statement);
 });
 
 $("segmentation").addEventListener("change", async (event) => {

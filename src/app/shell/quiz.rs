@@ -1,0 +1,158 @@
+//! The viewer's quiz panel: the question asked ("Find it": a name to click in the view; "Name
+//! it": a highlighted structure and four names to pick from), right or wrong at once, and the
+//! score at the end. It takes the place of the structure list, whose names would give the
+//! answers away.
+
+use eframe::egui;
+
+use super::Shell;
+use crate::app::document::Document;
+use crate::case::QuizMode;
+
+const RIGHT: egui::Color32 = egui::Color32::from_rgb(110, 200, 120);
+const WRONG: egui::Color32 = egui::Color32::from_rgb(235, 110, 100);
+
+impl Shell {
+    /// The quiz's start button, where the case has a quiz and none runs.
+    pub(super) fn quiz_start(&mut self, ui: &mut egui::Ui) {
+        let mut doc = self.doc.borrow_mut();
+        if doc.case().lesson().quiz.is_none() || doc.quiz.is_some() {
+            return;
+        }
+        let start = ui.button("Take the quiz");
+        doc.panel.lesson.push(("quiz", start.rect.into()));
+        if start.clicked() {
+            ui.ctx().request_repaint();
+            if let Err(e) = doc.start_quiz() {
+                log::warn!("{e}");
+            }
+        }
+        ui.separator();
+    }
+
+    /// The running quiz; whether one runs (the panel then shows nothing else).
+    pub(super) fn quiz_panel(&mut self, ui: &mut egui::Ui) -> bool {
+        let mut doc = self.doc.borrow_mut();
+        doc.panel.lesson.clear();
+        if doc.quiz.is_none() {
+            return false;
+        }
+        // The structure list is not drawn while the quiz runs.
+        doc.panel.structures.clear();
+        doc.panel.structure_filter = None;
+        let Some(run) = &doc.quiz else {
+            return false;
+        };
+        let mut drawn: Vec<(&'static str, egui::Rect)> = Vec::new();
+        let mut act = Act::None;
+        let names: Vec<String> = (doc.case().structure_names().into_iter())
+            .map(str::to_string)
+            .collect();
+        let name = |i: usize| names.get(i).map_or("?", String::as_str);
+        let total = run.questions().len();
+        match run.current() {
+            Some((i, question)) => {
+                ui.strong(format!("Quiz: question {} of {total}", i + 1));
+                let asked = name(question.structure);
+                match question.mode {
+                    QuizMode::FindIt => {
+                        ui.label(format!("Find it: click the {asked} in the view."))
+                    }
+                    QuizMode::NameIt => ui.label("Name it: which structure is highlighted?"),
+                };
+                if question.mode == QuizMode::NameIt {
+                    const KEYS: [&str; 4] = ["choice-0", "choice-1", "choice-2", "choice-3"];
+                    let open = run.answered().is_none();
+                    for (k, &c) in question.choices.iter().enumerate() {
+                        let button = ui.add_enabled(open, egui::Button::new(name(c)));
+                        drawn.push((KEYS[k.min(3)], button.rect));
+                        if button.clicked() {
+                            act = Act::Answer(c);
+                        }
+                    }
+                }
+                if let Some(answer) = run.answered() {
+                    let (text, colour) = match answer.right {
+                        true => (format!("✔ Right: the {asked}."), RIGHT),
+                        false => (
+                            format!(
+                                "✘ No, that is the {}. The {asked} is highlighted.",
+                                name(answer.given)
+                            ),
+                            WRONG,
+                        ),
+                    };
+                    ui.colored_label(colour, text);
+                    let last = i + 1 == total;
+                    let next = ui.button(if last {
+                        "See the score"
+                    } else {
+                        "Next question ▶"
+                    });
+                    drawn.push(("next-question", next.rect));
+                    if next.clicked() {
+                        act = Act::Next;
+                    }
+                }
+            }
+            None => {
+                let (right, _) = run.score();
+                ui.strong("Quiz finished");
+                let percent = (100.0 * run.scaled()).round();
+                ui.label(format!("{right} of {total} right ({percent}%)."));
+                let mark = (100.0 * run.quiz().pass_mark).round();
+                match run.passed() {
+                    true => ui.colored_label(RIGHT, format!("Passed (the pass mark is {mark}%).")),
+                    false => ui.colored_label(
+                        WRONG,
+                        format!("Not passed yet (the pass mark is {mark}%)."),
+                    ),
+                };
+                let again = ui.button("Try again");
+                drawn.push(("again", again.rect));
+                if again.clicked() {
+                    act = Act::Again;
+                }
+            }
+        }
+        ui.separator();
+        let end = ui.button("End the quiz");
+        drawn.push(("end-quiz", end.rect));
+        if end.clicked() {
+            act = Act::End;
+        }
+        (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
+        // What changed is drawn at once, not at the next input.
+        if !matches!(act, Act::None) {
+            ui.ctx().request_repaint();
+        }
+        if let Err(e) = act.on(&mut doc) {
+            log::warn!("{e}");
+        }
+        true
+    }
+}
+
+/// What the student's click in the panel asks.
+enum Act {
+    None,
+    Answer(usize),
+    Next,
+    Again,
+    End,
+}
+
+impl Act {
+    fn on(self, doc: &mut Document) -> Result<(), String> {
+        match self {
+            Act::None => Ok(()),
+            Act::Answer(given) => doc.answer_quiz(given),
+            Act::Next => doc.next_question(),
+            Act::Again => doc.start_quiz(),
+            Act::End => {
+                doc.end_quiz();
+                Ok(())
+            }
+        }
+    }
+}

@@ -1,0 +1,221 @@
+// End-to-end tests of a case's lesson: the viewer plays its tour (steps, captions, the camera's
+// flight, labels) and its quiz ("Find it" by clicking in the view, "Name it" by picking a name,
+// the score); the authoring page records steps and sets the lesson, which the case glTF carries.
+//
+//   E2E_MODE=webgpu|cpu node --test tests/e2e/lesson.test.mjs   (tests/e2e/run.sh runs both)
+import assert from "node:assert/strict";
+import { existsSync, readFileSync } from "node:fs";
+import { join } from "node:path";
+
+import * as cli from "./lib/cli.mjs";
+import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
+import { EVERY_RUN, appSuite, testIn } from "./lib/suite.mjs";
+import { drag, frames } from "./lib/input.mjs";
+import { changedPixels, drawn } from "./lib/view.mjs";
+
+const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
+
+const PHANTOM_NRRD = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
+const TIMEOUT = 240_000;
+const lessonFile = join(ROOT, "tests/data/phantom_lesson.json");
+const lesson = JSON.parse(readFileSync(lessonFile, "utf8"));
+
+/** The phantom's case glTF with its lesson, built by the CLI once per run. */
+async function lessonCaseBytes() {
+    const file = join(E2E_OUT, MODE, "lesson-case.glb");
+    if (!existsSync(file)) {
+        await cli.cliJson("case", "build", PHANTOM_NRRD, "--search", "local", "--lesson", lessonFile, "-o", file, "--json");
+    }
+    return readFileSync(file);
+}
+
+const viewingTheLesson = async () => ({ query: "?mode=viewer&case=cases/lesson.glb", routes: { "cases/lesson.glb": await lessonCaseBytes() } });
+const phantomShown = (app) => app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.layout.structures.length === 4, "the phantom's four structures");
+
+testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, clip, caption and camera, by button and by call", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        const state = await phantomShown(app);
+        assert.deepEqual(state.tour, { step: null, steps: 3, title: null, caption: null });
+        const press = async (button) => {
+            const s = await app.stateWhen((s) => s.layout.lesson?.[button], `the tour's ${button} button`);
+            const r = s.layout.lesson[button];
+            await app.page.mouse.click(r.x + r.width / 2, r.y + r.height / 2);
+        };
+        // At a step: its title and caption, and the camera arrived at its view.
+        const atStep = (i) =>
+            app.stateWhen((s) => {
+                const c = s.view.camera;
+                const want = lesson.steps[i].camera;
+                const close = (a, b) => Math.abs(a - b) <= 1e-3 * Math.max(1, Math.abs(b));
+                return s.tour?.step === i && c && close(c.yaw, want.yaw) && close(c.pitch, want.pitch) && close(c.distance, want.distance) && c.target.every((x, k) => close(x, want.target[k]));
+            }, `step ${i + 1} shown, its camera arrived`);
+        const shown = (s) => s.structures.structures.map((x) => [x.name, x.visible, Number(x.opacity.toFixed(3))]);
+
+        await press("start");
+        let s = await atStep(0);
+        assert.equal(s.tour.title, lesson.steps[0].title);
+        assert.equal(s.tour.caption, lesson.steps[0].caption);
+        assert.deepEqual(shown(s), [["liver", true, 1], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", true, 1]]);
+        const inView = (l) => l.x > s.view.x && l.x < s.view.x + s.view.width && l.y > s.view.y && l.y < s.view.y + s.view.height;
+        assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver", "Tumour"], "both labels drawn");
+        assert.ok(s.view.labels.every(inView), `the labels' points lie in the view: ${JSON.stringify(s.view.labels)}`);
+        const first = drawn(await app.screenshot("L1-step-1"), s.view);
+        // The labels' switch takes them away and brings them back.
+        await press("labels");
+        await app.stateWhen((s) => s.view.labels.length === 0, "the labels off");
+        await press("labels");
+        await app.stateWhen((s) => s.view.labels.length === 2, "the labels on again");
+
+        await press("next");
+        s = await atStep(1);
+        assert.deepEqual(shown(s), [["liver", true, 0.3], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", false, 1]], "the kidney hidden, the liver see-through");
+        assert.equal(s.structures.current, 2, "the tumour selected");
+        assert.equal(s.view.clip, null);
+        const second = drawn(await app.screenshot("L1-step-2"), s.view);
+        assert.ok(second.count > 500 && first.count > 500, `both views draw the case: ${first.count}, ${second.count} pixels`);
+
+        // The platform's call, as its own buttons would make it.
+        await app.call("showStep", 2);
+        s = await atStep(2);
+        const clip = lesson.steps[2].clip;
+        assert.deepEqual({ ...s.view.clip, at: Math.fround(s.view.clip.at) }, { ...clip, at: Math.fround(clip.at) }, "the step's clip (f32)");
+        assert.equal(s.view.toward_segmentation, 0.25);
+        // The cut takes away the tumour's label (above it); the liver's lies below the plane.
+        s = await app.stateWhen((s) => s.view.labels.length === 1, "one label left by the cut");
+        assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver"]);
+        assert.deepEqual(shown(s).map((x) => x.slice(1)), [[true, 1], [true, 1], [true, 1], [true, 1]], "the step shows every structure again, opaque");
+        await app.screenshot("L1-step-3");
+
+        await press("back");
+        s = await atStep(1);
+        await press("leave");
+        s = await app.stateWhen((s) => s.tour.step === null, "the tour left");
+        assert.equal(Math.fround(s.view.camera.yaw), Math.fround(lesson.steps[1].camera.yaw), "the view stays where the tour left it");
+        const refused = await app.attempt("showStep", 3);
+        assert.equal(refused.ok, false);
+        assert.match(refused.message, /the case's tour has steps 0 to 2: no step 3/);
+
+        // The student's drag takes the camera from a flight under way: it stays where the hand
+        // left it, not at the step's view.
+        const want = lesson.steps[0].camera;
+        await app.call("showStep", 0);
+        s = await app.stateWhen((s) => s.tour.step === 0 && Math.abs(s.view.camera.yaw - want.yaw) > 0.05 && Math.abs(s.view.camera.yaw - lesson.steps[1].camera.yaw) > 0.01, "the camera on its way");
+        const centre = { x: s.view.x + s.view.width / 2, y: s.view.y + s.view.height / 2 };
+        await drag(app, "left", centre, { x: 120, y: 0 }, { steps: 3 });
+        await new Promise((r) => setTimeout(r, 1500));
+        s = await app.state();
+        assert.ok(Math.abs(s.view.camera.yaw - want.yaw) > 0.05, `the drag ended the flight: yaw ${s.view.camera.yaw}, the step's ${want.yaw}`);
+    }, await viewingTheLesson());
+});
+
+testIn(EVERY_RUN, "L2 the author records tour steps in the page; the case glTF carries them to the viewer and back", { timeout: TIMEOUT }, async () => {
+    let exported;
+    let authored;
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd", "loadCase");
+        await app.stateWhen((s) => s.loading === null && s.view.camera, "the case open and framed");
+        assert.equal(await app.call("recordStep", { title: "All four", caption: "The whole case." }), 1);
+        await app.call("setStructure", { index: 0, opacity: 0.4 });
+        await app.call("setView", { from: "S", clip: { axis: "axial", at: 0.5, flip: false } });
+        await app.stateWhen((s) => s.view.clip?.axis === "axial", "the clip set");
+        assert.equal(await app.call("recordStep", { title: "From above, cut" }), 2);
+        const refused = await app.attempt("setLesson", { labels: [{ structure: "spleen", point: [0, 0, 0], text: "Spleen" }] });
+        assert.match(refused.message, /setLesson: label 1 \('Spleen'\) names 'spleen', which the case does not have/);
+        const lesson = await app.call("lesson");
+        assert.deepEqual(lesson.steps.map((s) => s.title), ["All four", "From above, cut"]);
+        assert.deepEqual(Object.keys(lesson.steps[1].opacity), ["liver"]);
+        assert.equal(Math.fround(lesson.steps[1].opacity.liver), Math.fround(0.4));
+        assert.equal(lesson.steps[1].clip.axis, "axial");
+        lesson.labels = [{ structure: "tumor", point: [45.12, 38.06, 38.75], text: "Tumour" }];
+        lesson.quiz = { structures: [], modes: ["find-it"], pass_mark: 0.5 };
+        await app.call("setLesson", lesson);
+        authored = await app.call("lesson");
+        exported = Buffer.from(await app.call("exportCase", "glb"));
+    });
+    await withApp(async (app) => {
+        const s = await app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null, "the case in the viewer");
+        assert.equal(s.tour.steps, 2);
+        await app.call("showStep", 1);
+        const at = await app.stateWhen((s) => s.tour.step === 1 && s.view.clip?.axis === "axial", "the second step");
+        assert.equal(at.structures.structures[0].opacity.toFixed(3), "0.400");
+    }, { query: "?mode=viewer&case=cases/authored.glb", routes: { "cases/authored.glb": exported } });
+    await withApp(async (app) => {
+        await app.loadMesh(exported, "authored.glb", "loadCase");
+        assert.deepEqual(await app.call("lesson"), authored, "reopened in the page, the same lesson");
+    });
+});
+
+testIn(EVERY_RUN, "L3 the student takes the case's quiz: find it by clicking, name it by picking, right and wrong at once, the score", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        let s = await phantomShown(app);
+        assert.deepEqual(s.quiz, { running: false, modes: ["find-it", "name-it"], pass_mark: 0.5 });
+        // The liver under the pointer where its label points, before the quiz hides the labels.
+        const liver = s.view.labels.find((l) => l.text === "Liver");
+        await app.page.mouse.move(liver.x, liver.y);
+        await app.stateWhen((s) => s.view.pointed === "liver", "the liver under its label's point");
+        const before = await app.screenshot("L3-before-the-quiz");
+        const press = async (key) => {
+            const state = await app.stateWhen((s) => s.layout.lesson?.[key], `the quiz's ${key} button`);
+            const r = state.layout.lesson[key];
+            await app.page.mouse.click(r.x + r.width / 2, r.y + r.height / 2);
+        };
+
+        await press("quiz");
+        // The names' list gives way to the quiz, and the labels go.
+        s = await app.stateWhen((s) => s.quiz.running && s.quiz.question === 0 && s.layout.structures.length === 0 && s.view.labels.length === 0, "the quiz started, no names shown");
+        assert.equal(s.quiz.questions, 8, "four structures, two modes");
+        let rightFound = 0;
+        let rightNamed = 0;
+        let highlighted = null;
+        for (let q = 0; q < 8; q++) {
+            // Drawn: the panel shows this question, not the last one's answer.
+            s = await app.stateWhen((s) => s.quiz.question === q && !s.layout.lesson["next-question"], `question ${q + 1}`);
+            const { mode, asked, choices } = s.quiz;
+            assert.equal(mode, q < 4 ? "find-it" : "name-it", "the author's modes in order");
+            let expectRight;
+            if (mode === "find-it") {
+                assert.deepEqual(choices, []);
+                // Always the liver: right once, wrong for the other three.
+                await app.page.mouse.click(liver.x, liver.y);
+                expectRight = asked === "liver";
+                rightFound += expectRight;
+            } else {
+                assert.equal(choices.length, 4);
+                assert.ok(choices.includes(asked), `${asked} among ${choices}`);
+                if (highlighted === null) {
+                    await frames(app);
+                    highlighted = await app.screenshot("L3-name-it-highlighted");
+                }
+                // Right the first time, wrong after.
+                const pick = rightNamed === 0 ? choices.indexOf(asked) : choices.findIndex((c) => c !== asked);
+                await press(`choice-${pick}`);
+                expectRight = choices[pick] === asked;
+                rightNamed += expectRight;
+            }
+            s = await app.stateWhen((s) => s.quiz.answer !== null, `question ${q + 1} answered`);
+            assert.equal(s.quiz.answer.right, expectRight, `${mode} ${asked}: ${JSON.stringify(s.quiz.answer)}`);
+            if (mode === "find-it") assert.equal(s.quiz.answer.given, "liver");
+            if (q === 0) await app.screenshot("L3-answered");
+            await press("next-question");
+        }
+        assert.equal(rightFound, 1, "the liver found once");
+        assert.equal(rightNamed, 1, "one name right");
+        s = await app.stateWhen((s) => s.quiz.finished, "the quiz finished");
+        assert.equal(s.quiz.question, null);
+        assert.equal(s.quiz.right, 2);
+        assert.equal(s.quiz.answered, 8);
+        assert.equal(s.quiz.score, 0.25);
+        assert.equal(s.quiz.passed, false, "2 of 8 is below the pass mark of one half");
+        await app.screenshot("L3-score");
+        const view = s.view;
+        assert.ok(changedPixels(highlighted, before, view) > 2000, "Name it singles out its structure (the others faded)");
+
+        await press("again");
+        s = await app.stateWhen((s) => s.quiz.running && s.quiz.question === 0 && s.quiz.answered === 0, "the quiz again");
+        await press("end-quiz");
+        s = await app.stateWhen((s) => !s.quiz.running && s.layout.structures.length === 4, "the quiz ended, the list back");
+        assert.equal(s.view.labels.length, 2, "the labels back");
+        const refused = await app.attempt("nextQuestion");
+        assert.match(refused.message, /nextQuestion: no quiz is running/);
+    }, await viewingTheLesson());
+});
