@@ -129,6 +129,58 @@ fn fs_surface_cut(f: SurfaceFragment, @builtin(front_facing) front: bool) -> Cut
     return out;
 }
 
+// A closed surface cut open by the clipping plane, drawn solid, as an anatomy atlas shows a
+// cut: its front faces lit as ever, and its inside, which shows only through the cut, drawn
+// where the eye's ray crosses the plane (its depth there), in the structure's colour lit as a
+// face turned to the removed side. What lies inside the structure behind the plane stays hidden.
+const CAP_TOWARD_INSIDE: f32 = 0.01;
+
+@fragment
+fn fs_surface_capped(f: SurfaceFragment, @builtin(front_facing) front: bool) -> CutOutput {
+    if dot(view.clip.xyz, f.world) > view.clip.w {
+        discard;
+    }
+    var out: CutOutput;
+    if front {
+        out.depth = f.clip.z;
+        out.color = shade(f, true);
+        return out;
+    }
+    let eye = view.eye.xyz;
+    let from_eye = f.world - eye;
+    let across = dot(view.clip.xyz, from_eye);
+    // Along the ray from the eye to this inside point, where it meets the plane.
+    var t = 1.0;
+    if abs(across) > 1e-12 {
+        t = clamp((view.clip.w - dot(view.clip.xyz, eye)) / across, 0.0, 1.0);
+    }
+    var cap = f;
+    cap.world = eye + t * from_eye;
+    cap.normal = view.clip.xyz;
+    let at = view.view_proj * vec4<f32>(cap.world, 1.0);
+    // Nested structures cut together cap at the same plane: the inner one, whose inside lies
+    // nearer, must win, so each cap lies a little towards its own inside.
+    out.depth = mix(at.z / at.w, f.clip.z, CAP_TOWARD_INSIDE);
+    out.color = shade(cap, true);
+    return out;
+}
+
+// A translucent surface: where the clipping plane cuts it, its cut outline in its own colour,
+// opaque, so that the cut reads through it (a translucent structure gets no cap).
+@fragment
+fn fs_translucent(f: SurfaceFragment, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let past = dot(view.clip.xyz, f.world) - view.clip.w;
+    let band = CUT_LINE_PIXELS * fwidth(past);
+    if past > 0.0 {
+        discard;
+    }
+    let cutting = any(view.clip.xyz != vec3<f32>(0.0));
+    if cutting && -past <= band {
+        return encode(f.albedo, 1.0);
+    }
+    return shade(f, front);
+}
+
 fn shade(f: SurfaceFragment, front: bool) -> vec4<f32> {
     let to_eye = normalize(view.eye.xyz - f.world);
     // Vertices without area have a zero normal: light them as if facing the eye.

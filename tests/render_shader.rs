@@ -4,10 +4,12 @@
 
 use meshsmooth::view::{SliceUniforms, ViewUniforms, RENDER_SHADER};
 
-const ENTRY_POINTS: [(&str, naga::ShaderStage); 9] = [
+const ENTRY_POINTS: [(&str, naga::ShaderStage); 11] = [
     ("vs_surface", naga::ShaderStage::Vertex),
     ("fs_surface", naga::ShaderStage::Fragment),
     ("fs_surface_cut", naga::ShaderStage::Fragment),
+    ("fs_surface_capped", naga::ShaderStage::Fragment),
+    ("fs_translucent", naga::ShaderStage::Fragment),
     ("vs_slice", naga::ShaderStage::Vertex),
     ("fs_slice", naga::ShaderStage::Fragment),
     ("vs_wire", naga::ShaderStage::Vertex),

@@ -11,7 +11,7 @@ import { join } from "node:path";
 import * as cli from "./lib/cli.mjs";
 import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
 import { colourAt, decodePng } from "./lib/png.mjs";
-import { changedPixels, drawn } from "./lib/view.mjs";
+import { changedPixels, drawn, roughnessAcross } from "./lib/view.mjs";
 import { EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
@@ -411,4 +411,26 @@ testIn(EVERY_RUN, "V6 a glTF meshsmooth did not smooth is shown as the file hold
         const shot = await app.screenshot("V6-as-read");
         assert.ok(drawn(shot, later.view).count > 2000, "the surface is drawn");
     }, { query: "?mode=viewer&case=cases/converted.glb", routes: { "cases/converted.glb": bytes } });
+});
+
+testIn(EVERY_RUN, "V7 a cut shows each closed structure solid, its cut face filled in its colour; a translucent one shows its outline", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        let s = await phantomShown(app);
+        const view = s.view;
+        const cut = { from: "S", clip: { axis: "axial", at: 0.6, flip: false } };
+        await app.call("setView", cut);
+        await app.stateWhen((s) => s.view.clip?.axis === "axial", "the axial cut");
+        const face = (image) => roughnessAcross(image, view);
+        const flat = (i) => face(i).pairs > 3000 && face(i).step < 4;
+        const solid = face(await app.screenshotWhen("V7-axial-cut-solid", flat, "the liver's cut face, flat"));
+        assert.equal(solid.holes, 0, "no background inside the cut's outline");
+        // The same cut through a liver barely translucent: hollow, its inside's relief shows.
+        await app.call("setStructure", { index: 0, opacity: 0.97 });
+        const hollow = face(await app.screenshotWhen("V7-axial-cut-translucent", (i) => face(i).step > 2 * solid.step, "the liver hollow"));
+        console.log(`viewer ${MODE}: colour steps across the cut face: solid ${solid.step.toFixed(2)}, hollow ${hollow.step.toFixed(2)}`);
+        await app.call("setStructure", { index: 0, opacity: 1 });
+        await app.call("setView", { from: "R", clip: { axis: "sagittal", at: 0.5, flip: false } });
+        const side = face(await app.screenshotWhen("V7-sagittal-cut-solid", (i) => face(i).pairs > 3000 && face(i).step < 4, "the sagittal cut face, flat"));
+        assert.equal(side.holes, 0, "no background inside the sagittal cut");
+    }, await viewingThePhantom());
 });

@@ -104,16 +104,14 @@ impl ViewResources {
         // A translucent model is drawn with the translucent structures, first.
         let model_translucent = frame.uniforms.base_color[3] < 1.0;
         // A closed surface's back faces lie behind its front ones, unless a plane cuts it open:
-        // not drawing them spares the rasteriser about half its work.
+        // not drawing them spares the rasteriser about half its work; cut open, it is drawn
+        // solid. Over the image's slice, the slice shows what the cut holds.
         let cut = frame.uniforms.clip[..3].iter().any(|&n| n != 0.0);
-        let opaque = |closed: bool| {
-            if frame.outlined {
-                &self.pipelines.surface_cut
-            } else if closed && !cut {
-                &self.pipelines.front_faces
-            } else {
-                &self.pipelines.surface
-            }
+        let opaque = |closed: bool| match (frame.outlined, closed, cut) {
+            (true, _, _) => &self.pipelines.surface_cut,
+            (false, true, false) => &self.pipelines.front_faces,
+            (false, true, true) => &self.pipelines.capped,
+            (false, false, _) => &self.pipelines.surface,
         };
         pass.set_bind_group(0, &self.view_group, &[]);
         if let Some(resources) = &self.slice {
@@ -185,7 +183,13 @@ impl ViewResources {
             let mut pass = view_pass(&mut encoder, &target);
             pass.set_bind_group(0, &self.view_group, &[]);
             // Not the slice's pipelines: only a case with an image uses them.
-            for pipeline in [&p.surface, &p.front_faces, &p.translucent, &p.over] {
+            for pipeline in [
+                &p.surface,
+                &p.front_faces,
+                &p.capped,
+                &p.translucent,
+                &p.over,
+            ] {
                 pass.set_pipeline(pipeline);
                 draw_surface(&mut pass, &mesh);
             }

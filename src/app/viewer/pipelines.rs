@@ -43,6 +43,8 @@ pub struct Pipelines {
     pub over: wgpu::RenderPipeline,
     /// Two-sided surfaces over the image's slice: their cut outline drawn on it.
     pub surface_cut: wgpu::RenderPipeline,
+    /// Closed surfaces cut open by the clipping plane, drawn solid (their cut face filled).
+    pub capped: wgpu::RenderPipeline,
     /// The image's slice on the clipping plane; opaque, writes depth.
     pub slice: wgpu::RenderPipeline,
     /// Edges as a line list over the same positions; tests depth, writes none.
@@ -110,7 +112,13 @@ impl Pipelines {
             // Two-sided: open meshes show their inside.
             surface: build.surface("meshsmooth surface", None, true, less, None),
             front_faces: build.surface("meshsmooth front faces", back, true, less, None),
-            translucent: build.surface("meshsmooth translucent surface", None, false, less, blend),
+            translucent: build.triangles(
+                "meshsmooth translucent surface",
+                None,
+                Builder::depth(false, less),
+                blend,
+                "fs_translucent",
+            ),
             over: build.surface(
                 "meshsmooth surface over all",
                 None,
@@ -118,7 +126,9 @@ impl Pipelines {
                 wgpu::CompareFunction::Always,
                 blend,
             ),
-            surface_cut: build.surface_cut(),
+            surface_cut: build
+                .two_sided_with_depth("meshsmooth surface over a slice", "fs_surface_cut"),
+            capped: build.two_sided_with_depth("meshsmooth capped surface", "fs_surface_capped"),
             slice: build.slice(),
             wire: build.wire(),
             composite: build.composite(egui_depth_format),
@@ -252,16 +262,11 @@ impl<'a> Builder<'a> {
         )
     }
 
-    /// Two-sided, depth written: the surfaces beside the image's slice, outlined where cut.
-    fn surface_cut(&self) -> wgpu::RenderPipeline {
+    /// Two-sided, opaque, depth written by `fragment` (a cut's outline or cap lies off the
+    /// triangles' own depth).
+    fn two_sided_with_depth(&self, label: &str, fragment: &str) -> wgpu::RenderPipeline {
         let depth = Self::depth(true, wgpu::CompareFunction::Less);
-        self.triangles(
-            "meshsmooth surface over a slice",
-            None,
-            depth,
-            None,
-            "fs_surface_cut",
-        )
+        self.triangles(label, None, depth, None, fragment)
     }
 
     fn triangles(

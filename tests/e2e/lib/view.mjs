@@ -41,3 +41,37 @@ export function changedPixels(a, b, view) {
     }
     return count;
 }
+
+/**
+ * Across the rows within `rows` pixels of the view's centre: the mean colour step between
+ * neighbouring surface pixels (sum over red, green and blue; a flat face has almost none,
+ * relief and rings have more), and the background pixels lying between a row's first and last
+ * surface pixel (holes in what is drawn).
+ */
+export function roughnessAcross(image, view, rows = 20) {
+    const at = (x, y) => {
+        const i = (y * image.width + x) * 4;
+        return [image.rgba[i], image.rgba[i + 1], image.rgba[i + 2]];
+    };
+    const background = at(Math.round(view.x + view.width - 4), Math.round(view.y + 4));
+    const surface = (c) => c.some((v, k) => Math.abs(v - background[k]) > 24);
+    const centre = Math.round(view.y + view.height / 2);
+    let steps = 0;
+    let pairs = 0;
+    let holes = 0;
+    for (let y = centre - rows; y <= centre + rows; y++) {
+        const row = [];
+        for (let x = Math.round(view.x); x < Math.round(view.x + view.width); x++) row.push(at(x, y));
+        const first = row.findIndex(surface);
+        const last = row.findLastIndex(surface);
+        for (let x = first; first >= 0 && x < last; x++) {
+            const [a, b] = [row[x], row[x + 1]];
+            if (!surface(a)) holes++;
+            if (surface(a) && surface(b)) {
+                steps += a.reduce((sum, v, k) => sum + Math.abs(v - b[k]), 0);
+                pairs++;
+            }
+        }
+    }
+    return { step: pairs ? steps / pairs : NaN, pairs, holes };
+}
