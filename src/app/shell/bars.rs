@@ -66,8 +66,11 @@ impl Shell {
     pub(super) fn status_bar(&self, ui: &mut egui::Ui) {
         let doc = self.doc.borrow();
         ui.horizontal(|ui| {
-            // A quiz names no structure but in its questions.
-            if let Some(model) = doc.case().model().filter(|_| doc.quiz.is_none()) {
+            // A quiz names no structure but in its questions; a phone has room for the
+            // privacy note alone.
+            let narrow = ui.ctx().content_rect().width() < super::reading::NARROW;
+            let named = doc.quiz.is_none() && !(narrow && self.reading);
+            if let Some(model) = doc.case().model().filter(|_| named) {
                 ui.label(format!(
                     "{}: {} vertices, {} faces",
                     model.name, model.report.vertices, model.report.faces

@@ -9,7 +9,7 @@ use crate::app::structure_list::StructureAction;
 use crate::session::ColorField;
 
 /// Below this page width (points) the case's panel goes under the view: a phone held upright.
-const NARROW: f32 = 700.0;
+pub(super) const NARROW: f32 = 700.0;
 
 impl Shell {
     pub(super) fn reading_top_bar(&mut self, ui: &mut egui::Ui) {
