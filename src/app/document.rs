@@ -119,6 +119,8 @@ pub struct Document {
     pub panel: PanelLayout,
     /// The tour step shown, while the student follows the case's tour.
     pub tour: Option<usize>,
+    /// The step the student left the tour at.
+    pub tour_left: Option<usize>,
     /// The quiz the student is taking.
     pub quiz: Option<crate::view::QuizRun>,
     /// What the lesson's player tells the embedding page (event, detail), in order.
@@ -183,6 +185,7 @@ impl Document {
             finished_opening: None,
             panel: PanelLayout::default(),
             tour: None,
+            tour_left: None,
             quiz: None,
             lesson_events: Vec::new(),
             waiting: Vec::new(),
@@ -312,6 +315,7 @@ impl Document {
         self.timings = None;
         // Another case: another lesson.
         self.tour = None;
+        self.tour_left = None;
         self.quiz = None;
     }
 
@@ -440,7 +444,7 @@ impl Document {
         state["view"]["planes"] = serde_json::to_value(self.view_asks.planes).unwrap_or_default();
         state["view"]["pointed"] = serde_json::json!(self.pointed);
         state["view"]["labels"] = (v.labels.iter())
-            .map(|(text, [x, y])| serde_json::json!({"text": text, "x": x, "y": y}))
+            .map(|(text, [x, y], faded)| serde_json::json!({"text": text, "x": x, "y": y, "faded": faded}))
             .collect();
         state["view"]["toward_segmentation"] =
             serde_json::json!(self.view_asks.toward_segmentation);

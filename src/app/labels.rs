@@ -8,16 +8,16 @@ use glam::Vec2;
 
 use super::document::Document;
 use super::viewer::Viewer;
-use crate::view::label_spots;
+use crate::view::{label_spots, Ray};
 
-/// Draws the labels of the open case that the view shows; returns each drawn label's text and
-/// its point on the page.
+/// Draws the labels of the open case that the view shows; returns each drawn label's text, its
+/// point on the page and whether it is faded.
 pub fn paint(
     ui: &egui::Ui,
     rect: egui::Rect,
     viewer: &Viewer,
     doc: &Document,
-) -> Vec<(String, [f32; 2])> {
+) -> Vec<(String, [f32; 2], bool)> {
     let labels = &doc.case().lesson().labels;
     if labels.is_empty() {
         return Vec::new();
@@ -28,13 +28,23 @@ pub fn paint(
         .collect();
     let shown = |name: &str| visible.contains(name);
     let size = Vec2::new(rect.width(), rect.height());
-    let spots = label_spots(labels, shown, viewer.camera(), size, viewer.clip_plane());
+    let plane = viewer.clip_plane();
+    let structures = doc.case().case_structures();
+    let nearest = |ray: &Ray, structure: &str| {
+        let (i, hit) = doc.case().opaque_at(ray, plane)?;
+        Some((hit.distance, structures[i].name == structure))
+    };
+    let spots = label_spots(labels, shown, (viewer.camera(), nearest), size, plane);
     let painter = ui.painter_at(rect);
     let font = egui::FontId::proportional(14.0);
-    let ink = egui::Color32::from_gray(240);
     let mut drawn = Vec::with_capacity(spots.len());
     for spot in spots {
         let label = &labels[spot.index];
+        // A label whose point lies behind a surface stays, faint, so it does not jump away.
+        let (ink, shade) = match spot.faded {
+            false => (egui::Color32::from_gray(240), 170),
+            true => (egui::Color32::from_gray(240).gamma_multiply(0.35), 60),
+        };
         let at = |v: Vec2| rect.min + egui::vec2(v.x, v.y);
         let (point, text) = (at(spot.point), at(spot.text));
         painter.line_segment([point, text], egui::Stroke::new(1.5, ink));
@@ -48,9 +58,9 @@ pub fn paint(
         };
         let corner = egui::pos2(left, text.y - galley.size().y / 2.0);
         let plate = egui::Rect::from_min_size(corner, galley.size()).expand(3.0);
-        painter.rect_filled(plate, 3.0, egui::Color32::from_black_alpha(170));
+        painter.rect_filled(plate, 3.0, egui::Color32::from_black_alpha(shade));
         painter.galley(corner, galley, ink);
-        drawn.push((label.text.clone(), [point.x, point.y]));
+        drawn.push((label.text.clone(), [point.x, point.y], spot.faded));
     }
     drawn
 }

@@ -42,7 +42,7 @@ pub struct ViewReport {
     pub brush_on: bool,
     pub pick_ms: Option<f64>,
     /// Each label drawn: its text and where its point is on the page.
-    pub labels: Vec<(String, [f32; 2])>,
+    pub labels: Vec<(String, [f32; 2], bool)>,
 }
 
 /// Where the bottom panel's clickable parts were drawn in the latest frame (points), for
@@ -58,8 +58,8 @@ pub struct PanelLayout {
     pub structure_name: Option<PageRect>,
     pub structure_filter: Option<PageRect>,
     /// The lesson's controls as drawn, by what they do (`labels`, the tour's `start`, `back`,
-    /// `next`, `leave`, the quiz's `quiz`, `choice-0` to `choice-3`, `next-question`,
-    /// `again`, `end-quiz`).
+    /// `next`, `leave`, `resume`, the quiz's `quiz`, `choice-0` to `choice-3`,
+    /// `next-question`, `again`, `end-quiz`).
     pub lesson: Vec<(&'static str, PageRect)>,
 }
 

@@ -16,16 +16,18 @@ impl Document {
             });
         }
         self.view_asks.step = Some(index);
+        self.tour_left = None;
         Ok(())
     }
 
-    /// Leaves the tour, the view staying as it is.
+    /// Leaves the tour, the view staying as it is; the step left is offered to come back to.
     pub fn leave_tour(&mut self) {
-        self.tour = None;
+        self.tour_left = self.tour.take().or(self.tour_left);
         self.view_asks.step = None;
     }
 
-    /// `{step, steps, title, caption}` (`step` null outside the tour), or null without a tour.
+    /// `{step, steps, title, caption, left}` (`step` null outside the tour, `left` the step
+    /// the student left it at), or null without a tour.
     pub fn tour_json(&self) -> Value {
         let steps = &self.case().lesson().steps;
         if steps.is_empty() {
@@ -37,6 +39,7 @@ impl Document {
             "steps": steps.len(),
             "title": shown.map(|s| &s.title),
             "caption": shown.map(|s| &s.caption),
+            "left": self.tour_left,
         })
     }
 

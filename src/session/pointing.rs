@@ -13,21 +13,27 @@ impl CaseDocument {
     /// The structure `ray` meets first, and where, of those drawn; `plane` is the view's
     /// clipping plane `(n, d)` (`n . p > d` is cut away; zero cuts nothing).
     pub fn structure_at(&self, ray: &Ray, plane: [f32; 4]) -> Option<(usize, Hit)> {
-        let current = self.current_structure()?;
+        self.first_hit(ray, plane, SEEN_THROUGH)
+    }
+
+    /// The opaque structure `ray` meets first, and where: what hides whatever lies behind it
+    /// (a translucent one lets it show).
+    pub fn opaque_at(&self, ray: &Ray, plane: [f32; 4]) -> Option<(usize, Hit)> {
+        self.first_hit(ray, plane, 1.0)
+    }
+
+    /// The first hit among the shown structures at least `opacity` opaque.
+    fn first_hit(&self, ray: &Ray, plane: [f32; 4], opacity: f32) -> Option<(usize, Hit)> {
+        self.current_structure()?;
         let normal = Vec3::new(plane[0], plane[1], plane[2]);
         let kept = |p: Vec3| normal.dot(p) <= plane[3];
-        let model = self.model()?;
+        // Each structure as drawn: its smoothed surface where it has one (the model's too,
+        // measured or not), else the surface as read.
         (self.case.structures.iter().enumerate())
-            .filter(|(_, s)| s.visible && s.color[3] >= SEEN_THROUGH)
+            .filter(|(_, s)| s.visible && s.color[3] >= opacity)
             .filter_map(|(i, s)| {
-                let positions: &[[f32; 3]] = if i == current {
-                    self.last_result()
-                        .map_or(&model.mesh().positions, |r| &r.positions)
-                } else {
-                    s.positions()
-                };
                 let triangles = &s.original.triangles;
-                pick_triangle_where(positions, triangles, ray, kept).map(|hit| (i, hit))
+                pick_triangle_where(s.positions(), triangles, ray, kept).map(|hit| (i, hit))
             })
             .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))
     }

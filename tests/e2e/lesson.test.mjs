@@ -35,7 +35,7 @@ const phantomShown = (app) => app.stateWhen((s) => s.structures?.structures.leng
 testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, clip, caption and camera, by button and by call", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         const state = await phantomShown(app);
-        assert.deepEqual(state.tour, { step: null, steps: 3, title: null, caption: null });
+        assert.deepEqual(state.tour, { step: null, steps: 3, title: null, caption: null, left: null });
         const press = async (button) => {
             const s = await app.stateWhen((s) => s.layout.lesson?.[button], `the tour's ${button} button`);
             const r = s.layout.lesson[button];
@@ -58,6 +58,7 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
         assert.deepEqual(shown(s), [["liver", true, 1], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", true, 1]]);
         const inView = (l) => l.x > s.view.x && l.x < s.view.x + s.view.width && l.y > s.view.y && l.y < s.view.y + s.view.height;
         assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver", "Tumour"], "both labels drawn");
+        assert.deepEqual(s.view.labels.map((l) => l.faded), [false, true], "the tumour's, inside the opaque liver, faded");
         assert.ok(s.view.labels.every(inView), `the labels' points lie in the view: ${JSON.stringify(s.view.labels)}`);
         const first = drawn(await app.screenshot("L1-step-1"), s.view);
         // The labels' switch takes them away and brings them back.
@@ -70,6 +71,8 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
         s = await atStep(1);
         assert.deepEqual(shown(s), [["liver", true, 0.3], ["portal_vein", true, 1], ["tumor", true, 1], ["right_kidney", false, 1]], "the kidney hidden, the liver see-through");
         assert.equal(s.structures.current, 2, "the tumour selected");
+        s = await app.stateWhen((s) => s.view.labels.length === 2, "the labels at step 2");
+        assert.equal(s.view.labels.find((l) => l.text === "Tumour").faded, false, "through the see-through liver, the tumour's label is clear");
         assert.equal(s.view.clip, null);
         const second = drawn(await app.screenshot("L1-step-2"), s.view);
         assert.ok(second.count > 500 && first.count > 500, `both views draw the case: ${first.count}, ${second.count} pixels`);
@@ -91,6 +94,13 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
         await press("leave");
         s = await app.stateWhen((s) => s.tour.step === null, "the tour left");
         assert.equal(Math.fround(s.view.camera.yaw), Math.fround(lesson.steps[1].camera.yaw), "the view stays where the tour left it");
+        assert.equal(s.tour.left, 1);
+        // Back to the step left, and out again.
+        await press("resume");
+        s = await atStep(1);
+        assert.equal(s.tour.left, null);
+        await press("leave");
+        s = await app.stateWhen((s) => s.tour.step === null, "the tour left again");
         const refused = await app.attempt("showStep", 3);
         assert.equal(refused.ok, false);
         assert.match(refused.message, /the case's tour has steps 0 to 2: no step 3/);
@@ -218,4 +228,35 @@ testIn(EVERY_RUN, "L3 the student takes the case's quiz: find it by clicking, na
         const refused = await app.attempt("nextQuestion");
         assert.match(refused.message, /nextQuestion: no quiz is running/);
     }, await viewingTheLesson());
+});
+
+testIn(EVERY_RUN, "L4 on a phone the tour and the quiz work by touch, the view first", { timeout: TIMEOUT }, async () => {
+    const phone = { viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true, deviceScaleFactor: 1 };
+    await withApp(async (app) => {
+        let s = await phantomShown(app);
+        assert.ok(s.view.width >= 380 && s.view.height > 844 * 0.4, `the view comes first and large: ${JSON.stringify(s.view)}`);
+        const tap = async (key) => {
+            const state = await app.stateWhen((s) => s.layout.lesson?.[key], `the ${key} button`);
+            const r = state.layout.lesson[key];
+            assert.ok(r.y > s.view.y + s.view.height, `${key} lies under the view, not over it`);
+            await app.page.touchscreen.tap(r.x + r.width / 2, r.y + r.height / 2);
+        };
+        await tap("start");
+        const want = lesson.steps[0].camera;
+        s = await app.stateWhen((s) => s.tour.step === 0 && Math.abs(s.view.camera.distance - want.distance) < 1e-3 && s.view.labels.length === 2, "the first step by touch");
+        const inView = (l) => l.x > s.view.x && l.x < s.view.x + s.view.width && l.y > s.view.y && l.y < s.view.y + s.view.height;
+        assert.ok(s.view.labels.every(inView), `the labels lie in the view: ${JSON.stringify(s.view.labels)}`);
+        await app.screenshot("L4-phone-tour");
+        const liver = s.view.labels.find((l) => l.text === "Liver");
+        assert.equal(liver.faded, false);
+        await tap("quiz");
+        s = await app.stateWhen((s) => s.quiz.running && s.quiz.question === 0 && !s.layout.lesson["next-question"], "the quiz by touch");
+        assert.equal(s.quiz.mode, "find-it");
+        await app.page.touchscreen.tap(liver.x, liver.y);
+        s = await app.stateWhen((s) => s.quiz.answer !== null && s.layout.lesson["next-question"], "answered by a tap in the view");
+        assert.equal(s.quiz.answer.given, "liver");
+        await app.screenshot("L4-phone-quiz-answered");
+        await tap("end-quiz");
+        await app.stateWhen((s) => !s.quiz.running, "the quiz ended by touch");
+    }, { ...(await viewingTheLesson()), device: phone });
 });

@@ -97,10 +97,11 @@
 //!   smoothed surfaces, 1: the segmentation's); `state().view` reads them back
 //! - `showStep(index)`: shows the case's tour step (from 0: its structures, clip, slide and
 //!   selection at once, the camera flying to its view); `leaveTour()` leaves the tour, the view
-//!   staying; `state().tour` is `{step, steps, title, caption}` (`step` null outside the
-//!   tour), or null when the case has no tour; `state().layout.lesson` where its buttons, the
-//!   quiz's and the labels' switch are; `state().view.labels` the labels drawn (`[{text, x,
-//!   y}]`, their points on the page)
+//!   staying; `state().tour` is `{step, steps, title, caption, left}` (`step` null outside
+//!   the tour, `left` the step it was left at), or null when the case has no tour;
+//!   `state().layout.lesson` where its buttons, the quiz's and the labels' switch are;
+//!   `state().view.labels` the labels drawn (`[{text, x, y, faded}]`, their points on the
+//!   page, `faded` where a surface lies in front of the point)
 //! - `startQuiz()` starts the case's quiz (again; the tour left, the structures it asks shown):
 //!   "Find it" questions are answered by clicking the structure in the view, "Name it" ones
 //!   by one of the offered names; `nextQuestion()` moves on once the question is answered;

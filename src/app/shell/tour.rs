@@ -67,8 +67,14 @@ impl Shell {
         let Some(index) = doc.tour else {
             let start = ui.button(format!("▶ Take the tour ({count} steps)"));
             doc.panel.lesson.push(("start", start.rect.into()));
-            if start.clicked() {
-                let _ = doc.ask_step(0);
+            let mut asked = start.clicked().then_some(0);
+            if let Some(left) = doc.tour_left.filter(|&i| i < count) {
+                let resume = ui.button(format!("Back to step {} of {count}", left + 1));
+                doc.panel.lesson.push(("resume", resume.rect.into()));
+                asked = asked.or(resume.clicked().then_some(left));
+            }
+            if let Some(i) = asked {
+                let _ = doc.ask_step(i);
             }
             ui.separator();
             return;
