@@ -123,6 +123,8 @@ pub struct Document {
     pub tour_left: Option<usize>,
     /// The quiz the student is taking.
     pub quiz: Option<crate::view::QuizRun>,
+    /// The author's next click in the view places a label.
+    pub placing_label: bool,
     /// What the lesson's player tells the embedding page (event, detail), in order.
     pub lesson_events: Vec<(&'static str, serde_json::Value)>,
     waiting: Vec<Waiter>,
@@ -187,6 +189,7 @@ impl Document {
             tour: None,
             tour_left: None,
             quiz: None,
+            placing_label: false,
             lesson_events: Vec::new(),
             waiting: Vec::new(),
             waiting_for: Vec::new(),

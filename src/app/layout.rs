@@ -59,8 +59,11 @@ pub struct PanelLayout {
     pub structure_filter: Option<PageRect>,
     /// The lesson's controls as drawn, by what they do (`labels`, the tour's `start`, `back`,
     /// `next`, `leave`, `resume`, the quiz's `quiz`, `choice-0` to `choice-3`,
-    /// `next-question`, `again`, `end-quiz`).
-    pub lesson: Vec<(&'static str, PageRect)>,
+    /// `next-question`, `again`, `end-quiz`; the authoring page's `lesson-tab` and its Lesson
+    /// panel: `record`, `step-title-N`, `step-caption-N`, `step-up-N`, `step-down-N`,
+    /// `step-delete-N`, `step-show-N`, `place-label`, `label-text-N`, `label-delete-N`,
+    /// `quiz-on`, `quiz-find-it`, `quiz-name-it`).
+    pub lesson: Vec<(String, PageRect)>,
 }
 
 /// One row of the Structures list: its visibility box, show-alone button and name (which
@@ -103,7 +106,7 @@ impl PanelLayout {
             })).collect::<Vec<_>>(),
             "structure_name": self.structure_name.map(PageRect::to_json),
             "structure_filter": self.structure_filter.map(PageRect::to_json),
-            "lesson": self.lesson.iter().map(|(k, r)| (k.to_string(), r.to_json()))
+            "lesson": self.lesson.iter().map(|(k, r)| (k.clone(), r.to_json()))
                 .collect::<serde_json::Map<_, _>>(),
         })
     }

@@ -39,6 +39,7 @@ mod guide;
 mod labels;
 mod layout;
 mod legend;
+mod lesson_panel;
 mod orientation_marker;
 mod page;
 mod picture;

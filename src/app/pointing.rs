@@ -14,6 +14,8 @@ pub struct Pointing {
     asked: Option<Asked>,
     /// The structure under the pointer (index, name).
     pub named: Option<(usize, String)>,
+    /// Where the pointer meets it (RAS mm).
+    pub point: Option<glam::Vec3>,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -40,6 +42,7 @@ impl Pointing {
         let Some(pointer) = pointer else {
             self.asked = None;
             self.named = None;
+            self.point = None;
             return None;
         };
         let asked = Asked {
@@ -56,11 +59,11 @@ impl Pointing {
             let rect = response.rect;
             let at = Vec2::new(pointer.x - rect.left(), pointer.y - rect.top());
             let ray = camera.ray_through(at, Vec2::new(rect.width(), rect.height()));
-            self.named = ray
-                .and_then(|ray| session.case().structure_at(&ray, plane))
-                .and_then(|(i, _)| {
-                    Some((i, session.case().case_structures().get(i)?.name.clone()))
-                });
+            let hit = ray.and_then(|ray| session.case().structure_at(&ray, plane));
+            self.point = hit.map(|(_, h)| h.point);
+            self.named = hit.and_then(|(i, _)| {
+                Some((i, session.case().case_structures().get(i)?.name.clone()))
+            });
             self.asked = Some(asked);
         }
         let (index, name) = self.named.as_ref()?;

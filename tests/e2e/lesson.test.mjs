@@ -260,3 +260,104 @@ testIn(EVERY_RUN, "L4 on a phone the tour and the quiz work by touch, the view f
         await app.stateWhen((s) => !s.quiz.running, "the quiz ended by touch");
     }, { ...(await viewingTheLesson()), device: phone });
 });
+
+testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: three steps, two labels placed by clicking, a quiz; the viewer plays it", { timeout: TIMEOUT }, async () => {
+    let exported;
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd", "loadCase");
+        let s = await app.stateWhen((s) => s.loading === null && s.view.camera && s.layout.lesson?.["lesson-tab"], "the case open");
+        const centreOf = (r) => [r.x + r.width / 2, r.y + r.height / 2];
+        const press = async (key) => {
+            const state = await app.stateWhen((s) => s.layout.lesson?.[key], `the Lesson panel's ${key}`);
+            await app.page.mouse.click(...centreOf(state.layout.lesson[key]));
+            await frames(app);
+        };
+        await press("lesson-tab");
+        const typeInto = async (key, text) => {
+            await press(key);
+            await app.page.keyboard.press("Control+A");
+            await app.page.keyboard.type(text);
+            await frames(app);
+        };
+        const lessonNow = () => app.call("lesson");
+        const lessonWhen = async (test, what) => {
+            for (let tries = 0; tries < 100; tries++) {
+                const l = await lessonNow();
+                if (test(l)) return l;
+                await frames(app);
+            }
+            throw new Error(`the lesson: ${what} not reached: ${JSON.stringify(await lessonNow())}`);
+        };
+
+        // Step 1, from the front as opened, titled and captioned in the panel.
+        await press("record");
+        await lessonWhen((l) => l.steps.length === 1, "one step");
+        await typeInto("step-title-0", "The whole abdomen");
+        await typeInto("step-caption-0", "Four structures of the phantom.");
+        let lesson = await lessonWhen((l) => l.steps[0].title === "The whole abdomen" && l.steps[0].caption === "Four structures of the phantom.", "the first step's words");
+
+        // Two labels placed by clicking: the liver at the view's centre, the kidney found along
+        // the row through it.
+        s = await app.state();
+        const row = s.view.y + s.view.height / 2;
+        const pointed = async (x) => {
+            await app.page.mouse.move(x, row);
+            await frames(app);
+            return (await app.state()).view.pointed;
+        };
+        const under = { liver: [], right_kidney: [] };
+        for (let x = s.view.x + 20; x < s.view.x + s.view.width - 20; x += 24) under[await pointed(x)]?.push(x);
+        assert.ok(under.liver.length > 2 && under.right_kidney.length > 2, `the liver and the kidney under the row through the centre: ${JSON.stringify(under)}`);
+        // Each clicked in the middle of its stretch of the row, away from its outline.
+        const spots = Object.entries(under).map(([name, xs]) => [name, xs[Math.floor(xs.length / 2)]]);
+        for (const [name, x] of spots) {
+            await press("place-label");
+            await app.page.mouse.click(x, row);
+            await lessonWhen((l) => l.labels.some((label) => label.structure === name), `a label on the ${name}`);
+        }
+        lesson = await lessonNow();
+        const kidney = lesson.labels.findIndex((l) => l.structure === "right_kidney");
+        await typeInto(`label-text-${kidney}`, "Right kidney");
+        await lessonWhen((l) => l.labels[kidney].text === "Right kidney", "the kidney's label text");
+
+        // Steps 2 and 3 from above and cut; a fourth recorded, moved up and deleted.
+        await app.call("setView", { from: "S" });
+        await frames(app);
+        await press("record");
+        await app.call("setStructure", { index: 0, opacity: 0.3 });
+        await app.call("setView", { clip: { axis: "axial", at: 0.5, flip: false } });
+        await app.stateWhen((s) => s.view.clip?.axis === "axial", "the cut");
+        await press("record");
+        await press("record");
+        await lessonWhen((l) => l.steps.length === 4, "four steps");
+        await press("step-up-3");
+        lesson = await lessonWhen((l) => l.steps[2].title === "Step 4", "the fourth step moved up");
+        assert.deepEqual(lesson.steps.map((x) => x.title), ["The whole abdomen", "Step 2", "Step 4", "Step 3"]);
+        await press("step-delete-2");
+        lesson = await lessonWhen((l) => l.steps.length === 3, "three steps");
+        assert.deepEqual(lesson.steps.map((x) => x.title), ["The whole abdomen", "Step 2", "Step 3"]);
+        assert.equal(lesson.steps[2].clip.axis, "axial");
+        assert.equal(Math.fround(lesson.steps[2].opacity.liver), Math.fround(0.3));
+
+        // The quiz: on, both modes, one taken off and put back.
+        await press("quiz-on");
+        lesson = await lessonWhen((l) => l.quiz !== null, "a quiz");
+        assert.deepEqual(lesson.quiz, { structures: [], modes: ["find-it", "name-it"], pass_mark: 0.5 });
+        await press("quiz-name-it");
+        await lessonWhen((l) => l.quiz.modes.join() === "find-it", "Find it alone");
+        await press("quiz-name-it");
+        lesson = await lessonWhen((l) => l.quiz.modes.join() === "find-it,name-it", "both modes again");
+        await app.screenshot("L5-lesson-panel");
+        exported = Buffer.from(await app.call("exportCase", "glb"));
+    });
+    await withApp(async (app) => {
+        const s = await app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.view.labels.length === 2, "the authored case in the viewer, its labels drawn");
+        assert.equal(s.tour.steps, 3);
+        assert.deepEqual(s.view.labels.map((l) => l.text).sort(), ["Right kidney", "liver"]);
+        assert.equal(s.quiz.running, false);
+        assert.deepEqual(s.quiz.modes, ["find-it", "name-it"]);
+        await app.call("showStep", 2);
+        await app.stateWhen((s) => s.tour.step === 2 && s.view.clip?.axis === "axial", "the third step, cut");
+        await app.screenshot("L5-authored-step-3");
+    }, { query: "?mode=viewer&case=cases/authored.glb", routes: { "cases/authored.glb": exported } });
+});

@@ -10,7 +10,7 @@ use wasm_bindgen::JsValue;
 
 use super::{error, from_js, to_js, Api};
 use crate::app::document::{Document, SharedDocument};
-use crate::view::{recorded_step, ViewRequest};
+use crate::view::ViewRequest;
 
 pub(super) fn set_view(
     doc: &SharedDocument,
@@ -162,20 +162,9 @@ fn define_lesson(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result
     )
 }
 
-/// Adds the view as it stands as the tour's last step; returns the number of steps.
+/// `recordStep({title, caption})`: the view as it stands as the tour's last step.
 fn record_step(doc: &mut Document, value: &JsValue) -> Result<usize, String> {
     let v = from_js(value)?;
-    let text = |key: &str| {
-        v.get(key)
-            .and_then(|t| t.as_str())
-            .unwrap_or_default()
-            .to_string()
-    };
-    let names = doc.case().structure_names();
-    let step = recorded_step(&doc.view_link(), &names, &text("title"), &text("caption"))?;
-    let mut lesson = doc.case().lesson().clone();
-    lesson.steps.push(step);
-    let steps = lesson.steps.len();
-    doc.case_mut().set_lesson(lesson)?;
-    Ok(steps)
+    let text = |key: &str| v.get(key).and_then(|t| t.as_str()).unwrap_or_default();
+    doc.record_step(text("title"), text("caption"))
 }

@@ -58,6 +58,8 @@ pub struct Shell {
     bake_colors: bool,
     show_original: bool,
     help_open: bool,
+    /// The right panel shows the lesson rather than the mesh report.
+    lesson_tab: bool,
     /// Why the last export failed.
     export_error: Option<String>,
     /// The WebGPU engine, where the page has WebGPU.
@@ -186,6 +188,7 @@ impl Shell {
             bake_colors: false,
             show_original: false,
             help_open: false,
+            lesson_tab: false,
             export_error: None,
             gpu,
             gpu_fallback: None,
@@ -544,10 +547,20 @@ impl Shell {
             .resizable(true)
             .default_size(260.0)
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    if let Some(model) = self.doc.borrow().case().model() {
-                        report_view::show(ui, model);
-                    }
+                let mut doc = self.doc.borrow_mut();
+                doc.panel.lesson.clear();
+                ui.horizontal(|ui| {
+                    ui.selectable_value(&mut self.lesson_tab, false, "Report");
+                    let tab = ui.selectable_value(&mut self.lesson_tab, true, "Lesson");
+                    doc.panel
+                        .lesson
+                        .push(("lesson-tab".into(), tab.rect.into()));
+                });
+                ui.separator();
+                egui::ScrollArea::vertical().show(ui, |ui| match doc.case().model() {
+                    Some(_) if self.lesson_tab => crate::app::lesson_panel::show(ui, &mut doc),
+                    Some(model) => report_view::show(ui, model),
+                    None => {}
                 });
             });
     }

@@ -20,7 +20,7 @@ impl Shell {
             return;
         }
         let start = ui.button("Take the quiz");
-        doc.panel.lesson.push(("quiz", start.rect.into()));
+        doc.panel.lesson.push(("quiz".into(), start.rect.into()));
         if start.clicked() {
             ui.ctx().request_repaint();
             if let Err(e) = doc.start_quiz() {
@@ -121,7 +121,7 @@ impl Shell {
         if end.clicked() {
             act = Act::End;
         }
-        (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
+        (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k.into(), r.into())));
         // What changed is drawn at once, not at the next input.
         if !matches!(act, Act::None) {
             ui.ctx().request_repaint();

@@ -56,7 +56,7 @@ impl Shell {
         if !doc.case().lesson().labels.is_empty() {
             let mut shown = !doc.view_asks.hide_labels;
             let toggle = ui.checkbox(&mut shown, "Labels");
-            doc.panel.lesson.push(("labels", toggle.rect.into()));
+            doc.panel.lesson.push(("labels".into(), toggle.rect.into()));
             doc.view_asks.hide_labels = !shown;
         }
         let steps = &doc.case().lesson().steps;
@@ -66,11 +66,11 @@ impl Shell {
         let count = steps.len();
         let Some(index) = doc.tour else {
             let start = ui.button(format!("▶ Take the tour ({count} steps)"));
-            doc.panel.lesson.push(("start", start.rect.into()));
+            doc.panel.lesson.push(("start".into(), start.rect.into()));
             let mut asked = start.clicked().then_some(0);
             if let Some(left) = doc.tour_left.filter(|&i| i < count) {
                 let resume = ui.button(format!("Back to step {} of {count}", left + 1));
-                doc.panel.lesson.push(("resume", resume.rect.into()));
+                doc.panel.lesson.push(("resume".into(), resume.rect.into()));
                 asked = asked.or(resume.clicked().then_some(left));
             }
             if let Some(i) = asked {
@@ -99,7 +99,7 @@ impl Shell {
                 ("leave", out.rect),
             ];
         });
-        (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
+        (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k.into(), r.into())));
         if let Some(i) = asked {
             let _ = doc.ask_step(i);
         }

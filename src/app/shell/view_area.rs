@@ -119,6 +119,13 @@ fn point(
         }
         return;
     }
+    if let (true, Some(i), Some(at)) = (doc.placing_label, clicked, pointing.point) {
+        doc.placing_label = false;
+        if let Err(e) = doc.place_label(i, at) {
+            log::warn!("{e}");
+        }
+        return;
+    }
     let current = doc.case().current_structure();
     if let (true, Some(i)) = (reading, clicked.filter(|&i| Some(i) != current)) {
         if let Err(e) = doc.select_structure(i) {

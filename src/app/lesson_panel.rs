@@ -1,0 +1,187 @@
+//! The authoring page's Lesson panel: the tour's steps recorded from the view as it stands,
+//! their titles and captions edited, reordered, deleted and shown again; labels placed by
+//! clicking a structure in the view, their texts edited; the quiz's modes and pass mark. Every
+//! edit goes through `CaseDocument::set_lesson`, which checks it against the case.
+
+use eframe::egui;
+use glam::Vec3;
+
+use super::document::Document;
+use crate::case::{Label, Lesson, Quiz, QuizMode};
+use crate::view::recorded_step;
+
+impl Document {
+    /// Adds the view as it stands as the tour's last step; returns the number of steps.
+    pub fn record_step(&mut self, title: &str, caption: &str) -> Result<usize, String> {
+        let names = self.case().structure_names();
+        let step = recorded_step(&self.view_link(), &names, title, caption)?;
+        let mut lesson = self.case().lesson().clone();
+        lesson.steps.push(step);
+        let steps = lesson.steps.len();
+        self.case_mut().set_lesson(lesson)?;
+        Ok(steps)
+    }
+
+    /// Adds a label on structure `index` at `point` (where the author clicked it), its text
+    /// the structure's name until edited.
+    pub fn place_label(&mut self, index: usize, point: Vec3) -> Result<(), String> {
+        let name = (self.case().case_structures().get(index))
+            .map(|s| s.name.clone())
+            .ok_or(format!("the case has no structure {index}"))?;
+        let mut lesson = self.case().lesson().clone();
+        lesson.labels.push(Label {
+            structure: name.clone(),
+            point: point.to_array(),
+            text: name,
+            note: String::new(),
+        });
+        self.case_mut().set_lesson(lesson)
+    }
+}
+
+/// What the panel's controls asked this frame besides edits of the lesson itself.
+#[derive(Default)]
+struct Asked {
+    record: bool,
+    show_step: Option<usize>,
+}
+
+/// The Lesson panel.
+pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
+    let mut lesson = doc.case().lesson().clone();
+    let before = lesson.clone();
+    let mut drawn: Vec<(String, egui::Rect)> = Vec::new();
+    let mut asked = Asked::default();
+    let record = ui.button("Record the view as a step");
+    drawn.push(("record".into(), record.rect));
+    asked.record = record.clicked();
+    steps(ui, &mut lesson, &mut drawn, &mut asked);
+    ui.separator();
+    let place = ui.toggle_value(&mut doc.placing_label, "Place a label");
+    drawn.push(("place-label".into(), place.rect));
+    if doc.placing_label {
+        ui.small("Click a structure in the view where the label points.");
+    }
+    labels(ui, &mut lesson, &mut drawn);
+    ui.separator();
+    quiz(ui, &mut lesson, &mut drawn);
+    (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
+    if lesson != before {
+        if let Err(e) = doc.case_mut().set_lesson(lesson) {
+            // An emptied title or text: the edit waits for a non-empty one.
+            log::info!("lesson edit refused: {e}");
+        }
+    }
+    if asked.record {
+        let n = doc.case().lesson().steps.len() + 1;
+        if let Err(e) = doc.record_step(&format!("Step {n}"), "") {
+            log::warn!("{e}");
+        }
+    }
+    if let Some(i) = asked.show_step {
+        let _ = doc.ask_step(i);
+    }
+}
+
+/// Each step's title and caption, with its buttons: up, down, delete, show.
+fn steps(
+    ui: &mut egui::Ui,
+    lesson: &mut Lesson,
+    drawn: &mut Vec<(String, egui::Rect)>,
+    asked: &mut Asked,
+) {
+    let mut moved: Option<(usize, usize)> = None;
+    let mut deleted = None;
+    let count = lesson.steps.len();
+    for (i, step) in lesson.steps.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            ui.label(format!("{}.", i + 1));
+            let title = ui.add(egui::TextEdit::singleline(&mut step.title).desired_width(130.0));
+            drawn.push((format!("step-title-{i}"), title.rect));
+            let up = ui.add_enabled(i > 0, egui::Button::new("▲").small());
+            let down = ui.add_enabled(i + 1 < count, egui::Button::new("▼").small());
+            let delete = ui.small_button("✕").on_hover_text("Delete the step");
+            let show = ui.small_button("Show");
+            for (key, r) in [("up", &up), ("down", &down), ("delete", &delete)] {
+                drawn.push((format!("step-{key}-{i}"), r.rect));
+            }
+            drawn.push((format!("step-show-{i}"), show.rect));
+            moved = moved
+                .or(up.clicked().then(|| (i, i - 1)))
+                .or(down.clicked().then_some((i, i + 1)));
+            deleted = deleted.or(delete.clicked().then_some(i));
+            asked.show_step = asked.show_step.or(show.clicked().then_some(i));
+        });
+        let caption = ui.add(
+            egui::TextEdit::multiline(&mut step.caption)
+                .desired_rows(1)
+                .hint_text("Caption: what the student sees here"),
+        );
+        drawn.push((format!("step-caption-{i}"), caption.rect));
+    }
+    if let Some((a, b)) = moved {
+        lesson.steps.swap(a, b);
+    }
+    if let Some(i) = deleted {
+        lesson.steps.remove(i);
+    }
+}
+
+/// Each label's structure and text, and its delete button.
+fn labels(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui::Rect)>) {
+    let mut deleted = None;
+    for (i, label) in lesson.labels.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            ui.small(&label.structure);
+            let text = ui.add(egui::TextEdit::singleline(&mut label.text).desired_width(120.0));
+            let delete = ui.small_button("✕").on_hover_text("Delete the label");
+            drawn.push((format!("label-text-{i}"), text.rect));
+            drawn.push((format!("label-delete-{i}"), delete.rect));
+            deleted = deleted.or(delete.clicked().then_some(i));
+        });
+    }
+    if let Some(i) = deleted {
+        lesson.labels.remove(i);
+    }
+}
+
+/// Whether the case asks a quiz, in which modes, and its pass mark; it asks the structures
+/// shown when the student starts it.
+fn quiz(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui::Rect)>) {
+    let mut on = lesson.quiz.is_some();
+    let toggle = ui.checkbox(&mut on, "Quiz the student (the structures shown)");
+    drawn.push(("quiz-on".into(), toggle.rect));
+    match (on, &mut lesson.quiz) {
+        (false, quiz) => *quiz = None,
+        (true, None) => {
+            lesson.quiz = Some(Quiz {
+                structures: Vec::new(),
+                modes: vec![QuizMode::FindIt, QuizMode::NameIt],
+                pass_mark: 0.5,
+            })
+        }
+        (true, Some(quiz)) => {
+            ui.horizontal(|ui| {
+                for (mode, word, key) in [
+                    (QuizMode::FindIt, "Find it", "quiz-find-it"),
+                    (QuizMode::NameIt, "Name it", "quiz-name-it"),
+                ] {
+                    let mut asked = quiz.modes.contains(&mode);
+                    let r = ui.checkbox(&mut asked, word);
+                    drawn.push((key.into(), r.rect));
+                    quiz.modes.retain(|m| *m != mode);
+                    if asked {
+                        quiz.modes.push(mode);
+                    }
+                }
+            });
+            // Find it before Name it, whatever order they were ticked in.
+            quiz.modes.sort_by_key(|m| *m == QuizMode::NameIt);
+            let mut percent = (quiz.pass_mark * 100.0).round();
+            let slider = egui::Slider::new(&mut percent, 0.0..=100.0).text("pass mark %");
+            if ui.add(slider).changed() {
+                quiz.pass_mark = percent / 100.0;
+            }
+        }
+    }
+}
