@@ -1,17 +1,23 @@
 //! The case in words, for screen readers: egui draws on a canvas that assistive technology
-//! cannot read, so the page keeps the canvas's label and a list of the structures (hidden from
-//! sight) up to date with the case. Element ids match `index.html`.
+//! cannot read, so the page keeps the canvas's label, a list of the structures and a list of
+//! what the lesson shows (the tour's step and caption, the labels drawn, the quiz's question
+//! and answer, read out as they change), hidden from sight, up to date with the case. Element
+//! ids match `index.html`.
 
+use super::document::Document;
 use crate::session::Session;
 
 const CANVAS_ID: &str = "meshsmooth_canvas";
 const LIST_ID: &str = "case_structures";
+const LESSON_ID: &str = "case_lesson";
 
 /// What the page's words were last written for: the structures' version, the selected one,
 /// the case's file and title.
 #[derive(Default)]
 pub struct CaseText {
     written: Option<(u64, Option<usize>, String, String)>,
+    /// The lesson's lines last written.
+    lesson: Vec<String>,
 }
 
 impl CaseText {
@@ -35,16 +41,68 @@ impl CaseText {
         if let Some(canvas) = document.get_element_by_id(CANVAS_ID) {
             let _ = canvas.set_attribute("aria-label", &words.0);
         }
-        if let Some(list) = document.get_element_by_id(LIST_ID) {
-            list.set_inner_html("");
-            for line in &words.1 {
-                if let Ok(item) = document.create_element("li") {
-                    item.set_text_content(Some(line));
-                    let _ = list.append_child(&item);
-                }
+        write_list(LIST_ID, &words.1);
+    }
+
+    /// Rewrites the lesson's list where what it shows changed.
+    pub fn update_lesson(&mut self, doc: &Document) {
+        let lines = lesson_lines(doc);
+        if lines != self.lesson {
+            write_list(LESSON_ID, &lines);
+            self.lesson = lines;
+        }
+    }
+}
+
+/// Replaces the items of the list `id` with `lines`.
+fn write_list(id: &str, lines: &[String]) {
+    let Some(document) = web_sys::window().and_then(|w| w.document()) else {
+        return;
+    };
+    if let Some(list) = document.get_element_by_id(id) {
+        list.set_inner_html("");
+        for line in lines {
+            if let Ok(item) = document.create_element("li") {
+                item.set_text_content(Some(line));
+                let _ = list.append_child(&item);
             }
         }
     }
+}
+
+/// The tour's step with its caption, the labels drawn, the quiz's question, its choices and
+/// the answer's outcome.
+fn lesson_lines(doc: &Document) -> Vec<String> {
+    let mut lines = Vec::new();
+    let steps = &doc.case().lesson().steps;
+    if let Some(step) = doc.tour.and_then(|i| Some((i, steps.get(i)?))) {
+        let (i, step) = step;
+        let mut line = format!("Tour step {} of {}: {}.", i + 1, steps.len(), step.title);
+        if !step.caption.is_empty() {
+            line.push_str(&format!(" {}", step.caption));
+        }
+        lines.push(line);
+    }
+    for (text, _, faded) in &doc.view.labels {
+        let behind = if *faded { " (behind a surface)" } else { "" };
+        lines.push(format!("Label: {text}{behind}"));
+    }
+    let words = doc.quiz_words();
+    if !words.heading.is_empty() {
+        lines.push(format!("{}. {}", words.heading, words.question));
+        let names = doc.case().structure_names();
+        let choices = (doc.quiz.as_ref().and_then(|r| r.current()))
+            .map(|(_, q)| q.choices.iter().filter_map(|&c| names.get(c).copied()))
+            .map(|c| c.collect::<Vec<_>>().join(", "))
+            .filter(|c| !c.is_empty());
+        if let Some(choices) = choices {
+            lines.push(format!("Choices: {choices}."));
+        }
+        if let Some((_, outcome)) = words.outcome {
+            lines.push(outcome);
+        }
+    }
+    lines
 }
 
 /// The canvas's label: what the view shows.

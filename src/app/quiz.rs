@@ -9,6 +9,15 @@ use crate::case::{xapi, QuizMode};
 use crate::session::StructureChange;
 use crate::view::QuizRun;
 
+/// The quiz in words ([`Document::quiz_words`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct QuizWords {
+    pub heading: String,
+    pub question: String,
+    /// Right (or passed), and the sentence that says so.
+    pub outcome: Option<(bool, String)>,
+}
+
 impl Document {
     /// Starts the case's quiz (again), leaving the tour; the structures it asks are shown.
     pub fn start_quiz(&mut self) -> Result<(), String> {
@@ -107,6 +116,51 @@ impl Document {
             .current()
             .is_some_and(|(_, q)| q.mode == QuizMode::FindIt);
         asking && run.answered().is_none()
+    }
+
+    /// The quiz in words, as the panel shows it and a screen reader reads it: the heading
+    /// ("Quiz: question 3 of 8"), the question, and once answered whether it was right and
+    /// what; once finished, the score and whether it passes. Empty when no quiz runs.
+    pub fn quiz_words(&self) -> QuizWords {
+        let Some(run) = &self.quiz else {
+            return QuizWords::default();
+        };
+        let names = self.case().structure_names();
+        let name = |i: usize| names.get(i).copied().unwrap_or("?");
+        let total = run.questions().len();
+        let Some((i, question)) = run.current() else {
+            let percent = (100.0 * run.scaled()).round();
+            let mark = (100.0 * run.quiz().pass_mark).round();
+            let verdict = match run.passed() {
+                true => format!("Passed (the pass mark is {mark}%)."),
+                false => format!("Not passed yet (the pass mark is {mark}%)."),
+            };
+            return QuizWords {
+                heading: "Quiz finished".into(),
+                question: format!("{} of {total} right ({percent}%).", run.score().0),
+                outcome: Some((run.passed(), verdict)),
+            };
+        };
+        let asked = name(question.structure);
+        let question_text = match question.mode {
+            QuizMode::FindIt => format!("Find it: click the {asked} in the view."),
+            QuizMode::NameIt => "Name it: which structure is highlighted?".to_string(),
+        };
+        let outcome = run.answered().map(|a| match a.right {
+            true => (true, format!("Right: the {asked}.")),
+            false => (
+                false,
+                format!(
+                    "No, that is the {}. The {asked} is highlighted.",
+                    name(a.given)
+                ),
+            ),
+        });
+        QuizWords {
+            heading: format!("Quiz: question {} of {total}", i + 1),
+            question: question_text,
+            outcome,
+        }
     }
 
     /// The quiz for `state()`: null without one in the case; `running` false until started.

@@ -60,6 +60,9 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
         assert.deepEqual(s.view.labels.map((l) => l.text), ["Liver", "Tumour"], "both labels drawn");
         assert.deepEqual(s.view.labels.map((l) => l.faded), [false, true], "the tumour's, inside the opaque liver, faded");
         assert.ok(s.view.labels.every(inView), `the labels' points lie in the view: ${JSON.stringify(s.view.labels)}`);
+        // The same for a screen reader, read out as it changes.
+        const mirror = () => app.page.locator("#case_lesson li").allTextContents();
+        assert.deepEqual(await mirror(), [`Tour step 1 of 3: ${lesson.steps[0].title}. ${lesson.steps[0].caption}`, "Label: Liver", "Label: Tumour (behind a surface)"]);
         const first = drawn(await app.screenshot("L1-step-1"), s.view);
         // The labels' switch takes them away and brings them back.
         await press("labels");
@@ -205,6 +208,13 @@ testIn(EVERY_RUN, "L3 the student takes the case's quiz: find it by clicking, na
             s = await app.stateWhen((s) => s.quiz.answer !== null, `question ${q + 1} answered`);
             assert.equal(s.quiz.answer.right, expectRight, `${mode} ${asked}: ${JSON.stringify(s.quiz.answer)}`);
             if (mode === "find-it") assert.equal(s.quiz.answer.given, "liver");
+            // A screen reader hears the question, the choices and the outcome (written at the
+            // next frame's start).
+            await frames(app);
+            const heard = await app.page.locator("#case_lesson li").allTextContents();
+            assert.match(heard[0], new RegExp(`^Quiz: question ${q + 1} of 8\\. ${mode === "find-it" ? `Find it: click the ${asked}` : "Name it"}`));
+            assert.equal(heard.at(-1).startsWith(expectRight ? "Right" : "No, that is the"), true, heard.join(" | "));
+            if (mode === "name-it") assert.ok(heard.includes(`Choices: ${choices.join(", ")}.`), heard.join(" | "));
             if (q === 0) await app.screenshot("L3-answered");
             await press("next-question");
         }
@@ -221,7 +231,7 @@ testIn(EVERY_RUN, "L3 the student takes the case's quiz: find it by clicking, na
         assert.ok(changedPixels(highlighted, before, view) > 2000, "Name it singles out its structure (the others faded)");
 
         await press("again");
-        s = await app.stateWhen((s) => s.quiz.running && s.quiz.question === 0 && s.quiz.answered === 0, "the quiz again");
+        s = await app.stateWhen((s) => s.quiz.running && s.quiz.question === 0 && s.quiz.answered === 0 && !s.layout.lesson.again, "the quiz again, drawn");
         await press("end-quiz");
         s = await app.stateWhen((s) => !s.quiz.running && s.layout.structures.length === 4, "the quiz ended, the list back");
         assert.equal(s.view.labels.length, 2, "the labels back");

@@ -477,6 +477,7 @@ impl eframe::App for Shell {
             }
             doc.lesson_events.clear();
             self.case_text.update(doc.session());
+            self.case_text.update_lesson(&doc);
             self.repainting = doc.working();
             if self.repainting && doc.working_elsewhere() {
                 // The replies wake the page; this only moves the progress on. Frames drawn

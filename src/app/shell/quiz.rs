@@ -7,7 +7,6 @@ use eframe::egui;
 
 use super::Shell;
 use crate::app::document::Document;
-use crate::case::QuizMode;
 
 const RIGHT: egui::Color32 = egui::Color32::from_rgb(110, 200, 120);
 const WRONG: egui::Color32 = egui::Color32::from_rgb(235, 110, 100);
@@ -45,74 +44,41 @@ impl Shell {
         };
         let mut drawn: Vec<(&'static str, egui::Rect)> = Vec::new();
         let mut act = Act::None;
-        let names: Vec<String> = (doc.case().structure_names().into_iter())
-            .map(str::to_string)
-            .collect();
-        let name = |i: usize| names.get(i).map_or("?", String::as_str);
-        let total = run.questions().len();
-        match run.current() {
-            Some((i, question)) => {
-                ui.strong(format!("Quiz: question {} of {total}", i + 1));
-                let asked = name(question.structure);
-                match question.mode {
-                    QuizMode::FindIt => {
-                        ui.label(format!("Find it: click the {asked} in the view."))
-                    }
-                    QuizMode::NameIt => ui.label("Name it: which structure is highlighted?"),
-                };
-                if question.mode == QuizMode::NameIt {
-                    const KEYS: [&str; 4] = ["choice-0", "choice-1", "choice-2", "choice-3"];
-                    let open = run.answered().is_none();
-                    for (k, &c) in question.choices.iter().enumerate() {
-                        let button = ui.add_enabled(open, egui::Button::new(name(c)));
-                        drawn.push((KEYS[k.min(3)], button.rect));
-                        if button.clicked() {
-                            act = Act::Answer(c);
-                        }
-                    }
-                }
-                if let Some(answer) = run.answered() {
-                    let (text, colour) = match answer.right {
-                        true => (format!("✔ Right: the {asked}."), RIGHT),
-                        false => (
-                            format!(
-                                "✘ No, that is the {}. The {asked} is highlighted.",
-                                name(answer.given)
-                            ),
-                            WRONG,
-                        ),
-                    };
-                    ui.colored_label(colour, text);
-                    let last = i + 1 == total;
-                    let next = ui.button(if last {
-                        "See the score"
-                    } else {
-                        "Next question ▶"
-                    });
-                    drawn.push(("next-question", next.rect));
-                    if next.clicked() {
-                        act = Act::Next;
-                    }
-                }
+        let words = doc.quiz_words();
+        ui.strong(&words.heading);
+        ui.label(&words.question);
+        let names = doc.case().structure_names();
+        let choices = run.current().map_or(&[][..], |(_, q)| &q.choices[..]);
+        const KEYS: [&str; 4] = ["choice-0", "choice-1", "choice-2", "choice-3"];
+        for (k, &c) in choices.iter().enumerate() {
+            let label = names.get(c).copied().unwrap_or("?");
+            let button = ui.add_enabled(run.answered().is_none(), egui::Button::new(label));
+            drawn.push((KEYS[k.min(3)], button.rect));
+            if button.clicked() {
+                act = Act::Answer(c);
             }
-            None => {
-                let (right, _) = run.score();
-                ui.strong("Quiz finished");
-                let percent = (100.0 * run.scaled()).round();
-                ui.label(format!("{right} of {total} right ({percent}%)."));
-                let mark = (100.0 * run.quiz().pass_mark).round();
-                match run.passed() {
-                    true => ui.colored_label(RIGHT, format!("Passed (the pass mark is {mark}%).")),
-                    false => ui.colored_label(
-                        WRONG,
-                        format!("Not passed yet (the pass mark is {mark}%)."),
-                    ),
-                };
-                let again = ui.button("Try again");
-                drawn.push(("again", again.rect));
-                if again.clicked() {
-                    act = Act::Again;
-                }
+        }
+        if let Some((good, text)) = &words.outcome {
+            let mark = if *good { "✔" } else { "✘" };
+            ui.colored_label(if *good { RIGHT } else { WRONG }, format!("{mark} {text}"));
+        }
+        if let Some((i, _)) = run.current().filter(|_| run.answered().is_some()) {
+            let last = i + 1 == run.questions().len();
+            let next = ui.button(if last {
+                "See the score"
+            } else {
+                "Next question ▶"
+            });
+            drawn.push(("next-question", next.rect));
+            if next.clicked() {
+                act = Act::Next;
+            }
+        }
+        if run.finished() {
+            let again = ui.button("Try again");
+            drawn.push(("again", again.rect));
+            if again.clicked() {
+                act = Act::Again;
             }
         }
         ui.separator();
