@@ -1,7 +1,7 @@
 //! The authoring page's Lesson panel: the tour's steps recorded from the view as it stands,
 //! their titles and captions edited, reordered, deleted and shown again; labels placed by
-//! clicking a structure in the view, their texts edited; the quiz's modes and pass mark. Every
-//! edit goes through `CaseDocument::set_lesson`, which checks it against the case.
+//! clicking a structure in the view, their texts edited; the quiz's modes, structures and pass
+//! mark. Every edit goes through `CaseDocument::set_lesson`, which checks it against the case.
 
 use eframe::egui;
 use glam::Vec3;
@@ -64,7 +64,10 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     }
     labels(ui, &mut lesson, &mut drawn);
     ui.separator();
-    quiz(ui, &mut lesson, &mut drawn);
+    let names: Vec<String> = (doc.case().structure_names().into_iter())
+        .map(str::to_string)
+        .collect();
+    quiz(ui, &mut lesson, &names, &mut drawn);
     (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
     if lesson != before {
         if let Err(e) = doc.case_mut().set_lesson(lesson) {
@@ -145,11 +148,16 @@ fn labels(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui:
     }
 }
 
-/// Whether the case asks a quiz, in which modes, and its pass mark; it asks the structures
-/// shown when the student starts it.
-fn quiz(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui::Rect)>) {
+/// Whether the case asks a quiz, in which modes, about which of the case's structures (`names`;
+/// none ticked: those shown when the student starts it), and its pass mark.
+fn quiz(
+    ui: &mut egui::Ui,
+    lesson: &mut Lesson,
+    names: &[String],
+    drawn: &mut Vec<(String, egui::Rect)>,
+) {
     let mut on = lesson.quiz.is_some();
-    let toggle = ui.checkbox(&mut on, "Quiz the student (the structures shown)");
+    let toggle = ui.checkbox(&mut on, "Quiz the student");
     drawn.push(("quiz-on".into(), toggle.rect));
     match (on, &mut lesson.quiz) {
         (false, quiz) => *quiz = None,
@@ -177,6 +185,20 @@ fn quiz(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui::R
             });
             // Find it before Name it, whatever order they were ticked in.
             quiz.modes.sort_by_key(|m| *m == QuizMode::NameIt);
+            ui.small("Asking about (none ticked: the structures shown):");
+            ui.horizontal_wrapped(|ui| {
+                for (i, name) in names.iter().enumerate() {
+                    let mut asked = quiz.structures.contains(name);
+                    let r = ui.checkbox(&mut asked, name);
+                    drawn.push((format!("quiz-structure-{i}"), r.rect));
+                    if r.changed() {
+                        quiz.structures.retain(|s| s != name);
+                        if asked {
+                            quiz.structures.push(name.clone());
+                        }
+                    }
+                }
+            });
             let mut percent = (quiz.pass_mark * 100.0).round();
             let slider = egui::Slider::new(&mut percent, 0.0..=100.0).text("pass mark %");
             if ui.add(slider).changed() {

@@ -357,6 +357,11 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         await lessonWhen((l) => l.quiz.modes.join() === "find-it", "Find it alone");
         await press("quiz-name-it");
         lesson = await lessonWhen((l) => l.quiz.modes.join() === "find-it,name-it", "both modes again");
+        // Asked about the liver and the kidney only.
+        await press("quiz-structure-3");
+        await press("quiz-structure-0");
+        lesson = await lessonWhen((l) => l.quiz.structures.length === 2, "two structures asked");
+        assert.deepEqual(lesson.quiz.structures, ["right_kidney", "liver"]);
         await app.screenshot("L5-lesson-panel");
         exported = Buffer.from(await app.call("exportCase", "glb"));
     });
@@ -366,6 +371,11 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         assert.deepEqual(s.view.labels.map((l) => l.text).sort(), ["Right kidney", "liver"]);
         assert.equal(s.quiz.running, false);
         assert.deepEqual(s.quiz.modes, ["find-it", "name-it"]);
+        await app.call("startQuiz");
+        const quiz = (await app.stateWhen((s) => s.quiz.running, "the quiz")).quiz;
+        assert.equal(quiz.questions, 4, "two structures in two modes");
+        assert.ok(["liver", "right_kidney"].includes(quiz.asked));
+        await app.call("endQuiz");
         await app.call("showStep", 2);
         await app.stateWhen((s) => s.tour.step === 2 && s.view.clip?.axis === "axial", "the third step, cut");
         await app.screenshot("L5-authored-step-3");
