@@ -31,17 +31,15 @@ impl Shell {
 
     /// The running quiz; whether one runs (the panel then shows nothing else).
     pub(super) fn quiz_panel(&mut self, ui: &mut egui::Ui) -> bool {
-        let mut doc = self.doc.borrow_mut();
+        let mut held = self.doc.borrow_mut();
+        let doc = &mut *held;
         doc.panel.lesson.clear();
-        if doc.quiz.is_none() {
-            return false;
-        }
-        // The structure list is not drawn while the quiz runs.
-        doc.panel.structures.clear();
-        doc.panel.structure_filter = None;
         let Some(run) = &doc.quiz else {
             return false;
         };
+        // The structure list is not drawn while the quiz runs.
+        doc.panel.structures.clear();
+        doc.panel.structure_filter = None;
         let mut drawn: Vec<(&'static str, egui::Rect)> = Vec::new();
         let mut act = Act::None;
         let words = doc.quiz_words();
@@ -92,7 +90,7 @@ impl Shell {
         if !matches!(act, Act::None) {
             ui.ctx().request_repaint();
         }
-        if let Err(e) = act.on(&mut doc) {
+        if let Err(e) = act.on(doc) {
             log::warn!("{e}");
         }
         true
