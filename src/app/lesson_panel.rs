@@ -44,12 +44,14 @@ impl Document {
 struct Asked {
     record: bool,
     show_step: Option<usize>,
+    /// Whether a control changed the lesson (the panel's copy of it then replaces the case's).
+    edited: bool,
 }
 
 /// The Lesson panel.
 pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
+    // The panel edits a copy: every edit must pass the case's checks before it lands.
     let mut lesson = doc.case().lesson().clone();
-    let before = lesson.clone();
     let mut drawn: Vec<(String, egui::Rect)> = Vec::new();
     let mut asked = Asked::default();
     let record = ui.button("Record the view as a step");
@@ -62,14 +64,12 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     if doc.placing_label {
         ui.small("Click a structure in the view where the label points.");
     }
-    labels(ui, &mut lesson, &mut drawn);
+    labels(ui, &mut lesson, &mut drawn, &mut asked);
     ui.separator();
-    let names: Vec<String> = (doc.case().structure_names().into_iter())
-        .map(str::to_string)
-        .collect();
-    quiz(ui, &mut lesson, &names, &mut drawn);
+    let names = doc.case().structure_names();
+    quiz(ui, &mut lesson, &names, &mut drawn, &mut asked);
     (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
-    if lesson != before {
+    if asked.edited {
         if let Err(e) = doc.case_mut().set_lesson(lesson) {
             // An emptied title or text: the edit waits for a non-empty one.
             log::info!("lesson edit refused: {e}");
@@ -100,6 +100,7 @@ fn steps(
         ui.horizontal(|ui| {
             ui.label(format!("{}.", i + 1));
             let title = ui.add(egui::TextEdit::singleline(&mut step.title).desired_width(130.0));
+            asked.edited |= title.changed();
             drawn.push((format!("step-title-{i}"), title.rect));
             let up = ui.add_enabled(i > 0, egui::Button::new("▲").small());
             let down = ui.add_enabled(i + 1 < count, egui::Button::new("▼").small());
@@ -121,6 +122,7 @@ fn steps(
                 .hint_text("Caption: what the student sees here"),
         );
         drawn.push((format!("step-caption-{i}"), caption.rect));
+        asked.edited |= caption.changed();
     }
     if let Some((a, b)) = moved {
         lesson.steps.swap(a, b);
@@ -128,16 +130,23 @@ fn steps(
     if let Some(i) = deleted {
         lesson.steps.remove(i);
     }
+    asked.edited |= moved.is_some() || deleted.is_some();
 }
 
 /// Each label's structure and text, and its delete button.
-fn labels(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui::Rect)>) {
+fn labels(
+    ui: &mut egui::Ui,
+    lesson: &mut Lesson,
+    drawn: &mut Vec<(String, egui::Rect)>,
+    asked: &mut Asked,
+) {
     let mut deleted = None;
     for (i, label) in lesson.labels.iter_mut().enumerate() {
         ui.horizontal(|ui| {
             ui.small(&label.structure);
             let text = ui.add(egui::TextEdit::singleline(&mut label.text).desired_width(120.0));
             let delete = ui.small_button("✕").on_hover_text("Delete the label");
+            asked.edited |= text.changed();
             drawn.push((format!("label-text-{i}"), text.rect));
             drawn.push((format!("label-delete-{i}"), delete.rect));
             deleted = deleted.or(delete.clicked().then_some(i));
@@ -145,6 +154,7 @@ fn labels(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui:
     }
     if let Some(i) = deleted {
         lesson.labels.remove(i);
+        asked.edited = true;
     }
 }
 
@@ -153,12 +163,14 @@ fn labels(ui: &mut egui::Ui, lesson: &mut Lesson, drawn: &mut Vec<(String, egui:
 fn quiz(
     ui: &mut egui::Ui,
     lesson: &mut Lesson,
-    names: &[String],
+    names: &[&str],
     drawn: &mut Vec<(String, egui::Rect)>,
+    asked: &mut Asked,
 ) {
     let mut on = lesson.quiz.is_some();
     let toggle = ui.checkbox(&mut on, "Quiz the student");
     drawn.push(("quiz-on".into(), toggle.rect));
+    asked.edited |= toggle.changed();
     match (on, &mut lesson.quiz) {
         (false, quiz) => *quiz = None,
         (true, None) => {
@@ -174,12 +186,15 @@ fn quiz(
                     (QuizMode::FindIt, "Find it", "quiz-find-it"),
                     (QuizMode::NameIt, "Name it", "quiz-name-it"),
                 ] {
-                    let mut asked = quiz.modes.contains(&mode);
-                    let r = ui.checkbox(&mut asked, word);
+                    let mut ticked = quiz.modes.contains(&mode);
+                    let r = ui.checkbox(&mut ticked, word);
                     drawn.push((key.into(), r.rect));
-                    quiz.modes.retain(|m| *m != mode);
-                    if asked {
-                        quiz.modes.push(mode);
+                    if r.changed() {
+                        asked.edited = true;
+                        quiz.modes.retain(|m| *m != mode);
+                        if ticked {
+                            quiz.modes.push(mode);
+                        }
                     }
                 }
             });
@@ -187,14 +202,15 @@ fn quiz(
             quiz.modes.sort_by_key(|m| *m == QuizMode::NameIt);
             ui.small("Asking about (none ticked: the structures shown):");
             ui.horizontal_wrapped(|ui| {
-                for (i, name) in names.iter().enumerate() {
-                    let mut asked = quiz.structures.contains(name);
-                    let r = ui.checkbox(&mut asked, name);
+                for (i, &name) in names.iter().enumerate() {
+                    let mut ticked = quiz.structures.iter().any(|s| s == name);
+                    let r = ui.checkbox(&mut ticked, name);
                     drawn.push((format!("quiz-structure-{i}"), r.rect));
                     if r.changed() {
+                        asked.edited = true;
                         quiz.structures.retain(|s| s != name);
-                        if asked {
-                            quiz.structures.push(name.clone());
+                        if ticked {
+                            quiz.structures.push(name.to_string());
                         }
                     }
                 }
@@ -202,6 +218,7 @@ fn quiz(
             let mut percent = (quiz.pass_mark * 100.0).round();
             let slider = egui::Slider::new(&mut percent, 0.0..=100.0).text("pass mark %");
             if ui.add(slider).changed() {
+                asked.edited = true;
                 quiz.pass_mark = percent / 100.0;
             }
         }
