@@ -36,7 +36,9 @@ pub(super) struct Shown {
     pub(super) legend: Option<Legend>,
     /// The version of the structures' looks and the slide towards the segmentation the other
     /// structures were uploaded for.
-    pub(super) looks: Option<(u64, u32, Option<usize>)>,
+    pub(super) looks: Option<(u64, u32)>,
+    /// The structure singled out (by the quiz) when the colours were last set.
+    pub(super) highlight: Option<Option<usize>>,
     /// The checks' marks and the looks' version they were uploaded for.
     pub(super) marks: (Option<u64>, u64),
 }
@@ -89,10 +91,16 @@ impl Shell {
             shown.colors = colors;
         }
         let highlight = doc.quiz_highlight();
-        let looks = (session.case().case_version(), toward.to_bits(), highlight);
+        let looks = (session.case().case_version(), toward.to_bits());
         if shown.looks != Some(looks) {
             upload_looks(viewer, rs, session, (toward, highlight));
             shown.looks = Some(looks);
+            shown.highlight = Some(highlight);
+        } else if shown.highlight != Some(highlight) {
+            // Only the colours change: the surfaces stay where they are on the GPU.
+            viewer.set_context_colors(rs, &context_colors(session, highlight));
+            set_model_look(viewer, session, highlight);
+            shown.highlight = Some(highlight);
         }
         let marks = (
             session.background().marks_key(),
@@ -235,12 +243,6 @@ fn upload_looks(
     session: &Session,
     (toward, highlight): (f32, Option<usize>),
 ) {
-    let look = |index: usize, mut color: [f32; 4]| {
-        if highlight.is_some_and(|h| h != index) {
-            color[3] *= FADED;
-        }
-        color
-    };
     let others = session.case().other_structures();
     let list = session.case().case_structures();
     let moved: Vec<Option<Vec<[f32; 3]>>> = (others.iter())
@@ -251,20 +253,43 @@ fn upload_looks(
                 .flatten()
         })
         .collect();
-    let surfaces: Vec<viewer::ContextSurface<'_>> = (others.iter().zip(&moved))
-        .map(|(o, moved)| viewer::ContextSurface {
+    let colors = context_colors(session, highlight);
+    let surfaces: Vec<viewer::ContextSurface<'_>> = (others.iter().zip(&moved).zip(colors))
+        .map(|((o, moved), color)| viewer::ContextSurface {
             positions: moved.as_deref().unwrap_or(o.positions),
             triangles: o.triangles,
-            color: look(o.index, o.color).map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
+            color,
             closed: o.closed,
         })
         .collect();
     viewer.set_context(rs, &surfaces);
     viewer.set_image(rs, session.case().case_image());
+    set_model_look(viewer, session, highlight);
+}
+
+/// A structure's colour, faded where another (`highlight`) is singled out.
+fn look(index: usize, mut color: [f32; 4], highlight: Option<usize>) -> [f32; 4] {
+    if highlight.is_some_and(|h| h != index) {
+        color[3] *= FADED;
+    }
+    color
+}
+
+/// The colours of the case's other structures, in `other_structures`' order.
+fn context_colors(session: &Session, highlight: Option<usize>) -> Vec<[u8; 4]> {
+    (session.case().other_structures().iter())
+        .map(|o| {
+            look(o.index, o.color, highlight).map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
+        })
+        .collect()
+}
+
+/// The model's look as a structure of the case.
+fn set_model_look(viewer: &mut viewer::Viewer, session: &Session, highlight: Option<usize>) {
     let model = session.case().model_structure();
     let current = session.case().current_structure().unwrap_or_default();
     viewer.set_model_look(
-        model.map(|l| look(current, l.color)),
+        model.map(|l| look(current, l.color, highlight)),
         model.is_none_or(|l| l.visible),
         model.is_some_and(|l| l.closed_outward()),
     );

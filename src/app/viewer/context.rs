@@ -48,6 +48,14 @@ impl ContextMesh {
             centre: centre(surface.positions),
         })
     }
+
+    /// A new colour and opacity for the whole structure.
+    pub fn recolor(&mut self, queue: &wgpu::Queue, color: [u8; 4]) -> Result<(), String> {
+        let count = self.buffers.vertex_count as usize;
+        self.buffers.set_colors(queue, &vec![color; count])?;
+        self.opaque = color[3] == 255;
+        Ok(())
+    }
 }
 
 /// Every one of `surfaces` on the GPU, or why not.

@@ -189,6 +189,28 @@ impl Viewer {
         }
     }
 
+    /// New colours for the structures `set_context` gave, in the same order; their surfaces
+    /// stay as uploaded.
+    pub fn set_context_colors(&mut self, rs: &egui_wgpu::RenderState, colors: &[[u8; 4]]) {
+        let result = with_resources(rs, |view| {
+            if view.context.len() != colors.len() {
+                return Err(format!(
+                    "{} colours for {} structures",
+                    colors.len(),
+                    view.context.len()
+                ));
+            }
+            for (mesh, &color) in view.context.iter_mut().zip(colors) {
+                mesh.recolor(&rs.queue, color)?;
+            }
+            view.context_generation += 1;
+            Ok(())
+        });
+        if let Err(e) = result {
+            self.fail(e);
+        }
+    }
+
     /// Marks drawn over everything (replacing those set before): where the last checks'
     /// warnings lie.
     pub fn set_marks(&mut self, rs: &egui_wgpu::RenderState, surfaces: &[ContextSurface<'_>]) {
