@@ -8,20 +8,56 @@ use glam::Vec2;
 
 use super::document::Document;
 use super::viewer::Viewer;
-use crate::view::{label_spots, Ray};
+use crate::view::{label_spots, LabelSpot, OrbitCamera, Ray};
 
-/// Draws the labels of the open case that the view shows; returns each drawn label's text, its
-/// point on the page and whether it is faded.
-pub fn paint(
-    ui: &egui::Ui,
-    rect: egui::Rect,
-    viewer: &Viewer,
-    doc: &Document,
-) -> Vec<(String, [f32; 2], bool)> {
-    let labels = &doc.case().lesson().labels;
-    if labels.is_empty() {
-        return Vec::new();
+/// The labels' spots as last worked out, and for what: each label's fading casts a ray through
+/// every opaque structure, so it is done again only when the view or the case changed.
+#[derive(Default)]
+pub struct LabelPainter {
+    asked: Option<Asked>,
+    spots: Vec<LabelSpot>,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+struct Asked {
+    camera: OrbitCamera,
+    plane: [f32; 4],
+    size: [f32; 2],
+    /// The case's version (its lesson and looks) and its results' revision (its surfaces).
+    case: (u64, u64),
+}
+
+impl LabelPainter {
+    /// Draws the labels of the open case that the view shows; returns each drawn label's
+    /// text, its point on the page and whether it is faded.
+    pub fn paint(
+        &mut self,
+        ui: &egui::Ui,
+        rect: egui::Rect,
+        viewer: &Viewer,
+        doc: &Document,
+    ) -> Vec<(String, [f32; 2], bool)> {
+        let labels = &doc.case().lesson().labels;
+        if labels.is_empty() {
+            return Vec::new();
+        }
+        let asked = Asked {
+            camera: *viewer.camera(),
+            plane: viewer.clip_plane(),
+            size: [rect.width(), rect.height()],
+            case: (doc.case().case_version(), doc.case().revision()),
+        };
+        if self.asked != Some(asked) {
+            self.spots = spots(rect, viewer, doc);
+            self.asked = Some(asked);
+        }
+        draw(ui, rect, &self.spots, doc)
     }
+}
+
+/// Where the case's labels go in the view, and which are faded.
+fn spots(rect: egui::Rect, viewer: &Viewer, doc: &Document) -> Vec<LabelSpot> {
+    let labels = &doc.case().lesson().labels;
     let visible: HashSet<&str> = (doc.case().case_structures().iter())
         .filter(|s| s.visible)
         .map(|s| s.name.as_str())
@@ -34,12 +70,24 @@ pub fn paint(
         let (i, hit) = doc.case().opaque_at(ray, plane)?;
         Some((hit.distance, structures[i].name == structure))
     };
-    let spots = label_spots(labels, shown, (viewer.camera(), nearest), size, plane);
+    label_spots(labels, shown, (viewer.camera(), nearest), size, plane)
+}
+
+/// The labels at `spots`, each with its point, leader line and text.
+fn draw(
+    ui: &egui::Ui,
+    rect: egui::Rect,
+    spots: &[LabelSpot],
+    doc: &Document,
+) -> Vec<(String, [f32; 2], bool)> {
+    let labels = &doc.case().lesson().labels;
     let painter = ui.painter_at(rect);
     let font = egui::FontId::proportional(14.0);
     let mut drawn = Vec::with_capacity(spots.len());
     for spot in spots {
-        let label = &labels[spot.index];
+        let Some(label) = labels.get(spot.index) else {
+            continue;
+        };
         // A label whose point lies behind a surface stays, faint, so it does not jump away.
         let (ink, shade) = match spot.faded {
             false => (egui::Color32::from_gray(240), 170),

@@ -11,6 +11,7 @@ use super::drag_params::DragParams;
 use super::file_input::{Arrived, FileInput, FilesFor};
 use super::gpu_engine::{GpuEngine, Sent};
 use super::guide::Guide;
+use super::labels::LabelPainter;
 use super::picture::Picture;
 use super::pointing::Pointing;
 use super::shortcuts::{self, Action};
@@ -79,6 +80,7 @@ pub struct Shell {
     reading_filter: String,
     /// The structure under the pointer.
     pointing: Pointing,
+    labels: LabelPainter,
     /// The page that embeds this one (`?parent=ORIGIN`), told what happens here.
     embedding: Option<api::Embedding>,
     /// A picture of the view asked for.
@@ -199,6 +201,7 @@ impl Shell {
             reading,
             reading_filter: String::new(),
             pointing: Pointing::default(),
+            labels: LabelPainter::default(),
             embedding,
             picture: Picture::default(),
             link,

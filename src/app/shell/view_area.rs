@@ -8,7 +8,7 @@ use super::Shell;
 use crate::app::document::Document;
 use crate::app::layout::ViewReport;
 use crate::app::pointing::Pointing;
-use crate::app::{labels, legend, orientation_marker, status, view_tools, viewer};
+use crate::app::{legend, orientation_marker, status, view_tools, viewer};
 
 impl Shell {
     /// The 3D view with its legend, its tools and the messages over it; the structure under
@@ -52,7 +52,7 @@ impl Shell {
                 let quiet = doc.view_asks.hide_labels || doc.quiz.is_some();
                 let labels = match quiet || self.picture.pending {
                     true => Vec::new(),
-                    false => labels::paint(ui, response.rect, viewer, doc),
+                    false => self.labels.paint(ui, response.rect, viewer, doc),
                 };
                 // A picture shows the view alone (and which way the patient lies).
                 if !self.picture.pending {
