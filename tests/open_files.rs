@@ -133,3 +133,32 @@ fn files_opened_together_make_the_case_the_cli_makes() {
     assert!(why.contains("a.txt") && why.contains("b.txt"), "{why}");
     assert!(session.case().model().is_none());
 }
+
+/// A surface opened after a segmentation keeps the filter and parameters the author was
+/// trying, but not the displacement bound, which was half the last structure's voxel diagonal.
+#[test]
+fn a_surface_opened_after_a_segmentation_keeps_its_settings_but_not_its_voxel_bound() {
+    let mut session = Session::default();
+    let map = read("labelmaps/case_phantom_shared.seg.nrrd");
+    session
+        .open("case_phantom_shared.seg.nrrd", &map)
+        .expect("opens");
+    let mut liver = *session.case().params();
+    assert_eq!(liver.max_displacement, Some(1.3662723), "the liver's bound");
+    liver.iterations = 17;
+    session.case_mut().set_params(liver).expect("set");
+    let tube = read("synthetic/synthetic_bent_tube_r3.5.ply");
+    session.open("tube.ply", &tube).expect("opens");
+    let kept = *session.case().params();
+    assert_eq!(kept.max_displacement, None);
+    assert_eq!(
+        (kept.filter, kept.alpha, kept.beta, kept.iterations),
+        (liver.filter, liver.alpha, liver.beta, 17)
+    );
+    // A bound the author chose for a surface stays with the next one.
+    let mut chosen = kept;
+    chosen.max_displacement = Some(0.4);
+    session.case_mut().set_params(chosen).expect("set");
+    session.open("again.ply", &tube).expect("opens");
+    assert_eq!(session.case().params().max_displacement, Some(0.4));
+}

@@ -196,9 +196,19 @@ impl CaseDocument {
                 Format::from_name(first_file),
                 Some(Format::Glb | Format::Gltf)
             );
-        let before = (self.structure())
-            .filter(|_| !own_settings)
-            .map(|s| (s.params, s.other_params.clone(), s.tau));
+        let before = (self.structure()).filter(|_| !own_settings).map(|s| {
+            // Half the last structure's voxel diagonal was a bound for its voxels, not this
+            // surface's.
+            let voxels = s.default_bound();
+            let unbound = |mut p: Params| {
+                if voxels.is_some() && p.max_displacement == voxels {
+                    p.max_displacement = None;
+                }
+                p
+            };
+            let others = s.other_params.iter().copied().map(unbound).collect();
+            (unbound(s.params), others, s.tau)
+        });
         self.case = case;
         self.case_file = file.to_string();
         self.current = 0;
