@@ -513,18 +513,21 @@ mod tests {
 
     wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
 
+    /// A voxelised bent tube: one small staircase surface.
+    const TUBE_NAME: &str = "bent_tube_staircase.ply";
+    const TUBE: &[u8] = include_bytes!("../../tests/data/bent_tube_staircase.ply");
+
     #[wasm_bindgen_test]
     fn a_bad_file_keeps_the_previous_model_and_reports_why() {
         let mut doc = Document::new(Backend::Cpu);
-        doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
-            .unwrap();
+        doc.open(TUBE_NAME, TUBE).unwrap();
         let generation = doc.session.case().model_id();
         let error = doc.open("notes.txt", b"not a mesh").unwrap_err();
         assert!(error.starts_with("Cannot open notes.txt: "), "{error}");
         assert!(error.contains(".stl .obj .ply"), "{error}");
         assert_eq!(doc.session.case().model_id(), generation);
         let state = doc.state_json();
-        assert_eq!(state["model"], crate::app::SAMPLE_NAME);
+        assert_eq!(state["model"], TUBE_NAME);
         assert_eq!(state["error"], error.as_str());
         assert!(doc.open("empty.stl", b"").unwrap_err().contains("empty"));
     }
@@ -535,8 +538,7 @@ mod tests {
         let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
         let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
         doc.session.set_cpu_engine(pool);
-        doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
-            .unwrap();
+        doc.open(TUBE_NAME, TUBE).unwrap();
         assert!(
             !doc.step_cpu_engine(),
             "the smoothing is asked, not answered"
@@ -561,8 +563,7 @@ mod tests {
     #[wasm_bindgen_test]
     fn waiting_calls_are_answered_once_the_result_is_computed() {
         let mut doc = Document::new(Backend::Cpu);
-        doc.open(crate::app::SAMPLE_NAME, crate::app::SAMPLE_BYTES)
-            .unwrap();
+        doc.open(TUBE_NAME, TUBE).unwrap();
         let answered = Rc::new(Cell::new(0));
         let seen = answered.clone();
         doc.when_current(Box::new(move |s| {
@@ -582,7 +583,7 @@ mod tests {
         assert_eq!(
             (model.report.vertices, model.report.faces),
             (2296, 4588),
-            "the bundled sample"
+            "the tube"
         );
     }
 }

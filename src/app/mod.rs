@@ -72,9 +72,10 @@ fn wake(ctx: &eframe::egui::Context) {
     ctx.request_repaint_after(std::time::Duration::from_millis(1));
 }
 
-/// The mesh shown when the app opens: a voxelised bent tube (a staircase vessel surface).
-pub const SAMPLE_NAME: &str = "bent_tube_staircase.ply";
-pub const SAMPLE_BYTES: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+/// The case the pages open at start: a synthetic abdomen's four structures, smoothed from their
+/// label map, with a tour, labels and a quiz (built by `web/sample/build.sh`).
+pub const SAMPLE_NAME: &str = "abdomen_phantom.glb";
+pub const SAMPLE_BYTES: &[u8] = include_bytes!("../../web/sample/abdomen_phantom.glb");
 
 /// Entry point of the wasm32 binary.
 pub fn start() {

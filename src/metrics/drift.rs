@@ -320,7 +320,7 @@ mod resume_tests {
 
     #[test]
     fn a_drift_resumed_from_its_state_goes_on_as_if_never_stopped() {
-        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let bytes = include_bytes!("../../tests/data/bent_tube_staircase.ply");
         let mesh = crate::io::load(bytes, "sample.ply").unwrap();
         let original = Original::new(&mesh, &crate::mesh::Topology::build(&mesh));
         let steps = steps(&original, 12);

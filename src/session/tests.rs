@@ -5,7 +5,7 @@ use crate::io;
 use crate::metrics::{self, DriftingReference, VertexMeasures};
 use crate::smooth::{Filter, Params};
 
-const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+const SAMPLE: &[u8] = include_bytes!("../../tests/data/bent_tube_staircase.ply");
 
 /// A result's per-vertex measures, as an engine hands them over.
 fn vertex(r: &Smoothed) -> VertexMeasures {

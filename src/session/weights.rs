@@ -117,7 +117,7 @@ mod tests {
     use crate::session::Session;
     use crate::smooth::Filter;
 
-    const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+    const SAMPLE: &[u8] = include_bytes!("../../tests/data/bent_tube_staircase.ply");
 
     fn sample_session() -> Session {
         let mut s = Session::default();

@@ -386,7 +386,7 @@ mod tests {
         assert_eq!(Plan::choose(rings, 64), Plan::TwoPass);
         // The sample tube has three chunks: one thread sweeps them, more take two passes.
         let tube = crate::io::load(
-            include_bytes!("../../web/sample/bent_tube_staircase.ply"),
+            include_bytes!("../../tests/data/bent_tube_staircase.ply"),
             "tube.ply",
         )
         .expect("the sample");

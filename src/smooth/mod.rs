@@ -289,7 +289,7 @@ mod tests {
     /// The bundled sample, its topology and uneven weights (0, 0.5, 1 in turn).
     fn sample_with_weights() -> (Mesh, Topology, Vec<f32>) {
         let mesh = crate::io::load(
-            include_bytes!("../../web/sample/bent_tube_staircase.ply"),
+            include_bytes!("../../tests/data/bent_tube_staircase.ply"),
             "tube.ply",
         )
         .unwrap();

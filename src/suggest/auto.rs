@@ -183,7 +183,7 @@ mod tests {
 
     #[test]
     fn only_hcs_local_search_resumes_runs_from_kept_states() {
-        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let bytes = include_bytes!("../../tests/data/bent_tube_staircase.ply");
         let mesh = crate::io::load(bytes, "tube.ply").expect("the sample");
         let topology = Topology::build(&mesh);
         let original = Original::new(&mesh, &topology);

@@ -294,7 +294,7 @@ mod tests {
 
     #[test]
     fn a_run_that_moves_nothing_is_answered_without_smoothing_and_truthfully() {
-        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let bytes = include_bytes!("../../tests/data/bent_tube_staircase.ply");
         let mesh = crate::io::load(bytes, "sample.ply").unwrap();
         let original = Original::new(&mesh, &crate::mesh::Topology::build(&mesh));
         let mut params = Params::defaults(Filter::Laplace);
@@ -319,7 +319,7 @@ mod tests {
     }
 
     fn bent_tube() -> Original {
-        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let bytes = include_bytes!("../../tests/data/bent_tube_staircase.ply");
         let mesh = crate::io::load(bytes, "sample.ply").unwrap();
         Original::new(&mesh, &crate::mesh::Topology::build(&mesh))
     }
@@ -372,7 +372,7 @@ mod tests {
 
     #[test]
     fn bounds_are_the_terms_without_the_local_error() {
-        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let bytes = include_bytes!("../../tests/data/bent_tube_staircase.ply");
         let mesh = crate::io::load(bytes, "sample.ply").unwrap();
         let original = Original::new(&mesh, &crate::mesh::Topology::build(&mesh));
         let mut ev = MeshEvaluator::new(&original, None).unwrap();

@@ -155,7 +155,7 @@ mod tests {
 
     #[test]
     fn the_bundled_sample_is_flat_and_seen_face_on() {
-        let bytes = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+        let bytes = include_bytes!("../../tests/data/bent_tube_staircase.ply");
         let mesh = crate::io::load(bytes, "bent_tube_staircase.ply").expect("the sample loads");
         let (flatness, axis) = thinnest_axis(&mesh.positions).expect("an axis");
         assert!(flatness < 0.4, "flatness {flatness}");

@@ -211,7 +211,7 @@ mod tests {
 
     fn sample() -> Mesh {
         crate::io::load(
-            include_bytes!("../../web/sample/bent_tube_staircase.ply"),
+            include_bytes!("../../tests/data/bent_tube_staircase.ply"),
             "tube.ply",
         )
         .unwrap()

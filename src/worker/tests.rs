@@ -5,7 +5,7 @@ use crate::io;
 use crate::model::Model;
 use crate::smooth::Filter;
 
-const SAMPLE: &[u8] = include_bytes!("../../web/sample/bent_tube_staircase.ply");
+const SAMPLE: &[u8] = include_bytes!("../../tests/data/bent_tube_staircase.ply");
 
 fn sample() -> Original {
     let mesh = io::load(SAMPLE, "bent_tube_staircase.ply").unwrap();

@@ -16,7 +16,7 @@ import * as cli from "./lib/cli.mjs";
 import { jsonDifferences, metricDifferences, relativeDifference } from "./lib/compare.mjs";
 import { gltfValidator } from "./lib/deps.mjs";
 import { colourAt, colourHistogram, flatBoxes } from "./lib/png.mjs";
-import { E2E_OUT, meshPath } from "./lib/paths.mjs";
+import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
 import { CPU_RUN, EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const tmp = mkdtempSync(join(tmpdir(), "meshsmooth-e2e-"));
@@ -25,7 +25,15 @@ after(() => rmSync(tmp, { recursive: true, force: true }));
 // The start itself is under test here: pages are handed over before their API is up.
 const { MODE, OUT, withApp } = appSuite({ beforeAll: () => cli.requireCli(), waitForApi: false });
 
-const SAMPLE = { name: "bent_tube_staircase.ply", vertices: 2296, faces: 4588 };
+/** The bundled sample case (web/sample/abdomen_phantom.glb) as the page opens it: its first
+ * structure is the model. */
+const SAMPLE = {
+    name: "abdomen_phantom.glb: liver",
+    vertices: 22644,
+    faces: 45292,
+    structures: ["liver", "portal_vein", "tumor", "right_kidney"],
+    lesson: JSON.parse(readFileSync(join(ROOT, "web/sample/abdomen_phantom_lesson.json"), "utf8")),
+};
 const TORUS = meshPath("synthetic/synthetic_torus_R24_r8.ply");
 const SCALP = meshPath("real/fsaverage_head_scalp_mne.ply");
 const BRAIN = meshPath("segmentations/seg_mni152_gm_plus_wm_p0.5_1mm.ply");
@@ -123,7 +131,27 @@ testIn(EVERY_RUN, "1b the API reports the sample and the engine backend", { time
         assert.equal(state.error, null, "state().error");
         assert.equal(typeof state.busy, "boolean", "state().busy");
         assert.equal(await app.backend(), MODES[MODE].backend, `backend() in the ${MODE} run`);
+        // A whole case: every structure, and its lesson in the Lesson panel.
+        assert.deepEqual(state.structures.structures.map((s) => s.name), SAMPLE.structures);
+        assert.equal(state.tour.steps, SAMPLE.lesson.steps.length, "state().tour.steps");
+        assert.ok(state.quiz !== null, "the sample has a quiz");
     });
+});
+
+testIn(EVERY_RUN, "1c the viewer opens the same sample case: its structures, tour, labels and quiz", { timeout: 120_000 }, async () => {
+    await withApp(async (app) => {
+        const texts = SAMPLE.lesson.labels.map((l) => l.text);
+        const state = await app.stateWhen(
+            (s) => s.structures?.structures.length === SAMPLE.structures.length && s.view.labels.length === texts.length,
+            "the sample's structures and labels",
+        );
+        assert.equal(state.mode, "viewer");
+        assert.equal(state.model, SAMPLE.name);
+        assert.deepEqual(state.view.labels.map((l) => l.text).sort(), [...texts].sort());
+        assert.equal(state.tour.steps, SAMPLE.lesson.steps.length);
+        assert.ok(state.layout.lesson.start && state.layout.lesson.quiz, "the tour's and the quiz's buttons");
+        await app.screenshot("01c-viewer-sample");
+    }, { query: "?mode=viewer" });
 });
 
 // --- 2: privacy ---

@@ -11,7 +11,9 @@ import { ROOT, meshPath } from "./lib/paths.mjs";
 import { CPU_RUN, EVERY_RUN, WEBGPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
-const SAMPLE = join(ROOT, "web/sample/bent_tube_staircase.ply");
+const TUBE = join(ROOT, "tests/data/bent_tube_staircase.ply");
+/** A small staircase vessel, opened in place of the page's sample case. */
+const openTube = (app) => app.loadMesh(readFileSync(TUBE), "bent_tube_staircase.ply");
 /** The background searches run the same Rust code on the CPU in both modes (wasm: one thread,
  * so f64 sums may differ in order from the native CLI's: 1e-9 relative allows that). */
 const RTOL = 1e-9;
@@ -33,10 +35,11 @@ function assertClose(actual, expected, what) {
 
 testIn(EVERY_RUN, "G1 suggest() equals the CLI's suggest --json for the same mesh, filter and tau", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
+        await openTube(app);
         await app.call("setFilter", "laplace");
         for (const search of ["local", "grid"]) {
             const got = await app.call("suggest", { tau: 0.6, search });
-            const want = await cli.cliJson("suggest", SAMPLE, "--filter", "laplace", "--tau", "0.6", "--search", search, "--json");
+            const want = await cli.cliJson("suggest", TUBE, "--filter", "laplace", "--tau", "0.6", "--search", search, "--json");
             assert.deepEqual(got.params, want.params, `${search}: parameters`);
             assert.equal(got.evaluations, want.evaluations, `${search}: evaluations`);
             assertClose(got.terms, want.terms, `${search}: terms`);
@@ -56,7 +59,7 @@ testIn(EVERY_RUN, "G1 suggest() equals the CLI's suggest --json for the same mes
         // ...and the measures are those of the CLI smoothing with the suggested parameters.
         const given = Object.fromEntries(Object.entries(suggested).filter(([, v]) => v !== null));
         const out = join(mkdtempSync(join(tmpdir(), "meshsmooth-g1-")), "s.ply");
-        const reference = await cli.smooth(SAMPLE, out, "laplace", given);
+        const reference = await cli.smooth(TUBE, out, "laplace", given);
         // The CLI's score is for its default tau 0.5; the page's for the tau just set (0.6).
         const { score: _a, ...measured } = metrics;
         const { score: _b, ...expected } = reference.metrics;
@@ -66,11 +69,12 @@ testIn(EVERY_RUN, "G1 suggest() equals the CLI's suggest --json for the same mes
 
 testIn(WEBGPU_RUN, "G1b on WebGPU with ?guidance=gpu, suggest() runs on the GPU engine and equals the CLI's", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
+        await openTube(app);
         await app.call("setFilter", "laplace");
         for (const search of ["local", "grid"]) {
             const got = await app.call("suggest", { tau: 0.6, search });
             assert.equal((await state(app)).guidance.engine, "webgpu", "the background ran on the GPU");
-            const want = await cli.cliJson("suggest", SAMPLE, "--filter", "laplace", "--tau", "0.6", "--search", search, "--json");
+            const want = await cli.cliJson("suggest", TUBE, "--filter", "laplace", "--tau", "0.6", "--search", search, "--json");
             assert.deepEqual(got.params, want.params, `${search}: parameters`);
             // f32 WGSL against the CLI's f64 sums, as metrics() on WebGPU.
             assert.deepEqual(jsonDifferences(got.terms, want.terms, 1e-4), [], `${search}: terms`);
@@ -81,8 +85,13 @@ testIn(WEBGPU_RUN, "G1b on WebGPU with ?guidance=gpu, suggest() runs on the GPU 
 
 testIn(WEBGPU_RUN, "G2 sweep() equals the CLI's sweep --json; a click in a graph sets the parameter", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
+        await openTube(app);
         const got = await app.call("sweep");
-        const want = await cli.cliJson("sweep", SAMPLE, "--filter", "hc", "--json");
+        // Around the parameters the page has (a surface opened keeps those the author was trying).
+        const { filter, params } = await state(app);
+        assert.equal(filter, "hc", "the sample's filter, kept");
+        const around = ["alpha", "beta", "iterations"].flatMap((k) => [`--${k}`, String(params[k])]);
+        const want = await cli.cliJson("sweep", TUBE, "--filter", filter, ...around, "--json");
         assert.deepEqual(got.current, want.current);
         assert.equal(got.curves.length, 3);
         for (const [k, curve] of got.curves.entries()) {
@@ -94,13 +103,14 @@ testIn(WEBGPU_RUN, "G2 sweep() equals the CLI's sweep --json; a click in a graph
         const before = await state(app);
         const shot = await app.screenshot("guidance-graphs");
         console.log(`graphs screenshot: ${shot.path}`);
-        // A click in the iterations column's error strip, at 30 iterations (from where the
-        // page says it drew the strip), sets the iterations to 30.
+        // A click in the iterations column's error strip, at another count than the current
+        // one (from where the page says it drew the strip), sets the iterations to it.
+        const target = before.params.iterations === 20 ? 30 : 20;
         const column = before.layout.graphs.find((c) => c.param === "iterations");
         assert.ok(column, `state().layout.graphs: ${JSON.stringify(before.layout.graphs)}`);
         assert.equal(column.strips.length, 4);
         const strip = column.strips[1];
-        await app.page.mouse.click(xOfValue(strip, 30), strip.y + strip.height / 2);
+        await app.page.mouse.click(xOfValue(strip, target), strip.y + strip.height / 2);
         await app.page.waitForFunction(
             (it) => window.meshsmooth.state().params.iterations !== it,
             before.params.iterations,
@@ -108,7 +118,7 @@ testIn(WEBGPU_RUN, "G2 sweep() equals the CLI's sweep --json; a click in a graph
         );
         const after = await state(app);
         assert.equal(after.params.alpha, before.params.alpha, "only the clicked parameter changes");
-        assert.equal(after.params.iterations, 30);
+        assert.equal(after.params.iterations, target);
         await app.screenshotWhen(
             "guidance-graphs-after-click",
             () => true,
@@ -122,11 +132,12 @@ testIn(WEBGPU_RUN, "G2 sweep() equals the CLI's sweep --json; a click in a graph
 
 testIn(WEBGPU_RUN, "G3 the gallery shows five results; a click on one takes its tau and parameters", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
+        await openTube(app);
         await app.call("setFilter", "laplace");
         const picks = await app.call("gallery");
         assert.deepEqual(picks.map((p) => p.tau), [0.1, 0.3, 0.5, 0.7, 0.9]);
         for (const p of picks) {
-            const want = await cli.cliJson("suggest", SAMPLE, "--filter", "laplace", "--tau", String(p.tau), "--search", "local", "--json");
+            const want = await cli.cliJson("suggest", TUBE, "--filter", "laplace", "--tau", String(p.tau), "--search", "local", "--json");
             assert.deepEqual(p.params, want.params, `tau ${p.tau}`);
         }
         // Pictures are drawn one per frame after the gallery is made.

@@ -3,7 +3,7 @@ use crate::metrics;
 use crate::suggest::{quality_graphs, suggest, Evaluator, Terms};
 use std::cell::Cell;
 
-const SAMPLE: &[u8] = include_bytes!("../../../web/sample/bent_tube_staircase.ply");
+const SAMPLE: &[u8] = include_bytes!("../../../tests/data/bent_tube_staircase.ply");
 
 fn session(filter: &str) -> Session {
     let mut s = Session::default();
