@@ -98,11 +98,15 @@ fn draw(
         painter.line_segment([point, text], egui::Stroke::new(1.5, ink));
         painter.circle_filled(point, 3.0, ink);
         let galley = painter.layout_no_wrap(label.text.clone(), font.clone(), ink);
-        // The text on the side of its end away from the point.
-        let left = if spot.text.x < spot.point.x {
-            text.x - galley.size().x - 6.0
-        } else {
-            text.x + 6.0
+        // The text on the side of its end away from the point, unless the view's edge would
+        // cut it there.
+        let width = galley.size().x;
+        let (before, after) = (text.x - width - 6.0, text.x + 6.0);
+        let left = match spot.text.x < spot.point.x {
+            true if before < rect.left() => after,
+            false if after + width > rect.right() => before,
+            true => before,
+            false => after,
         };
         let corner = egui::pos2(left, text.y - galley.size().y / 2.0);
         let plate = egui::Rect::from_min_size(corner, galley.size()).expand(3.0);
