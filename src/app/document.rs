@@ -125,6 +125,8 @@ pub struct Document {
     pub quiz: Option<crate::view::QuizRun>,
     /// The author's next click in the view places a label.
     pub placing_label: bool,
+    /// The author sees the case as the student will, in the viewer's panel, without exporting.
+    pub previewing: bool,
     /// What the lesson's player tells the embedding page (event, detail), in order.
     pub lesson_events: Vec<(&'static str, serde_json::Value)>,
     waiting: Vec<Waiter>,
@@ -190,6 +192,7 @@ impl Document {
             tour_left: None,
             quiz: None,
             placing_label: false,
+            previewing: false,
             lesson_events: Vec::new(),
             waiting: Vec::new(),
             waiting_for: Vec::new(),
@@ -421,6 +424,7 @@ impl Document {
         let mut state = super::api::json::session_state(&self.session, self.busy());
         state["backend"] = serde_json::json!(self.backend.name());
         state["mode"] = serde_json::json!(if self.reading { "viewer" } else { "author" });
+        state["preview"] = serde_json::json!(self.previewing);
         state["shortcuts"] = serde_json::json!(self.shortcuts);
         // The page's own memory beside its workers' (each instance's peak: it only grows).
         state["memory"] = serde_json::json!({

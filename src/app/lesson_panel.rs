@@ -37,6 +37,12 @@ impl Document {
         });
         self.case_mut().set_lesson(lesson)
     }
+
+    /// Back from the preview to authoring: a quiz taken there ends (it asked nothing of the case).
+    pub fn end_preview(&mut self) {
+        self.previewing = false;
+        self.end_quiz();
+    }
 }
 
 /// What the panel's controls asked this frame besides edits of the lesson itself.
@@ -54,6 +60,14 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     let mut lesson = doc.case().lesson().clone();
     let mut drawn: Vec<(String, egui::Rect)> = Vec::new();
     let mut asked = Asked::default();
+    let preview = ui.button("Preview as the student sees it");
+    drawn.push(("preview".into(), preview.rect));
+    if preview.clicked() {
+        doc.previewing = true;
+        doc.placing_label = false;
+        ui.ctx().request_repaint();
+    }
+    ui.separator();
     let record = ui.button("Record the view as a step");
     drawn.push(("record".into(), record.rect));
     asked.record = record.clicked();

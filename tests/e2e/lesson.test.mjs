@@ -381,3 +381,34 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         await app.screenshot("L5-authored-step-3");
     }, { query: "?mode=viewer&case=cases/authored.glb", routes: { "cases/authored.glb": exported } });
 });
+
+testIn(EVERY_RUN, "L6 the author previews the sample's lesson as the student sees it, without exporting, and comes back", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        const sample = JSON.parse(readFileSync(join(ROOT, "web/sample/abdomen_phantom_lesson.json"), "utf8"));
+        await app.stateWhen((s) => s.loading === null && s.tour.steps === sample.steps.length && s.layout.lesson?.["lesson-tab"], "the sample case with its lesson");
+        const centreOf = (r) => [r.x + r.width / 2, r.y + r.height / 2];
+        const press = async (key) => {
+            const state = await app.stateWhen((s) => s.layout.lesson?.[key], `the ${key} button`);
+            await app.page.mouse.click(...centreOf(state.layout.lesson[key]));
+            await frames(app);
+        };
+        await press("lesson-tab");
+        await press("preview");
+        // The viewer's panel: the tour, the quiz, the case's list; no smoothing panel.
+        let s = await app.stateWhen((s) => s.preview && s.layout.lesson["end-preview"] && s.layout.lesson.start && s.layout.lesson.quiz, "the preview");
+        assert.equal(s.mode, "author", "the page stays the authoring page");
+        assert.equal(s.layout.lesson.record, undefined, "no Lesson panel in the preview");
+        await press("start");
+        s = await app.stateWhen((s) => s.tour.step === 0, "the tour's first step");
+        assert.equal(s.tour.title, sample.steps[0].title);
+        await app.screenshot("L6-preview-tour");
+        await press("quiz");
+        await app.stateWhen((s) => s.quiz.running && s.layout.lesson["end-preview"], "the quiz in the preview");
+        await press("end-preview");
+        // Back to authoring: the Lesson panel again, the quiz ended, the lesson as it was.
+        s = await app.stateWhen((s) => !s.preview && s.layout.lesson?.record, "the Lesson panel again");
+        assert.equal(s.quiz.running, false, "the quiz ended with the preview");
+        const lesson = await app.call("lesson");
+        assert.deepEqual(lesson.steps.map((step) => step.title), sample.steps.map((step) => step.title));
+    });
+});

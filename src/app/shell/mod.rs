@@ -76,6 +76,8 @@ pub struct Shell {
     structures: StructureList,
     /// The page is the viewer (`?mode=viewer`): the case's structures and the view, no editing.
     reading: bool,
+    /// The authoring page shows the viewer's frame for now (`Document::previewing`).
+    preview: reading::Preview,
     /// The viewer's filter of its structure list.
     reading_filter: String,
     /// The structure under the pointer.
@@ -199,6 +201,7 @@ impl Shell {
             framed_case: None,
             structures: StructureList::default(),
             reading,
+            preview: Default::default(),
             reading_filter: String::new(),
             pointing: Pointing::default(),
             labels: LabelPainter::default(),
@@ -420,6 +423,7 @@ impl eframe::App for Shell {
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        self.sync_preview();
         self.receive_files(&ctx);
         let keys = self.doc.borrow().shortcuts;
         let pressed = if keys {
@@ -428,7 +432,7 @@ impl eframe::App for Shell {
             Vec::new()
         };
         for action in pressed {
-            if !self.reading || shortcuts::reads(action) {
+            if !self.reads() || shortcuts::reads(action) {
                 self.apply(action);
             }
         }
@@ -493,7 +497,7 @@ impl eframe::App for Shell {
 
         egui::Panel::top("top_bar").show(ui, |ui| self.top_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        if self.reading {
+        if self.reads() {
             self.reading_panel(ui);
         } else {
             self.authoring_panels(ui);

@@ -33,7 +33,6 @@ impl Shell {
     pub(super) fn quiz_panel(&mut self, ui: &mut egui::Ui) -> bool {
         let mut held = self.doc.borrow_mut();
         let doc = &mut *held;
-        doc.panel.lesson.clear();
         let Some(run) = &doc.quiz else {
             return false;
         };

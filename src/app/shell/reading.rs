@@ -11,7 +11,55 @@ use crate::session::ColorField;
 /// Below this page width (points) the case's panel goes under the view: a phone held upright.
 pub(super) const NARROW: f32 = 700.0;
 
+/// The author's preview of the viewer.
+#[derive(Default)]
+pub(super) struct Preview {
+    on: bool,
+    /// The author's colouring of the view, put back after the preview (a student's viewer
+    /// opens without one).
+    author_coloring: Option<ColorField>,
+}
+
 impl Shell {
+    /// Whether the viewer's frame is shown: the viewer's page, or the author's preview.
+    pub(super) fn reads(&self) -> bool {
+        self.reading || self.preview.on
+    }
+
+    /// Follows the document's preview switch (flipped by the Lesson panel or the way back).
+    pub(super) fn sync_preview(&mut self) {
+        let on = self.doc.borrow().previewing;
+        if on != self.preview.on {
+            self.preview.on = on;
+            match on {
+                true => {
+                    self.preview.author_coloring = self.coloring.take();
+                    // The student's clicks in the view select; they paint no weights.
+                    self.brush.active = false;
+                }
+                false => self.coloring = self.preview.author_coloring.take(),
+            }
+        }
+    }
+
+    /// The author's way back from the preview.
+    fn preview_back(&mut self, ui: &mut egui::Ui) {
+        if !self.preview.on {
+            return;
+        }
+        let mut doc = self.doc.borrow_mut();
+        let back = ui.button("◀ Back to authoring");
+        doc.panel
+            .lesson
+            .push(("end-preview".into(), back.rect.into()));
+        ui.small("The case as the student will see it in the viewer.");
+        ui.separator();
+        if back.clicked() {
+            doc.end_preview();
+            ui.ctx().request_repaint();
+        }
+    }
+
     pub(super) fn reading_top_bar(&mut self, ui: &mut egui::Ui) {
         let narrow = ui.ctx().content_rect().width() < NARROW;
         ui.horizontal_wrapped(|ui| {
@@ -53,6 +101,8 @@ impl Shell {
             // Filling the panel: under the view it would otherwise shrink to its first lines.
             let scroll = egui::ScrollArea::vertical().auto_shrink([false, false]);
             scroll.show(ui, |ui| {
+                self.doc.borrow_mut().panel.lesson.clear();
+                self.preview_back(ui);
                 if self.quiz_panel(ui) {
                     return;
                 }

@@ -52,7 +52,6 @@ impl Shell {
     /// them.
     pub(super) fn tour_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
-        doc.panel.lesson.clear();
         if !doc.case().lesson().labels.is_empty() {
             let mut shown = !doc.view_asks.hide_labels;
             let toggle = ui.checkbox(&mut shown, "Labels");

@@ -25,6 +25,7 @@ impl Shell {
         if let Some((strip, l)) = strip {
             legend::paint(ui, strip, l, viewer::BACKGROUND);
         }
+        let reads = self.reads();
         let rect = match &mut self.view {
             Some((viewer, _)) => {
                 viewer.painting = self.brush.active;
@@ -42,7 +43,7 @@ impl Shell {
                     .inner;
                 if !self.brush.active && !self.picture.pending {
                     let at = (viewer.camera(), viewer.clip_plane());
-                    point(&mut self.pointing, self.reading, ui, &response, at, doc);
+                    point(&mut self.pointing, reads, ui, &response, at, doc);
                 } else {
                     self.pointing = Default::default();
                 }
