@@ -4,7 +4,7 @@
 //! The panels edit the case document alone. Every edit goes to it as a whole parameter set;
 //! it refuses invalid sets (e.g. Taubin's mu >= -lambda) and the message shows under the controls until fixed.
 
-use super::document::EngineTimings;
+use super::backend::EngineTimings;
 use crate::session::{CaseDocument, ColorField};
 use crate::smooth::{Filter, Params};
 use eframe::egui;

@@ -4,11 +4,12 @@
 //! Both sides only change the session; the shell computes what a change needs once per frame
 //! (so an API call never blocks the page inside a frame), then answers the waiting calls.
 
-use crate::session::{Session, Timings};
+use crate::session::Session;
 use crate::suggest::Offload;
 use crate::view::{Clip, Planes, StandardView, ViewLink};
 use crate::worker::NamedFile;
 
+use super::backend::{Backend, EngineTimings};
 use super::layout::{PanelLayout, ViewReport};
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -20,49 +21,6 @@ pub type Waiter = Box<dyn FnOnce(&Session)>;
 /// A call waiting for a file being opened (the API's `loadMesh`): the session once the file is
 /// open, or why it is not.
 pub type LoadWaiter = Box<dyn FnOnce(Result<&Session, String>)>;
-
-/// Which engine smooths.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Backend {
-    /// WGSL compute on the page's WebGPU device.
-    WebGpu,
-    /// The CPU engine in WebAssembly (where WebGPU is missing).
-    Cpu,
-}
-
-impl Backend {
-    /// The name the embedding API's `backend()` returns.
-    pub fn name(self) -> &'static str {
-        match self {
-            Backend::WebGpu => "webgpu",
-            Backend::Cpu => "cpu",
-        }
-    }
-}
-
-/// How long the last result took.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum EngineTimings {
-    /// The CPU engine: smoothing and the measure pass, each on its own.
-    Cpu(Timings),
-    /// The GPU engine: from submitting the run (smoothing, drift, normals, measures) to
-    /// having its results back on the CPU.
-    Gpu { run_ms: f64 },
-}
-
-impl EngineTimings {
-    pub fn describe(&self) -> String {
-        match self {
-            EngineTimings::Cpu(t) => format!(
-                "{:.1} ms smoothing, {:.1} ms measures",
-                t.smooth_ms, t.measure_ms
-            ),
-            EngineTimings::Gpu { run_ms } => {
-                format!("{run_ms:.1} ms smoothing + measures on the GPU, with readback")
-            }
-        }
-    }
-}
 
 /// A call waiting for a picture of the view (the API's `screenshot()`): PNG bytes, or why not.
 pub type PictureWaiter = Box<dyn FnOnce(Result<Vec<u8>, String>)>;

@@ -13,7 +13,8 @@
 //! does not wait for the queue, so without this the work of several frames piles up in it and
 //! every frame drawn meanwhile waits for all of it.
 
-use super::document::{now_ms, Document, EngineTimings};
+use super::backend::EngineTimings;
+use super::document::{now_ms, Document};
 use crate::gpu::{
     FrameWork, GpuEvaluator, GpuMesh, GpuSmoother, MeasureReadback, ResultReadback, RunPieces,
 };

@@ -21,6 +21,7 @@
 //! - `shell` (the `eframe::App` that lays these out each frame) and `viewer` (the 3D view).
 
 mod api;
+mod backend;
 mod bottom_panel;
 mod brush;
 mod case_export_view;
@@ -57,7 +58,8 @@ mod view_tools;
 pub mod viewer;
 mod workers;
 
-pub use document::{Backend, Document};
+pub use backend::Backend;
+pub use document::Document;
 
 /// How often the page redraws only to move a progress on (bytes read, an opening's stage, the
 /// workers' jobs). Each frame draws the whole page and its model, which a software GPU pays

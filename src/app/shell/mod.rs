@@ -2,11 +2,12 @@
 //! left (filter, parameters, measures, colours), the mesh report on the right, the status bar,
 //! and the view in the middle. Owns no algorithm: edits go to the shared document's session.
 
+use super::backend::Backend;
 use super::bottom_panel::BottomPanel;
 use super::brush::Brush;
 use super::case_text::CaseText;
 use super::controls::{self, Controls};
-use super::document::{now_ms, Backend, Document, Opening, SharedDocument};
+use super::document::{now_ms, Document, Opening, SharedDocument};
 use super::drag_params::DragParams;
 use super::file_input::{Arrived, FileInput, FilesFor};
 use super::gpu_engine::{GpuEngine, Sent};
@@ -483,7 +484,7 @@ impl eframe::App for Shell {
                 embedding.after_frame(&mut doc);
             }
             doc.lesson_events.clear();
-            self.case_text.update(doc.session());
+            self.case_text.update(&doc);
             self.case_text.update_lesson(&doc);
             self.repainting = doc.working();
             if self.repainting && doc.working_elsewhere() {
