@@ -1,7 +1,8 @@
 //! The viewer's panel (`?mode=viewer`), for a student reading a case: its title and
 //! description, its structures by group to show, hide, isolate and make transparent, and the
 //! selected one's name, description, provenance and quality record, with its local error on
-//! demand. Nothing here edits the anatomy.
+//! demand; structures are named in the reader's language where the case has a name in it.
+//! Nothing here edits the anatomy.
 
 use eframe::egui;
 
@@ -9,15 +10,16 @@ use super::layout::{PanelLayout, StructureRow};
 use super::structure_list::{
     filter_field, grouped_rows, measures, show_box, solo_button, StructureAction,
 };
-use crate::case::CaseStructure;
+use crate::case::{names, CaseStructure};
 use crate::io::StructureCodes;
 use crate::session::{Session, StructureChange};
 
-/// Shows the panel; `error_colours` is whether the selected structure is coloured by how far
-/// it moved from the segmentation. `layout` gets where the rows were drawn.
+/// Shows the panel to a reader of `languages` (most wanted first); `error_colours` is whether
+/// the selected structure is coloured by how far it moved from the segmentation. `layout` gets
+/// where the rows were drawn.
 pub fn show(
     ui: &mut egui::Ui,
-    session: &Session,
+    (session, languages): (&Session, &[String]),
     layout: &mut PanelLayout,
     (filter, error_colours): (&mut String, &mut bool),
 ) -> Vec<StructureAction> {
@@ -57,22 +59,23 @@ pub fn show(
         .id_salt("case structures")
         .show(ui, |ui| {
             grouped_rows(ui, list, filter, |ui, i, s| {
-                let drawn = row(ui, i, s, i == current, &mut actions);
+                let shown = names::pick(&s.name, &s.names, languages);
+                let drawn = row(ui, (i, s, shown), i == current, &mut actions);
                 layout.structures.push(drawn);
             });
         });
     ui.separator();
     if let Some(s) = list.get(current) {
-        record(ui, session, s, current, error_colours);
+        let shown = names::pick(&s.name, &s.names, languages);
+        record(ui, session, (s, shown), current, error_colours);
     }
     actions
 }
 
-/// One structure: show box, its colour, show alone, its opacity, its name to select.
+/// One structure: show box, its colour, show alone, its opacity, its `shown` name to select.
 fn row(
     ui: &mut egui::Ui,
-    i: usize,
-    s: &CaseStructure,
+    (i, s, shown): (usize, &CaseStructure, &str),
     selected: bool,
     actions: &mut Vec<StructureAction>,
 ) -> StructureRow {
@@ -96,7 +99,7 @@ fn row(
             };
             actions.push(StructureAction::Change(i, change));
         }
-        let name = ui.selectable_label(selected, &s.name);
+        let name = ui.selectable_label(selected, shown);
         if name.clicked() && !selected {
             actions.push(StructureAction::Select(i));
         }
@@ -115,11 +118,15 @@ fn row(
 fn record(
     ui: &mut egui::Ui,
     session: &Session,
-    s: &CaseStructure,
+    (s, shown): (&CaseStructure, &str),
     index: usize,
     error_colours: &mut bool,
 ) {
-    ui.heading(&s.name);
+    ui.heading(shown);
+    if let Some(others) = other_names(s, shown) {
+        ui.small(others)
+            .on_hover_text("Its names in the case's other languages");
+    }
     if let Some(group) = &s.group {
         ui.label(format!("in {group}"));
     }
@@ -156,6 +163,16 @@ fn record(
             "The local error: the distance from each point of the smooth surface to the \
              segmentation's surface",
         );
+}
+
+/// The structure's names other than the `shown` one: its own, then each by language tag.
+fn other_names(s: &CaseStructure, shown: &str) -> Option<String> {
+    let own = (s.name != shown).then(|| s.name.clone());
+    let others = (s.names.iter())
+        .filter(|(_, n)| n.as_str() != shown)
+        .map(|(tag, n)| format!("{tag}: {n}"));
+    let all: Vec<String> = own.into_iter().chain(others).collect();
+    (!all.is_empty()).then(|| format!("Also: {}", all.join("; ")))
 }
 
 /// "SNOMED CT 64033007 Kidney, 24028007 Right (Anatomical Structure)".

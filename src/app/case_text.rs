@@ -5,36 +5,38 @@
 //! ids match `index.html`.
 
 use super::document::Document;
-use crate::session::Session;
 
 const CANVAS_ID: &str = "meshsmooth_canvas";
 const LIST_ID: &str = "case_structures";
 const LESSON_ID: &str = "case_lesson";
 
 /// What the page's words were last written for: the structures' version, the selected one,
-/// the case's file and title.
+/// whether the author previews (names in the reader's language), the case's file and title.
 #[derive(Default)]
 pub struct CaseText {
-    written: Option<(u64, Option<usize>, String, String)>,
+    written: Option<(u64, Option<usize>, bool, String, String)>,
     /// The lesson's lines last written.
     lesson: Vec<String>,
 }
 
 impl CaseText {
     /// Rewrites the canvas's label and the structures' list where the case changed.
-    pub fn update(&mut self, session: &Session) {
+    pub fn update(&mut self, doc: &Document) {
+        let session = doc.session();
         let (version, current) = (
             session.case().case_version(),
             session.case().current_structure(),
         );
         let (file, title) = (session.case().case_file(), session.case().case_title());
-        if let Some((v, c, f, t)) = &self.written {
-            if (*v, *c, f.as_str(), t.as_str()) == (version, current, file, title) {
+        if let Some((v, c, p, f, t)) = &self.written {
+            let now = (version, current, doc.previewing, file, title);
+            if (*v, *c, *p, f.as_str(), t.as_str()) == now {
                 return;
             }
         }
-        self.written = Some((version, current, file.to_string(), title.to_string()));
-        let words = (label(session), lines(session));
+        let (file, title) = (file.to_string(), title.to_string());
+        self.written = Some((version, current, doc.previewing, file, title));
+        let words = (label(doc), lines(doc));
         let Some(document) = web_sys::window().and_then(|w| w.document()) else {
             return;
         };
@@ -90,9 +92,8 @@ fn lesson_lines(doc: &Document) -> Vec<String> {
     let words = doc.quiz_words();
     if !words.heading.is_empty() {
         lines.push(format!("{}. {}", words.heading, words.question));
-        let names = doc.case().structure_names();
         let choices = (doc.quiz.as_ref().and_then(|r| r.current()))
-            .map(|(_, q)| q.choices.iter().filter_map(|&c| names.get(c).copied()))
+            .map(|(_, q)| q.choices.iter().map(|&c| doc.shown_name(c)))
             .map(|c| c.collect::<Vec<_>>().join(", "))
             .filter(|c| !c.is_empty());
         if let Some(choices) = choices {
@@ -106,7 +107,8 @@ fn lesson_lines(doc: &Document) -> Vec<String> {
 }
 
 /// The canvas's label: what the view shows.
-fn label(session: &Session) -> String {
+fn label(doc: &Document) -> String {
+    let session = doc.session();
     let structures = session.case().case_structures();
     let shown = structures.iter().filter(|s| s.visible).count();
     let title = session.case().case_title();
@@ -119,19 +121,19 @@ fn label(session: &Session) -> String {
         "3D view of {what}: {} structures, {shown} shown",
         structures.len()
     );
-    if let Some(s) = session.case().model_structure() {
-        text.push_str(&format!("; selected: {}", s.name));
+    if let Some(i) = session.case().current_structure() {
+        text.push_str(&format!("; selected: {}", doc.shown_name(i)));
     }
     text
 }
 
 /// One line per structure: its name, group, whether it is shown and how opaque, whether it is
 /// selected, and its description.
-fn lines(session: &Session) -> Vec<String> {
-    let current = session.case().current_structure();
-    (session.case().case_structures().iter().enumerate())
+fn lines(doc: &Document) -> Vec<String> {
+    let current = doc.case().current_structure();
+    (doc.case().case_structures().iter().enumerate())
         .map(|(i, s)| {
-            let mut line = s.name.clone();
+            let mut line = doc.shown_name(i).to_string();
             if let Some(group) = &s.group {
                 line.push_str(&format!(" ({group})"));
             }

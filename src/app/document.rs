@@ -68,6 +68,9 @@ pub struct Document {
     pub pointed: Option<String>,
     /// The page is the viewer (`?mode=viewer`): it reads cases and edits none.
     pub reading: bool,
+    /// The reader's languages, most wanted first: the viewer (and the author's preview) names
+    /// structures in the first one they have a name in.
+    pub languages: Vec<String>,
     /// Whether keys act (an embedding page can turn them off).
     pub shortcuts: bool,
     /// How the latest files asked to open ended, once all of them have: for the embedding
@@ -115,6 +118,19 @@ impl Document {
         self.session.case_mut()
     }
 
+    /// Structure `index`'s name as the page shows it: in the reader's language where it has a
+    /// name in one and the page is read (the viewer, the author's preview), else its own.
+    pub fn shown_name(&self, index: usize) -> &str {
+        let Some(s) = self.case().case_structures().get(index) else {
+            return "";
+        };
+        let languages: &[String] = match self.reading || self.previewing {
+            true => &self.languages,
+            false => &[],
+        };
+        crate::case::names::pick(&s.name, &s.names, languages)
+    }
+
     /// What guidance, Suggest all and the checks found.
     pub fn background(&self) -> crate::session::Background<'_> {
         self.session.background()
@@ -143,6 +159,7 @@ impl Document {
             view_asks: ViewAsks::default(),
             pointed: None,
             reading: false,
+            languages: Vec::new(),
             shortcuts: true,
             finished_opening: None,
             panel: PanelLayout::default(),

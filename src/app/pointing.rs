@@ -5,14 +5,14 @@
 use eframe::egui;
 use glam::Vec2;
 
-use crate::session::Session;
+use super::document::Document;
 use crate::view::OrbitCamera;
 
 /// What the pointer was over last time it was asked.
 #[derive(Default)]
 pub struct Pointing {
     asked: Option<Asked>,
-    /// The structure under the pointer (index, name).
+    /// The structure under the pointer (index, its own name).
     pub named: Option<(usize, String)>,
     /// Where the pointer meets it (RAS mm).
     pub point: Option<glam::Vec3>,
@@ -28,14 +28,15 @@ struct Asked {
 
 impl Pointing {
     /// Finds the structure under the pointer over the view (`response`), names it beside the
-    /// pointer unless `quiet` (a quiz asks for it), and returns it when it was clicked.
+    /// pointer (in the reader's language) unless `quiet` (a quiz asks for it), and returns it
+    /// when it was clicked.
     /// `plane` is the view's clipping plane.
     pub fn update(
         &mut self,
         ui: &egui::Ui,
         response: &egui::Response,
         (camera, plane): (&OrbitCamera, [f32; 4]),
-        session: &Session,
+        doc: &Document,
         quiet: bool,
     ) -> Option<usize> {
         let pointer = response.hover_pos().filter(|_| !response.dragged());
@@ -45,6 +46,7 @@ impl Pointing {
             self.point = None;
             return None;
         };
+        let session = doc.session();
         let asked = Asked {
             pointer,
             camera: *camera,
@@ -66,17 +68,18 @@ impl Pointing {
             });
             self.asked = Some(asked);
         }
-        let (index, name) = self.named.as_ref()?;
+        let index = self.named.as_ref()?.0;
+        let name = doc.shown_name(index).to_string();
         if quiet {
-            return response.clicked().then_some(*index);
+            return response.clicked().then_some(index);
         }
         let font = egui::TextStyle::Body.resolve(ui.style());
         let place = pointer + egui::vec2(14.0, -6.0);
         let painter = ui.painter_at(response.rect);
-        let galley = painter.layout_no_wrap(name.clone(), font, egui::Color32::WHITE);
+        let galley = painter.layout_no_wrap(name, font, egui::Color32::WHITE);
         let back = egui::Rect::from_min_size(place, galley.size()).expand(3.0);
         painter.rect_filled(back, 3.0, egui::Color32::from_black_alpha(170));
         painter.galley(place, galley, egui::Color32::WHITE);
-        response.clicked().then_some(*index)
+        response.clicked().then_some(index)
     }
 }

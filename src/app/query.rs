@@ -25,6 +25,21 @@ pub fn viewer_mode() -> bool {
     param("mode").as_deref() == Some("viewer")
 }
 
+/// The reader's languages, most wanted first: `?lang=de` (or `de,fr`) where the embedding
+/// platform knows the student's, else the browser's.
+pub fn languages() -> Vec<String> {
+    if let Some(list) = param("lang") {
+        let tags = list.split(',').map(str::trim).filter(|t| !t.is_empty());
+        return tags.map(str::to_string).collect();
+    }
+    let Some(window) = web_sys::window() else {
+        return Vec::new();
+    };
+    (window.navigator().languages().iter())
+        .filter_map(|tag| tag.as_string())
+        .collect()
+}
+
 /// The `case` or else the `model` query parameter (its key and value), if there is one.
 pub fn case_param() -> Option<(&'static str, String)> {
     (param("case").map(|c| ("case", c))).or_else(|| param("model").map(|m| ("model", m)))

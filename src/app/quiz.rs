@@ -125,8 +125,7 @@ impl Document {
         let Some(run) = &self.quiz else {
             return QuizWords::default();
         };
-        let names = self.case().structure_names();
-        let name = |i: usize| names.get(i).copied().unwrap_or("?");
+        let name = |i: usize| self.shown_name(i);
         let total = run.questions().len();
         let Some((i, question)) = run.current() else {
             let percent = (100.0 * run.scaled()).round();

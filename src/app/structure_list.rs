@@ -6,7 +6,7 @@
 use eframe::egui;
 
 use super::layout::{PanelLayout, StructureRow};
-use crate::case::CaseStructure;
+use crate::case::{names, CaseStructure};
 use crate::metrics::Metrics;
 use crate::session::{Session, StructureChange};
 
@@ -53,8 +53,11 @@ pub struct StructureList {
 struct Editing {
     /// The session's model and the structure it is.
     key: (u64, usize),
-    taken: (String, String, String),
-    text: (String, String, String),
+    /// Name, group, description and the names in other languages as one line.
+    taken: [String; 4],
+    text: [String; 4],
+    /// Why the names line as typed was not taken.
+    names_error: Option<String>,
 }
 
 fn to_bytes(c: [f32; 4]) -> [u8; 4] {
@@ -118,16 +121,18 @@ impl StructureList {
     ) {
         let key = (session.case().model_id(), current);
         let group = s.group.clone().unwrap_or_default();
-        let stored = (s.name.clone(), group, s.description.clone());
+        let names_line = names::to_line(&s.names);
+        let stored = [s.name.clone(), group, s.description.clone(), names_line];
         let editing = match &mut self.editing {
             Some(e) if e.key == key && e.taken == stored => e,
             editing => editing.insert(Editing {
                 key,
                 taken: stored.clone(),
                 text: stored,
+                names_error: None,
             }),
         };
-        let (name, group, description) = &mut editing.text;
+        let [name, group, description, names_line] = &mut editing.text;
         ui.horizontal(|ui| {
             ui.label("Name");
             let edit = ui.add(egui::TextEdit::singleline(name).desired_width(110.0));
@@ -166,6 +171,8 @@ impl StructureList {
             };
             actions.push(StructureAction::Change(current, change));
         }
+        let error = &mut editing.names_error;
+        names_field(ui, (current, s), (names_line, error), actions);
         let [how, what] = measures(s, session, current);
         ui.small(how);
         ui.small(what);
@@ -365,6 +372,43 @@ pub fn grouped_rows(
                     .show(ui, draw);
             }
         }
+    }
+}
+
+/// The structure's names in other languages as one line to edit (`de: Leber; fr: Foie`), and
+/// why the line typed was not taken.
+fn names_field(
+    ui: &mut egui::Ui,
+    (current, s): (usize, &CaseStructure),
+    (line, error): (&mut String, &mut Option<String>),
+    actions: &mut Vec<StructureAction>,
+) {
+    ui.horizontal(|ui| {
+        ui.label("Other languages");
+        let edit = egui::TextEdit::singleline(line)
+            .hint_text("de: Leber; fr: Foie")
+            .desired_width(f32::INFINITY);
+        let edit = ui.add(edit).on_hover_text(
+            "The structure's name in the languages a student may read, each as a language tag \
+             (de, fr, pt-BR), a colon and the name; the viewer shows the student's",
+        );
+        if edit.lost_focus() {
+            *error = None;
+            match names::from_line(line) {
+                Ok(typed) if typed != s.names => {
+                    let change = StructureChange {
+                        names: Some(typed),
+                        ..Default::default()
+                    };
+                    actions.push(StructureAction::Change(current, change));
+                }
+                Ok(_) => {}
+                Err(e) => *error = Some(e),
+            }
+        }
+    });
+    if let Some(e) = error {
+        ui.colored_label(ui.visuals().error_fg_color, e.as_str());
     }
 }
 

@@ -11,6 +11,7 @@ mod checks;
 mod from_files;
 mod image;
 mod lesson;
+pub mod names;
 mod pipeline;
 mod record;
 pub mod relations;
@@ -63,6 +64,9 @@ pub struct Case {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseStructure {
     pub name: String,
+    /// Its name in other languages, by language tag (see [`names`]).
+    #[serde(default)]
+    pub names: names::Names,
     /// Display (sRGB) colour and opacity, each in [0, 1].
     pub color: [f32; 4],
     pub visible: bool,
@@ -123,7 +127,10 @@ pub struct Smoothed {
 
 impl PartialEq for CaseStructure {
     fn eq(&self, o: &Self) -> bool {
-        (self.name == o.name && self.color == o.color && self.visible == o.visible)
+        (self.name == o.name
+            && self.names == o.names
+            && self.color == o.color
+            && self.visible == o.visible)
             && (self.group == o.group && self.description == o.description)
             && (self.source == o.source && self.label == o.label)
             && (self.voxel_size == o.voxel_size && self.voxels == o.voxels && self.grid == o.grid)
@@ -164,6 +171,7 @@ impl CaseStructure {
     pub fn from_mesh(name: &str, mesh: Mesh, color: [f32; 3]) -> Self {
         Self {
             name: name.to_string(),
+            names: names::Names::new(),
             color: [color[0], color[1], color[2], 1.0],
             visible: true,
             group: None,
@@ -340,8 +348,8 @@ impl Case {
 }
 
 /// The structures as a list shows them: the ungrouped ones, then each group's, groups in
-/// the order they first appear; only those whose name or group contains `filter` (any
-/// case), and no group left empty by it.
+/// the order they first appear; only those whose name (in any of its languages) or group
+/// contains `filter` (any case), and no group left empty by it.
 pub fn listed<'a>(
     structures: &'a [CaseStructure],
     filter: &str,
@@ -351,7 +359,8 @@ pub fn listed<'a>(
     let mut listed: Vec<(Option<&str>, Vec<usize>)> = vec![(None, Vec::new())];
     for (i, s) in structures.iter().enumerate() {
         let group = s.group.as_deref();
-        if !filter.is_empty() && !matches(&s.name) && !group.is_some_and(matches) {
+        let named = matches(&s.name) || s.names.values().any(|n| matches(n));
+        if !filter.is_empty() && !named && !group.is_some_and(matches) {
             continue;
         }
         match listed.iter_mut().find(|(g, _)| *g == group) {

@@ -53,6 +53,9 @@ pub fn structure_record(s: &CaseStructure) -> Value {
         "vertices": s.original.vertex_count(),
         "triangles": s.original.triangle_count(),
     });
+    if !s.names.is_empty() {
+        r["names"] = json!(s.names);
+    }
     if let Some(m) = s.smoothed_now().map(|m| &m.metrics) {
         let in_diagonals = |mm: f64| diagonal.map(|d| mm / d);
         r["volume_mm3"] = json!(m.volume);
@@ -171,6 +174,9 @@ fn structure(
     };
     read_looks(&mut s, record, &node, ours);
     read_smoothing(&mut s, record).map_err(fail)?;
+    if let Some(names) = record.get("names").filter(|v| !v.is_null()) {
+        s.names = super::names::from_json(names).map_err(fail)?;
+    }
     let smoothed = record.get("smoothed").and_then(Value::as_bool) == Some(true);
     let metrics = record
         .get("metrics")

@@ -89,6 +89,11 @@ pub(super) struct BuildArgs {
     /// structures named as the case names them.
     #[arg(long, value_name = "LESSON")]
     lesson: Option<PathBuf>,
+    /// The structures' names in other languages (JSON: each structure's name, as the case names
+    /// it, to its names by language tag: {"Liver": {"de": "Leber", "fr": "Foie"}}); the viewer
+    /// shows the student's language.
+    #[arg(long, value_name = "NAMES")]
+    names: Option<PathBuf>,
     /// Leave out the original surface (the morph target a viewer slides to, and what a
     /// reopened case smooths again from).
     #[arg(long)]
@@ -141,31 +146,7 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     super::check_destination(&args.output)?;
     let started = Instant::now();
     let mut case = open(args)?;
-    if let Some(path) = &args.image {
-        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let name = path.display().to_string();
-        (case.add_image(&bytes, &name, args.window, args.image_voxels))
-            .map_err(|e| format!("{name}: {e}"))?;
-    }
-    if let Some(t) = &args.title {
-        case.title = t.clone();
-    }
-    if let Some(d) = &args.description {
-        case.description = d.clone();
-    }
-    if let Some(path) = &args.lesson {
-        let name = path.display();
-        let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
-        case.lesson = case::Lesson::from_json(&bytes).map_err(|e| format!("{name}: {e}"))?;
-        case.lesson
-            .check(&case)
-            .map_err(|e| format!("{name}: {e}"))?;
-    }
-    if args.no_bound {
-        for s in &mut case.structures {
-            s.params.max_displacement = None;
-        }
-    }
+    author(&mut case, args)?;
     let opened = started.elapsed().as_secs_f64();
     let checks_started = Instant::now();
     let before = case::check(&case, false);
@@ -218,6 +199,41 @@ fn build(args: &BuildArgs) -> Result<(), String> {
             args.output.display(),
             bytes.len()
         );
+    }
+    Ok(())
+}
+
+/// What the author adds to the structures opened: the image, title, description, lesson,
+/// names in other languages, and no bound where asked.
+fn author(case: &mut Case, args: &BuildArgs) -> Result<(), String> {
+    let read = |path: &Path| {
+        let name = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
+        Ok::<_, String>((bytes, name))
+    };
+    if let Some((bytes, name)) = args.image.as_deref().map(read).transpose()? {
+        (case.add_image(&bytes, &name, args.window, args.image_voxels))
+            .map_err(|e| format!("{name}: {e}"))?;
+    }
+    if let Some(t) = &args.title {
+        case.title = t.clone();
+    }
+    if let Some(d) = &args.description {
+        case.description = d.clone();
+    }
+    if let Some((bytes, name)) = args.lesson.as_deref().map(read).transpose()? {
+        // Checked here, before the searches, though the export checks it again.
+        let lesson = case::Lesson::from_json(&bytes).map_err(|e| format!("{name}: {e}"))?;
+        lesson.check(case).map_err(|e| format!("{name}: {e}"))?;
+        case.lesson = lesson;
+    }
+    if let Some((bytes, name)) = args.names.as_deref().map(read).transpose()? {
+        case::names::apply_table(case, &bytes).map_err(|e| format!("{name}: {e}"))?;
+    }
+    if args.no_bound {
+        for s in &mut case.structures {
+            s.params.max_displacement = None;
+        }
     }
     Ok(())
 }

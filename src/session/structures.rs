@@ -3,6 +3,7 @@
 //! shows every structure smoothed its own way and selecting one again finds it as it was.
 
 use super::{CaseDocument, Model};
+use crate::case::names::{self, Names};
 use crate::case::{Case, CaseStructure};
 use crate::io::{self, Format};
 use crate::metrics::Metrics;
@@ -21,6 +22,8 @@ pub struct StructureChange {
     /// `Some(None)` takes the structure out of its group.
     pub group: Option<Option<String>>,
     pub description: Option<String>,
+    /// Its names in other languages, all of them (see [`crate::case::names`]).
+    pub names: Option<Names>,
 }
 
 /// A structure drawn around the model.
@@ -102,8 +105,8 @@ impl CaseDocument {
         Ok(true)
     }
 
-    /// Changes structure `index`'s name, colour, opacity, visibility, group or description;
-    /// all or nothing.
+    /// Changes structure `index`'s name, colour, opacity, visibility, group, description or
+    /// names in other languages; all or nothing.
     pub fn set_structure(&mut self, index: usize, change: StructureChange) -> Result<(), String> {
         let count = self.case.structures.len();
         let s = self
@@ -140,11 +143,15 @@ impl CaseDocument {
         }
         let description = (change.description.as_deref())
             .map_or_else(|| s.description.clone(), |d| d.trim().to_string());
+        let names = match &change.names {
+            Some(n) => names::checked(n).map_err(|e| format!("structure '{}': {e}", s.name))?,
+            None => s.names.clone(),
+        };
         let was = (&s.name, s.color, s.visible, &s.group, &s.description);
-        if was != (&name, color, visible, &group, &description) {
+        if was != (&name, color, visible, &group, &description) || s.names != names {
             let old = std::mem::replace(&mut s.name, name);
             (s.color, s.visible, s.group) = (color, visible, group);
-            s.description = description;
+            (s.description, s.names) = (description, names);
             // The lesson names structures: it follows a rename.
             let new = &self.case.structures[index].name;
             self.case.lesson.rename(&old, new);

@@ -154,6 +154,31 @@ testIn(EVERY_RUN, "1c the viewer opens the same sample case: its structures, tou
     }, { query: "?mode=viewer" });
 });
 
+testIn(EVERY_RUN, "1d the viewer names the sample's structures in the student's language", { timeout: 120_000 }, async () => {
+    const names = JSON.parse(readFileSync(join(ROOT, "web/sample/abdomen_phantom_names.json"), "utf8"));
+    for (const [lang, tag] of [["de", "de"], ["fr-CA,de", "fr"]]) {
+        await withApp(async (app) => {
+            await app.stateWhen((s) => s.structures?.structures.length === SAMPLE.structures.length, "the sample open");
+            const want = SAMPLE.structures.map((n) => names[n][tag]);
+            const listed = () => app.page.locator("#case_structures li").allTextContents();
+            // The list is written at the frame after the case opened.
+            let items = await listed();
+            for (let t = 0; t < 100 && !(items[0] ?? "").startsWith(want[0]); t++) {
+                await new Promise((r) => setTimeout(r, 100));
+                items = await listed();
+            }
+            assert.deepEqual(items.map((l) => l.split(",")[0]), want, `?lang=${lang}`);
+            const label = await app.page.getAttribute("#meshsmooth_canvas", "aria-label");
+            assert.match(label, new RegExp(`selected: ${want[0]}$`));
+            // The API keeps the case's own names, with the others beside them.
+            const state = await app.state();
+            assert.deepEqual(state.structures.structures.map((s) => s.name), SAMPLE.structures);
+            assert.equal(state.structures.structures[0].names[tag], want[0]);
+            if (tag === "de") await app.screenshot("01d-viewer-sample-de");
+        }, { query: `?mode=viewer&lang=${lang}` });
+    }
+});
+
 // --- 2: privacy ---
 
 testIn(WEBGPU_RUN, "2 every request the page makes goes to its own origin", { timeout: 120_000 }, async () => {

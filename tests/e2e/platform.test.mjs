@@ -84,7 +84,9 @@ testIn(EVERY_RUN, "P1 a platform on another origin authors a case in the embedde
     await assert.rejects(call("author", "setParams", { iterations: -1 }), /iterations/);
     await assert.rejects(call("author", "noSuchCall"), /no call 'noSuchCall' here: loadMesh/);
     await assert.rejects(call("viewer", "exportCase", "glb"), /no call 'exportCase' here/, "the viewer exports nothing");
-    await assert.rejects(call("viewer", "setStructure", { index: 0, name: "x" }), /not its name, group or description/);
+    const refused = /not its name, group, description or names/;
+    await assert.rejects(call("viewer", "setStructure", { index: 0, name: "x" }), refused);
+    await assert.rejects(call("viewer", "setStructure", { index: 0, names: { de: "x" } }), refused);
 
     // Published: the case glTF the authoring page exported opens in the viewer, with what the
     // author wrote about a structure.

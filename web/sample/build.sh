@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the bundled sample case (web/sample/abdomen_phantom.glb, what the page opens at start)
-# from its label map and lesson, the way an author's pipeline would. A test builds it again and
+# from its label map, lesson and names in other languages, the way an author's pipeline would. A test builds it again and
 # checks that the committed case is what this gives: run this after a change that alters it.
 #
 # Usage: bash web/sample/build.sh [OUTPUT]      (MESHSMOOTH names the binary to use)
@@ -17,4 +17,5 @@ fi
     --title "Abdominal phantom" \
     --description "A synthetic abdominal case: four structures from a label map, with a tour, labels and a quiz." \
     --lesson abdomen_phantom_lesson.json \
+    --names abdomen_phantom_names.json \
     -o "$out"

@@ -30,11 +30,14 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
         "setStructure",
         setter(doc, ctx, move |session, values| {
             let (index, change) = super::json::structure_change(&from_js(&values)?)?;
-            if reading
-                && (change.name.is_some() || change.group.is_some() || change.description.is_some())
-            {
+            let words = [&change.name, &change.description]
+                .iter()
+                .any(|c| c.is_some())
+                || change.group.is_some()
+                || change.names.is_some();
+            if reading && words {
                 return Err("setStructure: the viewer changes how a structure is shown \
-                    (visible, opacity, color), not its name, group or description"
+                    (visible, opacity, color), not its name, group, description or names"
                     .into());
             }
             let index = (index.or(session.case().current_structure())).ok_or("nothing is open")?;

@@ -30,6 +30,7 @@ pub(crate) fn structures(case: &CaseDocument) -> Option<Value> {
                 "visible": s.visible,
                 "group": s.group,
                 "description": s.description,
+                "names": s.names,
                 "source": s.source,
                 "voxels": s.voxels,
                 "voxel_size": s.voxel_size,
@@ -96,9 +97,13 @@ pub(crate) fn structure_change(value: &Value) -> Result<(Option<usize>, Structur
                 change.group = Some(group);
             }
             "description" => change.description = Some(text()?),
+            "names" => {
+                let names = crate::case::names::from_json(v).map_err(|e| format!("setStructure: {e}"))?;
+                change.names = Some(names);
+            }
             other => {
                 return Err(format!(
-                    "setStructure: unknown key {other} (index, name, color, opacity, visible, group, description)"
+                    "setStructure: unknown key {other} (index, name, color, opacity, visible, group, description, names)"
                 ))
             }
         }
@@ -244,6 +249,7 @@ mod tests {
         let (index, change) = structure_change(&json!({
             "index": 2, "name": " tumour ", "color": [0.0, 1.0, 0.0], "opacity": 0.4,
             "visible": false, "group": null, "description": "it grows",
+            "names": {"DE": "Tumor"},
         }))
         .unwrap();
         assert_eq!(index, Some(2));
@@ -254,6 +260,7 @@ mod tests {
             visible: Some(false),
             group: Some(None),
             description: Some("it grows".into()),
+            names: Some([("de".to_string(), "Tumor".to_string())].into()),
         };
         assert_eq!(change, expected);
         assert_eq!(
@@ -267,6 +274,8 @@ mod tests {
             (json!({"index": -1}), "index"),
             (json!({"colour": [0, 1, 0]}), "colour"),
             (json!([1]), "an object"),
+            (json!({"names": "Tumor"}), "names must be an object"),
+            (json!({"names": {"de": 1}}), "the name in 'de' is not text"),
         ] {
             let e = structure_change(&bad).unwrap_err();
             assert!(e.contains(named), "{bad}: {e}");
@@ -286,6 +295,7 @@ mod tests {
         assert_eq!(list["current"], 0);
         assert_eq!(list["file"], crate::app::SAMPLE_NAME);
         assert_eq!(list["structures"][0]["group"], "Vessels");
+        assert_eq!(list["structures"][0]["names"]["de"], "Leber");
         assert!(
             list["structures"][0]["metrics"].is_null(),
             "not smoothed yet"

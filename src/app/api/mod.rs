@@ -20,17 +20,19 @@
 //!   `mri-auto`), read by a worker; replaces the case's image; rejects with the offset found
 //!   when it lies elsewhere, the image the case had staying. `removeImage()` takes it away
 //! - `structures()`: `{file, current, title, description, structures: [{label, name, color,
-//!   opacity, visible, group, source, voxels, voxel_size, codes, vertices, triangles, volume,
-//!   metrics, shown_as_read}]}` of the open case, or null with nothing open (`metrics`: its last
+//!   opacity, visible, group, description, names, source, voxels, voxel_size, codes, vertices,
+//!   triangles, volume, metrics, shown_as_read}]}` of the open case, or null with nothing open (`metrics`: its last
 //!   smoothing's measures, or null; `shown_as_read`: the viewer shows it as its file holds it,
 //!   the file holding no smoothing of it; `label`, `voxels`, `voxel_size`: null where it came
 //!   from no label map;
-//!   `codes`: `{category, type, modifier}` in standard codes, as the case glTF's record, or null)
+//!   `codes`: `{category, type, modifier}` in standard codes, as the case glTF's record, or null;
+//!   `names`: its names in other languages by language tag, `{"de": "Leber"}`, maybe empty)
 //! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`;
 //!   the structure left keeps its smoothing, one coming back gets its own back
-//! - `setStructure({index, name, color, opacity, visible, group})`: changes how a structure
-//!   (by default the model's) is shown and grouped (`group` null or "" ungroups); throws on a
-//!   bad value; `soloStructure(index)` shows that structure alone (again: all of them)
+//! - `setStructure({index, name, color, opacity, visible, group, description, names})`: changes
+//!   how a structure (by default the model's) is shown, grouped and named (`group` null or ""
+//!   ungroups; `names` replaces its names in other languages); throws on a bad value;
+//!   `soloStructure(index)` shows that structure alone (again: all of them)
 //! - `setFilter(name)`, `setParams(object)` (keys `lambda mu alpha beta passband iterations
 //!   max_displacement`); both throw with the engine's message on a bad name or value
 //! - `metrics(): Promise<object>` (the CLI's `measure --json` keys), once the current

@@ -170,6 +170,7 @@ impl Shell {
             // The viewer shows no guidance: nothing runs for it in the background.
             let mut doc = doc.borrow_mut();
             doc.reading = reading;
+            doc.languages = query::languages();
             doc.session_mut().set_graphs_wanted(!reading);
             doc.session_mut().set_suggest_on_open(!reading);
             doc.session_mut().case_mut().show_as_read(reading);

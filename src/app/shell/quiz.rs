@@ -44,11 +44,10 @@ impl Shell {
         let words = doc.quiz_words();
         ui.strong(&words.heading);
         ui.label(&words.question);
-        let names = doc.case().structure_names();
         let choices = run.current().map_or(&[][..], |(_, q)| &q.choices[..]);
         const KEYS: [&str; 4] = ["choice-0", "choice-1", "choice-2", "choice-3"];
         for (k, &c) in choices.iter().enumerate() {
-            let label = names.get(c).copied().unwrap_or("?");
+            let label = doc.shown_name(c);
             let button = ui.add_enabled(run.answered().is_none(), egui::Button::new(label));
             drawn.push((KEYS[k.min(3)], button.rect));
             if button.clicked() {

@@ -112,9 +112,11 @@ impl Shell {
                 let doc = &mut *guard;
                 let was = self.coloring == Some(ColorField::LocalError);
                 let mut error_colours = was;
+                let languages = doc.languages.clone();
                 let (session, panel) = doc.session_and_panel();
                 let filter = &mut self.reading_filter;
-                let actions = case_reader::show(ui, session, panel, (filter, &mut error_colours));
+                let reader = (&*session, &languages[..]);
+                let actions = case_reader::show(ui, reader, panel, (filter, &mut error_colours));
                 if error_colours != was {
                     self.coloring = error_colours.then_some(ColorField::LocalError);
                 }

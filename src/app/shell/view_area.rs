@@ -110,7 +110,7 @@ fn point(
     doc: &mut Document,
 ) {
     let quiz = doc.quiz.is_some();
-    let clicked = pointing.update(ui, response, at, doc.session(), quiz);
+    let clicked = pointing.update(ui, response, at, doc, quiz);
     if quiz {
         if let Some(i) = clicked.filter(|_| doc.quiz_wants_click()) {
             if let Err(e) = doc.answer_quiz(i) {
