@@ -124,11 +124,28 @@ impl Document {
         let Some(s) = self.case().case_structures().get(index) else {
             return "";
         };
-        let languages: &[String] = match self.reading || self.previewing {
+        let languages = self.reader_languages();
+        crate::case::names::pick(&s.name, &s.names, languages)
+    }
+
+    /// The reader's languages where the page is read (the viewer, the author's preview); none
+    /// while the author edits, who sees the case's own names.
+    pub fn reader_languages(&self) -> &[String] {
+        match self.reading || self.previewing {
             true => &self.languages,
             false => &[],
+        }
+    }
+
+    /// A lesson label's text as the page shows it: one naming its structure in the reader's
+    /// language where the page is read ([`crate::case::names::label_text`]).
+    pub fn label_text<'a>(&'a self, label: &'a crate::case::Label) -> &'a str {
+        let structures = self.case().case_structures();
+        let Some(s) = structures.iter().find(|s| s.name == label.structure) else {
+            return &label.text;
         };
-        crate::case::names::pick(&s.name, &s.names, languages)
+        let languages = self.reader_languages();
+        crate::case::names::label_text(&label.text, (&s.name, &s.names), languages)
     }
 
     /// What guidance, Suggest all and the checks found.

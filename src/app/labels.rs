@@ -97,7 +97,8 @@ fn draw(
         let (point, text) = (at(spot.point), at(spot.text));
         painter.line_segment([point, text], egui::Stroke::new(1.5, ink));
         painter.circle_filled(point, 3.0, ink);
-        let galley = painter.layout_no_wrap(label.text.clone(), font.clone(), ink);
+        let said = doc.label_text(label).to_string();
+        let galley = painter.layout_no_wrap(said.clone(), font.clone(), ink);
         // The text on the side of its end away from the point, unless the view's edge would
         // cut it there.
         let width = galley.size().x;
@@ -112,7 +113,7 @@ fn draw(
         let plate = egui::Rect::from_min_size(corner, galley.size()).expand(3.0);
         painter.rect_filled(plate, 3.0, egui::Color32::from_black_alpha(shade));
         painter.galley(corner, galley, ink);
-        drawn.push((label.text.clone(), [point.x, point.y], spot.faded));
+        drawn.push((said, [point.x, point.y], spot.faded));
     }
     drawn
 }

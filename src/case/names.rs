@@ -134,6 +134,11 @@ pub fn apply_table(case: &mut Case, table: &[u8]) -> Result<(), String> {
 /// of them it has one in, the exact tag before another region or script of the language; its
 /// own name where English comes first or none is there.
 pub fn pick<'a>(own: &'a str, names: &'a Names, languages: &[String]) -> &'a str {
+    found(names, languages).unwrap_or(own)
+}
+
+/// The name [`pick`] takes from `names`; `None` where it takes the own name.
+fn found<'a>(names: &'a Names, languages: &[String]) -> Option<&'a str> {
     for wanted in languages {
         let exact = names.iter().find(|(t, _)| t.eq_ignore_ascii_case(wanted));
         let same = || {
@@ -141,13 +146,31 @@ pub fn pick<'a>(own: &'a str, names: &'a Names, languages: &[String]) -> &'a str
             (names.iter()).find(|(t, _)| language(t).eq_ignore_ascii_case(lang))
         };
         if let Some((_, name)) = exact.or_else(same) {
-            return name;
+            return Some(name);
         }
         if language(wanted).eq_ignore_ascii_case("en") {
-            return own;
+            return None;
         }
     }
-    own
+    None
+}
+
+/// A lesson label's `text` as a reader of `languages` sees it on a structure named `own` with
+/// `names`: a text that names the structure (its own name or one of its names, in any case) is
+/// its name in the reader's language where it has one; any other text is the author's own.
+pub fn label_text<'a>(
+    text: &'a str,
+    (own, names): (&'a str, &'a Names),
+    languages: &[String],
+) -> &'a str {
+    let said = text.trim().to_lowercase();
+    let names_it = std::iter::once(own)
+        .chain(names.values().map(String::as_str))
+        .any(|n| n.to_lowercase() == said);
+    match names_it {
+        true => found(names, languages).unwrap_or(text),
+        false => text,
+    }
 }
 
 #[cfg(test)]
@@ -200,6 +223,20 @@ mod tests {
         // The exact tag before another region of the language.
         let two = names(&[("pt-BR", "Fígado"), ("pt-PT", "Fígado (PT)")]);
         assert_eq!(pick("Liver", &two, &langs(&["pt-PT"])), "Fígado (PT)");
+    }
+
+    #[test]
+    fn a_label_naming_its_structure_follows_the_reader_and_other_words_stay() {
+        let n = names(&[("en", "Liver"), ("de", "Leber")]);
+        let de = langs(&["de"]);
+        assert_eq!(label_text("Liver", ("liver", &n), &de), "Leber");
+        assert_eq!(label_text("liver ", ("liver", &n), &de), "Leber");
+        assert_eq!(label_text("LEBER", ("liver", &n), &langs(&["en"])), "Liver");
+        assert_eq!(label_text("Liver", ("liver", &n), &[]), "Liver");
+        assert_eq!(label_text("Liver", ("liver", &n), &langs(&["ja"])), "Liver");
+        let words = "Segment VIII of the liver";
+        assert_eq!(label_text(words, ("liver", &n), &de), words);
+        assert_eq!(label_text("Liver", ("liver", &Names::new()), &de), "Liver");
     }
 
     #[test]

@@ -158,8 +158,11 @@ testIn(EVERY_RUN, "1d the viewer names the sample's structures in the student's 
     const names = JSON.parse(readFileSync(join(ROOT, "web/sample/abdomen_phantom_names.json"), "utf8"));
     for (const [lang, tag] of [["de", "de"], ["fr-CA,de", "fr"]]) {
         await withApp(async (app) => {
-            await app.stateWhen((s) => s.structures?.structures.length === SAMPLE.structures.length, "the sample open");
+            const open = (s) => s.structures?.structures.length === SAMPLE.structures.length;
+            const labelled = await app.stateWhen((s) => open(s) && s.view.labels.length === 4, "the sample and its labels");
             const want = SAMPLE.structures.map((n) => names[n][tag]);
+            // The labels name their structures: in the reader's language too.
+            assert.deepEqual(labelled.view.labels.map((l) => l.text).sort(), [...want].sort());
             const listed = () => app.page.locator("#case_structures li").allTextContents();
             // The list is written at the frame after the case opened.
             let items = await listed();

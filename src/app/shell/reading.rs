@@ -112,7 +112,7 @@ impl Shell {
                 let doc = &mut *guard;
                 let was = self.coloring == Some(ColorField::LocalError);
                 let mut error_colours = was;
-                let languages = doc.languages.clone();
+                let languages = doc.reader_languages().to_vec();
                 let (session, panel) = doc.session_and_panel();
                 let filter = &mut self.reading_filter;
                 let reader = (&*session, &languages[..]);
