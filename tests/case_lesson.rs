@@ -101,13 +101,6 @@ fn phantom_with_lesson() -> Case {
     case
 }
 
-/// The JSON chunk and the binary chunk of a GLB.
-fn glb_parts(bytes: &[u8]) -> (Value, Vec<u8>) {
-    let len = u32::from_le_bytes(bytes[12..16].try_into().expect("4")) as usize;
-    let json = serde_json::from_slice(&bytes[20..20 + len]).expect("JSON");
-    (json, bytes[20 + len + 8..].to_vec())
-}
-
 fn read_back(bytes: &[u8], name: &str) -> Case {
     from_gltf_scene(load_gltf_scene(bytes, name).expect("reads"), name).expect("a case")
 }
@@ -143,7 +136,7 @@ fn the_lesson_reads_back_the_same_from_every_kind_of_case_gltf() {
     // A case without a lesson writes no camera and reads back without one.
     let plain = label_maps::phantom_case();
     let bytes = write_case(&plain, &CaseGltfOptions::default()).expect("writes");
-    assert!(glb_parts(&bytes).0.get("cameras").is_none());
+    assert!(glb::parts(&bytes).0.get("cameras").is_none());
     assert!(read_back(&bytes, "none.glb").lesson.is_empty());
 }
 
@@ -198,7 +191,7 @@ fn steps_are_cameras_and_labels_are_named_nodes_at_their_points_in_metres() {
             compressed,
             ..Default::default()
         };
-        let (doc, _) = glb_parts(&write_case(&case, &options).expect("writes"));
+        let (doc, _) = glb::parts(&write_case(&case, &options).expect("writes"));
         let world = world_matrices(&doc);
         let nodes = doc["nodes"].as_array().expect("nodes");
         let cameras: Vec<usize> = (0..nodes.len())
@@ -267,7 +260,7 @@ fn a_lesson_naming_what_the_case_lacks_is_refused_when_written_and_when_read() {
     // to a structure it does not have.
     let good = write_case(&phantom_with_lesson(), &CaseGltfOptions::default()).expect("writes");
     let lie = |edit: &dyn Fn(&mut Value)| {
-        let (mut doc, bin) = glb_parts(&good);
+        let (mut doc, bin) = glb::parts(&good);
         edit(&mut doc);
         let bytes = glb::glb(&doc, &bin);
         from_gltf_scene(

@@ -6,7 +6,7 @@ use meshsmooth::case::{from_gltf_scene, names::Names};
 use meshsmooth::export::CaseGltfOptions;
 use meshsmooth::io::load_gltf_scene;
 use meshsmooth::session::{Session, StructureChange};
-use serde_json::{json, Value};
+use serde_json::json;
 
 #[path = "common/glb.rs"]
 mod glb;
@@ -18,13 +18,6 @@ fn names(pairs: &[(&str, &str)]) -> Names {
     (pairs.iter())
         .map(|(t, n)| (t.to_string(), n.to_string()))
         .collect()
-}
-
-/// The JSON chunk and the binary chunk of a GLB.
-fn glb_parts(bytes: &[u8]) -> (Value, Vec<u8>) {
-    let len = u32::from_le_bytes(bytes[12..16].try_into().expect("4")) as usize;
-    let json = serde_json::from_slice(&bytes[20..20 + len]).expect("JSON");
-    (json, bytes[20 + len + 8..].to_vec())
 }
 
 #[test]
@@ -141,7 +134,7 @@ fn the_session_sets_names_that_travel_and_a_lying_record_is_refused() {
         assert_eq!(case.structures[0].names, kept, "compressed: {compressed}");
         assert!(case.structures[1].names.is_empty());
 
-        let (mut doc, bin) = glb_parts(&bytes);
+        let (mut doc, bin) = glb::parts(&bytes);
         let nodes = doc["nodes"].as_array_mut().expect("nodes");
         let node = (nodes.iter_mut())
             .find(|n| n["extras"]["meshsmooth"]["names"].is_object())

@@ -23,3 +23,11 @@ pub fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {
     out.extend(&bin);
     out
 }
+
+/// The JSON chunk and the binary chunk of a GLB `glb` assembled (not every test reads one back).
+#[allow(dead_code)]
+pub fn parts(bytes: &[u8]) -> (Value, Vec<u8>) {
+    let len = u32::from_le_bytes(bytes[12..16].try_into().expect("4")) as usize;
+    let json = serde_json::from_slice(&bytes[20..20 + len]).expect("JSON");
+    (json, bytes[20 + len + 8..].to_vec())
+}
