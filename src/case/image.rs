@@ -8,7 +8,7 @@ use serde_json::{json, Value};
 use std::sync::Arc;
 
 use super::file_name;
-use crate::io::{load_image, Affine, ImageVolume};
+use crate::io::{load_image, load_image_series, Affine, ImageVolume};
 
 /// The voxels an image is reduced to by default: what a phone's browser takes with the case.
 pub const DEFAULT_IMAGE_VOXELS: usize = 16 << 20;
@@ -205,22 +205,51 @@ impl CaseImage {
         max_voxels: usize,
         grids: &[(String, Affine)],
     ) -> Result<Self, String> {
-        if grids.is_empty() {
-            return Err(
-                "the case has no structure from a label map, so there is no \
-                        segmentation grid to place the image on"
-                    .to_string(),
-            );
-        }
+        has_grid(grids)?;
         let image = load_image(bytes, name, max_voxels).map_err(|e| e.to_string())?;
+        Self::placed(&image, name, preset, grids)
+    }
+
+    /// [`CaseImage::read`] for the slices of a DICOM series, `files` (name, bytes), named
+    /// `name` (their folder). A refusal's reason names the slice at fault, if one is.
+    pub fn read_series(
+        files: &[(&str, &[u8])],
+        name: &str,
+        preset: WindowPreset,
+        max_voxels: usize,
+        grids: &[(String, Affine)],
+    ) -> Result<Self, String> {
+        has_grid(grids)?;
+        let image = load_image_series(files, max_voxels).map_err(|e| e.to_string())?;
+        Self::placed(&image, name, preset, grids)
+    }
+
+    fn placed(
+        image: &ImageVolume,
+        name: &str,
+        preset: WindowPreset,
+        grids: &[(String, Affine)],
+    ) -> Result<Self, String> {
         for (structure, grid) in grids {
-            check_frame(&image, grid).map_err(|e| match grids.len() {
+            check_frame(image, grid).map_err(|e| match grids.len() {
                 1 => e,
                 _ => format!("{e}; the grid is {structure}'s"),
             })?;
         }
-        Ok(CaseImage::new(&image, file_name(name), preset))
+        Ok(CaseImage::new(image, file_name(name), preset))
     }
+}
+
+/// Refuses an image for a case with no segmentation grid.
+fn has_grid(grids: &[(String, Affine)]) -> Result<(), String> {
+    if grids.is_empty() {
+        return Err(
+            "the case has no structure from a label map, so there is no segmentation grid to \
+             place the image on"
+                .to_string(),
+        );
+    }
+    Ok(())
 }
 
 impl super::Case {
@@ -247,6 +276,21 @@ impl super::Case {
     ) -> Result<(), String> {
         let grids = self.image_grids();
         let image = CaseImage::read(bytes, name, preset, max_voxels, &grids)?;
+        self.image = Some(Arc::new(image));
+        Ok(())
+    }
+
+    /// Adds the image whose slices are `files` (a DICOM series, [`CaseImage::read_series`]),
+    /// named `name`; the case is unchanged when it is refused.
+    pub fn add_image_series(
+        &mut self,
+        files: &[(&str, &[u8])],
+        name: &str,
+        preset: WindowPreset,
+        max_voxels: usize,
+    ) -> Result<(), String> {
+        let grids = self.image_grids();
+        let image = CaseImage::read_series(files, name, preset, max_voxels, &grids)?;
         self.image = Some(Arc::new(image));
         Ok(())
     }

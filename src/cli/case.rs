@@ -73,8 +73,9 @@ pub(super) struct BuildArgs {
     #[arg(long)]
     level: Option<f64>,
     /// The image the segmentation was drawn on (CT or MRI: NIfTI, NRRD as 3D Slicer saves a
-    /// volume, or FreeSurfer's MGH/MGZ), carried in the case for the viewer to show under the
-    /// surfaces; it must lie on the segmentation's voxel grid.
+    /// volume, FreeSurfer's MGH/MGZ, or a folder of a DICOM series, one slice a file), carried
+    /// in the case for the viewer to show under the surfaces; it must lie on the
+    /// segmentation's voxel grid.
     #[arg(long, value_name = "IMAGE")]
     image: Option<PathBuf>,
     /// The window the image's grey levels are made with: ct-soft-tissue, ct-bone, ct-lung,
@@ -203,6 +204,24 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// Adds the image at `path`: one file, or a folder of a DICOM series' slices.
+fn add_image(case: &mut Case, path: &Path, args: &BuildArgs) -> Result<(), String> {
+    let name = path.display().to_string();
+    let added = if path.is_dir() {
+        let files = super::inputs::read_folder(path)?;
+        // Each slice by its file name: the error's prefix names the folder.
+        let slices: Vec<(&str, &[u8])> = (files.iter())
+            .map(|(n, b)| (case::file_name(n), b.as_slice()))
+            .collect();
+        let folder = name.trim_end_matches(['/', '\\']);
+        case.add_image_series(&slices, folder, args.window, args.image_voxels)
+    } else {
+        let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
+        case.add_image(&bytes, &name, args.window, args.image_voxels)
+    };
+    added.map_err(|e| format!("{name}: {e}"))
+}
+
 /// What the author adds to the structures opened: the image, title, description, lesson,
 /// names in other languages, and no bound where asked.
 fn author(case: &mut Case, args: &BuildArgs) -> Result<(), String> {
@@ -211,9 +230,8 @@ fn author(case: &mut Case, args: &BuildArgs) -> Result<(), String> {
         let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
         Ok::<_, String>((bytes, name))
     };
-    if let Some((bytes, name)) = args.image.as_deref().map(read).transpose()? {
-        (case.add_image(&bytes, &name, args.window, args.image_voxels))
-            .map_err(|e| format!("{name}: {e}"))?;
+    if let Some(path) = &args.image {
+        add_image(case, path, args)?;
     }
     if let Some(t) = &args.title {
         case.title = t.clone();

@@ -13,6 +13,26 @@ fn read(path: &Path) -> Result<(String, Vec<u8>), String> {
     Ok((path.display().to_string(), bytes))
 }
 
+/// The files of a folder (a DICOM series' slices), sorted by name: every regular file but
+/// hidden ones and a DICOMDIR index, which holds no slice.
+pub(super) fn read_folder(dir: &Path) -> Result<Vec<(String, Vec<u8>)>, String> {
+    let failed = |e: std::io::Error| format!("{}: {e}", dir.display());
+    let mut paths = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(failed)? {
+        let entry = entry.map_err(failed)?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let skipped = name.starts_with('.') || name.eq_ignore_ascii_case("DICOMDIR");
+        if !skipped && entry.file_type().map_err(failed)?.is_file() {
+            paths.push(entry.path());
+        }
+    }
+    if paths.is_empty() {
+        return Err(format!("{}: the folder holds no file", dir.display()));
+    }
+    paths.sort();
+    paths.iter().map(|p| read(p)).collect()
+}
+
 impl Inputs {
     /// Reads every input and the table; an error names the file.
     pub(super) fn read(inputs: &[PathBuf], table: Option<&Path>) -> Result<Self, String> {

@@ -8,8 +8,6 @@
 
 use super::{Format, LoadError};
 
-const FORMAT: Format = Format::DicomSeg;
-
 const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
 const IMPLICIT_LE: &str = "1.2.840.10008.1.2";
 const UNDEFINED: u32 = u32::MAX;
@@ -28,18 +26,20 @@ pub(super) struct Layout {
 }
 
 /// The file's [`Layout`], once every element length has been checked.
-pub(super) fn check(bytes: &[u8]) -> Result<Layout, LoadError> {
+/// `format` is what the errors call the file (a SEG, or a slice of an image series).
+pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
     let start = if bytes.get(128..132) == Some(b"DICM") {
         132
     } else if bytes.starts_with(b"DICM") {
         4
     } else {
         return Err(LoadError::BadMagic {
-            format: FORMAT,
+            format,
             detail: "no 'DICM' after a 128-byte preamble".into(),
         });
     };
     let mut walk = Walk {
+        format,
         bytes,
         at: start,
         pixel_data: None,
@@ -48,7 +48,7 @@ pub(super) fn check(bytes: &[u8]) -> Result<Layout, LoadError> {
     let implicit = match syntax.as_str() {
         EXPLICIT_LE => false,
         IMPLICIT_LE => true,
-        other => return Err(unsupported_syntax(other)),
+        other => return Err(unsupported_syntax(other, format)),
     };
     walk.data_set(implicit)?;
     Ok(Layout {
@@ -57,7 +57,7 @@ pub(super) fn check(bytes: &[u8]) -> Result<Layout, LoadError> {
     })
 }
 
-fn unsupported_syntax(uid: &str) -> LoadError {
+fn unsupported_syntax(uid: &str, format: Format) -> LoadError {
     let what = match uid {
         "1.2.840.10008.1.2.2" => "explicit VR big endian",
         "1.2.840.10008.1.2.1.99" => "deflated explicit VR little endian",
@@ -65,7 +65,7 @@ fn unsupported_syntax(uid: &str) -> LoadError {
         _ => "a compressed or unknown encoding",
     };
     LoadError::Unsupported {
-        format: FORMAT,
+        format,
         detail: format!(
             "transfer syntax {uid} ({what}): only uncompressed little-endian files are read"
         ),
@@ -73,6 +73,7 @@ fn unsupported_syntax(uid: &str) -> LoadError {
 }
 
 struct Walk<'a> {
+    format: Format,
     bytes: &'a [u8],
     at: usize,
     pixel_data: Option<std::ops::Range<usize>>,
@@ -98,7 +99,7 @@ impl Walk<'_> {
 
     fn truncated(&self) -> LoadError {
         LoadError::Truncated {
-            format: FORMAT,
+            format: self.format,
             offset: self.bytes.len(),
             detail: format!("an element header at byte {} is cut off", self.at),
         }
@@ -126,7 +127,7 @@ impl Walk<'_> {
             let header = self.header(implicit)?;
             if header.tag == PIXEL_DATA && header.len == UNDEFINED {
                 return Err(LoadError::Unsupported {
-                    format: FORMAT,
+                    format: self.format,
                     detail: "encapsulated (compressed) pixel data is not read".into(),
                 });
             }
@@ -216,7 +217,7 @@ impl Walk<'_> {
         let left = self.bytes.len() - self.at.min(self.bytes.len());
         if len as usize > left {
             return Err(LoadError::CountTooLarge {
-                format: FORMAT,
+                format: self.format,
                 what: "bytes in an element",
                 claimed: u64::from(len),
                 possible: left as u64,
@@ -227,7 +228,7 @@ impl Walk<'_> {
 
     fn bad(&self, detail: &str) -> LoadError {
         LoadError::Unsupported {
-            format: FORMAT,
+            format: self.format,
             detail: format!("byte {}: {detail}", self.at),
         }
     }
@@ -275,10 +276,13 @@ mod tests {
     #[test]
     fn a_length_past_the_end_is_refused_before_parsing() {
         let good = element((0x0010, 0x0010), b"PN", b"Anon");
-        assert_eq!(check(&file(EXPLICIT_LE, &good)).map(|l| l.start), Ok(128));
+        assert_eq!(
+            check(&file(EXPLICIT_LE, &good), Format::DicomSeg).map(|l| l.start),
+            Ok(128)
+        );
         let mut lying = element((0x7FE0, 0x0010), b"OB", &[1, 2]);
         lying[8..12].copy_from_slice(&0xF000_0000u32.to_le_bytes());
-        let error = check(&file(EXPLICIT_LE, &lying)).unwrap_err();
+        let error = check(&file(EXPLICIT_LE, &lying), Format::DicomSeg).unwrap_err();
         assert!(
             matches!(error, LoadError::CountTooLarge { claimed, .. } if claimed == 0xF000_0000)
         );
@@ -295,7 +299,7 @@ mod tests {
         item.extend(&inner);
         let sequence = element((0x0062, 0x0002), b"SQ", &item);
         assert!(matches!(
-            check(&file(EXPLICIT_LE, &sequence)),
+            check(&file(EXPLICIT_LE, &sequence), Format::DicomSeg),
             Err(LoadError::CountTooLarge {
                 claimed: 0xFFF0,
                 ..
@@ -305,15 +309,15 @@ mod tests {
 
     #[test]
     fn other_encodings_are_named() {
-        let error = check(&file("1.2.840.10008.1.2.4.90", &[])).unwrap_err();
+        let error = check(&file("1.2.840.10008.1.2.4.90", &[]), Format::DicomSeg).unwrap_err();
         assert!(
             error.to_string().contains("1.2.840.10008.1.2.4.90"),
             "{error}"
         );
-        let error = check(&file("1.2.840.10008.1.2.2", &[])).unwrap_err();
+        let error = check(&file("1.2.840.10008.1.2.2", &[]), Format::DicomSeg).unwrap_err();
         assert!(error.to_string().contains("big endian"), "{error}");
         assert!(matches!(
-            check(b"not dicom"),
+            check(b"not dicom", Format::DicomSeg),
             Err(LoadError::BadMagic { .. })
         ));
     }

@@ -32,7 +32,7 @@ pub(super) enum Pixels {
 }
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
-    let layout = dicom_lengths::check(bytes)?;
+    let layout = dicom_lengths::check(bytes, FORMAT)?;
     // The pixels are read in place, not copied into the object.
     let object = OpenFileOptions::new()
         .read_preamble(ReadPreamble::Never)
@@ -103,7 +103,7 @@ fn unsupported(detail: String) -> LoadError {
     }
 }
 
-fn text(object: &InMemDicomObject, tag: Tag) -> Option<String> {
+pub(super) fn text(object: &InMemDicomObject, tag: Tag) -> Option<String> {
     let element = object.element(tag).ok()?;
     let value = element.to_str().ok()?;
     let value = value.trim_matches(|c: char| c == '\0' || c.is_whitespace());

@@ -64,11 +64,26 @@ fn error(detail: String) -> LoadError {
     }
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+/// Voxel index to RAS millimetres for a grid whose `i, j, k` axes run along `axes` (unit, LPS)
+/// `spacing` apart, voxel 0 at `origin` (LPS): DICOM's patient frame is LPS.
+pub(super) fn ras_affine(axes: [[f64; 3]; 3], spacing: [f64; 3], origin: [f64; 3]) -> Affine {
+    Affine(std::array::from_fn(|r| {
+        // LPS to RAS: the first two world axes change sign.
+        let sign = if r < 2 { -1.0 } else { 1.0 };
+        [
+            sign * axes[0][r] * spacing[0],
+            sign * axes[1][r] * spacing[1],
+            sign * axes[2][r] * spacing[2],
+            sign * origin[r],
+        ]
+    }))
+}
+
+pub(super) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+pub(super) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -170,18 +185,11 @@ impl Grid {
                 size[1]
             )));
         }
-        let mut m = [[0.0; 4]; 3];
-        for r in 0..3 {
-            // LPS to RAS: the first two world axes change sign.
-            let sign = if r < 2 { -1.0 } else { 1.0 };
-            m[r] = [
-                sign * row[r] * along_row,
-                sign * column[r] * along_column,
-                sign * normal[r] * step,
-                sign * origin[r],
-            ];
-        }
-        let affine = Affine(m);
+        let affine = ras_affine(
+            [row, column, normal],
+            [along_row, along_column, step],
+            origin,
+        );
         let location = Location::Item("frame", 1);
         check_affine(&affine, FORMAT, location, "the plane geometry")?;
         Ok(Grid {

@@ -13,7 +13,10 @@ pub enum LoadError {
          .nii .nii.gz .nrrd .mgz .mgh .dcm (label maps)"
     )]
     UnknownFormat { name: String },
-    #[error("cannot tell the image format of '{name}': use one of .nii .nii.gz .nrrd .mgz .mgh")]
+    #[error(
+        "cannot tell the image format of '{name}': use one of .nii .nii.gz .nrrd .mgz .mgh .dcm \
+         (or a folder of a DICOM series)"
+    )]
     UnknownImageFormat { name: String },
     #[error("{format}: not a {format} file ({detail})")]
     BadMagic { format: Format, detail: String },

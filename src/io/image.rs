@@ -1,9 +1,10 @@
 //! The image a segmentation was drawn on (CT or MRI), as a student sees it under the surfaces:
 //! one scalar volume in world RAS millimetres, reduced to a size a learning platform can carry.
 
+use super::dicom_series::{load_image_series, SeriesError};
 use super::intensity::IntensitySink;
 use super::label_map::Affine;
-use super::{mgh, nifti, nrrd, Format, LoadError};
+use super::{dicom_seg, mgh, nifti, nrrd, Format, LoadError};
 
 /// An intensity volume on its (possibly reduced) grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -21,10 +22,20 @@ pub struct ImageVolume {
 }
 
 /// Reads `name`'s image (NIfTI `.nii`/`.nii.gz`, NRRD `.nrrd` with its data attached, or
-/// FreeSurfer `.mgz`/`.mgh`), reduced by the smallest whole factor that leaves at most
+/// FreeSurfer `.mgz`/`.mgh`, or a DICOM image of one slice: a series of several is read by
+/// [`load_image_series`]), reduced by the smallest whole factor that leaves at most
 /// `max_voxels` voxels.
 pub fn load_image(bytes: &[u8], name: &str, max_voxels: usize) -> Result<ImageVolume, LoadError> {
     let lower = name.to_ascii_lowercase();
+    if lower.ends_with(".dcm") || dicom_seg::is_dicom(bytes) {
+        return load_image_series(&[(name, bytes)], max_voxels).map_err(|e| match e {
+            SeriesError::File { error, .. } => error,
+            SeriesError::Series(detail) => LoadError::Unsupported {
+                format: Format::DicomImage,
+                detail,
+            },
+        });
+    }
     let sink = |format| move |layout: &_| IntensitySink::new(layout, format, max_voxels);
     let (format, volume) = if lower.ends_with(".nrrd") {
         (Format::Nrrd, nrrd::read(bytes, sink(Format::Nrrd))?.plain())

@@ -124,6 +124,13 @@ impl IntensitySink {
         })
     }
 
+    /// Scales the samples fed from now on by `slope` and `inter` instead (each slice of a DICOM
+    /// series has its own).
+    pub(super) fn rescale(&mut self, slope: f64, inter: f64) {
+        self.layout.slope = slope;
+        self.layout.inter = inter;
+    }
+
     /// The factor the grid is reduced by along each axis.
     pub(super) fn factor(&self) -> usize {
         self.means.factor

@@ -7,6 +7,7 @@ mod color_table;
 mod dicom_lengths;
 mod dicom_seg;
 mod dicom_seg_grid;
+mod dicom_series;
 mod error;
 mod freesurfer_lut;
 mod gltf;
@@ -31,6 +32,7 @@ mod weld;
 
 pub use codes::{Code, StructureCodes};
 pub use color_table::{is_color_table, parse_color_table, LabelEntry};
+pub use dicom_series::{load_image_series, SeriesError};
 pub use error::{LoadError, Location};
 pub use gltf::{GltfNode, GltfScene, Mat4};
 pub use image::{load_image, reduced_affine, ImageVolume};
@@ -58,6 +60,8 @@ pub enum Format {
     Mgh,
     /// A DICOM Segmentation object: a label map, read by [`load_label_map`].
     DicomSeg,
+    /// One slice of a DICOM image series (CT or MR), read by [`load_image_series`].
+    DicomImage,
     /// A label map's colour table, read by [`parse_color_table`].
     ColorTable,
 }
@@ -74,6 +78,7 @@ impl std::fmt::Display for Format {
             Format::Nrrd => "NRRD",
             Format::Mgh => "MGH",
             Format::DicomSeg => "DICOM SEG",
+            Format::DicomImage => "DICOM image",
             Format::ColorTable => "colour table",
         })
     }
@@ -147,12 +152,15 @@ pub fn load_as(bytes: &[u8], format: Format) -> Result<Mesh, LoadError> {
         Format::Obj => obj::parse(bytes),
         Format::Ply => ply::parse(bytes),
         Format::Glb | Format::Gltf => gltf::parse(bytes, format),
-        Format::Nifti | Format::Nrrd | Format::Mgh | Format::DicomSeg | Format::ColorTable => {
-            Err(LoadError::Unsupported {
-                format,
-                detail: "not a mesh format: open label maps as a segmentation (meshsmooth extract)"
-                    .into(),
-            })
-        }
+        Format::Nifti
+        | Format::Nrrd
+        | Format::Mgh
+        | Format::DicomSeg
+        | Format::DicomImage
+        | Format::ColorTable => Err(LoadError::Unsupported {
+            format,
+            detail: "not a mesh format: open label maps as a segmentation (meshsmooth extract)"
+                .into(),
+        }),
     }
 }

@@ -50,6 +50,8 @@ run fuzz_nrrd "$(corpus nrrd '*.nrrd')" 8192
 run fuzz_mgh "$(corpus mgh '*.mgz')" 8192
 # DICOM SEG: the seeds are up to 180 KB; longer inputs let the fuzzer keep whole frames.
 run fuzz_dicom_seg "$(corpus dicom_seg '*.dcm')" 32768
+# DICOM image slices (and the SEGs, which it must refuse).
+run fuzz_dicom_series "$(corpus dicom_series '*.dcm')" 8192
 run fuzz_stl "$(corpus stl '*.stl')"
 run fuzz_obj "$(corpus obj '*.obj')"
 run fuzz_ply "$(corpus ply '*.ply')"

@@ -1,0 +1,214 @@
+//! A DICOM image series (one CT slice a file, written by pydicom: tests/data/make_dicom_series.py)
+//! read as the image under a case: the same voxels and world frame as its NIfTI twin, whatever
+//! the files' order, and refused, naming the file or the reason, when its slices cannot be one
+//! image.
+
+use meshsmooth::io::{load_image, load_image_series, ImageVolume, SeriesError};
+use std::path::{Path, PathBuf};
+
+#[path = "common/cli.rs"]
+mod common_cli;
+
+const ALL: usize = usize::MAX;
+
+fn folder(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/dicom_series")
+        .join(name)
+}
+
+/// The files of a series folder, sorted by name (not slice order: the names are hashes).
+fn slices(name: &str) -> Vec<(String, Vec<u8>)> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(folder(name))
+        .expect("the series folder")
+        .map(|e| e.expect("an entry").path())
+        .collect();
+    paths.sort();
+    (paths.iter())
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read(p).expect("a slice"))
+        })
+        .collect()
+}
+
+fn read(files: &[(String, Vec<u8>)], max_voxels: usize) -> Result<ImageVolume, SeriesError> {
+    let named: Vec<(&str, &[u8])> = (files.iter())
+        .map(|(n, b)| (n.as_str(), b.as_slice()))
+        .collect();
+    load_image_series(&named, max_voxels)
+}
+
+fn twin(max_voxels: usize) -> ImageVolume {
+    let bytes = std::fs::read(folder("oblique.nii.gz")).expect("the NIfTI twin");
+    load_image(&bytes, "oblique.nii.gz", max_voxels).expect("the twin reads")
+}
+
+fn assert_same(got: &ImageVolume, want: &ImageVolume) {
+    assert_eq!(got.dims, want.dims);
+    assert_eq!(got.source_dims, want.source_dims);
+    assert_eq!(
+        got.values, want.values,
+        "the voxels, slice by slice rescaled"
+    );
+    for (affine, other) in [
+        (&got.affine, &want.affine),
+        (&got.source_affine, &want.source_affine),
+    ] {
+        for (r, row) in affine.0.iter().enumerate() {
+            for (c, v) in row.iter().enumerate() {
+                // The DICOM writes directions to 9 decimals and positions to 6.
+                assert!(
+                    (v - other.0[r][c]).abs() < 1e-5,
+                    "{:?} vs {:?}",
+                    affine,
+                    other
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn an_oblique_series_reads_as_its_nifti_twin_in_any_file_order() {
+    let files = slices("oblique");
+    assert_eq!(files.len(), 12);
+    let image = read(&files, ALL).expect("the series reads");
+    assert_eq!(image.dims, [24, 20, 12]);
+    assert_same(&image, &twin(ALL));
+    let mut reversed = files.clone();
+    reversed.reverse();
+    assert_same(&read(&reversed, ALL).expect("reversed"), &twin(ALL));
+    // Reduced to fit, as any image is, by the same whole factor as the twin.
+    let small = read(&files, 1000).expect("reduced");
+    assert!(small.dims.iter().product::<usize>() <= 1000);
+    assert_same(&small, &twin(1000));
+}
+
+#[test]
+fn one_slice_reads_as_an_image_of_one_slice() {
+    let files = slices("oblique");
+    let (name, bytes) = &files[0];
+    let image = load_image(bytes, name, ALL).expect("one slice");
+    assert_eq!(image.dims, [24, 20, 1]);
+    let values: std::collections::HashSet<i32> = image.values.iter().map(|&v| v as i32).collect();
+    assert!(values.len() > 2, "the slice's HU: {values:?}");
+}
+
+fn refusal(files: &[(String, Vec<u8>)]) -> String {
+    read(files, ALL).expect_err("refused").to_string()
+}
+
+#[test]
+fn slices_that_cannot_be_one_image_are_refused_naming_the_files() {
+    let gap = refusal(&slices("gap"));
+    assert!(
+        gap.contains("not evenly spaced") && gap.contains(".dcm"),
+        "{gap}"
+    );
+    let tilted = refusal(&slices("tilted"));
+    assert!(
+        tilted.contains("gantry tilt") && tilted.contains(".dcm"),
+        "{tilted}"
+    );
+
+    let mut mixed = slices("oblique");
+    mixed.push(slices("gap").remove(0));
+    let mixed = refusal(&mixed);
+    assert!(mixed.contains("different series"), "{mixed}");
+
+    let mut twice = slices("oblique");
+    let mut copy = twice[3].clone();
+    copy.0 = "copy.dcm".into();
+    twice.push(copy);
+    let twice = refusal(&twice);
+    assert!(
+        twice.contains("same position") && twice.contains("copy.dcm"),
+        "{twice}"
+    );
+
+    assert!(refusal(&[]).contains("no slice"));
+}
+
+#[test]
+fn a_broken_or_foreign_file_in_a_series_is_named() {
+    let mut files = slices("oblique");
+    let (name, bytes) = files[5].clone();
+    files[5].1.truncate(bytes.len() - 100);
+    let cut = refusal(&files);
+    assert!(cut.starts_with(&format!("{name}: DICOM image:")), "{cut}");
+
+    let mut files = slices("oblique");
+    let seg = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/dicom_seg/phantom.dcm"),
+    )
+    .expect("a SEG");
+    files.push(("seg.dcm".into(), seg));
+    let seg = refusal(&files);
+    assert!(
+        seg.starts_with("seg.dcm:") && seg.contains("DICOM SEG"),
+        "{seg}"
+    );
+
+    let mut files = slices("oblique");
+    files.push(("notes.txt".into(), b"not a slice".to_vec()));
+    let text = refusal(&files);
+    assert!(
+        text.starts_with("notes.txt:") && text.contains("DICM"),
+        "{text}"
+    );
+
+    let mut files = slices("oblique");
+    let map = common_cli::data("labelmaps/case_phantom_shared.nii.gz");
+    files.insert(
+        0,
+        (
+            "map.nii.gz".into(),
+            std::fs::read(map).expect("a label map"),
+        ),
+    );
+    let map = refusal(&files);
+    assert!(
+        map.starts_with("map.nii.gz:") && map.contains("DICM"),
+        "{map}"
+    );
+}
+
+/// `case build --image FOLDER`: the series' image in the case, the same as from its twin; a
+/// tilted series refused naming the slice, with no case written.
+#[test]
+fn case_build_takes_a_series_folder_as_the_image() {
+    let twin_path = folder("oblique.nii.gz").display().to_string();
+    let build = |image: &Path, out: &Path| {
+        common_cli::meshsmooth(&[
+            "case",
+            "build",
+            &twin_path,
+            "--level",
+            "0",
+            "--image",
+            &image.display().to_string(),
+            "-o",
+            &out.display().to_string(),
+            "--json",
+        ])
+    };
+    let from_series = common_cli::json(&build(&folder("oblique"), &common_cli::tmp("s.glb")));
+    let from_twin = common_cli::json(&build(&folder("oblique.nii.gz"), &common_cli::tmp("t.glb")));
+    let (a, b) = (&from_series["image"], &from_twin["image"]);
+    assert_eq!(a["source"], "oblique");
+    assert_eq!(a["dims"], serde_json::json!([24, 20, 12]));
+    for key in ["dims", "preset", "window", "bytes"] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+
+    let out = common_cli::tmp("tilted.glb");
+    let refused = build(&folder("tilted"), &out);
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("tilted") && stderr.contains("gantry tilt"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
