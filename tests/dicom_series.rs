@@ -3,11 +3,17 @@
 //! the files' order, and refused, naming the file or the reason, when its slices cannot be one
 //! image.
 
+use meshsmooth::case::{CaseImage, WindowPreset};
 use meshsmooth::io::{load_image, load_image_series, ImageVolume, SeriesError};
+use meshsmooth::session::Session;
+use meshsmooth::worker::NamedFile;
 use std::path::{Path, PathBuf};
 
 #[path = "common/cli.rs"]
 mod common_cli;
+
+#[path = "common/label_maps.rs"]
+mod label_maps;
 
 const ALL: usize = usize::MAX;
 
@@ -211,4 +217,49 @@ fn case_build_takes_a_series_folder_as_the_image() {
         "{stderr}"
     );
     assert!(!out.exists());
+}
+
+/// The page's session reads a series chosen together (its worker on this thread): the
+/// phantom's first 24 CT slices under its segmentation, the same grey levels as the NIfTI CT's
+/// slices; a tilted series refused naming the slice, the image kept.
+#[test]
+fn the_page_session_adds_a_series_under_the_phantom() {
+    let mut session = Session::default();
+    let seg = label_maps::read("labelmaps/case_phantom_shared.seg.nrrd");
+    label_maps::open_in_session(&mut session, "case_phantom_shared.seg.nrrd", seg);
+    let named = |folder: &str| -> Vec<NamedFile> {
+        (slices(folder).into_iter())
+            .map(|(name, bytes)| NamedFile { name, bytes })
+            .collect()
+    };
+    (session.begin_image_files(named("phantom_ct"), WindowPreset::CtSoftTissue)).expect("asked");
+    session.poll_opening().expect("done").expect("read");
+    let image = session.case().case_image().expect("added").clone();
+    assert_eq!(image.source, "DICOM series (24 slices)");
+    assert_eq!(image.dims, [160, 140, 24]);
+
+    let ct =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/phantom_ct.nii.gz"))
+            .expect("the NIfTI CT");
+    let mut volume = load_image(&ct, "phantom_ct.nii.gz", ALL).expect("the NIfTI CT reads");
+    volume.dims[2] = 24;
+    volume.values.truncate(160 * 140 * 24);
+    let want = CaseImage::new(&volume, "phantom_ct.nii.gz", WindowPreset::CtSoftTissue);
+    assert_eq!(
+        image.voxels, want.voxels,
+        "the NIfTI's first 24 slices' grey levels"
+    );
+    let (got, wanted) = (image.affine.0, want.affine.0);
+    for (g, w) in got.iter().flatten().zip(wanted.iter().flatten()) {
+        assert!((g - w).abs() < 1e-4, "{got:?} {wanted:?}");
+    }
+
+    (session.begin_image_files(named("tilted"), WindowPreset::CtBone)).expect("asked");
+    let error = session.poll_opening().expect("done").expect_err("tilted");
+    assert!(
+        error.starts_with("Cannot open the image DICOM series (12 slices): ")
+            && error.contains("gantry tilt"),
+        "{error}"
+    );
+    assert_eq!(session.case().case_image(), Some(&image), "kept");
 }

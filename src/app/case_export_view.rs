@@ -126,7 +126,7 @@ impl ExportChoice {
                     });
                 if ui
                     .button("Add image...")
-                    .on_hover_text("The CT or MRI the segmentation was drawn on (NIfTI, NRRD or MGH/MGZ, on the segmentation's voxel grid), windowed to grey levels: shown on the clipping plane and carried in the case glTF")
+                    .on_hover_text("The CT or MRI the segmentation was drawn on (NIfTI, NRRD, MGH/MGZ, or every slice file of a DICOM series chosen together; on the segmentation's voxel grid), windowed to grey levels: shown on the clipping plane and carried in the case glTF")
                     .clicked()
                 {
                     actions.push(StructureAction::AddImage(self.preset));

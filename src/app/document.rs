@@ -249,16 +249,16 @@ impl Document {
         self.waiting_for_load.extend(waiter);
     }
 
-    /// Starts reading the image under the open case's surfaces in a worker. `waiter`, when
-    /// given, hears once it is read (or at once, when it cannot be asked).
+    /// Starts reading the image under the open case's surfaces in a worker: one file, or the
+    /// slices of a DICOM series. `waiter`, when given, hears once it is read (or at once, when
+    /// it cannot be asked).
     pub fn begin_image(
         &mut self,
-        name: &str,
-        bytes: Vec<u8>,
+        files: Vec<crate::worker::NamedFile>,
         preset: crate::case::WindowPreset,
         waiter: Option<LoadWaiter>,
     ) {
-        match self.session.begin_image(name, bytes, preset) {
+        match self.session.begin_image_files(files, preset) {
             Ok(()) => self.waiting_for_load.extend(waiter),
             Err(why) => {
                 log::warn!("{why}");

@@ -128,12 +128,31 @@ impl Session {
         bytes: Vec<u8>,
         preset: case::WindowPreset,
     ) -> Result<(), String> {
+        let file = NamedFile {
+            name: name.to_string(),
+            bytes,
+        };
+        self.begin_image_files(vec![file], preset)
+    }
+
+    /// [`Self::begin_image`] of one file, or of the slices of a DICOM series (several files,
+    /// named "DICOM series (N slices)").
+    pub fn begin_image_files(
+        &mut self,
+        files: Vec<NamedFile>,
+        preset: case::WindowPreset,
+    ) -> Result<(), String> {
+        let name = match files.as_slice() {
+            [one] => one.name.clone(),
+            _ => format!("DICOM series ({} slices)", files.len()),
+        };
+        let name = name.as_str();
         if self.opening.is_some() || !self.additions.is_empty() || self.doc.model().is_none() {
             let why = "open the segmentation first, and wait until it is open";
             return Err(self.fail(name, why));
         }
         let input = Input::Image {
-            bytes,
+            files,
             preset: preset.name().to_string(),
             grids: self.doc.case.image_grids(),
         };

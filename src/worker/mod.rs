@@ -39,11 +39,11 @@ pub enum Input {
     /// A file's bytes read as a case only, to add its structures to the open one.
     Addition(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
     /// The image the segmentation was drawn on, read as a case holding only it
-    /// ([`crate::case::CaseImage::read`]): windowed by the preset so named, checked against
-    /// the open case's grids.
+    /// ([`crate::case::CaseImage::read`]; several files are the slices of a DICOM series,
+    /// [`crate::case::CaseImage::read_series`]): windowed by the preset so named, checked
+    /// against the open case's grids.
     Image {
-        #[serde(with = "crate::mesh::flat_bytes")]
-        bytes: Vec<u8>,
+        files: Vec<NamedFile>,
         preset: String,
         grids: Vec<(String, crate::io::Affine)>,
     },
@@ -288,7 +288,7 @@ impl Worker {
                 .map(|case| (None, case))
                 .map_err(|e| e.reason()),
             Input::Image {
-                bytes,
+                files,
                 preset,
                 grids,
             } => {
@@ -297,7 +297,7 @@ impl Worker {
                     total: 1,
                     doing: "reading the image",
                 });
-                read_image(name, &bytes, &preset, &grids).map(|case| (None, case))
+                read_image(name, &files, &preset, &grids).map(|case| (None, case))
             }
         };
         let ended = clock();
@@ -446,16 +446,26 @@ pub fn metrics_of(json: &str) -> Result<Metrics, String> {
     serde_json::from_str(json).map_err(|e| format!("a worker's measures did not decode: {e}"))
 }
 
-/// A case holding only the image `name` ([`Input::Image`]).
+/// A case holding only the image `name` ([`Input::Image`]): one file, or the slices of a
+/// DICOM series.
 fn read_image(
     name: &str,
-    bytes: &[u8],
+    files: &[NamedFile],
     preset: &str,
     grids: &[(String, crate::io::Affine)],
 ) -> Result<Case, String> {
     let preset = (case::WindowPreset::from_name(preset))
         .ok_or_else(|| format!("{name}: no window preset named {preset:?}"))?;
-    let image = case::CaseImage::read(bytes, name, preset, case::DEFAULT_IMAGE_VOXELS, grids)?;
+    let most = case::DEFAULT_IMAGE_VOXELS;
+    let image = match files {
+        [one] => case::CaseImage::read(&one.bytes, &one.name, preset, most, grids)?,
+        _ => {
+            let slices: Vec<(&str, &[u8])> = (files.iter())
+                .map(|f| (f.name.as_str(), f.bytes.as_slice()))
+                .collect();
+            case::CaseImage::read_series(&slices, name, preset, most, grids)?
+        }
+    };
     Ok(Case {
         image: Some(std::sync::Arc::new(image)),
         ..Case::default()

@@ -5,7 +5,7 @@
 //
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/viewer.test.mjs   (tests/e2e/run.sh runs both)
 import assert from "node:assert/strict";
-import { readFileSync, writeFileSync } from "node:fs";
+import { readFileSync, readdirSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 
 import * as cli from "./lib/cli.mjs";
@@ -392,6 +392,38 @@ testIn(EVERY_RUN, "V5 the author adds the CT under the page's case, the case glT
         await app.call("setView", { from: "S", clip: { axis: "axial", at: 0.5 } });
         await app.screenshotWhen("V5-viewer-bone-window", (i) => pixelsWhere(i, view, boneLiver).count > 2000, "the CT's liver on the viewer's slice");
     }, { query: "?mode=viewer" });
+});
+
+testIn(EVERY_RUN, "V8 a DICOM CT series, its slices given together, goes under the case as case build --image FOLDER adds it", { timeout: TIMEOUT }, async () => {
+    const folder = join(ROOT, "tests/data/dicom_series/phantom_ct");
+    // Not in slice order: the slices are placed by their positions.
+    const names = readdirSync(folder).sort().reverse();
+    const native = (await cli.cliJson("case", "build", PHANTOM_NRRD, "--image", folder, "--search", "local", "-o", join(E2E_OUT, MODE, "V8-series-case.glb"), "--json")).image;
+    assert.deepEqual(native.dims, [160, 140, 24]);
+    await withApp(async (app) => {
+        await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd", "loadCase");
+        const addSeries = (files, names) =>
+            app.page.evaluate(async ([files, names]) => {
+                const slices = files.map((b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0)));
+                try {
+                    return { ok: true, value: await window.meshsmooth.addImage(slices, names, "ct-soft-tissue") };
+                } catch (e) {
+                    return { ok: false, message: e instanceof Error ? e.message : String(e) };
+                }
+            }, [files, names]);
+        const files = names.map((n) => readFileSync(join(folder, n)).toString("base64"));
+        const uneven = await addSeries(files, names.slice(1));
+        assert.match(uneven.message, /addImage\(bytes, names\): a series needs as many names as slices/);
+        const gapped = await addSeries(files.filter((_, i) => i !== 7), names.filter((_, i) => i !== 7));
+        assert.match(gapped.message, /Cannot open the image DICOM series \(23 slices\): the slices are not evenly spaced: CT\d{4}\.dcm and CT\d{4}\.dcm lie 5\.000 mm apart/);
+        const added = await addSeries(files, names);
+        assert.ok(added.ok, added.message);
+        assert.deepEqual(added.value.image, { source: "DICOM series (24 slices)", dims: native.dims, preset: native.preset, window: native.window });
+        const { view } = await app.stateWhen((s) => s.loading === null && s.layout.structures.length === 4, "the case open, the series read");
+        // The structures span slices 11 to 32, the series 0 to 23: a plane through slice 18.
+        await app.call("setView", { from: "S", clip: { axis: "axial", at: 0.35 } });
+        await app.screenshotWhen("V8-series-slice", (i) => pixelsWhere(i, view, liverGrey).count > 2000, "the series' liver on the slice");
+    });
 });
 
 testIn(EVERY_RUN, "V6 a glTF meshsmooth did not smooth is shown as the file holds it, with no smoothing record", { timeout: TIMEOUT }, async () => {

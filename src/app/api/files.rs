@@ -4,8 +4,9 @@
 use super::{error, settled, to_js};
 use crate::app::document::{LoadWaiter, SharedDocument};
 use crate::case::WindowPreset;
+use crate::worker::NamedFile;
 use eframe::egui;
-use js_sys::{Function, Promise, Uint8Array};
+use js_sys::{Array, Function, Promise, Uint8Array};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::{JsCast, JsValue};
 
@@ -91,15 +92,16 @@ pub(super) fn file_call(
 
 /// `addImage(bytes: Uint8Array, name, preset)`: the image under the open case's surfaces, read
 /// by a worker with the window `preset` names (`ct-soft-tissue` when left out); the promise
-/// settles with the structures (their `image`) once it is read, or with why not.
+/// settles with the structures (their `image`) once it is read, or with why not. A DICOM
+/// series comes as arrays: `addImage([bytes, ...], [name, ...], preset)`, one a slice.
 pub(super) fn image_call(
     doc: &SharedDocument,
     ctx: &egui::Context,
 ) -> Closure<dyn FnMut(JsValue, JsValue, JsValue) -> Promise> {
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move |bytes: JsValue, name: JsValue, preset: JsValue| {
-        let (bytes, name) = match file_arguments("addImage", &bytes, &name) {
-            Ok(file) => file,
+        let files = match image_files(&bytes, &name) {
+            Ok(files) => files,
             Err(why) => return settled(Err(why)),
         };
         let preset = match preset.as_string() {
@@ -112,17 +114,32 @@ pub(super) fn image_call(
             let why = format!("addImage: preset must be one of {}", names.join(", "));
             return settled(Err(why));
         };
-        let mut bytes = Some(bytes);
+        let mut files = Some(files);
         let (d, c) = (d.clone(), c.clone());
         Promise::new(&mut |resolve: Function, reject: Function| {
-            let Some(bytes) = bytes.take() else { return };
+            let Some(files) = files.take() else { return };
             let structures = |s: &crate::session::Session| super::json::structures(s.case());
             let waiter = load_waiter(resolve, reject, structures);
-            d.borrow_mut()
-                .begin_image(&name, bytes, preset, Some(waiter));
+            d.borrow_mut().begin_image(files, preset, Some(waiter));
             crate::app::wake(&c);
         })
     })
+}
+
+/// `addImage`'s files: one `(bytes, name)`, or arrays of the slices' bytes and names.
+fn image_files(bytes: &JsValue, names: &JsValue) -> Result<Vec<NamedFile>, String> {
+    let (Some(all), Some(names)) = (bytes.dyn_ref::<Array>(), names.dyn_ref::<Array>()) else {
+        let (bytes, name) = file_arguments("addImage", bytes, names)?;
+        return Ok(vec![NamedFile { name, bytes }]);
+    };
+    if all.length() != names.length() || all.length() == 0 {
+        return Err("addImage(bytes, names): a series needs as many names as slices".into());
+    }
+    (all.iter().zip(names.iter()))
+        .map(|(b, n)| {
+            file_arguments("addImage", &b, &n).map(|(bytes, name)| NamedFile { name, bytes })
+        })
+        .collect()
 }
 
 /// A call's `(bytes: Uint8Array, name)` arguments, or why they are not.

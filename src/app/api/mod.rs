@@ -15,7 +15,8 @@
 //! - `addFile(bytes, name): Promise<structures>`: adds the file's structures to the open case
 //!   (after a file still opening); the model stays
 //! - `addImage(bytes, name, preset): Promise<structures>`: the image the segmentation was drawn
-//!   on (NIfTI, NRRD or MGH/MGZ, on the voxel grid of every label map the structures came from),
+//!   on (NIfTI, NRRD, MGH/MGZ, or a DICOM series as arrays of its slices' bytes and names; on the
+//!   voxel grid of every label map the structures came from),
 //!   windowed by `preset` (`ct-soft-tissue`, the default, `ct-bone`, `ct-lung`, `ct-brain`,
 //!   `mri-auto`), read by a worker; replaces the case's image; rejects with the offset found
 //!   when it lies elsewhere, the image the case had staying. `removeImage()` takes it away

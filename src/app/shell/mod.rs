@@ -125,12 +125,9 @@ fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
                     doc.begin_add(&f.name, f.bytes, None);
                 }
             }
-            // One image: the first file chosen.
-            FilesFor::Image(preset) => {
-                if let Some(f) = files.into_iter().next() {
-                    doc.begin_image(&f.name, f.bytes, preset, None);
-                }
-            }
+            // One image: a file, or the slices of a DICOM series chosen together.
+            FilesFor::Image(preset) if !files.is_empty() => doc.begin_image(files, preset, None),
+            FilesFor::Image(_) => {}
             FilesFor::NewCase if !files.is_empty() => doc.begin_open_files(files, None),
             FilesFor::NewCase => {}
         }
