@@ -1,12 +1,12 @@
-//! DICOM Segmentation objects (SEG, one multi-frame file): BINARY and FRACTIONAL segmentations
-//! into a [`LabelMap`], each segment with its label, recommended display colour (CIELab) and
-//! coded category, type and type modifier.
+//! DICOM Segmentation objects (SEG, one multi-frame file): BINARY, FRACTIONAL and LABELMAP
+//! segmentations into a [`LabelMap`], each segment with its label, recommended display colour
+//! (CIELab) and coded category, type and type modifier.
 //!
 //! The parsing is `dicom-object`'s (dicom-rs, pure Rust, builds for wasm32), after
 //! [`super::dicom_lengths`] has checked every declared length against the bytes. What is read:
 //! uncompressed little-endian files (explicit or implicit VR). Refused with a reason: other
-//! objects than SEG, compressed or big-endian encodings, LABELMAP segmentations. The grid comes
-//! from the functional groups ([`super::dicom_seg_grid`]).
+//! objects than SEG, compressed or big-endian encodings. The grid comes from the functional
+//! groups ([`super::dicom_seg_grid`]).
 
 use dicom_core::Tag;
 use dicom_dictionary_std::tags;
@@ -20,6 +20,8 @@ use super::{dicom_lengths, Format, LoadError, Location};
 
 const FORMAT: Format = Format::DicomSeg;
 const SEGMENTATION_STORAGE: &str = "1.2.840.10008.5.1.4.1.1.66.4";
+/// A LABELMAP segmentation's own SOP class (DICOM 2024b on).
+const LABEL_MAP_SEGMENTATION_STORAGE: &str = "1.2.840.10008.5.1.4.1.1.66.7";
 
 /// How a SEG stores its pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +31,20 @@ pub(super) enum Pixels {
     /// One byte a pixel: the segment's share of the voxel, out of `max`; in the segment when
     /// `value >= threshold`.
     Fractional { threshold: u8 },
+    /// LABELMAP: each pixel the number of its segment (0 none), in `bytes` (1 or 2) little
+    /// endian; a frame holds every segment of its slice.
+    Labels { bytes: usize },
+}
+
+impl Pixels {
+    /// Bytes of pixel data `n` pixels take.
+    fn bytes_for(self, n: usize) -> Option<usize> {
+        match self {
+            Pixels::Binary => Some(n.div_ceil(8)),
+            Pixels::Fractional { .. } => Some(n),
+            Pixels::Labels { bytes } => n.checked_mul(bytes),
+        }
+    }
 }
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
@@ -40,7 +56,7 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
         .from_reader(&bytes[layout.start..])
         .map_err(|e| unsupported(format!("the DICOM object does not parse: {e}")))?;
     let sop_class = text(&object, tags::SOP_CLASS_UID).unwrap_or_default();
-    if sop_class != SEGMENTATION_STORAGE {
+    if sop_class != SEGMENTATION_STORAGE && sop_class != LABEL_MAP_SEGMENTATION_STORAGE {
         return Err(LoadError::BadMagic {
             format: FORMAT,
             detail: format!(
@@ -52,19 +68,15 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     let columns = number(&object, tags::COLUMNS, "Columns")?;
     let frames = number(&object, tags::NUMBER_OF_FRAMES, "Number of Frames")?;
     let pixels = pixels(&object, options)?;
-    let segments = segments(&object)?;
-    let per_frame = frame_geometry(&object, frames, &segments)?;
+    let segments = segments(&object, matches!(pixels, Pixels::Labels { .. }))?;
+    let per_frame = frame_geometry(&object, frames, &segments, pixels)?;
     let data = (layout.pixel_data)
         .map(|range| &bytes[range])
         .ok_or_else(|| unsupported("no Pixel Data".into()))?;
     // Checked: usize is 32 bits in the browser, and the sizes come from the file. Once the
     // pixel data holds every frame, frame * plane + pixel fits below.
     let pixels_in = (frames.checked_mul(rows)).and_then(|n| n.checked_mul(columns));
-    let needed = pixels_in.map(|n| match pixels {
-        Pixels::Binary => n.div_ceil(8),
-        Pixels::Fractional { .. } => n,
-    });
-    let needed = needed.unwrap_or(usize::MAX);
+    let needed = (pixels_in.and_then(|n| pixels.bytes_for(n))).unwrap_or(usize::MAX);
     if data.len() < needed {
         return Err(LoadError::CountTooLarge {
             format: FORMAT,
@@ -157,29 +169,31 @@ fn pixels(object: &InMemDicomObject, options: &LabelMapOptions) -> Result<Pixels
             let threshold = (level * max as f64).ceil().clamp(1.0, 255.0) as u8;
             Ok(Pixels::Fractional { threshold })
         }
-        ("LABELMAP", _) => Err(unsupported(
-            "a LABELMAP segmentation is not read yet (BINARY and FRACTIONAL are)".into(),
-        )),
+        ("LABELMAP", 8 | 16) => Ok(Pixels::Labels { bytes: bits / 8 }),
         (kind, bits) => Err(unsupported(format!(
-            "segmentation type '{kind}' with {bits} bits a pixel: BINARY (1 bit) and \
-             FRACTIONAL (8 bits) are read"
+            "segmentation type '{kind}' with {bits} bits a pixel: BINARY (1 bit), FRACTIONAL \
+             (8 bits) and LABELMAP (8 or 16 bits) are read"
         ))),
     }
 }
 
 /// The segments the Segment Sequence declares, by number (the value): name, colour and codes
-/// (the layer is set once the voxels are placed).
-fn segments(object: &InMemDicomObject) -> Result<Vec<Segment>, LoadError> {
+/// (the layer is set once the voxels are placed). A label map's segment 0, its background, is
+/// left out.
+fn segments(object: &InMemDicomObject, labels: bool) -> Result<Vec<Segment>, LoadError> {
     let mut out: Vec<Segment> = Vec::new();
     for (index, item) in items(object, tags::SEGMENT_SEQUENCE).iter().enumerate() {
         let number = (item.element(tags::SEGMENT_NUMBER).ok())
             .and_then(|e| e.to_int::<u16>().ok())
-            .filter(|&n| n > 0)
+            .filter(|&n| n > 0 || labels)
             .ok_or_else(|| LoadError::Syntax {
                 format: FORMAT,
                 location: Location::Item("segment", index + 1),
                 detail: "no Segment Number from 1 to 65535".into(),
             })?;
+        if number == 0 {
+            continue;
+        }
         if out.iter().any(|s| segment_number(s) == number) {
             return Err(unsupported(format!(
                 "segment number {number} is declared twice"
@@ -243,6 +257,7 @@ fn frame_geometry(
     object: &InMemDicomObject,
     frames: usize,
     segments: &[Segment],
+    pixels: Pixels,
 ) -> Result<Vec<FrameGeometry>, LoadError> {
     let groups = items(object, tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE);
     if groups.len() != frames {
@@ -257,6 +272,8 @@ fn frame_geometry(
         [only] => Some(segment_number(only)),
         _ => None,
     });
+    // A label map's frame holds every segment of its slice: it refers to none.
+    let labels = matches!(pixels, Pixels::Labels { .. });
     (groups.iter().enumerate())
         .map(|(index, group)| {
             let at = |detail: &str| LoadError::Syntax {
@@ -271,10 +288,12 @@ fn frame_geometry(
             if position.iter().any(|v| !v.is_finite()) {
                 return Err(at("Image Position (Patient) is not finite"));
             }
-            let segment = segment_of(group)
-                .or(only)
-                .ok_or_else(|| at("no Referenced Segment Number"))?;
-            if !segments.iter().any(|s| segment_number(s) == segment) {
+            let segment = match labels {
+                true => 0,
+                false => (segment_of(group).or(only))
+                    .ok_or_else(|| at("no Referenced Segment Number"))?,
+            };
+            if !labels && !segments.iter().any(|s| segment_number(s) == segment) {
                 return Err(at(&format!("segment {segment} is not declared")));
             }
             let orientation = dicom_seg_grid::orientation_of(group);

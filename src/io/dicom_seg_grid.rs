@@ -238,6 +238,9 @@ pub(super) fn fill(
     data: &[u8],
     pixels: Pixels,
 ) -> Result<(Vec<LabelLayer>, Vec<usize>), LoadError> {
+    if let Pixels::Labels { bytes } = pixels {
+        return fill_labels(grid, frames.len(), segments, data, bytes);
+    }
     let plane = grid.dims[0] * grid.dims[1];
     let voxels = plane * grid.dims[2];
     let mut layers: Vec<LabelLayer> = Vec::new();
@@ -277,6 +280,52 @@ pub(super) fn fill(
         placed.push(index);
     }
     Ok((layers, placed))
+}
+
+/// A LABELMAP's frames into one layer: each pixel's segment number to its segment's code.
+/// Segments cannot overlap in a label map, so every segment is in layer 0.
+fn fill_labels(
+    grid: &Grid,
+    frames: usize,
+    segments: &[u16],
+    data: &[u8],
+    bytes: usize,
+) -> Result<(Vec<LabelLayer>, Vec<usize>), LoadError> {
+    if segments.len() > MAX_LABELS {
+        return Err(error(format!(
+            "{} segments: a label map holds at most {MAX_LABELS}",
+            segments.len()
+        )));
+    }
+    let plane = grid.dims[0] * grid.dims[1];
+    let mut layer = new_layer(plane * grid.dims[2], 0, grid.budget)?;
+    // Segment number to code: 0 stays background, an undeclared number is refused.
+    let mut code_of = vec![None; 1 << (8 * bytes)];
+    code_of[0] = Some(0u16);
+    for (index, &number) in segments.iter().enumerate() {
+        code_of[usize::from(number)] = Some(index as u16 + 1);
+        layer.values.push(i64::from(number));
+    }
+    for f in 0..frames {
+        let base = grid.slices[f] * plane;
+        for p in 0..plane {
+            let at = (f * plane + p) * bytes;
+            let number = match bytes {
+                1 => usize::from(data[at]),
+                _ => usize::from(u16::from_le_bytes([data[at], data[at + 1]])),
+            };
+            let code = code_of[number].ok_or_else(|| {
+                error(format!(
+                    "frame {}: pixel value {number} is no segment the Segment Sequence declares",
+                    f + 1
+                ))
+            })?;
+            if code != 0 {
+                layer.codes[base + p] = code;
+            }
+        }
+    }
+    Ok((vec![layer], vec![0; segments.len()]))
 }
 
 fn new_layer(voxels: usize, existing: usize, budget: usize) -> Result<LabelLayer, LoadError> {
@@ -329,6 +378,8 @@ fn in_segment(
         Pixels::Fractional { threshold } => {
             (0..count).any(|p| data[first + p] >= threshold && visit(p))
         }
+        // A label map's frames are not one segment's: `fill_labels` reads them.
+        Pixels::Labels { .. } => false,
     }
 }
 

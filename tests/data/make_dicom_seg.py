@@ -11,6 +11,8 @@ Outputs, in tests/data/dicom_seg/ (README.md and expected.json there describe th
   of case_phantom_shared_labels.txt as CIELab), empty frames omitted (highdicom's default), so
   each segment holds only the slices it occupies (53 frames, not 4 x 48). The NIfTI affine is
   float32 (-0.77999997); it is rounded to 6 decimals (0.78) for the DICOM and expected.json;
+- labelmap.dcm: the same phantom as one LABELMAP SEG (8-bit, each pixel its segment's number;
+  SOP class Label Map Segmentation Storage), one frame per slice the phantom occupies;
 - gap.dcm + gap.nii.gz: 40 x 32 x 30 axis-aligned BINARY SEG of two segments (a box low, a
   sphere high, slices 3..9 and 20..26); slices 10..19 are empty for every segment, so no frame
   has their positions (nor those of 0..2 and 27..29);
@@ -371,6 +373,41 @@ def phantom(facts):
     }
 
 
+def labelmap(facts):
+    """The phantom again as one LABELMAP SEG: each frame a slice of segment numbers."""
+    image = nib.load(f"{SHARED}/case_phantom_shared.nii.gz")
+    labels = np.asanyarray(image.dataobj).astype(np.uint8)
+    affine = np.round(image.affine, 6)
+    phantom_facts = facts["phantom.dcm"]
+    specs = [
+        (s["number"], s["label"], tuple(s["srgb"]), tuple(s["category"]), tuple(s["type"]),
+         s["description"], tuple(s["modifier"]) if s["modifier"] else None)
+        for s in phantom_facts["segments"]
+    ]
+    descs, segs = zip(*(segment(n, l, c, cat, t, d, m) for n, l, c, cat, t, d, m in specs))
+    write_seg("labelmap", labels, affine, list(descs), kind="LABELMAP")
+    ds = pydicom.dcmread(f"{OUT}/labelmap.dcm")
+    assert ds.SOPClassUID == "1.2.840.10008.5.1.4.1.1.66.7", ds.SOPClassUID
+    frames = ds.pixel_array.reshape(int(ds.NumberOfFrames), ds.Rows, ds.Columns)
+    occupied = [k for k in range(labels.shape[2]) if labels[:, :, k].any()]
+    assert len(frames) == len(occupied), (len(frames), len(occupied))
+    positions = [float(g.PlanePositionSequence[0].ImagePositionPatient[2])
+                 for g in ds.PerFrameFunctionalGroupsSequence]
+    for frame, z in zip(frames, positions):
+        k = int(round((z - affine[2, 3]) / affine[2, 2]))
+        assert np.array_equal(frame.T, labels[:, :, k]), k
+    facts["labelmap.dcm"] = {
+        "source": "../shared/data/labelmaps/case_phantom_shared.nii.gz",
+        "segmentation_type": "LABELMAP",
+        "dims": list(labels.shape),
+        "affine": affine_fact(affine),
+        "frames": int(ds.NumberOfFrames),
+        "bits_allocated": int(ds.BitsAllocated),
+        "photometric_interpretation": ds.PhotometricInterpretation,
+        "segments": list(segs),
+    }
+
+
 def gap(facts):
     shape = (40, 32, 30)
     affine = np.array([[-0.9, 0, 0, 18.0], [0, -0.9, 0, 12.5], [0, 0, 1.5, -20.0], [0, 0, 0, 1]])
@@ -499,6 +536,7 @@ def main():
         },
     }
     phantom(facts)
+    labelmap(facts)
     gap(facts)
     oblique(facts)
     fractional(facts)

@@ -507,3 +507,35 @@ fn a_folder_of_segs_keeps_every_segment_and_masks_beside_them_stay_masks() {
     assert_eq!(structures[3].codes, alone[3].codes);
     assert_eq!(structures[3].mesh, alone[3].mesh);
 }
+
+/// The phantom as a LABELMAP SEG (each frame a slice of segment numbers) gives the structures
+/// the BINARY one gives; a pixel whose number no segment has is refused.
+#[test]
+fn a_labelmap_seg_reads_as_the_binary_one() {
+    let labels = seg("labelmap.dcm");
+    let binary = seg("phantom.dcm");
+    let from_labels = open(&[("labelmap.dcm", &labels)], None);
+    let from_binary = open(&[("phantom.dcm", &binary)], None);
+    assert_eq!(from_labels.len(), 4);
+    for (l, b) in from_labels.iter().zip(&from_binary) {
+        assert_eq!((&l.name, &l.color, &l.codes), (&b.name, &b.color, &b.codes));
+        assert!(largest_offset(l, b) <= 1e-6, "{}", l.name);
+    }
+    let map = load_named(&labels, "labelmap.dcm");
+    assert_eq!(map.layers.len(), 1);
+    assert_same_voxels(
+        &map,
+        &load_named(&read("case_phantom_shared.nii.gz"), "p.nii.gz"),
+    );
+
+    let undeclared = edit(&labels, |o| {
+        with_items(o, tags::SEGMENT_SEQUENCE, |items| {
+            items.pop();
+        })
+    });
+    refused(&undeclared, "pixel value 4 is no segment");
+    refused(
+        &edit(&labels, |o| put_u16(o, tags::BITS_ALLOCATED, 1)),
+        "LABELMAP (8 or 16 bits)",
+    );
+}
