@@ -464,7 +464,7 @@ impl Document {
 
 impl Document {
     /// The view as it stands: camera, hidden and see-through structures, the selected one,
-    /// the clipping plane and the slide towards the segmentation.
+    /// the clipping plane or the image's planes and the slide towards the segmentation.
     pub fn view_link(&self) -> ViewLink {
         let listed = self.session.case().case_structures().iter().enumerate();
         ViewLink {
@@ -477,6 +477,7 @@ impl Document {
                 .collect(),
             selected: self.session.case().current_structure().filter(|&i| i > 0),
             clip: self.view_asks.clip,
+            planes: self.view_asks.planes,
             toward_segmentation: self.view_asks.toward_segmentation,
         }
     }

@@ -1,15 +1,16 @@
 //! A link that restores a view of a case: the camera, which structures are hidden, their
-//! opacity, the one selected, the clipping plane and the slide towards the segmentation, as
-//! query parameters beside the page's `?case=URL`. A teacher sends the link; a student opens
+//! opacity, the one selected, the clipping plane or the image's three planes and the slide
+//! towards the segmentation, as query parameters beside the page's `?case=URL`. A teacher sends the link; a student opens
 //! the case as the teacher saw it.
 //!
-//! `cam=yaw,pitch,distance,x,y,z&hide=0,3&opacity=1:0.5&select=2&clip=sagittal,0.5,flip&toward=0.3`
-//! (angles in radians, lengths in the case's units; structures by index). Each part is
+//! `cam=yaw,pitch,distance,x,y,z&hide=0,3&opacity=1:0.5&select=2&clip=sagittal,0.5,flip&toward=0.3`,
+//! or `planes=sagittal,coronal,axial` (each plane's place, 0 to 1) in place of `clip` (angles in
+//! radians, lengths in the case's units; structures by index). Each part is
 //! optional: what a link leaves out stays as the page opens it.
 
 use glam::Vec3;
 
-use super::{Clip, ClipAxis, OrbitCamera, PITCH_LIMIT};
+use super::{Clip, ClipAxis, OrbitCamera, Planes, PITCH_LIMIT};
 
 /// Where the camera is: what [`OrbitCamera`] holds that the user moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,11 +52,15 @@ pub struct ViewLink {
     pub opacity: Vec<(usize, f32)>,
     pub selected: Option<usize>,
     pub clip: Option<Clip>,
+    /// The image's three standard planes, shown together instead of a clip.
+    pub planes: Option<Planes>,
     pub toward_segmentation: f32,
 }
 
 /// The query keys a link sets.
-pub const LINK_KEYS: [&str; 6] = ["cam", "hide", "opacity", "select", "clip", "toward"];
+pub const LINK_KEYS: [&str; 7] = [
+    "cam", "hide", "opacity", "select", "clip", "planes", "toward",
+];
 
 impl ViewLink {
     /// The query parameters (without `?`), parts at their defaults left out.
@@ -83,6 +88,10 @@ impl ViewLink {
         if let Some(c) = self.clip {
             let flip = if c.flip { ",flip" } else { "" };
             parts.push(format!("clip={},{}{flip}", c.axis.name(), short(c.at)));
+        }
+        if let Some(p) = self.planes {
+            let at = [p.sagittal, p.coronal, p.axial].map(short);
+            parts.push(format!("planes={}", list(at.to_vec())));
         }
         if self.toward_segmentation > 0.0 {
             parts.push(format!("toward={}", short(self.toward_segmentation)));
@@ -155,6 +164,17 @@ impl ViewLink {
                     .ok_or_else(|| format!("{axis} is none of axial, coronal, sagittal"))?;
                 let at = number(at)?.clamp(0.0, 1.0);
                 self.clip = Some(Clip { axis, at, flip });
+            }
+            "planes" => {
+                let [sagittal, coronal, axial] = numbers(&items)?[..] else {
+                    return Err("three places from 0 to 1: sagittal, coronal, axial".into());
+                };
+                let at = |x: f32| x.clamp(0.0, 1.0);
+                self.planes = Some(Planes {
+                    sagittal: at(sagittal),
+                    coronal: at(coronal),
+                    axial: at(axial),
+                });
             }
             "toward" => self.toward_segmentation = number(value)?.clamp(0.0, 1.0),
             _ => {}
@@ -230,6 +250,7 @@ mod tests {
                 at: 0.4,
                 flip: true,
             }),
+            planes: None,
             toward_segmentation: 0.3,
         }
     }
@@ -248,6 +269,30 @@ mod tests {
         // As a browser may have escaped it.
         let escaped = query.replace(',', "%2C").replace(':', "%3A");
         assert_eq!(ViewLink::from_query(&escaped), Ok(Some(full())));
+    }
+
+    #[test]
+    fn the_images_planes_read_back_in_place_of_a_clip() {
+        let link = ViewLink {
+            clip: None,
+            planes: Some(Planes {
+                sagittal: 0.25,
+                coronal: 0.5,
+                axial: 0.875,
+            }),
+            ..full()
+        };
+        let query = link.to_query();
+        assert!(
+            query.ends_with("&select=2&planes=0.25,0.5,0.875&toward=0.3"),
+            "{query}"
+        );
+        assert_eq!(ViewLink::from_query(&query), Ok(Some(link)));
+        let beyond = ViewLink::from_query("?planes=-1,0.5,2").unwrap().unwrap();
+        assert_eq!(
+            beyond.planes.map(|p| [p.sagittal, p.axial]),
+            Some([0.0, 1.0])
+        );
     }
 
     #[test]
@@ -272,6 +317,7 @@ mod tests {
             ("clip=oblique,0.5", "oblique is none of axial"),
             ("clip=axial", "axis,at"),
             ("toward=much", "much is not a number"),
+            ("planes=0.5,0.5", "three places from 0 to 1"),
         ] {
             let e = ViewLink::from_query(query).unwrap_err();
             assert!(e.contains(says), "{query}: {e}");

@@ -30,6 +30,7 @@ pub fn step_view(step: &Step, names: &[&str]) -> ViewLink {
             .collect(),
         selected: step.selected.as_deref().and_then(index),
         clip: step.clip,
+        planes: None,
         toward_segmentation: step.toward_segmentation,
     }
 }
@@ -203,6 +204,7 @@ mod tests {
                 at: 0.3,
                 flip: false,
             }),
+            planes: None,
             toward_segmentation: 0.1,
         };
         let step = recorded_step(&link, &names, "inside", "The tumour.").expect("recorded");

@@ -362,6 +362,32 @@ testIn(EVERY_RUN, "V4 the clipping plane shows the case's CT slice, the liver's 
     }, { query: "?mode=viewer" });
 });
 
+testIn(EVERY_RUN, "V9 a link carries the image's three planes, and opens the case showing them", { timeout: TIMEOUT }, async () => {
+    const routes = { "cases/ct.glb": await phantomWithImage() };
+    const shown = (app) => app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.layout.structures.length === 4, "the case's four rows");
+    let link, seen, view;
+    await withApp(async (app) => {
+        const before = (await shown(app)).view.camera;
+        await app.call("setView", { from: "A", planes: { sagittal: 0.25, axial: 0.75 } });
+        // The planes are asked at once; the camera turns in the next frame.
+        const turned = (c) => c !== null && (c.yaw !== before.yaw || c.pitch !== before.pitch);
+        const state = await app.stateWhen((s) => s.view.planes !== null && turned(s.view.camera) && !s.busy, "the three planes, from the front");
+        link = new URL(state.view.link);
+        assert.equal(link.searchParams.get("planes"), "0.25,0.5,0.75");
+        assert.equal(link.searchParams.get("clip"), null, "no clip beside the planes");
+        view = state.view;
+        await app.page.mouse.move(view.x + 5, view.y + view.height - 60);
+        seen = await app.screenshot("V9-planes");
+    }, { query: "?mode=viewer&case=cases/ct.glb", routes });
+    await withApp(async (app) => {
+        const state = await shown(app);
+        assert.deepEqual(state.view.planes, { sagittal: 0.25, coronal: 0.5, axial: 0.75 });
+        assert.equal(state.view.clip, null);
+        await app.page.mouse.move(view.x + 5, view.y + view.height - 60);
+        await app.screenshotWhen("V9-linked-planes", (i) => changedPixels(i, seen, view) < 0.01 * view.width * view.height, "the same picture as the linking page's");
+    }, { query: `?mode=viewer&case=cases/ct.glb${link.search.replace(/^\?mode=viewer&case=[^&]*/, "")}`, routes });
+});
+
 testIn(EVERY_RUN, "V5 the author adds the CT under the page's case, the case glTF carries it, the viewer shows its slice", { timeout: TIMEOUT }, async () => {
     const ct = readFileSync(join(ROOT, "tests/data/phantom_ct.nii.gz"));
     const bone = { source: "phantom_ct.nii.gz", dims: [160, 140, 48], preset: "ct-bone", window: { center: 400, width: 1800 } };

@@ -89,8 +89,8 @@ impl Shell {
     }
 }
 
-/// Shows the structures, selection, clip and slide `link` asks for (not its camera); what
-/// could not be shown, in words.
+/// Shows the structures, selection, clip or planes and slide `link` asks for (not its
+/// camera); what could not be shown, in words.
 pub(super) fn show_view(doc: &mut Document, link: &ViewLink) -> Vec<String> {
     let count = doc.case().case_structures().len();
     let mut problems = Vec::new();
@@ -114,6 +114,11 @@ pub(super) fn show_view(doc: &mut Document, link: &ViewLink) -> Vec<String> {
         }
     }
     doc.view_asks.clip = link.clip;
+    // The image's planes and a clip exclude each other; a view (a tour step) that names
+    // neither leaves the planes as the reader set them.
+    if link.planes.is_some() || link.clip.is_some() {
+        doc.view_asks.planes = link.planes;
+    }
     doc.view_asks.toward_segmentation = link.toward_segmentation;
     if let Some(i) = link.selected {
         if let Err(e) = doc.select_structure(i) {
