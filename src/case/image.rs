@@ -194,33 +194,30 @@ impl CaseImage {
 }
 
 impl CaseImage {
-    /// Reads the image `name` (NIfTI, NRRD or MGH bytes), reduced to at most `max_voxels` and
-    /// windowed by `preset`, after checking that it lies on each of `grids`: the grids a case's
-    /// structures were extracted on, each with a structure's name ([`super::Case::image_grids`]).
-    /// A refusal's reason leaves the file to be named by the caller.
+    /// Reads the image `name`: one file (NIfTI, NRRD, MGH or a DICOM slice) or the slices of a
+    /// DICOM series, `files` (name, bytes), `name` then their folder. Reduced to at most
+    /// `max_voxels` and windowed by `preset`, after checking that it lies on each of `grids`: the
+    /// grids a case's structures were extracted on, each with a structure's name
+    /// ([`super::Case::image_grids`]). A refusal's reason leaves `name` to be named by the
+    /// caller, and names the slice at fault, if one is.
     pub fn read(
-        bytes: &[u8],
-        name: &str,
-        preset: WindowPreset,
-        max_voxels: usize,
-        grids: &[(String, Affine)],
-    ) -> Result<Self, String> {
-        has_grid(grids)?;
-        let image = load_image(bytes, name, max_voxels).map_err(|e| e.to_string())?;
-        Self::placed(&image, name, preset, grids)
-    }
-
-    /// [`CaseImage::read`] for the slices of a DICOM series, `files` (name, bytes), named
-    /// `name` (their folder). A refusal's reason names the slice at fault, if one is.
-    pub fn read_series(
         files: &[(&str, &[u8])],
         name: &str,
         preset: WindowPreset,
         max_voxels: usize,
         grids: &[(String, Affine)],
     ) -> Result<Self, String> {
-        has_grid(grids)?;
-        let image = load_image_series(files, max_voxels).map_err(|e| e.to_string())?;
+        if grids.is_empty() {
+            return Err(
+                "the case has no structure from a label map, so there is no segmentation grid \
+                 to place the image on"
+                    .to_string(),
+            );
+        }
+        let image = match files {
+            [(file, bytes)] => load_image(bytes, file, max_voxels).map_err(|e| e.to_string()),
+            _ => load_image_series(files, max_voxels).map_err(|e| e.to_string()),
+        }?;
         Self::placed(&image, name, preset, grids)
     }
 
@@ -238,18 +235,6 @@ impl CaseImage {
         }
         Ok(CaseImage::new(image, file_name(name), preset))
     }
-}
-
-/// Refuses an image for a case with no segmentation grid.
-fn has_grid(grids: &[(String, Affine)]) -> Result<(), String> {
-    if grids.is_empty() {
-        return Err(
-            "the case has no structure from a label map, so there is no segmentation grid to \
-             place the image on"
-                .to_string(),
-        );
-    }
-    Ok(())
 }
 
 impl super::Case {
@@ -274,13 +259,11 @@ impl super::Case {
         preset: WindowPreset,
         max_voxels: usize,
     ) -> Result<(), String> {
-        let grids = self.image_grids();
-        let image = CaseImage::read(bytes, name, preset, max_voxels, &grids)?;
-        self.image = Some(Arc::new(image));
-        Ok(())
+        let file = [(name, bytes)];
+        self.add_read(|grids| CaseImage::read(&file, name, preset, max_voxels, grids))
     }
 
-    /// Adds the image whose slices are `files` (a DICOM series, [`CaseImage::read_series`]),
+    /// Adds the image whose slices are `files` (a DICOM series, [`CaseImage::read`]),
     /// named `name`; the case is unchanged when it is refused.
     pub fn add_image_series(
         &mut self,
@@ -289,8 +272,15 @@ impl super::Case {
         preset: WindowPreset,
         max_voxels: usize,
     ) -> Result<(), String> {
-        let grids = self.image_grids();
-        let image = CaseImage::read_series(files, name, preset, max_voxels, &grids)?;
+        self.add_read(|grids| CaseImage::read(files, name, preset, max_voxels, grids))
+    }
+
+    /// The image `read` makes on the case's grids, in place of the one it had.
+    fn add_read(
+        &mut self,
+        read: impl FnOnce(&[(String, Affine)]) -> Result<CaseImage, String>,
+    ) -> Result<(), String> {
+        let image = read(&self.image_grids())?;
         self.image = Some(Arc::new(image));
         Ok(())
     }

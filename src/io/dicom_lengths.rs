@@ -26,6 +26,54 @@ pub(super) struct Layout {
 }
 
 /// The file's [`Layout`], once every element length has been checked.
+impl Layout {
+    /// The Pixel Data's bytes within `bytes` (the file walked), refused when there are none or
+    /// fewer than `needed` (`None`: more than memory holds), `what` saying what they are for.
+    pub(super) fn pixels<'a>(
+        &self,
+        bytes: &'a [u8],
+        needed: Option<usize>,
+        what: &'static str,
+        format: Format,
+    ) -> Result<&'a [u8], LoadError> {
+        let data = (self.pixel_data.clone())
+            .map(|range| &bytes[range])
+            .ok_or_else(|| LoadError::Unsupported {
+                format,
+                detail: "no Pixel Data".into(),
+            })?;
+        let needed = needed.unwrap_or(usize::MAX);
+        if data.len() < needed {
+            return Err(LoadError::CountTooLarge {
+                format,
+                what,
+                claimed: needed as u64,
+                possible: data.len() as u64,
+            });
+        }
+        Ok(data)
+    }
+}
+
+/// The file parsed up to its pixels (which stay in `bytes`, where [`Layout::pixel_data`]
+/// says), once [`check`] has measured every length; `format` names the file in errors.
+pub(super) fn open(
+    bytes: &[u8],
+    format: Format,
+) -> Result<(Layout, dicom_object::DefaultDicomObject), LoadError> {
+    use dicom_object::file::{OpenFileOptions, ReadPreamble};
+    let layout = check(bytes, format)?;
+    let object = OpenFileOptions::new()
+        .read_preamble(ReadPreamble::Never)
+        .read_until(dicom_dictionary_std::tags::PIXEL_DATA)
+        .from_reader(&bytes[layout.start..])
+        .map_err(|e| LoadError::Unsupported {
+            format,
+            detail: format!("the DICOM object does not parse: {e}"),
+        })?;
+    Ok((layout, object))
+}
+
 /// `format` is what the errors call the file (a SEG, or a slice of an image series).
 pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
     let start = if bytes.get(128..132) == Some(b"DICM") {

@@ -10,7 +10,6 @@
 
 use dicom_core::Tag;
 use dicom_dictionary_std::tags;
-use dicom_object::file::{OpenFileOptions, ReadPreamble};
 use dicom_object::mem::InMemDicomObject;
 
 use super::codes::{Code, StructureCodes};
@@ -48,13 +47,8 @@ impl Pixels {
 }
 
 pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
-    let layout = dicom_lengths::check(bytes, FORMAT)?;
     // The pixels are read in place, not copied into the object.
-    let object = OpenFileOptions::new()
-        .read_preamble(ReadPreamble::Never)
-        .read_until(tags::PIXEL_DATA)
-        .from_reader(&bytes[layout.start..])
-        .map_err(|e| unsupported(format!("the DICOM object does not parse: {e}")))?;
+    let (layout, object) = dicom_lengths::open(bytes, FORMAT)?;
     let sop_class = text(&object, tags::SOP_CLASS_UID).unwrap_or_default();
     if sop_class != SEGMENTATION_STORAGE && sop_class != LABEL_MAP_SEGMENTATION_STORAGE {
         return Err(LoadError::BadMagic {
@@ -70,21 +64,12 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     let pixels = pixels(&object, options)?;
     let segments = segments(&object, matches!(pixels, Pixels::Labels { .. }))?;
     let per_frame = frame_geometry(&object, frames, &segments, pixels)?;
-    let data = (layout.pixel_data)
-        .map(|range| &bytes[range])
-        .ok_or_else(|| unsupported("no Pixel Data".into()))?;
     // Checked: usize is 32 bits in the browser, and the sizes come from the file. Once the
     // pixel data holds every frame, frame * plane + pixel fits below.
     let pixels_in = (frames.checked_mul(rows)).and_then(|n| n.checked_mul(columns));
-    let needed = (pixels_in.and_then(|n| pixels.bytes_for(n))).unwrap_or(usize::MAX);
-    if data.len() < needed {
-        return Err(LoadError::CountTooLarge {
-            format: FORMAT,
-            what: "bytes of pixel data for the frames declared",
-            claimed: needed as u64,
-            possible: data.len() as u64,
-        });
-    }
+    let needed = pixels_in.and_then(|n| pixels.bytes_for(n));
+    let what = "bytes of pixel data for the frames declared";
+    let data = layout.pixels(bytes, needed, what, FORMAT)?;
     let shared = first_item(&object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
     let grid = Grid::place([columns, rows], shared, &per_frame)?;
     let numbers: Vec<u16> = segments.iter().map(segment_number).collect();

@@ -13,7 +13,6 @@
 
 use dicom_core::Tag;
 use dicom_dictionary_std::tags;
-use dicom_object::file::{OpenFileOptions, ReadPreamble};
 use dicom_object::mem::InMemDicomObject;
 
 use super::dicom_seg::{floats, text};
@@ -128,12 +127,7 @@ fn unsupported(detail: String) -> LoadError {
 }
 
 fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError> {
-    let layout = dicom_lengths::check(bytes, FORMAT)?;
-    let object = OpenFileOptions::new()
-        .read_preamble(ReadPreamble::Never)
-        .read_until(tags::PIXEL_DATA)
-        .from_reader(&bytes[layout.start..])
-        .map_err(|e| unsupported(format!("the DICOM object does not parse: {e}")))?;
+    let (layout, object) = dicom_lengths::open(bytes, FORMAT)?;
     if text(&object, tags::SOP_CLASS_UID).as_deref() == Some(SEGMENTATION_STORAGE) {
         return Err(unsupported(
             "a segmentation (DICOM SEG), not an image: open it as the case's structures".into(),
@@ -158,20 +152,9 @@ fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError
         required(&object, tags::ROWS, "Rows")?,
     ];
     let sample = sample_of(&object)?;
-    let needed = (size[0].checked_mul(size[1]))
-        .and_then(|n| n.checked_mul(sample.size()))
-        .unwrap_or(usize::MAX);
-    let pixels = (layout.pixel_data)
-        .map(|range| &bytes[range])
-        .ok_or_else(|| unsupported("no Pixel Data".into()))?;
-    if pixels.len() < needed {
-        return Err(LoadError::CountTooLarge {
-            format: FORMAT,
-            what: "bytes of pixel data for the rows and columns declared",
-            claimed: needed as u64,
-            possible: pixels.len() as u64,
-        });
-    }
+    let needed = (size[0].checked_mul(size[1])).and_then(|n| n.checked_mul(sample.size()));
+    let what = "bytes of pixel data for the rows and columns declared";
+    let pixels = layout.pixels(bytes, needed, what, FORMAT)?;
     let scale = |tag, default| match floats(&object, tag) {
         None => Ok(default),
         Some(v) if v.len() == 1 && v[0].is_finite() => Ok(v[0]),

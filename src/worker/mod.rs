@@ -39,9 +39,8 @@ pub enum Input {
     /// A file's bytes read as a case only, to add its structures to the open one.
     Addition(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
     /// The image the segmentation was drawn on, read as a case holding only it
-    /// ([`crate::case::CaseImage::read`]; several files are the slices of a DICOM series,
-    /// [`crate::case::CaseImage::read_series`]): windowed by the preset so named, checked
-    /// against the open case's grids.
+    /// ([`crate::case::CaseImage::read`]: one file, or the slices of a DICOM series): windowed
+    /// by the preset so named, checked against the open case's grids.
     Image {
         files: Vec<NamedFile>,
         preset: String,
@@ -456,16 +455,11 @@ fn read_image(
 ) -> Result<Case, String> {
     let preset = (case::WindowPreset::from_name(preset))
         .ok_or_else(|| format!("{name}: no window preset named {preset:?}"))?;
+    let files: Vec<(&str, &[u8])> = (files.iter())
+        .map(|f| (f.name.as_str(), f.bytes.as_slice()))
+        .collect();
     let most = case::DEFAULT_IMAGE_VOXELS;
-    let image = match files {
-        [one] => case::CaseImage::read(&one.bytes, &one.name, preset, most, grids)?,
-        _ => {
-            let slices: Vec<(&str, &[u8])> = (files.iter())
-                .map(|f| (f.name.as_str(), f.bytes.as_slice()))
-                .collect();
-            case::CaseImage::read_series(&slices, name, preset, most, grids)?
-        }
-    };
+    let image = case::CaseImage::read(&files, name, preset, most, grids)?;
     Ok(Case {
         image: Some(std::sync::Arc::new(image)),
         ..Case::default()

@@ -67,6 +67,27 @@ def hounsfield():
     return hu.astype(np.int16)
 
 
+def ct_slice(instance, study, series, frame, number):
+    """A grey CT Image Storage slice's identity, each UID made from the name given."""
+    meta = FileMetaDataset()
+    meta.MediaStorageSOPClassUID = CT_IMAGE_STORAGE
+    meta.MediaStorageSOPInstanceUID = uid(instance)
+    meta.TransferSyntaxUID = ExplicitVRLittleEndian
+    meta.ImplementationClassUID = uid("implementation")
+    ds = pydicom.Dataset()
+    ds.file_meta = meta
+    ds.SOPClassUID = CT_IMAGE_STORAGE
+    ds.SOPInstanceUID = meta.MediaStorageSOPInstanceUID
+    ds.StudyInstanceUID = uid(study)
+    ds.SeriesInstanceUID = uid(series)
+    ds.FrameOfReferenceUID = uid(frame)
+    ds.Modality = "CT"
+    ds.InstanceNumber = number
+    ds.SamplesPerPixel = 1
+    ds.PhotometricInterpretation = "MONOCHROME2"
+    return ds
+
+
 def write_series(folder, series_name, slices, shift_per_slice=0.0):
     os.makedirs(os.path.join(OUT, folder), exist_ok=True)
     rot = rotation()
@@ -78,28 +99,13 @@ def write_series(folder, series_name, slices, shift_per_slice=0.0):
                     + axis_i * shift_per_slice * k)
         intercept = -1024 if k % 2 == 0 else -1000
         stored = (hu[:, :, k].T.astype(np.int32) - intercept).astype(np.int16)
-        meta = FileMetaDataset()
-        meta.MediaStorageSOPClassUID = CT_IMAGE_STORAGE
-        meta.MediaStorageSOPInstanceUID = uid(f"{series_name}/{k}")
-        meta.TransferSyntaxUID = ExplicitVRLittleEndian
-        meta.ImplementationClassUID = uid("implementation")
-        ds = pydicom.Dataset()
-        ds.file_meta = meta
-        ds.SOPClassUID = CT_IMAGE_STORAGE
-        ds.SOPInstanceUID = meta.MediaStorageSOPInstanceUID
-        ds.StudyInstanceUID = uid("study")
-        ds.SeriesInstanceUID = uid(series_name)
-        ds.FrameOfReferenceUID = uid("frame")
-        ds.Modality = "CT"
+        ds = ct_slice(f"{series_name}/{k}", "study", series_name, "frame", len(slices) - n)
         ds.PatientName = "Phantom^Oblique"
         ds.PatientID = "meshsmooth-test"
-        ds.InstanceNumber = len(slices) - n
         ds.ImagePositionPatient = [f"{v:.6f}" for v in position]
         ds.ImageOrientationPatient = [f"{v:.9f}" for v in (*axis_i, *axis_j)]
         ds.PixelSpacing = [f"{SPACING[1]}", f"{SPACING[0]}"]
         ds.SliceThickness = f"{SPACING[2]}"
-        ds.SamplesPerPixel = 1
-        ds.PhotometricInterpretation = "MONOCHROME2"
         ds.Rows, ds.Columns = DIMS[1], DIMS[0]
         ds.BitsAllocated, ds.BitsStored, ds.HighBit = 16, 16, 15
         ds.PixelRepresentation = 1
@@ -121,26 +127,11 @@ def write_phantom():
     for k in range(24):
         stored = (hu[:, :, k].T - (-150)) // 10
         assert np.array_equal(stored * 10 - 150, hu[:, :, k].T)
-        meta = FileMetaDataset()
-        meta.MediaStorageSOPClassUID = CT_IMAGE_STORAGE
-        meta.MediaStorageSOPInstanceUID = uid(f"phantom/{k}")
-        meta.TransferSyntaxUID = ExplicitVRLittleEndian
-        meta.ImplementationClassUID = uid("implementation")
-        ds = pydicom.Dataset()
-        ds.file_meta = meta
-        ds.SOPClassUID = CT_IMAGE_STORAGE
-        ds.SOPInstanceUID = meta.MediaStorageSOPInstanceUID
-        ds.StudyInstanceUID = uid("phantom study")
-        ds.SeriesInstanceUID = uid("phantom")
-        ds.FrameOfReferenceUID = uid("phantom frame")
-        ds.Modality = "CT"
-        ds.InstanceNumber = k + 1
+        ds = ct_slice(f"phantom/{k}", "phantom study", "phantom", "phantom frame", k + 1)
         ds.ImagePositionPatient = [f"{v:.6f}" for v in lps[:3, 3] + lps[:3, 2] * k]
         ds.ImageOrientationPatient = [f"{v:.6f}" for v in (*axes[:, 0], *axes[:, 1])]
         ds.PixelSpacing = [f"{spacing[1]:.6f}", f"{spacing[0]:.6f}"]
         ds.SliceThickness = f"{spacing[2]:.6f}"
-        ds.SamplesPerPixel = 1
-        ds.PhotometricInterpretation = "MONOCHROME2"
         ds.Rows, ds.Columns = stored.shape
         ds.BitsAllocated, ds.BitsStored, ds.HighBit = 8, 8, 7
         ds.PixelRepresentation = 0
