@@ -188,4 +188,21 @@ mod tests {
         assert_eq!(entry(0), None);
         assert_eq!(entry(3000), None);
     }
+
+    #[test]
+    fn the_standard_codes_give_freesurfers_labels_freesurfers_colours() {
+        let mut coded = 0;
+        for &(_, name, rgb) in TABLE {
+            if let Some(class) = crate::segmentation::standard_class(name) {
+                assert_eq!(
+                    class.color.map(|c| (c * 255.0).round() as u8),
+                    rgb,
+                    "{name}"
+                );
+                coded += 1;
+            }
+        }
+        // fs2dicom's 49 aseg labels, under FreeSurfer 7's names.
+        assert_eq!(coded, 49);
+    }
 }

@@ -1,25 +1,31 @@
-//! Standard codes for common structure names: the classes of TotalSegmentator's 'total' task
-//! with the SNOMED CT codes TotalSegmentator publishes for them
-//! (`totalsegmentator/resources/totalsegmentator_snomed_mapping.csv` of
-//! github.com/wasserth/TotalSegmentator, last changed in d90ebaf4d8d5), so that a case built
-//! from its output carries codes without the author typing them, and the display colour
-//! TotalSegmentator gives each class in its DICOM SEGs, for structures whose file gives none. A
-//! structure matches a class by its name as TotalSegmentator writes it or as it reads
-//! ("kidney_right", "Right kidney"), ignoring case.
+//! Standard codes for common structure names, so that a case built from these tools' output
+//! carries codes without the author typing them:
+//! - the classes of TotalSegmentator's 'total' task with the SNOMED CT codes TotalSegmentator
+//!   publishes for them (`totalsegmentator/resources/totalsegmentator_snomed_mapping.csv` of
+//!   github.com/wasserth/TotalSegmentator, last changed in d90ebaf4d8d5), and the display colour
+//!   it gives each class in its DICOM SEGs, for structures whose file gives none;
+//! - FreeSurfer's aseg labels with the codes fs2dicom gives them, in SNOMED CT
+//!   (`freesurfer_codes.tsv`, whose head and `tests/data/make_freesurfer_codes.py` say how).
+//!
+//! A structure matches a class by its name as the tool writes it or as it reads
+//! ("kidney_right", "Right kidney"; "Left-Hippocampus"), ignoring case.
 
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
 use crate::io::{readable_class_name, Code, StructureCodes};
 
-/// The table, compiled in so that a malformed row is caught by the tests, not met by a user.
-const TSV: &str = include_str!("standard_codes.tsv");
+/// The tables, compiled in so that a malformed row is caught by the tests, not met by a user.
+const TABLES: [(&str, &str); 2] = [
+    ("standard_codes.tsv", include_str!("standard_codes.tsv")),
+    ("freesurfer_codes.tsv", include_str!("freesurfer_codes.tsv")),
+];
 
 const HEADER: &str = "class\tcategory_scheme\tcategory_value\tcategory_meaning\t\
                       type_scheme\ttype_value\ttype_meaning\t\
                       modifier_scheme\tmodifier_value\tmodifier_meaning\tcolor";
 
-/// The parsed table: each class with its codes, and an index by both of its names.
+/// The parsed tables: each class with its codes, and an index by both of its names.
 struct Table {
     rows: Vec<Row<'static>>,
     /// Normalised name (as written and as read) to its row in `rows`.
@@ -63,17 +69,18 @@ fn parse_row(line: &str) -> Result<Row<'_>, String> {
 }
 
 impl Table {
-    /// Panics naming the line of a malformed row: the text is compiled in, so that is a
-    /// programming error, and the unit tests parse it.
-    fn parse(text: &'static str) -> Self {
-        let mut lines = (text.lines().enumerate()).filter(|(_, line)| !line.starts_with('#'));
-        let header = lines.next().map(|(_, line)| line);
-        assert_eq!(header, Some(HEADER), "standard_codes.tsv: header");
-        let rows: Vec<_> = lines
-            .map(|(i, line)| {
-                parse_row(line).unwrap_or_else(|e| panic!("standard_codes.tsv line {}: {e}", i + 1))
-            })
-            .collect();
+    /// Panics naming the file and line of a malformed row: the texts are compiled in, so that
+    /// is a programming error, and the unit tests parse them.
+    fn parse(tables: &[(&str, &'static str)]) -> Self {
+        let mut rows = Vec::new();
+        for (file, text) in tables {
+            let mut lines = (text.lines().enumerate()).filter(|(_, line)| !line.starts_with('#'));
+            let header = lines.next().map(|(_, line)| line);
+            assert_eq!(header, Some(HEADER), "{file}: header");
+            rows.extend(lines.map(|(i, line)| {
+                parse_row(line).unwrap_or_else(|e| panic!("{file} line {}: {e}", i + 1))
+            }));
+        }
         let mut by_name = HashMap::with_capacity(2 * rows.len());
         for (row, (class, ..)) in rows.iter().enumerate() {
             // Single-word classes ("liver") read as they are written: one key for both.
@@ -81,7 +88,7 @@ impl Table {
                 let before = by_name.insert(name.clone(), row);
                 assert!(
                     before.is_none_or(|b| b == row),
-                    "standard_codes.tsv: two classes are named '{name}'"
+                    "two classes are named '{name}'"
                 );
             }
         }
@@ -90,18 +97,18 @@ impl Table {
 
     fn get() -> &'static Self {
         static TABLE: OnceLock<Table> = OnceLock::new();
-        TABLE.get_or_init(|| Self::parse(TSV))
+        TABLE.get_or_init(|| Self::parse(&TABLES))
     }
 }
 
-/// One of TotalSegmentator's classes: its codes and display colour (sRGB, channels in [0, 1]).
+/// A class of the tables: its codes and display colour (sRGB, channels in [0, 1]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StandardClass {
     pub codes: StructureCodes,
     pub color: [f32; 3],
 }
 
-/// The class a structure named `name` is, when it is one of TotalSegmentator's.
+/// The class a structure named `name` is, when it is one of TotalSegmentator's or FreeSurfer's.
 pub fn standard_class(name: &str) -> Option<StandardClass> {
     let table = Table::get();
     let (_, codes, color) = &table.rows[*table.by_name.get(&normalise(name))?];
@@ -125,7 +132,7 @@ mod tests {
 
     #[test]
     fn totalsegmentator_classes_have_their_published_codes() {
-        assert_eq!(Table::get().rows.len(), 117);
+        assert_eq!(Table::get().rows.len(), 117 + 51);
         let kidney = codes_for_name("Right kidney").unwrap();
         assert_eq!(kidney.kind, Code::new("SCT", "64033007", "Kidney"));
         assert_eq!(kidney.modifier, Some(Code::new("SCT", "24028007", "Right")));
@@ -160,7 +167,7 @@ mod tests {
 
     #[test]
     fn every_row_is_whole_and_every_name_finds_its_own_row() {
-        let table = Table::parse(TSV);
+        let table = Table::parse(&TABLES[..1]);
         assert_eq!(table.rows.len(), 117);
         for (row, (class, codes, _)) in table.rows.iter().enumerate() {
             assert!(!class.is_empty() && !codes.kind.meaning.is_empty());
@@ -173,6 +180,50 @@ mod tests {
         let single_words = (table.rows.iter()).filter(|(c, ..)| !c.contains('_'));
         assert_eq!(single_words.count(), 16);
         assert_eq!(table.by_name.len(), 2 * 117 - 16);
+    }
+
+    #[test]
+    fn freesurfers_aseg_labels_have_snomed_ct_codes_and_freesurfers_colours() {
+        let table = Table::parse(&TABLES[1..]);
+        // fs2dicom's 49 labels, two of them under FreeSurfer 7's names as well.
+        assert_eq!(table.rows.len(), 51);
+        let hippocampus = codes_for_name("left-hippocampus").unwrap();
+        assert_eq!(hippocampus.kind, Code::new("SCT", "5366008", "Hippocampus"));
+        assert_eq!(
+            hippocampus.modifier,
+            Some(Code::new("SCT", "7771000", "Left"))
+        );
+        assert_eq!(hippocampus.category.value, "123037004");
+        let thalamus = codes_for_name("Right-Thalamus").unwrap();
+        assert_eq!(
+            codes_for_name("Right-Thalamus-Proper"),
+            Some(thalamus.clone())
+        );
+        assert_eq!(
+            (thalamus.kind.value.as_str(), thalamus.kind.scheme.as_str()),
+            ("119406000", "SCT")
+        );
+        assert_eq!(
+            codes_for_name("CSF").unwrap().category.meaning,
+            "Body Substance"
+        );
+        assert_eq!(
+            codes_for_name("CC Posterior"),
+            codes_for_name("CC_Posterior")
+        );
+        // Codes of DICOM's own scheme stay as they are.
+        let dc = codes_for_name("Left-VentralDC").unwrap().kind;
+        assert_eq!((dc.scheme.as_str(), dc.value.as_str()), ("DCM", "110700"));
+        // No SNOMED RT identifier is left (io's colour table checks the colours).
+        for (class, codes, _) in &table.rows {
+            let all = [
+                Some(&codes.category),
+                Some(&codes.kind),
+                codes.modifier.as_ref(),
+            ];
+            assert!(all.iter().flatten().all(|c| c.scheme != "SRT"), "{class}");
+        }
+        assert_eq!(codes_for_name("ctx-lh-insula"), None);
     }
 
     #[test]

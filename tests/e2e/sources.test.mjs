@@ -17,7 +17,7 @@ const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 const ASEG_MGZ = join(ROOT, "tests/data/phantom_aseg.mgz");
 const TIMEOUT = 240_000;
 
-testIn(EVERY_RUN, "F1 a FreeSurfer MGZ opens with FreeSurfer's names, as the CLI extracts it", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "F1 a FreeSurfer MGZ opens with FreeSurfer's names and codes, as the CLI extracts it", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(ASEG_MGZ), "phantom_aseg.mgz");
         const page = (await app.call("structures")).structures;
@@ -28,6 +28,9 @@ testIn(EVERY_RUN, "F1 a FreeSurfer MGZ opens with FreeSurfer's names, as the CLI
             native.map((s) => [s.label, s.name, s.voxels, s.vertices, s.triangles]),
         );
         page.forEach((s, i) => s.color.forEach((c, k) => assert.ok(Math.abs(c - native[i].color[k]) < 1e-6, `${s.name} colour`)));
+        // The aseg labels' SNOMED CT codes from the shipped table; the cortical parcel has none.
+        assert.deepEqual(page.map((s) => s.codes), native.map((s) => s.codes));
+        assert.deepEqual(page.map((s) => s.codes?.type.value ?? null), ["119406000", "5366008", "5366008", null]);
         await app.screenshot("F1-aseg-mgz-names");
     });
 });

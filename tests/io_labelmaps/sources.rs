@@ -84,6 +84,26 @@ fn aseg_labels_take_freesurfers_names_below_an_authors_table() {
     );
     let hippocampus = [220.0, 216.0, 20.0].map(|c: f32| c / 255.0);
     assert_eq!(structures[1].color, hippocampus);
+    // The aseg labels carry their SNOMED CT codes; the cortical parcel has none in the table.
+    let coded: Vec<Option<(&str, &str)>> = (structures.iter())
+        .map(|s| {
+            (s.codes.as_ref()).map(|c| {
+                (
+                    c.kind.value.as_str(),
+                    c.modifier.as_ref().map_or("", |m| m.meaning.as_str()),
+                )
+            })
+        })
+        .collect();
+    assert_eq!(
+        coded,
+        [
+            Some(("119406000", "Left")),
+            Some(("5366008", "Left")),
+            Some(("5366008", "Right")),
+            None
+        ]
+    );
     // The surfaces are the phantom's, its labels 2, 1, 3, 4 renumbered.
     let phantom = open(&[("phantom.nii.gz", &phantom_bytes)], None);
     for (s, p) in structures.iter().zip([1, 0, 2, 3].map(|i| &phantom[i])) {
@@ -94,6 +114,7 @@ fn aseg_labels_take_freesurfers_names_below_an_authors_table() {
     let renamed = open(&[("phantom_aseg.mgz", &mgz_bytes)], Some(table));
     assert_eq!(renamed[1].name, "Hippocampus");
     assert_eq!(renamed[1].color, [1.0, 0.0, 0.0]);
+    assert_eq!(renamed[1].codes, None, "codes follow the name shown");
     assert_eq!(renamed[0].name, "Left-Thalamus");
 }
 
