@@ -64,6 +64,9 @@ pub struct PanelLayout {
     /// `step-delete-N`, `step-show-N`, `place-label`, `label-text-N`, `label-delete-N`,
     /// `quiz-on`, `quiz-find-it`, `quiz-name-it`).
     pub lesson: Vec<(String, PageRect)>,
+    /// The sliders of the image's planes under the view (sagittal, coronal, axial), while the
+    /// planes are shown.
+    pub planes: Vec<PageRect>,
 }
 
 /// One row of the Structures list: its visibility box, show-alone button and name (which
@@ -108,6 +111,7 @@ impl PanelLayout {
             "structure_filter": self.structure_filter.map(PageRect::to_json),
             "lesson": self.lesson.iter().map(|(k, r)| (k.clone(), r.to_json()))
                 .collect::<serde_json::Map<_, _>>(),
+            "planes": self.planes.iter().map(|r| r.to_json()).collect::<Vec<_>>(),
         })
     }
 }

@@ -1,25 +1,38 @@
 //! The view's own tools, over its bottom-left corner: the standard views (A P L R S I), the
 //! clipping plane (axial, coronal or sagittal, where along the scene, which side is kept; or
-//! the case's image in its three planes) and
+//! the case's image in its three planes, each moved through the image by its own slider) and
 //! the slide from the segmentation to the smoothed surfaces. The
 //! view takes them up from the document, where the API sets them too.
 
 use eframe::egui;
 
 use super::document::ViewAsks;
-use crate::view::{Clip, ClipAxis, StandardView};
+use super::layout::PageRect;
+use crate::view::{Clip, ClipAxis, Planes, StandardView};
 
 /// Draws the tools along the bottom of `view` and records what was asked in `asks`: one row,
-/// or two on a narrow view (a phone). With the case's image, the image's three planes are one
-/// more choice.
-pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks, has_image: bool) {
+/// or two on a narrow view (a phone), three there while the image's planes are shown. With the
+/// case's image, the image's three planes are one more choice. Returns where the planes'
+/// sliders were drawn (sagittal, coronal, axial), while they are shown.
+pub fn show(
+    ui: &mut egui::Ui,
+    view: egui::Rect,
+    asks: &mut ViewAsks,
+    has_image: bool,
+) -> Vec<PageRect> {
     let narrow = view.width() < 560.0;
-    let height = if narrow { 56.0 } else { 30.0 };
+    let rows = match (narrow, asks.planes.is_some()) {
+        (false, _) => 1.0,
+        (true, false) => 2.0,
+        (true, true) => 3.0,
+    };
+    let height = 28.0 * rows + 2.0;
     let bar = egui::Rect::from_min_max(
         egui::pos2(view.left() + 6.0, view.bottom() - height),
         egui::pos2(view.right() - 6.0, view.bottom()),
     );
     let row = egui::Layout::left_to_right(egui::Align::Center);
+    let mut sliders = Vec::new();
     if narrow {
         let builder = egui::UiBuilder::new()
             .max_rect(bar)
@@ -30,6 +43,9 @@ pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks, has_image:
                 ui.separator();
                 clip(ui, asks, has_image);
             });
+            if let Some(planes) = &mut asks.planes {
+                ui.horizontal(|ui| sliders = plane_sliders(ui, planes));
+            }
             ui.horizontal(|ui| slide(ui, asks));
         });
     } else {
@@ -37,10 +53,14 @@ pub fn show(ui: &mut egui::Ui, view: egui::Rect, asks: &mut ViewAsks, has_image:
             sides(ui, asks);
             ui.separator();
             clip(ui, asks, has_image);
+            if let Some(planes) = &mut asks.planes {
+                sliders = plane_sliders(ui, planes);
+            }
             ui.separator();
             slide(ui, asks);
         });
     }
+    sliders
 }
 
 /// A P L R S I: look from that side of the patient.
@@ -109,6 +129,32 @@ fn clip(ui: &mut egui::Ui, asks: &mut ViewAsks, has_image: bool) {
         ui.toggle_value(&mut clip.flip, "flip")
             .on_hover_text("Keep the other side");
     }
+}
+
+/// Where each of the image's planes lies across the scene: S, C and A, as a radiology viewer
+/// scrolls through its slices.
+fn plane_sliders(ui: &mut egui::Ui, planes: &mut Planes) -> Vec<PageRect> {
+    ui.spacing_mut().slider_width = 56.0;
+    let each = [
+        (
+            "S",
+            "The sagittal plane, from the patient's right to left",
+            &mut planes.sagittal,
+        ),
+        (
+            "C",
+            "The coronal plane, from back to front",
+            &mut planes.coronal,
+        ),
+        ("A", "The axial plane, from feet to head", &mut planes.axial),
+    ];
+    (each.into_iter())
+        .map(|(letter, tip, at)| {
+            ui.label(letter);
+            let slider = ui.add(egui::Slider::new(at, 0.0..=1.0).show_value(false));
+            slider.on_hover_text(tip).rect.into()
+        })
+        .collect()
 }
 
 /// The slide from the segmentation to the smoothed surfaces.

@@ -362,7 +362,7 @@ testIn(EVERY_RUN, "V4 the clipping plane shows the case's CT slice, the liver's 
     }, { query: "?mode=viewer" });
 });
 
-testIn(EVERY_RUN, "V9 a link carries the image's three planes, and opens the case showing them", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "V9 a link carries the image's three planes, and opens the case showing them; their sliders move them", { timeout: TIMEOUT }, async () => {
     const routes = { "cases/ct.glb": await phantomWithImage() };
     const shown = (app) => app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.layout.structures.length === 4, "the case's four rows");
     let link, seen, view;
@@ -385,6 +385,21 @@ testIn(EVERY_RUN, "V9 a link carries the image's three planes, and opens the cas
         assert.equal(state.view.clip, null);
         await app.page.mouse.move(view.x + 5, view.y + view.height - 60);
         await app.screenshotWhen("V9-linked-planes", (i) => changedPixels(i, seen, view) < 0.01 * view.width * view.height, "the same picture as the linking page's");
+        // The student looks from above and moves the axial plane down with its slider: the
+        // picture and the link follow.
+        const before = state.view.camera;
+        await app.call("setView", { from: "S" });
+        await app.stateWhen((s) => s.view.camera.pitch !== before.pitch && !s.busy, "the view from above");
+        await app.page.mouse.move(view.x + 5, view.y + view.height - 60);
+        const above = await app.screenshot("V9-planes-from-above");
+        const [sagittal, , axial] = state.layout.planes;
+        assert.ok(sagittal.x < axial.x, JSON.stringify(state.layout.planes));
+        await app.page.mouse.click(axial.x + 0.15 * axial.width, axial.y + axial.height / 2);
+        const moved = await app.stateWhen((s) => s.view.planes?.axial < 0.3, "the axial plane moved down");
+        assert.deepEqual([moved.view.planes.sagittal, moved.view.planes.coronal], [0.25, 0.5], "the others stay");
+        assert.match(new URL(moved.view.link).searchParams.get("planes"), /^0\.25,0\.5,(0|0\.[0-2]\d*)$/);
+        await app.page.mouse.move(view.x + 5, view.y + view.height - 60);
+        await app.screenshotWhen("V9-axial-plane-moved", (i) => changedPixels(i, above, view) > 0.01 * view.width * view.height, "the lower axial slice");
     }, { query: `?mode=viewer&case=cases/ct.glb${link.search.replace(/^\?mode=viewer&case=[^&]*/, "")}`, routes });
 });
 

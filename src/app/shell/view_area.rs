@@ -58,7 +58,8 @@ impl Shell {
                 // A picture shows the view alone (and which way the patient lies).
                 if !self.picture.pending {
                     let has_image = doc.case().case_image().is_some();
-                    view_tools::show(ui, response.rect, &mut doc.view_asks, has_image);
+                    let asks = &mut doc.view_asks;
+                    doc.panel.planes = view_tools::show(ui, response.rect, asks, has_image);
                 }
                 if doc.view_asks != asked {
                     ui.ctx().request_repaint();
