@@ -6,7 +6,7 @@ use glam::{Mat4, Quat, Vec3};
 use meshsmooth::case::{from_gltf_scene, Camera, Case, Label, Lesson, Quiz, QuizMode, Step};
 use meshsmooth::export::{write_case, CaseGltfOptions, Container, ExportError, SceneFrame};
 use meshsmooth::io::load_gltf_scene;
-use meshsmooth::view::{Clip, ClipAxis};
+use meshsmooth::view::{Clip, ClipAxis, Planes};
 use serde_json::Value;
 
 #[path = "common/label_maps.rs"]
@@ -27,6 +27,7 @@ fn step(title: &str, camera: Camera) -> Step {
         opacity: Default::default(),
         selected: None,
         clip: None,
+        planes: None,
         toward_segmentation: 0.0,
     }
 }
@@ -51,6 +52,12 @@ fn phantom_with_lesson() -> Case {
     second.hidden = vec!["right_kidney".into()];
     second.opacity.insert("liver".into(), 0.3);
     second.selected = Some("tumor".into());
+    // The image's planes, as a step on a case with its image shows them.
+    second.planes = Some(Planes {
+        sagittal: 0.3,
+        coronal: 0.5,
+        axial: 0.8,
+    });
     let mut third = step(
         "an axial cut",
         Camera {
@@ -335,6 +342,16 @@ fn checks_refuse_numbers_and_texts_no_viewer_can_show() {
         })
     });
     assert!(e.contains("the clipping plane lies outside"), "{e}");
+    let e = refused(&|l| l.steps[1].planes.as_mut().expect("planes").axial = 1.5);
+    assert!(
+        e.contains("step 2 ('the tumour'): one of the image's planes lies outside"),
+        "{e}"
+    );
+    let e = refused(&|l| l.steps[2].planes = Some(Planes::default()));
+    assert!(
+        e.contains("step 3 ('an axial cut'): shows both a clipping plane and the image's planes"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::Case;
-use crate::view::Clip;
+use crate::view::{Clip, Planes};
 
 /// Longest step title, label text or structure name the lesson accepts (characters).
 const MAX_SHORT_TEXT: usize = 200;
@@ -48,6 +48,9 @@ pub struct Step {
     pub selected: Option<String>,
     #[serde(default)]
     pub clip: Option<Clip>,
+    /// The case's image in its three planes, where the step shows them (never beside a clip).
+    #[serde(default)]
+    pub planes: Option<Planes>,
     /// The slide from the smoothed surfaces (0) towards the segmentation (1).
     #[serde(default)]
     pub toward_segmentation: f32,
@@ -227,6 +230,18 @@ fn check_step(
     }
     if step.clip.is_some_and(|c| !unit(c.at)) {
         return Err(format!("{what}: the clipping plane lies outside [0, 1]"));
+    }
+    if let Some(p) = step.planes {
+        if step.clip.is_some() {
+            return Err(format!(
+                "{what}: shows both a clipping plane and the image's planes"
+            ));
+        }
+        if ![p.sagittal, p.coronal, p.axial].into_iter().all(unit) {
+            return Err(format!(
+                "{what}: one of the image's planes lies outside [0, 1]"
+            ));
+        }
     }
     if !unit(step.toward_segmentation) {
         return Err(format!(

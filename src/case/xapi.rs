@@ -145,6 +145,7 @@ mod tests {
             opacity: Default::default(),
             selected: None,
             clip: None,
+            planes: None,
             toward_segmentation: 0.0,
         };
         let mut case = Case {

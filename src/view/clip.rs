@@ -75,6 +75,7 @@ impl Clip {
 /// at its place across the scene (0 at its low end, 1 at its high end) along x (sagittal),
 /// y (coronal) and z (axial). They cut nothing.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Planes {
     pub sagittal: f32,
     pub coronal: f32,

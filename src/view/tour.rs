@@ -30,7 +30,7 @@ pub fn step_view(step: &Step, names: &[&str]) -> ViewLink {
             .collect(),
         selected: step.selected.as_deref().and_then(index),
         clip: step.clip,
-        planes: None,
+        planes: step.planes,
         toward_segmentation: step.toward_segmentation,
     }
 }
@@ -68,6 +68,7 @@ pub fn recorded_step(
             .collect::<Result<_, String>>()?,
         selected: link.selected.map(name).transpose()?,
         clip: link.clip,
+        planes: link.planes,
         toward_segmentation: link.toward_segmentation,
     })
 }
@@ -145,7 +146,7 @@ fn flight(from: CameraPose, to: CameraPose, t: f64) -> CameraPose {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::view::{Clip, ClipAxis};
+    use crate::view::{Clip, ClipAxis, Planes};
 
     fn pose(yaw: f32, distance: f32) -> CameraPose {
         CameraPose {
@@ -175,6 +176,7 @@ mod tests {
                 at: 0.4,
                 flip: true,
             }),
+            planes: None,
             toward_segmentation: 0.5,
         };
         let view = step_view(&step, &["liver", "tumour", "kidney"]);
@@ -223,12 +225,26 @@ mod tests {
         assert!(recorded_step(&nowhere, &names, "x", "").is_err());
         let stale = ViewLink {
             hidden: vec![7],
-            ..link
+            ..link.clone()
         };
         assert_eq!(
             recorded_step(&stale, &names, "x", "").expect_err("no structure 7"),
             "the case has no structure 7"
         );
+        // The image's planes, shown instead of a clip, are recorded and shown again.
+        let planes = Planes {
+            sagittal: 0.2,
+            coronal: 0.5,
+            axial: 0.9,
+        };
+        let on_the_image = ViewLink {
+            clip: None,
+            planes: Some(planes),
+            ..link
+        };
+        let step = recorded_step(&on_the_image, &names, "slices", "").expect("recorded");
+        assert_eq!((step.clip, step.planes), (None, Some(planes)));
+        assert_eq!(step_view(&step, &names).planes, Some(planes));
     }
 
     #[test]

@@ -492,3 +492,32 @@ fn codes_without_a_modifier_cross_the_wire() {
     let back = decode::<crate::io::StructureCodes>(&encode(&codes));
     assert_eq!(back, Ok(codes));
 }
+
+/// Messages are postcard, which is not self-describing: a field left out when written (serde's
+/// `skip_serializing_if`) would make the rest unreadable.
+#[test]
+fn a_lesson_crosses_to_a_worker_and_back_with_and_without_planes() {
+    use crate::case::{Camera, Lesson, Step};
+    let step = |planes| Step {
+        title: "slices".into(),
+        caption: String::new(),
+        camera: Camera {
+            target: [1.0, 2.0, 3.0],
+            yaw: 0.5,
+            pitch: 0.1,
+            distance: 90.0,
+        },
+        hidden: vec!["kidney".into()],
+        opacity: Default::default(),
+        selected: None,
+        clip: None,
+        planes,
+        toward_segmentation: 0.25,
+    };
+    let lesson = Lesson {
+        steps: vec![step(Some(crate::view::Planes::default())), step(None)],
+        ..Default::default()
+    };
+    let back: Lesson = decode(&encode(&lesson)).expect("decodes");
+    assert_eq!(back, lesson);
+}

@@ -403,6 +403,31 @@ testIn(EVERY_RUN, "V9 a link carries the image's three planes, and opens the cas
     }, { query: `?mode=viewer&case=cases/ct.glb${link.search.replace(/^\?mode=viewer&case=[^&]*/, "")}`, routes });
 });
 
+testIn(EVERY_RUN, "V10 a tour step records the image's three planes, and the viewer shows them at that step", { timeout: TIMEOUT }, async () => {
+    const withImage = await phantomWithImage();
+    let exported;
+    await withApp(async (app) => {
+        await app.loadMesh(withImage, "phantom-case-ct.glb", "loadCase");
+        await app.stateWhen((s) => s.loading === null && s.view.camera, "the case open and framed");
+        await app.call("setView", { planes: { sagittal: 0.3, axial: 0.2 } });
+        await app.stateWhen((s) => s.view.planes !== null, "the three planes");
+        assert.equal(await app.call("recordStep", { title: "Low slices" }), 1);
+        const { steps } = await app.call("lesson");
+        assert.deepEqual(steps[0].planes, { sagittal: Math.fround(0.3), coronal: 0.5, axial: Math.fround(0.2) });
+        assert.equal(steps[0].clip, null);
+        exported = Buffer.from(await app.call("exportCase", "glb"));
+    });
+    await withApp(async (app) => {
+        await app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.tour?.steps === 1, "the case and its tour");
+        await app.call("setView", { clip: { axis: "coronal", at: 0.4 } });
+        await app.stateWhen((s) => s.view.clip !== null, "a clip of the student's");
+        await app.call("showStep", 0);
+        const at = await app.stateWhen((s) => s.tour.step === 0 && s.view.planes !== null, "the step's planes");
+        assert.deepEqual(at.view.planes, { sagittal: Math.fround(0.3), coronal: 0.5, axial: Math.fround(0.2) });
+        assert.equal(at.view.clip, null, "the step's planes replace the student's clip");
+    }, { query: "?mode=viewer&case=cases/toured.glb", routes: { "cases/toured.glb": exported } });
+});
+
 testIn(EVERY_RUN, "V5 the author adds the CT under the page's case, the case glTF carries it, the viewer shows its slice", { timeout: TIMEOUT }, async () => {
     const ct = readFileSync(join(ROOT, "tests/data/phantom_ct.nii.gz"));
     const bone = { source: "phantom_ct.nii.gz", dims: [160, 140, 48], preset: "ct-bone", window: { center: 400, width: 1800 } };
