@@ -180,6 +180,37 @@ fn a_broken_or_foreign_file_in_a_series_is_named() {
     );
 }
 
+/// Each slice of `files` with `(0028,0101)` Bits Stored and `(0028,0102)` High Bit set (the
+/// files are explicit VR little endian: tag, "US", length 2, value) and the top 4 bits of every
+/// 16-bit pixel (the file's last bytes) set to 1010, as an overlay there would.
+fn twelve_bits(files: &mut [(String, Vec<u8>)], high_bit: u16) {
+    let element = |e: u8| [0x28, 0x00, e, 0x01, b'U', b'S', 0x02, 0x00];
+    for (name, bytes) in files.iter_mut() {
+        for (e, value) in [(0x01, 12u16), (0x02, high_bit)] {
+            let at = (bytes.windows(8).position(|w| w == element(e)))
+                .unwrap_or_else(|| panic!("{name}: no (0028,01{e:02x})"));
+            bytes[at + 8..at + 10].copy_from_slice(&value.to_le_bytes());
+        }
+        let plane = 24 * 20 * 2;
+        let start = bytes.len() - plane;
+        for pixel in bytes[start..].chunks_exact_mut(2) {
+            assert!(pixel[1] < 0x08, "{name}: a value beyond 11 bits");
+            pixel[1] |= 0xA0;
+        }
+    }
+}
+
+#[test]
+fn only_the_bits_stored_are_read() {
+    let mut files = slices("oblique");
+    twelve_bits(&mut files, 11);
+    assert_same(&read(&files, ALL).expect("12 bits of 16"), &twin(ALL));
+    let mut files = slices("oblique");
+    twelve_bits(&mut files, 15);
+    let e = refusal(&files);
+    assert!(e.contains("12 bits stored of 16, high bit 15"), "{e}");
+}
+
 /// `case build --image FOLDER`: the series' image in the case, the same as from its twin; a
 /// tilted series refused naming the slice, with no case written.
 #[test]

@@ -3,7 +3,9 @@
 //!
 //! The parsing is `dicom-object`'s, after [`super::dicom_lengths`] has checked every declared
 //! length against the file's bytes. What is read: single-frame, single-sample (grey) slices of
-//! 8, 16 or 32 bits, uncompressed little-endian, each with its own Rescale Slope and Intercept.
+//! 8, 16 or 32 bits, uncompressed little-endian, each with its own Rescale Slope and Intercept;
+//! where fewer bits are stored than allocated, only the stored (low) ones are read, so that old
+//! files' overlay bits above them are not taken for values.
 //! The slices are placed by Image Position (Patient) along the normal of their common Image
 //! Orientation, whatever the files' order or Instance Numbers. Refused, with the file or the
 //! reason named: slices of different series, sizes, orientations or pixel spacings; two slices
@@ -52,6 +54,8 @@ struct Slice<'a> {
     position: [f64; 3],
     thickness: Option<f64>,
     sample: Sample,
+    /// Bits Stored, where fewer than the sample's.
+    low_bits: Option<u32>,
     slope: f64,
     inter: f64,
     pixels: &'a [u8],
@@ -98,7 +102,12 @@ pub fn load_image_series(
     let plane = columns * rows * first.sample.size();
     for slice in &slices {
         sink.rescale(slice.slope, slice.inter);
-        sink.feed(&slice.pixels[..plane]).map_err(series_of)?;
+        let pixels = &slice.pixels[..plane];
+        match slice.low_bits {
+            Some(bits) => sink.feed(&only_stored(pixels, slice.sample, bits)),
+            None => sink.feed(pixels),
+        }
+        .map_err(series_of)?;
     }
     let factor = sink.factor();
     let (dims, values) = sink.finish(FORMAT).map_err(series_of)?;
@@ -152,6 +161,7 @@ fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError
         required(&object, tags::ROWS, "Rows")?,
     ];
     let sample = sample_of(&object)?;
+    let low_bits = stored_bits(&object, sample)?;
     let needed = (size[0].checked_mul(size[1])).and_then(|n| n.checked_mul(sample.size()));
     let what = "bytes of pixel data for the rows and columns declared";
     let pixels = layout.pixels(bytes, needed, what, FORMAT)?;
@@ -175,6 +185,7 @@ fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError
         position: numbers(&object, tags::IMAGE_POSITION_PATIENT, "Image Position")?,
         thickness: floats(&object, tags::SLICE_THICKNESS).and_then(|v| v.first().copied()),
         sample,
+        low_bits,
         slope: scale(tags::RESCALE_SLOPE, 1.0)?,
         inter: scale(tags::RESCALE_INTERCEPT, 0.0)?,
         pixels,
@@ -222,6 +233,41 @@ fn sample_of(object: &InMemDicomObject) -> Result<Sample, LoadError> {
             )))
         }
     })
+}
+
+/// Bits Stored where fewer than the sample's bits, the value in the low ones (High Bit one
+/// below Bits Stored, as CT and MR write them; other placements are refused).
+fn stored_bits(object: &InMemDicomObject, sample: Sample) -> Result<Option<u32>, LoadError> {
+    let allocated = 8 * sample.size();
+    let stored = whole(object, tags::BITS_STORED).unwrap_or(allocated);
+    let high = whole(object, tags::HIGH_BIT).unwrap_or(stored.wrapping_sub(1));
+    if stored == 0 || stored > allocated || high + 1 != stored {
+        return Err(unsupported(format!(
+            "{stored} bits stored of {allocated}, high bit {high}: the value must fill the low \
+             bits"
+        )));
+    }
+    Ok((stored < allocated).then_some(stored as u32))
+}
+
+/// `pixels` with only each sample's low `bits` kept, sign-extended from them where the sample
+/// is signed.
+fn only_stored(pixels: &[u8], sample: Sample, bits: u32) -> Vec<u8> {
+    let width = sample.size();
+    let signed = matches!(sample, Sample::I8 | Sample::I16 | Sample::I32);
+    let unused = 64 - bits;
+    let mut out = Vec::with_capacity(pixels.len());
+    for chunk in pixels.chunks_exact(width) {
+        let mut word = [0u8; 8];
+        word[..width].copy_from_slice(chunk);
+        let raised = u64::from_le_bytes(word) << unused;
+        let value = match signed {
+            true => ((raised as i64) >> unused) as u64,
+            false => raised >> unused,
+        };
+        out.extend_from_slice(&value.to_le_bytes()[..width]);
+    }
+    out
 }
 
 /// Refuses slices that cannot be one image: another series, size, orientation, spacing or
@@ -314,4 +360,21 @@ fn slice_step(slices: &[Slice], axes: &[[f64; 3]; 3]) -> Result<f64, SeriesError
     // The mean gap: positions are rounded decimal strings.
     let span = height(&slices[slices.len() - 1]) - height(lowest);
     Ok(span / (slices.len() - 1) as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_stored_bits_are_kept_signed_values_extended_from_them() {
+        let le = |v: &[u16]| v.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>();
+        // -1000 in 12 bits is 0xC18; an overlay bit above it is dropped either way.
+        let pixels = le(&[0xAC18, 0x03E8, 0x07FF, 0x0800]);
+        let signed = le(&[0xFC18, 0x03E8, 0x07FF, 0xF800]);
+        assert_eq!(only_stored(&pixels, Sample::I16, 12), signed);
+        let unsigned = le(&[0x0C18, 0x03E8, 0x07FF, 0x0800]);
+        assert_eq!(only_stored(&pixels, Sample::U16, 12), unsigned);
+        assert_eq!(only_stored(&[0xF3, 0x1C], Sample::I8, 4), [0x03, 0xFC]);
+    }
 }
