@@ -10,6 +10,32 @@ use std::io::Write;
 use flate2::{write::GzEncoder, Compression};
 use meshsmooth::io::{load_gltf_scene, load_label_map, LabelMap, LabelMapOptions};
 use meshsmooth::session::Session;
+use meshsmooth::worker::NamedFile;
+
+/// [`Case::add_image`] of one file.
+fn add_one(
+    case: &mut Case,
+    bytes: &[u8],
+    name: &str,
+    preset: WindowPreset,
+    max_voxels: usize,
+) -> Result<(), String> {
+    case.add_image(&[(name, bytes)], name, preset, max_voxels)
+}
+
+/// [`Session::begin_image`] of one file.
+fn begin_one(
+    session: &mut Session,
+    name: &str,
+    bytes: Vec<u8>,
+    preset: WindowPreset,
+) -> Result<(), String> {
+    let file = NamedFile {
+        name: name.to_string(),
+        bytes,
+    };
+    session.begin_image(vec![file], preset)
+}
 
 #[path = "common/label_maps.rs"]
 mod label_maps;
@@ -77,7 +103,8 @@ fn phantom_ct_nrrd() -> Vec<u8> {
 fn phantom_with_image() -> Case {
     let mut case = label_maps::phantom_case();
     let ct = phantom_ct([0.0; 3]);
-    case.add_image(
+    add_one(
+        &mut case,
         &ct,
         "scans/ct.nii",
         WindowPreset::CtSoftTissue,
@@ -114,7 +141,8 @@ fn the_image_is_windowed_and_read_back_from_the_case_gltf_as_written() {
 fn a_slicer_nrrd_volume_reads_as_the_same_image_as_the_nifti() {
     let nifti = phantom_with_image().image.expect("added");
     let mut case = label_maps::phantom_case();
-    (case.add_image(
+    (add_one(
+        &mut case,
         &phantom_ct_nrrd(),
         "scans/ct.nrrd",
         WindowPreset::CtSoftTissue,
@@ -140,7 +168,7 @@ fn a_freesurfer_volume_reads_as_an_image_on_the_grid_of_its_segmentation() {
     ))
     .expect("the aseg MGZ");
     let mut case = label_maps::phantom_case();
-    (case.add_image(&aseg, "T1.mgz", WindowPreset::MriAuto, 1 << 24)).expect("on the grid");
+    (add_one(&mut case, &aseg, "T1.mgz", WindowPreset::MriAuto, 1 << 24)).expect("on the grid");
     let image = case.image.expect("added");
     assert_eq!(
         (image.source.as_str(), image.dims),
@@ -154,7 +182,7 @@ fn a_freesurfer_volume_reads_as_an_image_on_the_grid_of_its_segmentation() {
     );
     assert!(image.voxels.contains(&255) && image.voxels.contains(&0));
     let mut case = label_maps::phantom_case();
-    let error = (case.add_image(&aseg, "T1.stl", WindowPreset::MriAuto, 1 << 24))
+    let error = (add_one(&mut case, &aseg, "T1.stl", WindowPreset::MriAuto, 1 << 24))
         .expect_err("no image format");
     assert!(
         error.contains("cannot tell the image format of 'T1.stl'"),
@@ -167,7 +195,12 @@ fn a_freesurfer_volume_reads_as_an_image_on_the_grid_of_its_segmentation() {
 #[test]
 fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
     let mut session = Session::default();
-    let refused = session.begin_image("ct.nrrd", phantom_ct_nrrd(), WindowPreset::CtBone);
+    let refused = begin_one(
+        &mut session,
+        "ct.nrrd",
+        phantom_ct_nrrd(),
+        WindowPreset::CtBone,
+    );
     assert!(refused
         .expect_err("nothing open")
         .contains("open the segmentation first"));
@@ -178,16 +211,27 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
     session.poll_opening().expect("done").expect("opens");
     assert!(session.case().case_image().is_none());
     let nrrd = phantom_ct_nrrd();
-    (session.begin_image("scans/ct.nrrd", nrrd.clone(), WindowPreset::CtSoftTissue))
-        .expect("asked");
+    (begin_one(
+        &mut session,
+        "scans/ct.nrrd",
+        nrrd.clone(),
+        WindowPreset::CtSoftTissue,
+    ))
+    .expect("asked");
     session.poll_opening().expect("done").expect("read");
     let image = session.case().case_image().expect("added").clone();
     let mut case = label_maps::phantom_case();
-    case.add_image(&nrrd, "ct.nrrd", WindowPreset::CtSoftTissue, 1 << 24)
-        .expect("added");
+    add_one(
+        &mut case,
+        &nrrd,
+        "ct.nrrd",
+        WindowPreset::CtSoftTissue,
+        1 << 24,
+    )
+    .expect("added");
     assert_eq!(Some(&image), case.image.as_ref());
     let moved = phantom_ct([0.0, 0.0, 5.0]);
-    (session.begin_image("moved.nii", moved, WindowPreset::CtSoftTissue)).expect("asked");
+    (begin_one(&mut session, "moved.nii", moved, WindowPreset::CtSoftTissue)).expect("asked");
     let error = session
         .poll_opening()
         .expect("done")
@@ -207,19 +251,32 @@ fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept(
     let mut case = label_maps::phantom_case();
     let before = case.clone();
     let moved = phantom_ct([0.0, 0.0, 5.0]);
-    let error = (case.add_image(&moved, "ct.nii", WindowPreset::CtSoftTissue, 1 << 24))
-        .expect_err("moved 5 mm");
+    let error = (add_one(
+        &mut case,
+        &moved,
+        "ct.nii",
+        WindowPreset::CtSoftTissue,
+        1 << 24,
+    ))
+    .expect_err("moved 5 mm");
     assert!(
         error.starts_with("the image does not lie")
             && error.contains("offset 0.000, 0.000, 5.000 mm"),
         "{error}"
     );
-    let error = (case.add_image(b"not a nifti", "ct.nii", WindowPreset::CtBone, 1 << 24))
-        .expect_err("garbage");
+    let error = (add_one(
+        &mut case,
+        b"not a nifti",
+        "ct.nii",
+        WindowPreset::CtBone,
+        1 << 24,
+    ))
+    .expect_err("garbage");
     assert!(error.starts_with("NIfTI"), "{error}");
     assert_eq!(case, before);
     let mut surfaces = Case::default();
-    let error = (surfaces.add_image(
+    let error = (add_one(
+        &mut surfaces,
         &phantom_ct([0.0; 3]),
         "ct.nii",
         WindowPreset::CtBone,
@@ -237,7 +294,8 @@ fn every_grid_of_a_case_is_checked_not_only_the_first() {
     grid.0[2][3] += 5.0;
     let name = last.name.clone();
     let before = case.clone();
-    let error = (case.add_image(
+    let error = (add_one(
+        &mut case,
         &phantom_ct([0.0; 3]),
         "ct.nii",
         WindowPreset::CtSoftTissue,
@@ -255,8 +313,14 @@ fn every_grid_of_a_case_is_checked_not_only_the_first() {
 fn a_large_image_is_reduced_to_the_voxels_asked_for_and_stays_in_place() {
     let mut case = label_maps::phantom_case();
     let ct = phantom_ct([0.0; 3]);
-    case.add_image(&ct, "ct.nii", WindowPreset::CtSoftTissue, 100_000)
-        .expect("added");
+    add_one(
+        &mut case,
+        &ct,
+        "ct.nii",
+        WindowPreset::CtSoftTissue,
+        100_000,
+    )
+    .expect("added");
     let image = case.image.clone().expect("added");
     // 160 x 140 x 48 by 3: 54 x 47 x 16 = 40,608 voxels.
     assert_eq!(image.dims, [54, 47, 16]);

@@ -263,7 +263,7 @@ fn the_page_session_adds_a_series_under_the_phantom() {
             .map(|(name, bytes)| NamedFile { name, bytes })
             .collect()
     };
-    (session.begin_image_files(named("phantom_ct"), WindowPreset::CtSoftTissue)).expect("asked");
+    (session.begin_image(named("phantom_ct"), WindowPreset::CtSoftTissue)).expect("asked");
     session.poll_opening().expect("done").expect("read");
     let image = session.case().case_image().expect("added").clone();
     assert_eq!(image.source, "DICOM series (24 slices)");
@@ -285,7 +285,7 @@ fn the_page_session_adds_a_series_under_the_phantom() {
         assert!((g - w).abs() < 1e-4, "{got:?} {wanted:?}");
     }
 
-    (session.begin_image_files(named("tilted"), WindowPreset::CtBone)).expect("asked");
+    (session.begin_image(named("tilted"), WindowPreset::CtBone)).expect("asked");
     let error = session.poll_opening().expect("done").expect_err("tilted");
     assert!(
         error.starts_with("Cannot open the image DICOM series (12 slices): ")

@@ -258,7 +258,7 @@ impl Document {
         preset: crate::case::WindowPreset,
         waiter: Option<LoadWaiter>,
     ) {
-        match self.session.begin_image_files(files, preset) {
+        match self.session.begin_image(files, preset) {
             Ok(()) => self.waiting_for_load.extend(waiter),
             Err(why) => {
                 log::warn!("{why}");

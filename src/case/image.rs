@@ -250,37 +250,17 @@ impl super::Case {
         grids
     }
 
-    /// Adds the image `name` ([`CaseImage::read`] on the case's grids). The case is unchanged
-    /// when it is refused.
+    /// Adds the image read from `files`: one file, or the slices of a DICOM series, named
+    /// `name` ([`CaseImage::read`] on the case's grids), in place of the one it had. The case is
+    /// unchanged when it is refused.
     pub fn add_image(
-        &mut self,
-        bytes: &[u8],
-        name: &str,
-        preset: WindowPreset,
-        max_voxels: usize,
-    ) -> Result<(), String> {
-        let file = [(name, bytes)];
-        self.add_read(|grids| CaseImage::read(&file, name, preset, max_voxels, grids))
-    }
-
-    /// Adds the image whose slices are `files` (a DICOM series, [`CaseImage::read`]),
-    /// named `name`; the case is unchanged when it is refused.
-    pub fn add_image_series(
         &mut self,
         files: &[(&str, &[u8])],
         name: &str,
         preset: WindowPreset,
         max_voxels: usize,
     ) -> Result<(), String> {
-        self.add_read(|grids| CaseImage::read(files, name, preset, max_voxels, grids))
-    }
-
-    /// The image `read` makes on the case's grids, in place of the one it had.
-    fn add_read(
-        &mut self,
-        read: impl FnOnce(&[(String, Affine)]) -> Result<CaseImage, String>,
-    ) -> Result<(), String> {
-        let image = read(&self.image_grids())?;
+        let image = CaseImage::read(files, name, preset, max_voxels, &self.image_grids())?;
         self.image = Some(Arc::new(image));
         Ok(())
     }

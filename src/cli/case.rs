@@ -214,10 +214,10 @@ fn add_image(case: &mut Case, path: &Path, args: &BuildArgs) -> Result<(), Strin
             .map(|(n, b)| (case::file_name(n), b.as_slice()))
             .collect();
         let folder = name.trim_end_matches(['/', '\\']);
-        case.add_image_series(&slices, folder, args.window, args.image_voxels)
+        case.add_image(&slices, folder, args.window, args.image_voxels)
     } else {
         let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
-        case.add_image(&bytes, &name, args.window, args.image_voxels)
+        case.add_image(&[(&name, &bytes)], &name, args.window, args.image_voxels)
     };
     added.map_err(|e| format!("{name}: {e}"))
 }

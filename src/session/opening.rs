@@ -119,25 +119,11 @@ impl Session {
     }
 
     /// Starts reading the image the open case's segmentation was drawn on, windowed by
-    /// `preset`, in a worker; it replaces the case's image once read and checked against the
-    /// structures' grids. Refused at once when nothing is open, or while a file opens (the
+    /// `preset`, in a worker: one file, or the slices of a DICOM series (several files, named
+    /// "DICOM series (N slices)"). It replaces the case's image once read and checked against
+    /// the structures' grids. Refused at once when nothing is open, or while a file opens (the
     /// grids to check are not known yet).
     pub fn begin_image(
-        &mut self,
-        name: &str,
-        bytes: Vec<u8>,
-        preset: case::WindowPreset,
-    ) -> Result<(), String> {
-        let file = NamedFile {
-            name: name.to_string(),
-            bytes,
-        };
-        self.begin_image_files(vec![file], preset)
-    }
-
-    /// [`Self::begin_image`] of one file, or of the slices of a DICOM series (several files,
-    /// named "DICOM series (N slices)").
-    pub fn begin_image_files(
         &mut self,
         files: Vec<NamedFile>,
         preset: case::WindowPreset,
