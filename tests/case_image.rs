@@ -230,15 +230,15 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
     )
     .expect("added");
     assert_eq!(Some(&image), case.image.as_ref());
-    let moved = phantom_ct([0.0, 0.0, 5.0]);
+    let moved = phantom_ct([0.0, 0.0, 1.0]);
     (begin_one(&mut session, "moved.nii", moved, WindowPreset::CtSoftTissue)).expect("asked");
     let error = session
         .poll_opening()
         .expect("done")
-        .expect_err("moved 5 mm");
+        .expect_err("moved 1 mm");
     assert!(
         error.starts_with("Cannot open the image moved.nii: the image does not lie")
-            && error.contains("5.000 mm"),
+            && error.contains("1.000 mm"),
         "{error}"
     );
     assert_eq!(session.case().case_image(), Some(&image), "kept");
@@ -250,7 +250,7 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
 fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept() {
     let mut case = label_maps::phantom_case();
     let before = case.clone();
-    let moved = phantom_ct([0.0, 0.0, 5.0]);
+    let moved = phantom_ct([0.0, 0.0, 1.0]);
     let error = (add_one(
         &mut case,
         &moved,
@@ -258,10 +258,10 @@ fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept(
         WindowPreset::CtSoftTissue,
         1 << 24,
     ))
-    .expect_err("moved 5 mm");
+    .expect_err("moved 1 mm, 0.4 of a slice");
     assert!(
         error.starts_with("the image does not lie")
-            && error.contains("offset 0.000, 0.000, 5.000 mm"),
+            && error.contains("offset 0.000, 0.000, 1.000 mm"),
         "{error}"
     );
     let error = (add_one(
@@ -286,12 +286,71 @@ fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept(
     assert!(error.contains("no structure from a label map"), "{error}");
 }
 
+/// The phantom's CT cropped to slices `from..to` along k, in place: its origin moved by whole
+/// slices, as a CT cropped to the body (or a segmentation cropped to its segments) is.
+fn phantom_ct_slices(from: usize, to: usize) -> Vec<u8> {
+    let map = phantom_map();
+    let sform: [[f32; 4]; 3] = std::array::from_fn(|r| {
+        let m = &map.affine.0[r];
+        std::array::from_fn(|c| {
+            (if c == 3 {
+                m[3] + from as f64 * m[2]
+            } else {
+                m[c]
+            }) as f32
+        })
+    });
+    let [i, j, _] = map.dims;
+    let dims = [i, j, to - from];
+    let mut bytes = nifti::nifti_header(dims, sform, map.spacing().map(|s| s as f32));
+    bytes[70..72].copy_from_slice(&4i16.to_le_bytes()); // int16
+    bytes[72..74].copy_from_slice(&16i16.to_le_bytes());
+    let plane = i * j * 2;
+    bytes.extend(&phantom_hu(&map)[from * plane..to * plane]);
+    bytes
+}
+
+#[test]
+fn an_image_cropped_on_the_segmentations_lattice_is_placed_where_it_lies() {
+    let mut whole = label_maps::phantom_case();
+    let ct = phantom_ct([0.0; 3]);
+    add_one(
+        &mut whole,
+        &ct,
+        "ct.nii",
+        WindowPreset::CtSoftTissue,
+        1 << 24,
+    )
+    .expect("the CT");
+    let mut cropped = label_maps::phantom_case();
+    let part = phantom_ct_slices(10, 30);
+    add_one(
+        &mut cropped,
+        &part,
+        "part.nii",
+        WindowPreset::CtSoftTissue,
+        1 << 24,
+    )
+    .expect("whole slices of the grid");
+    let (whole, cropped) = (whole.image.expect("added"), cropped.image.expect("added"));
+    assert_eq!(cropped.dims, [whole.dims[0], whole.dims[1], 20]);
+    // The same grey at the same places; none outside the crop.
+    let grid = phantom_map().affine;
+    for k in 10..30 {
+        for (i, j) in [(40, 40), (80, 70), (120, 90), (10, 130)] {
+            let p = grid.apply([i as f64, j as f64, k as f64]);
+            assert_eq!(cropped.sample(p), whole.sample(p), "voxel ({i}, {j}, {k})");
+        }
+    }
+    assert_eq!(cropped.sample(grid.apply([40.0, 40.0, 5.0])), None);
+}
+
 #[test]
 fn every_grid_of_a_case_is_checked_not_only_the_first() {
     let mut case = label_maps::phantom_case();
     let last = case.structures.last_mut().expect("structures");
     let grid = last.grid.as_mut().expect("from a label map");
-    grid.0[2][3] += 5.0;
+    grid.0[2][3] += 1.0;
     let name = last.name.clone();
     let before = case.clone();
     let error = (add_one(
@@ -303,7 +362,7 @@ fn every_grid_of_a_case_is_checked_not_only_the_first() {
     ))
     .expect_err("off the last structure's grid");
     assert!(
-        error.contains("5.000 mm") && error.ends_with(&format!("the grid is {name}'s")),
+        error.contains("1.000 mm") && error.ends_with(&format!("the grid is {name}'s")),
         "{error}"
     );
     assert_eq!(case, before);

@@ -266,9 +266,11 @@ impl super::Case {
     }
 }
 
-/// Refuses an image whose grid is not the segmentation's: `grid` is the voxel grid the case's
-/// structures were extracted on. Names the largest offset between the two at the image's
-/// corners.
+/// Refuses an image whose voxels are not the segmentation's: `grid` is the voxel grid the case's
+/// structures were extracted on. The image may cover more or less than the segmentation (a CT
+/// cropped to the body, a 3D Slicer segmentation cropped to its segments) as long as its lattice
+/// is the grid's shifted by whole voxels. Names the largest offset found at the image's corners
+/// from the grid's nearest voxels.
 pub fn check_frame(image: &ImageVolume, grid: &Affine) -> Result<(), String> {
     let [di, dj, dk] = image.source_dims.map(|d| d.saturating_sub(1) as f64);
     let corners = [
@@ -282,10 +284,14 @@ pub fn check_frame(image: &ImageVolume, grid: &Affine) -> Result<(), String> {
         .chain(grid.spacing())
         .fold(f64::INFINITY, f64::min);
     let tolerance = 0.05 * smallest;
+    // Where the image's first voxel falls on the grid, to the nearest whole voxel.
+    let shift = (grid.inverse_apply(image.source_affine.apply([0.0; 3])))
+        .filter(|at| at.iter().all(|x| x.is_finite()))
+        .map_or([0.0; 3], |at| at.map(f64::round));
     let (worst, corner, offset) = (corners.iter())
         .map(|c| {
             let a = image.source_affine.apply(*c);
-            let b = grid.apply(*c);
+            let b = grid.apply(std::array::from_fn(|k| c[k] + shift[k]));
             let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
             ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), *c, d)
         })
@@ -375,7 +381,7 @@ mod tests {
     }
 
     #[test]
-    fn an_image_off_the_segmentation_grid_is_refused_with_its_offset() {
+    fn an_image_off_the_segmentation_lattice_is_refused_with_its_offset_a_crop_is_not() {
         let grid = Affine::scaled([1.5, 1.5, 3.0], [-100.0, -80.0, 20.0]);
         let same = volume([10, 10, 5], grid, vec![0.0; 500]);
         assert_eq!(check_frame(&same, &grid), Ok(()));
@@ -385,10 +391,33 @@ mod tests {
             vec![0.0; 500],
         );
         let error = check_frame(&moved, &grid).expect_err("moved");
+        // 12.5 mm is 8 1/3 voxels: a third of a voxel from the nearest.
         assert!(
-            error.starts_with("the image does not lie on") && error.contains("12.500 mm"),
+            error.starts_with("the image does not lie on") && error.contains("0.500 mm"),
             "{error}"
         );
-        assert!(error.contains("offset 0.000, 12.500, 0.000 mm"), "{error}");
+        assert!(error.contains("offset 0.000, 0.500, 0.000 mm"), "{error}");
+        // A crop of the grid (or the grid a crop of the image) lies on it: whole voxels apart.
+        let cropped = volume(
+            [4, 6, 2],
+            Affine::scaled([1.5, 1.5, 3.0], [-97.0, -74.0, 26.0]),
+            vec![0.0; 48],
+        );
+        assert_eq!(check_frame(&cropped, &grid), Ok(()));
+        assert_eq!(check_frame(&same, &cropped.source_affine), Ok(()));
+        // Half a voxel off the lattice, or of another spacing, it does not.
+        let half = volume(
+            [4, 6, 2],
+            Affine::scaled([1.5, 1.5, 3.0], [-97.75, -74.0, 26.0]),
+            vec![0.0; 48],
+        );
+        let error = check_frame(&half, &grid).expect_err("half a voxel");
+        assert!(error.contains("0.750 mm"), "{error}");
+        let finer = volume(
+            [10, 10, 5],
+            Affine::scaled([1.5, 1.5, 2.0], [-100.0, -80.0, 20.0]),
+            vec![0.0; 500],
+        );
+        assert!(check_frame(&finer, &grid).is_err());
     }
 }
