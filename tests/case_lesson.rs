@@ -22,6 +22,8 @@ fn step(title: &str, camera: Camera) -> Step {
     Step {
         title: title.into(),
         caption: format!("What {title} shows."),
+        titles: Default::default(),
+        captions: Default::default(),
         camera,
         hidden: Vec::new(),
         opacity: Default::default(),
@@ -52,6 +54,8 @@ fn phantom_with_lesson() -> Case {
     second.hidden = vec!["right_kidney".into()];
     second.opacity.insert("liver".into(), 0.3);
     second.selected = Some("tumor".into());
+    second.titles = [("de".to_string(), "der Tumor".to_string())].into();
+    second.captions = [("pt-BR".to_string(), "O tumor dentro do fígado.".to_string())].into();
     // The image's planes, as a step on a case with its image shows them.
     second.planes = Some(Planes {
         sagittal: 0.3,
@@ -140,6 +144,26 @@ fn the_lesson_reads_back_the_same_from_every_kind_of_case_gltf() {
         let again = write_case(&back, &options).expect("writes again");
         assert_eq!(read_back(&again, name).lesson, case.lesson, "{name}, twice");
     }
+    // A reader sees a step's title and caption in the first of their languages it has.
+    let langs = |l: &[&str]| l.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let (own_title, own_caption) = (&case.lesson.steps[1].title, &case.lesson.steps[1].caption);
+    assert_eq!(
+        case.lesson.step_text(1, &langs(&["de", "en"])),
+        Some(("der Tumor", own_caption.as_str()))
+    );
+    assert_eq!(
+        case.lesson.step_text(1, &langs(&["pt", "de"])),
+        Some(("der Tumor", "O tumor dentro do fígado."))
+    );
+    assert_eq!(
+        case.lesson.step_text(1, &langs(&["pt-PT"])),
+        Some((own_title.as_str(), "O tumor dentro do fígado."))
+    );
+    assert_eq!(
+        case.lesson.step_text(1, &langs(&["en", "de"])),
+        Some((own_title.as_str(), own_caption.as_str()))
+    );
+    assert_eq!(case.lesson.step_text(3, &[]), None);
     // A case without a lesson writes no camera and reads back without one.
     let plain = label_maps::phantom_case();
     let bytes = write_case(&plain, &CaseGltfOptions::default()).expect("writes");
@@ -342,6 +366,17 @@ fn checks_refuse_numbers_and_texts_no_viewer_can_show() {
         })
     });
     assert!(e.contains("the clipping plane lies outside"), "{e}");
+    let e = refused(&|l| {
+        l.steps[0].titles.insert("deutsch".into(), "Vorne".into());
+    });
+    assert!(
+        e.contains("step 1 ('the front'): its titles: 'deutsch' is not a language tag"),
+        "{e}"
+    );
+    let e = refused(&|l| {
+        l.steps[0].captions.insert("fr".into(), "x".repeat(5000));
+    });
+    assert!(e.contains("the caption in 'fr' has 5000 characters"), "{e}");
     let e = refused(&|l| l.steps[1].planes.as_mut().expect("planes").axial = 1.5);
     assert!(
         e.contains("step 2 ('the tumour'): one of the image's planes lies outside"),

@@ -77,11 +77,14 @@ fn write_list(id: &str, lines: &[String]) {
 fn lesson_lines(doc: &Document) -> Vec<String> {
     let mut lines = Vec::new();
     let steps = &doc.case().lesson().steps;
-    if let Some(step) = doc.tour.and_then(|i| Some((i, steps.get(i)?))) {
-        let (i, step) = step;
-        let mut line = format!("Tour step {} of {}: {}.", i + 1, steps.len(), step.title);
-        if !step.caption.is_empty() {
-            line.push_str(&format!(" {}", step.caption));
+    let lesson = doc.case().lesson();
+    let shown = doc
+        .tour
+        .and_then(|i| Some((i, lesson.step_text(i, doc.reader_languages())?)));
+    if let Some((i, (title, caption))) = shown {
+        let mut line = format!("Tour step {} of {}: {title}.", i + 1, steps.len());
+        if !caption.is_empty() {
+            line.push_str(&format!(" {caption}"));
         }
         lines.push(line);
     }

@@ -33,12 +33,13 @@ impl Document {
         if steps.is_empty() {
             return Value::Null;
         }
-        let shown = self.tour.and_then(|i| steps.get(i));
+        let lesson = self.case().lesson();
+        let shown = (self.tour).and_then(|i| lesson.step_text(i, self.reader_languages()));
         json!({
             "step": self.tour,
             "steps": steps.len(),
-            "title": shown.map(|s| &s.title),
-            "caption": shown.map(|s| &s.caption),
+            "title": shown.map(|(title, _)| title),
+            "caption": shown.map(|(_, caption)| caption),
             "left": self.tour_left,
         })
     }

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use super::names::{self, Names};
 use super::Case;
 use crate::view::{Clip, Planes};
 
@@ -37,6 +38,13 @@ pub struct Step {
     /// A few sentences shown beside the view.
     #[serde(default)]
     pub caption: String,
+    /// The title and caption in other languages, by language tag, as structures' names are
+    /// (the own ones stand for English); a reader sees those of the first of their languages
+    /// there is one in.
+    #[serde(default)]
+    pub titles: Names,
+    #[serde(default)]
+    pub captions: Names,
     pub camera: Camera,
     /// Structures hidden in this view (the others are shown).
     #[serde(default)]
@@ -150,6 +158,15 @@ impl Lesson {
         }
     }
 
+    /// The title and caption of step `index` a reader of `languages` (most wanted first) sees.
+    pub fn step_text(&self, index: usize, languages: &[String]) -> Option<(&str, &str)> {
+        let step = self.steps.get(index)?;
+        Some((
+            names::pick(&step.title, &step.titles, languages),
+            names::pick(&step.caption, &step.captions, languages),
+        ))
+    }
+
     /// Reads a lesson from JSON (a pipeline's file, or what a case glTF's `extras` hold).
     pub fn from_json(text: &[u8]) -> Result<Self, String> {
         serde_json::from_slice(text).map_err(|e| format!("not a lesson: {e}"))
@@ -204,6 +221,15 @@ fn check_step(
 ) -> Result<(), String> {
     text(what, "title", &step.title, MAX_SHORT_TEXT, false)?;
     text(what, "caption", &step.caption, MAX_LONG_TEXT, true)?;
+    for (field, texts, max) in [
+        ("title", &step.titles, MAX_SHORT_TEXT),
+        ("caption", &step.captions, MAX_LONG_TEXT),
+    ] {
+        names::checked(texts).map_err(|e| format!("{what}: its {field}s: {e}"))?;
+        for (tag, t) in texts {
+            text(what, &format!("{field} in '{tag}'"), t, max, false)?;
+        }
+    }
     let c = &step.camera;
     finite(
         what,

@@ -100,6 +100,20 @@ pub fn quiz_finished(case: &Case, quiz: &Quiz, right: usize, questions: usize) -
     })
 }
 
+/// An xAPI language map: the own text as English (en-US), then the text in each other
+/// language the author gave.
+fn language_map(own: &str, others: &super::names::Names) -> Value {
+    let mut map = serde_json::Map::new();
+    map.insert("en-US".into(), json!(own));
+    for (tag, text) in others
+        .iter()
+        .filter(|(t, _)| !t.eq_ignore_ascii_case("en-US"))
+    {
+        map.insert(tag.clone(), json!(text));
+    }
+    Value::Object(map)
+}
+
 /// An ISO 8601 duration, as xAPI's results carry it.
 fn duration(ms: f64) -> String {
     format!("PT{:.2}S", ms.max(0.0) / 1000.0)
@@ -114,8 +128,8 @@ pub fn step_shown(case: &Case, index: usize, step: &Step) -> Value {
             "id": activity_id(case, &format!("step-{}", index + 1)),
             "definition": {
                 "type": "http://adlnet.gov/expapi/activities/interaction",
-                "name": { "en-US": step.title },
-                "description": { "en-US": step.caption },
+                "name": language_map(&step.title, &step.titles),
+                "description": language_map(&step.caption, &step.captions),
             },
         },
         "context": { "extensions": {
@@ -135,6 +149,8 @@ mod tests {
         let step = Step {
             title: "The liver".into(),
             caption: "Seen from the front.".into(),
+            titles: [("de".to_string(), "Die Leber".to_string())].into(),
+            captions: Default::default(),
             camera: Camera {
                 target: [0.0; 3],
                 yaw: 0.0,
@@ -159,7 +175,15 @@ mod tests {
             s["object"]["id"],
             "urn:meshsmooth:case:Abdominal-phantom#step-2"
         );
-        assert_eq!(s["object"]["definition"]["name"]["en-US"], "The liver");
+        let definition = &s["object"]["definition"];
+        assert_eq!(
+            definition["name"],
+            json!({"en-US": "The liver", "de": "Die Leber"})
+        );
+        assert_eq!(
+            definition["description"],
+            json!({"en-US": "Seen from the front."})
+        );
         assert_eq!(s["context"]["extensions"]["urn:meshsmooth:steps"], 2);
         assert!(s.get("actor").is_none(), "the platform knows the student");
     }

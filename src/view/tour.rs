@@ -51,6 +51,8 @@ pub fn recorded_step(
     Ok(Step {
         title: title.to_string(),
         caption: caption.to_string(),
+        titles: Default::default(),
+        captions: Default::default(),
         camera: Camera {
             target: c.target.to_array(),
             yaw: c.yaw,
@@ -162,6 +164,8 @@ mod tests {
         let step = Step {
             title: "cut".into(),
             caption: String::new(),
+            titles: Default::default(),
+            captions: Default::default(),
             camera: Camera {
                 target: [1.0, 2.0, 3.0],
                 yaw: 0.5,

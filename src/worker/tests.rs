@@ -501,6 +501,8 @@ fn a_lesson_crosses_to_a_worker_and_back_with_and_without_planes() {
     let step = |planes| Step {
         title: "slices".into(),
         caption: String::new(),
+        titles: Default::default(),
+        captions: Default::default(),
         camera: Camera {
             target: [1.0, 2.0, 3.0],
             yaw: 0.5,

@@ -121,6 +121,27 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
     }, await viewingTheLesson());
 });
 
+testIn(EVERY_RUN, "L7 a step's title and caption in the reader's language, the English ones where it has none", { timeout: TIMEOUT }, async () => {
+    const de = { title: lesson.steps[0].titles.de, caption: lesson.steps[0].captions.de };
+    const viewing = await viewingTheLesson();
+    await withApp(async (app) => {
+        await phantomShown(app);
+        await app.call("showStep", 0);
+        const s = await app.stateWhen((s) => s.tour.step === 0, "the first step");
+        assert.deepEqual([s.tour.title, s.tour.caption], [de.title, de.caption]);
+        await app.screenshot("L7-step-in-german");
+        await app.call("showStep", 1);
+        const next = await app.stateWhen((s) => s.tour.step === 1, "the second step");
+        assert.equal(next.tour.title, lesson.steps[1].title, "no German title there: the English one");
+    }, { ...viewing, query: `${viewing.query}&lang=de` });
+    await withApp(async (app) => {
+        await phantomShown(app);
+        await app.call("showStep", 0);
+        const s = await app.stateWhen((s) => s.tour.step === 0, "the first step");
+        assert.equal(s.tour.title, lesson.steps[0].title, "a French reader gets the English one");
+    }, { ...viewing, query: `${viewing.query}&lang=fr` });
+});
+
 testIn(EVERY_RUN, "L2 the author records tour steps in the page; the case glTF carries them to the viewer and back", { timeout: TIMEOUT }, async () => {
     let exported;
     let authored;

@@ -78,10 +78,14 @@ impl Shell {
             ui.separator();
             return;
         };
-        let step = steps[index.min(count - 1)].clone();
-        ui.strong(format!("Step {} of {count}: {}", index + 1, step.title));
-        if !step.caption.is_empty() {
-            ui.label(&step.caption);
+        let languages = doc.reader_languages();
+        let lesson = doc.case().lesson();
+        let (title, caption) = (lesson.step_text(index.min(count - 1), languages))
+            .map(|(t, c)| (t.to_string(), c.to_string()))
+            .unwrap_or_default();
+        ui.strong(format!("Step {} of {count}: {title}", index + 1));
+        if !caption.is_empty() {
+            ui.label(caption);
         }
         let mut asked = None;
         let mut leave = false;
