@@ -68,14 +68,31 @@ fn phantom_hu(map: &LabelMap) -> Vec<u8> {
 
 /// A synthetic CT of the phantom as NIfTI on the label map's grid moved by `shift` mm.
 fn phantom_ct(shift: [f32; 3]) -> Vec<u8> {
+    phantom_ct_slices(shift, 0..phantom_map().dims[2])
+}
+
+/// [`phantom_ct`] cropped to `slices` along k, in place: its origin moved by whole slices, as a
+/// CT cropped to the body (or a segmentation cropped to its segments) is.
+fn phantom_ct_slices(shift: [f32; 3], slices: std::ops::Range<usize>) -> Vec<u8> {
     let map = phantom_map();
     let sform: [[f32; 4]; 3] = std::array::from_fn(|r| {
-        std::array::from_fn(|c| map.affine.0[r][c] as f32 + if c == 3 { shift[r] } else { 0.0 })
+        let m = &map.affine.0[r];
+        let origin = m[3] + slices.start as f64 * m[2];
+        std::array::from_fn(|c| {
+            if c == 3 {
+                origin as f32 + shift[r]
+            } else {
+                m[c] as f32
+            }
+        })
     });
-    let mut bytes = nifti::nifti_header(map.dims, sform, map.spacing().map(|s| s as f32));
+    let [i, j, _] = map.dims;
+    let dims = [i, j, slices.len()];
+    let mut bytes = nifti::nifti_header(dims, sform, map.spacing().map(|s| s as f32));
     bytes[70..72].copy_from_slice(&4i16.to_le_bytes()); // int16
     bytes[72..74].copy_from_slice(&16i16.to_le_bytes());
-    bytes.extend(phantom_hu(&map));
+    let plane = i * j * 2;
+    bytes.extend(&phantom_hu(&map)[slices.start * plane..slices.end * plane]);
     bytes
 }
 
@@ -286,30 +303,6 @@ fn an_image_off_the_grid_or_without_a_segmentation_is_refused_and_the_case_kept(
     assert!(error.contains("no structure from a label map"), "{error}");
 }
 
-/// The phantom's CT cropped to slices `from..to` along k, in place: its origin moved by whole
-/// slices, as a CT cropped to the body (or a segmentation cropped to its segments) is.
-fn phantom_ct_slices(from: usize, to: usize) -> Vec<u8> {
-    let map = phantom_map();
-    let sform: [[f32; 4]; 3] = std::array::from_fn(|r| {
-        let m = &map.affine.0[r];
-        std::array::from_fn(|c| {
-            (if c == 3 {
-                m[3] + from as f64 * m[2]
-            } else {
-                m[c]
-            }) as f32
-        })
-    });
-    let [i, j, _] = map.dims;
-    let dims = [i, j, to - from];
-    let mut bytes = nifti::nifti_header(dims, sform, map.spacing().map(|s| s as f32));
-    bytes[70..72].copy_from_slice(&4i16.to_le_bytes()); // int16
-    bytes[72..74].copy_from_slice(&16i16.to_le_bytes());
-    let plane = i * j * 2;
-    bytes.extend(&phantom_hu(&map)[from * plane..to * plane]);
-    bytes
-}
-
 #[test]
 fn an_image_cropped_on_the_segmentations_lattice_is_placed_where_it_lies() {
     let mut whole = label_maps::phantom_case();
@@ -323,7 +316,7 @@ fn an_image_cropped_on_the_segmentations_lattice_is_placed_where_it_lies() {
     )
     .expect("the CT");
     let mut cropped = label_maps::phantom_case();
-    let part = phantom_ct_slices(10, 30);
+    let part = phantom_ct_slices([0.0; 3], 10..30);
     add_one(
         &mut cropped,
         &part,
