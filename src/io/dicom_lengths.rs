@@ -15,6 +15,7 @@ const UNDEFINED: u32 = u32::MAX;
 const ITEM: (u16, u16) = (0xFFFE, 0xE000);
 const PIXEL_DATA: (u16, u16) = (0x7FE0, 0x0010);
 const TRANSFER_SYNTAX: (u16, u16) = (0x0002, 0x0010);
+const GROUP_LENGTH: (u16, u16) = (0x0002, 0x0000);
 
 /// What the walk found: where the DICOM stream starts (after the 128-byte preamble, or at 0 when
 /// a file has none) and where the last Pixel Data value lies, so that the pixels are read from
@@ -154,9 +155,18 @@ impl Walk<'_> {
     }
 
     /// The file meta group (always explicit VR little endian); returns the transfer syntax.
+    /// Its elements are those within the length (0002,0000) declares, whatever their group:
+    /// so dicom-rs reads them, and the data set starts where it says.
     fn meta_group(&mut self) -> Result<String, LoadError> {
+        let first = self.header(false)?;
+        if first.tag != GROUP_LENGTH || first.len != 4 {
+            return Err(self.bad("the file meta group does not open with its length (0002,0000)"));
+        }
+        let value = self.value(&first)?;
+        let declared = u32::from_le_bytes([value[0], value[1], value[2], value[3]]);
+        let end = self.at.saturating_add(declared as usize);
         let mut syntax = None;
-        while self.at < self.bytes.len() && self.u16_at(self.at)? == 0x0002 {
+        while self.at < end {
             let header = self.header(false)?;
             if header.nested {
                 return Err(self.bad("a sequence in the file meta group"));
@@ -316,7 +326,10 @@ mod tests {
         if uid.len() % 2 == 1 {
             uid.push(0);
         }
-        out.extend(element(TRANSFER_SYNTAX, b"UI", &uid));
+        let syntax = element(TRANSFER_SYNTAX, b"UI", &uid);
+        let length = (syntax.len() as u32).to_le_bytes();
+        out.extend(element(GROUP_LENGTH, b"UL", &length));
+        out.extend(syntax);
         out.extend(data_set);
         out
     }

@@ -453,6 +453,15 @@ fn a_lying_length_costs_no_memory() {
         peak_of(|| load_label_map(&mutated, "mutated.dcm", &LabelMapOptions::default()));
     assert!(result.is_err());
     assert!(peak < 16 * mutated.len() + (1 << 20), "held {peak} bytes");
+    // A file meta group whose declared length (0002,0000) takes in elements past those of group
+    // 2: dicom-rs reads by that length, and so must the walk, or the data set it checks is not
+    // the one dicom-rs parses (where a 1.8 GB value hid).
+    let mutated = seg("fuzz_meta_length.dcm");
+    let (result, peak) =
+        peak_of(|| load_label_map(&mutated, "mutated.dcm", &LabelMapOptions::default()));
+    let error = result.unwrap_err().to_string();
+    assert!(error.contains("1851878985"), "{error}");
+    assert!(peak < 16 * mutated.len() + (1 << 20), "held {peak} bytes");
 }
 
 #[test]
