@@ -15,6 +15,9 @@ mod common_cli;
 #[path = "common/label_maps.rs"]
 mod label_maps;
 
+#[path = "common/dicom.rs"]
+mod dicom;
+
 const ALL: usize = usize::MAX;
 
 fn folder(name: &str) -> PathBuf {
@@ -209,6 +212,76 @@ fn only_the_bits_stored_are_read() {
     twelve_bits(&mut files, 15);
     let e = refusal(&files);
     assert!(e.contains("12 bits stored of 16, high bit 15"), "{e}");
+}
+
+/// The oblique series as RLE Lossless (tests/data/make_dicom_compressed.py): two segments a 16-bit
+/// frame. A broken frame is refused naming its file.
+#[test]
+fn an_rle_series_reads_as_the_uncompressed_one() {
+    let files = slices("oblique_rle");
+    assert_eq!(files.len(), 12);
+    assert_same(&read(&files, ALL).expect("the RLE series"), &twin(ALL));
+    let refused = |index: usize, value: u32, words: &str| {
+        let mut files = slices("oblique_rle");
+        files[3].1 = dicom::with_rle_word(&files[3].1, index, value);
+        let e = refusal(&files);
+        assert!(
+            e.starts_with(&format!("{}: DICOM image:", files[3].0)),
+            "{e}"
+        );
+        assert!(e.contains(words), "wanted '{words}' in: {e}");
+    };
+    refused(0, 3, "3 segments for samples of 2 byte(s)");
+    refused(2, 60_000, "out of order or off the fragment");
+    refused(2, 66, "segment 1 holds fewer than the frame's 480 pixels");
+}
+
+/// The oblique series as JPEG Lossless (GDCM's codestreams) reads as the uncompressed one; the
+/// phantom CT's slices as lossy JPEG Baseline (8-bit) within a few stored units of theirs. A
+/// frame whose size is not the header's, or that is no JPEG, is refused naming its file.
+#[test]
+fn jpeg_series_read_as_the_uncompressed_ones() {
+    assert_same(
+        &read(&slices("oblique_jpeg"), ALL).expect("lossless"),
+        &twin(ALL),
+    );
+    let plain = read(&slices("phantom_ct"), ALL).expect("uncompressed");
+    let lossy = read(&slices("phantom_ct_jpeg"), ALL).expect("baseline");
+    assert_eq!(lossy.dims, plain.dims);
+    assert_eq!(lossy.affine, plain.affine);
+    let off: Vec<f32> = (lossy.values.iter().zip(&plain.values))
+        .map(|(a, b)| (a - b).abs())
+        .collect();
+    let mean = off.iter().sum::<f32>() / off.len() as f32;
+    let most = off.iter().copied().fold(0.0, f32::max);
+    eprintln!("JPEG baseline: mean {mean} HU, most {most} HU off");
+    // A stored unit is 10 HU.
+    assert!(mean < 2.0 && most <= 80.0, "mean {mean} HU, most {most} HU");
+
+    let refused = |change: &dyn Fn(&mut Vec<u8>), words: &str| {
+        let mut files = slices("oblique_jpeg");
+        change(&mut files[3].1);
+        let e = refusal(&files);
+        assert!(
+            e.starts_with(&format!("{}: DICOM image:", files[3].0)),
+            "{e}"
+        );
+        assert!(e.contains(words), "wanted '{words}' in: {e}");
+    };
+    let frame_header = |bytes: &[u8]| {
+        let start = dicom::first_fragment(bytes);
+        start + (bytes[start..].windows(2).position(|w| w == [0xFF, 0xC3])).expect("SOF3")
+    };
+    let columns = |b: &mut Vec<u8>| {
+        let at = frame_header(b) + 7;
+        b[at..at + 2].copy_from_slice(&25u16.to_be_bytes());
+    };
+    refused(&columns, "25 x 20 pixels of 1 component(s) and 16 bits");
+    let not_jpeg = |b: &mut Vec<u8>| {
+        let at = dicom::first_fragment(b);
+        b[at..at + 2].copy_from_slice(b"GI");
+    };
+    refused(&not_jpeg, "JPEG frame 1: the codestream does not start");
 }
 
 /// `case build --image FOLDER`: the series' image in the case, the same as from its twin; a

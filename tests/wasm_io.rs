@@ -190,3 +190,35 @@ fn cube_without_its_top_is_open() {
     );
     assert!(r.warnings().iter().any(|w| w.contains("boundary edges")));
 }
+
+/// The oblique CT series (tests/data/dicom_series) as its slices: `$folder/$prefix<hash>.dcm`.
+macro_rules! oblique_slices {
+    ($folder:literal, $prefix:literal) => {
+        oblique_slices!(@ $folder, $prefix, "03cc5f9046", "13010f1ebe", "28ddc11211",
+            "3026641af3", "50d501d659", "5553c51e9a", "5aaf62737a", "5d1dd86b7b", "7d66784147",
+            "82209cdccc", "c7afef1b17", "f77138cc1e")
+    };
+    (@ $folder:literal, $prefix:literal, $($hash:literal),*) => {
+        [$((
+            $hash,
+            include_bytes!(concat!("data/dicom_series/", $folder, "/", $prefix, $hash, ".dcm"))
+                .as_slice(),
+        )),*]
+    };
+}
+
+/// DICOM slices compressed as RLE Lossless and as JPEG Lossless decode in the browser to the
+/// voxels of the series' NIfTI twin.
+#[wasm_bindgen_test]
+fn compressed_dicom_series_read_as_their_nifti_twin() {
+    let twin = include_bytes!("data/dicom_series/oblique.nii.gz");
+    let want = io::load_image(twin, "oblique.nii.gz", usize::MAX).expect("the twin");
+    for files in [
+        oblique_slices!("oblique_rle", "rle_"),
+        oblique_slices!("oblique_jpeg", "jpeg_"),
+    ] {
+        let image = io::load_image_series(&files, usize::MAX).expect("the series");
+        assert_eq!(image.dims, want.dims);
+        assert_eq!(image.values, want.values);
+    }
+}

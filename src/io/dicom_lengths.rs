@@ -2,17 +2,30 @@
 //! bytes left, before `dicom-object` parses it: that parser reserves each value's declared
 //! length (up to 4 GiB) before reading it, so a lying length in a small file would otherwise
 //! cost gigabytes. The walk also finds the transfer syntax and refuses the encodings the reader
-//! does not take (big-endian, deflated, encapsulated pixel data). The walk reads headers exactly
-//! as dicom-rs does (an unknown VR has a 32-bit length, as UN), so that every value it will
-//! allocate has been measured; what the two would read differently is refused.
+//! does not take (big-endian, deflated, compressions other than RLE and JPEG). The walk reads
+//! headers exactly as dicom-rs does (an unknown VR has a 32-bit length, as UN), so that every
+//! value it will allocate has been measured; what the two would read differently is refused.
 
+use std::borrow::Cow;
+use std::ops::Range;
+
+use super::{dicom_jpeg, dicom_rle};
 use super::{Format, LoadError};
 
 const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
 const IMPLICIT_LE: &str = "1.2.840.10008.1.2";
+const RLE_LOSSLESS: &str = "1.2.840.10008.1.2.5";
+/// JPEG baseline, extended (8 and 12 bits), lossless and its first-order prediction.
+const JPEG: [&str; 4] = [
+    "1.2.840.10008.1.2.4.50",
+    "1.2.840.10008.1.2.4.51",
+    "1.2.840.10008.1.2.4.57",
+    "1.2.840.10008.1.2.4.70",
+];
 const UNDEFINED: u32 = u32::MAX;
 
 const ITEM: (u16, u16) = (0xFFFE, 0xE000);
+const SEQUENCE_END: (u16, u16) = (0xFFFE, 0xE0DD);
 const PIXEL_DATA: (u16, u16) = (0x7FE0, 0x0010);
 const TRANSFER_SYNTAX: (u16, u16) = (0x0002, 0x0010);
 const GROUP_LENGTH: (u16, u16) = (0x0002, 0x0000);
@@ -23,36 +36,153 @@ const GROUP_LENGTH: (u16, u16) = (0x0002, 0x0000);
 #[derive(Debug)]
 pub(super) struct Layout {
     pub start: usize,
-    pub pixel_data: Option<std::ops::Range<usize>>,
+    pub pixel_data: Option<PixelData>,
+}
+
+/// Where the pixels lie in the file.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum PixelData {
+    /// Uncompressed, one value.
+    Native(Range<usize>),
+    /// Compressed: each fragment after the offset table.
+    Encapsulated {
+        codec: Codec,
+        fragments: Vec<Range<usize>>,
+    },
+}
+
+/// How encapsulated pixels are compressed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Codec {
+    Rle,
+    Jpeg,
+}
+
+/// The frames a file declares: how many, their columns and rows, and `bits` a pixel (1, 8, 16
+/// or 32).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Frames {
+    pub count: usize,
+    pub size: [usize; 2],
+    pub bits: usize,
+}
+
+impl Frames {
+    fn pixels(&self) -> usize {
+        self.size[0].saturating_mul(self.size[1])
+    }
+}
+
+/// What a compressed frame decodes to: how many pixels, and how many bytes a pixel.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FrameShape {
+    pub pixels: usize,
+    pub bytes: usize,
+}
+
+impl FrameShape {
+    /// The frame's decoded bytes, refused when more than `expansion` times its `compressed`
+    /// bytes could hold (`what` names the codec's frames): what bounds a decoder's memory by
+    /// the file's size.
+    pub(super) fn bytes_within(
+        &self,
+        compressed: usize,
+        expansion: usize,
+        what: &'static str,
+        format: Format,
+    ) -> Result<usize, LoadError> {
+        let bytes = self.pixels.saturating_mul(self.bytes);
+        let possible = compressed.saturating_mul(expansion);
+        if bytes > possible {
+            return Err(LoadError::CountTooLarge {
+                format,
+                what,
+                claimed: bytes as u64,
+                possible: possible as u64,
+            });
+        }
+        Ok(bytes)
+    }
 }
 
 /// The file's [`Layout`], once every element length has been checked.
 impl Layout {
-    /// The Pixel Data's bytes within `bytes` (the file walked), refused when there are none or
-    /// fewer than `needed` (`None`: more than memory holds), `what` saying what they are for.
+    /// The frames' pixel data, uncompressed: in place within `bytes` (the file walked), or
+    /// decoded; refused when there is none, or less than `frames` declare (`what` says what
+    /// the bytes are for).
     pub(super) fn pixels<'a>(
         &self,
         bytes: &'a [u8],
-        needed: Option<usize>,
+        frames: Frames,
         what: &'static str,
         format: Format,
-    ) -> Result<&'a [u8], LoadError> {
-        let data = (self.pixel_data.clone())
-            .map(|range| &bytes[range])
-            .ok_or_else(|| LoadError::Unsupported {
-                format,
-                detail: "no Pixel Data".into(),
-            })?;
-        let needed = needed.unwrap_or(usize::MAX);
-        if data.len() < needed {
-            return Err(LoadError::CountTooLarge {
-                format,
-                what,
-                claimed: needed as u64,
-                possible: data.len() as u64,
-            });
+    ) -> Result<Cow<'a, [u8]>, LoadError> {
+        let no_pixels = || LoadError::Unsupported {
+            format,
+            detail: "no Pixel Data".into(),
+        };
+        match self.pixel_data.as_ref().ok_or_else(no_pixels)? {
+            PixelData::Native(range) => {
+                let data = &bytes[range.clone()];
+                // Checked: usize is 32 bits in the browser, and the sizes come from the file.
+                let needed = (frames.count.checked_mul(frames.pixels()))
+                    .and_then(|n| n.checked_mul(frames.bits))
+                    .map_or(usize::MAX, |n| n.div_ceil(8));
+                if data.len() < needed {
+                    return Err(LoadError::CountTooLarge {
+                        format,
+                        what,
+                        claimed: needed as u64,
+                        possible: data.len() as u64,
+                    });
+                }
+                Ok(Cow::Borrowed(data))
+            }
+            PixelData::Encapsulated { codec, fragments } => {
+                let fragments: Vec<&[u8]> = fragments.iter().map(|r| &bytes[r.clone()]).collect();
+                decode(*codec, &fragments, frames, format).map(Cow::Owned)
+            }
         }
-        Ok(data)
+    }
+}
+
+/// Encapsulated frames, decoded: one fragment a frame, or for a single frame (JPEG) all of
+/// them, in order.
+fn decode(
+    codec: Codec,
+    fragments: &[&[u8]],
+    frames: Frames,
+    format: Format,
+) -> Result<Vec<u8>, LoadError> {
+    let refuse = |detail: String| LoadError::Unsupported { format, detail };
+    if !frames.bits.is_multiple_of(8) || frames.bits == 0 {
+        return Err(refuse(format!(
+            "compressed pixels of {} bit(s) are not read",
+            frames.bits
+        )));
+    }
+    let joined;
+    let streams = match (codec, frames.count) {
+        (Codec::Jpeg, 1) if fragments.len() > 1 => {
+            joined = fragments.concat();
+            vec![joined.as_slice()]
+        }
+        _ if fragments.len() == frames.count => fragments.to_vec(),
+        _ => {
+            return Err(refuse(format!(
+                "{} fragments of compressed pixels for {} frames: one a frame is read",
+                fragments.len(),
+                frames.count
+            )))
+        }
+    };
+    let shape = FrameShape {
+        pixels: frames.pixels(),
+        bytes: frames.bits / 8,
+    };
+    match codec {
+        Codec::Rle => dicom_rle::decode(&streams, shape, format),
+        Codec::Jpeg => dicom_jpeg::decode(&streams, shape, frames.size, format),
     }
 }
 
@@ -94,12 +224,14 @@ pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
         pixel_data: None,
     };
     let syntax = walk.meta_group()?;
-    let implicit = match syntax.as_str() {
-        EXPLICIT_LE => false,
-        IMPLICIT_LE => true,
+    let (implicit, codec) = match syntax.as_str() {
+        EXPLICIT_LE => (false, None),
+        IMPLICIT_LE => (true, None),
+        RLE_LOSSLESS => (false, Some(Codec::Rle)),
+        jpeg if JPEG.contains(&jpeg) => (false, Some(Codec::Jpeg)),
         other => return Err(unsupported_syntax(other, format)),
     };
-    walk.data_set(implicit)?;
+    walk.data_set(implicit, codec)?;
     Ok(Layout {
         start: start - 4,
         pixel_data: walk.pixel_data,
@@ -110,13 +242,13 @@ fn unsupported_syntax(uid: &str, format: Format) -> LoadError {
     let what = match uid {
         "1.2.840.10008.1.2.2" => "explicit VR big endian",
         "1.2.840.10008.1.2.1.99" => "deflated explicit VR little endian",
-        "1.2.840.10008.1.2.5" => "RLE lossless",
         _ => "a compressed or unknown encoding",
     };
     LoadError::Unsupported {
         format,
         detail: format!(
-            "transfer syntax {uid} ({what}): only uncompressed little-endian files are read"
+            "transfer syntax {uid} ({what}): uncompressed little-endian, RLE Lossless and JPEG \
+             files are read"
         ),
     }
 }
@@ -125,7 +257,7 @@ struct Walk<'a> {
     format: Format,
     bytes: &'a [u8],
     at: usize,
-    pixel_data: Option<std::ops::Range<usize>>,
+    pixel_data: Option<PixelData>,
 }
 
 struct Header {
@@ -180,26 +312,55 @@ impl Walk<'_> {
         syntax.ok_or_else(|| self.bad("no transfer syntax (0002,0010) in the file meta group"))
     }
 
-    fn data_set(&mut self, implicit: bool) -> Result<(), LoadError> {
+    /// `codec`: how the pixels are compressed, if they are (then encapsulated).
+    fn data_set(&mut self, implicit: bool, codec: Option<Codec>) -> Result<(), LoadError> {
         while self.at < self.bytes.len() {
             let header = self.header(implicit)?;
-            if header.tag == PIXEL_DATA && header.len == UNDEFINED {
-                return Err(LoadError::Unsupported {
-                    format: self.format,
-                    detail: "encapsulated (compressed) pixel data is not read".into(),
-                });
+            if header.tag == PIXEL_DATA && (header.len == UNDEFINED) != codec.is_some() {
+                let detail = match codec {
+                    Some(_) => "compressed pixel data that is not encapsulated",
+                    None => "encapsulated pixel data in an uncompressed transfer syntax",
+                };
+                return Err(self.bad(detail));
             }
-            if !header.nested {
+            if let (PIXEL_DATA, Some(codec)) = (header.tag, codec) {
+                let fragments = self.fragments()?;
+                self.pixel_data = Some(PixelData::Encapsulated { codec, fragments });
+            } else if !header.nested {
                 let start = self.at;
                 self.value(&header)?;
                 if header.tag == PIXEL_DATA {
-                    self.pixel_data = Some(start..self.at);
+                    self.pixel_data = Some(PixelData::Native(start..self.at));
                 }
             } else if header.len != UNDEFINED {
                 self.room_for(header.len)?;
             }
         }
         Ok(())
+    }
+
+    /// The fragments of encapsulated pixel data, after its offset table, up to the delimiter.
+    fn fragments(&mut self) -> Result<Vec<Range<usize>>, LoadError> {
+        let mut items = Vec::new();
+        loop {
+            let tag = (self.u16_at(self.at)?, self.u16_at(self.at + 2)?);
+            let len = self.u32_at(self.at + 4)?;
+            self.at += 8;
+            match tag {
+                SEQUENCE_END => break,
+                ITEM if len != UNDEFINED => {
+                    self.room_for(len)?;
+                    items.push(self.at..self.at + len as usize);
+                    self.at += len as usize;
+                }
+                _ => return Err(self.bad("the encapsulated pixel data holds other than items")),
+            }
+        }
+        if items.is_empty() {
+            return Err(self.bad("encapsulated pixel data without its offset table"));
+        }
+        items.remove(0);
+        Ok(items)
     }
 
     /// Reads an element header at the cursor and steps past it (not past its value).

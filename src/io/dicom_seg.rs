@@ -4,18 +4,20 @@
 //!
 //! The parsing is `dicom-object`'s (dicom-rs, pure Rust, builds for wasm32), after
 //! [`super::dicom_lengths`] has checked every declared length against the bytes. What is read:
-//! uncompressed little-endian files (explicit or implicit VR). Refused with a reason: other
-//! objects than SEG, compressed or big-endian encodings. The grid comes from the functional
-//! groups ([`super::dicom_seg_grid`]).
+//! little-endian files (explicit or implicit VR), uncompressed, RLE Lossless or JPEG (decoded
+//! in [`super::dicom_rle`] and [`super::dicom_jpeg`]). Refused with a reason: other objects than
+//! SEG, other compressions, big-endian encodings. The grid comes from the functional groups
+//! ([`super::dicom_seg_grid`]).
 
 use dicom_core::Tag;
 use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
 use super::codes::{Code, StructureCodes};
+use super::dicom_lengths::{self, Frames};
 use super::dicom_seg_grid::{self, FrameGeometry, Grid};
 use super::label_map::{LabelMap, LabelMapOptions, Segment, DEFAULT_LEVEL};
-use super::{dicom_lengths, Format, LoadError, Location};
+use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::DicomSeg;
 const SEGMENTATION_STORAGE: &str = "1.2.840.10008.5.1.4.1.1.66.4";
@@ -36,12 +38,12 @@ pub(super) enum Pixels {
 }
 
 impl Pixels {
-    /// Bytes of pixel data `n` pixels take.
-    fn bytes_for(self, n: usize) -> Option<usize> {
+    /// Bits a pixel.
+    fn bits(self) -> usize {
         match self {
-            Pixels::Binary => Some(n.div_ceil(8)),
-            Pixels::Fractional { .. } => Some(n),
-            Pixels::Labels { bytes } => n.checked_mul(bytes),
+            Pixels::Binary => 1,
+            Pixels::Fractional { .. } => 8,
+            Pixels::Labels { bytes } => 8 * bytes,
         }
     }
 }
@@ -64,16 +66,17 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     let pixels = pixels(&object, options)?;
     let segments = segments(&object, matches!(pixels, Pixels::Labels { .. }))?;
     let per_frame = frame_geometry(&object, frames, &segments, pixels)?;
-    // Checked: usize is 32 bits in the browser, and the sizes come from the file. Once the
-    // pixel data holds every frame, frame * plane + pixel fits below.
-    let pixels_in = (frames.checked_mul(rows)).and_then(|n| n.checked_mul(columns));
-    let needed = pixels_in.and_then(|n| pixels.bytes_for(n));
+    let frames = Frames {
+        count: frames,
+        size: [columns, rows],
+        bits: pixels.bits(),
+    };
     let what = "bytes of pixel data for the frames declared";
-    let data = layout.pixels(bytes, needed, what, FORMAT)?;
+    let data = layout.pixels(bytes, frames, what, FORMAT)?;
     let shared = first_item(&object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
     let grid = Grid::place([columns, rows], shared, &per_frame)?;
     let numbers: Vec<u16> = segments.iter().map(segment_number).collect();
-    let (layers, placed) = dicom_seg_grid::fill(&grid, &per_frame, &numbers, data, pixels)?;
+    let (layers, placed) = dicom_seg_grid::fill(&grid, &per_frame, &numbers, &data, pixels)?;
     Ok(LabelMap {
         dims: grid.dims,
         affine: grid.affine,

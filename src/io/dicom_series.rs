@@ -3,27 +3,30 @@
 //!
 //! The parsing is `dicom-object`'s, after [`super::dicom_lengths`] has checked every declared
 //! length against the file's bytes. What is read: single-frame, single-sample (grey) slices of
-//! 8, 16 or 32 bits, uncompressed little-endian, each with its own Rescale Slope and Intercept;
-//! where fewer bits are stored than allocated, only the stored (low) ones are read, so that old
-//! files' overlay bits above them are not taken for values.
+//! 8, 16 or 32 bits, little-endian, uncompressed, RLE Lossless or JPEG, each with its own
+//! Rescale Slope and Intercept; where fewer bits are stored than allocated, only the stored
+//! (low) ones are read, so that old files' overlay bits above them are not taken for values.
 //! The slices are placed by Image Position (Patient) along the normal of their common Image
 //! Orientation, whatever the files' order or Instance Numbers. Refused, with the file or the
 //! reason named: slices of different series, sizes, orientations or pixel spacings; two slices
 //! at one position; slices shifted within their plane (a gantry tilt); uneven slice spacing (a
-//! slice missing); multi-frame (enhanced) objects, colour, MONOCHROME1, compressed encodings.
+//! slice missing); multi-frame (enhanced) objects, colour, MONOCHROME1, other compressions.
 //! Nothing of the header but the geometry and the pixels is kept.
+
+use std::borrow::Cow;
 
 use dicom_core::Tag;
 use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
+use super::dicom_lengths::{self, Frames};
 use super::dicom_seg::{floats, text};
 use super::dicom_seg_grid::{cross, dot, ras_affine};
 use super::image::{reduced_affine, ImageVolume};
 use super::intensity::IntensitySink;
 use super::label_map_checks::{check_affine, Sample, VoxelLayout};
 use super::voxels::Feed;
-use super::{dicom_lengths, Format, LoadError, Location};
+use super::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::DicomImage;
 const SEGMENTATION_STORAGE: &str = "1.2.840.10008.5.1.4.1.1.66.4";
@@ -58,7 +61,8 @@ struct Slice<'a> {
     low_bits: Option<u32>,
     slope: f64,
     inter: f64,
-    pixels: &'a [u8],
+    /// In the file's bytes where uncompressed.
+    pixels: Cow<'a, [u8]>,
 }
 
 /// Reads the slices `files` (name, bytes) as one image, reduced by the smallest whole factor
@@ -162,9 +166,13 @@ fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError
     ];
     let sample = sample_of(&object)?;
     let low_bits = stored_bits(&object, sample)?;
-    let needed = (size[0].checked_mul(size[1])).and_then(|n| n.checked_mul(sample.size()));
+    let frame = Frames {
+        count: 1,
+        size,
+        bits: 8 * sample.size(),
+    };
     let what = "bytes of pixel data for the rows and columns declared";
-    let pixels = layout.pixels(bytes, needed, what, FORMAT)?;
+    let pixels = layout.pixels(bytes, frame, what, FORMAT)?;
     let scale = |tag, default| match floats(&object, tag) {
         None => Ok(default),
         Some(v) if v.len() == 1 && v[0].is_finite() => Ok(v[0]),

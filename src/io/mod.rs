@@ -4,7 +4,9 @@
 
 mod codes;
 mod color_table;
+mod dicom_jpeg;
 mod dicom_lengths;
+mod dicom_rle;
 mod dicom_seg;
 mod dicom_seg_grid;
 mod dicom_series;

@@ -15,6 +15,9 @@ use meshsmooth::io::{load_label_map, Code, LabelMap, LabelMapOptions, StructureC
 
 type Object = FileDicomObject<InMemDicomObject>;
 
+#[path = "../common/dicom.rs"]
+mod dicom;
+
 fn seg(name: &str) -> Vec<u8> {
     ours(&format!("dicom_seg/{name}"))
 }
@@ -430,7 +433,10 @@ fn broken_segs_are_refused_by_what_is_wrong() {
         .position(|w| w == b"1.2.840.10008.1.2.1")
         .unwrap();
     compressed[at..at + 19].copy_from_slice(b"1.2.840.10008.1.2.5");
-    refused(&compressed, "RLE lossless");
+    refused(
+        &compressed,
+        "compressed pixel data that is not encapsulated",
+    );
 }
 
 #[test]
@@ -547,4 +553,26 @@ fn a_labelmap_seg_reads_as_the_binary_one() {
         &edit(&labels, |o| put_u16(o, tags::BITS_ALLOCATED, 1)),
         "LABELMAP (8 or 16 bits)",
     );
+}
+
+/// RLE Lossless twins of the LABELMAP and FRACTIONAL SEGs and a JPEG Lossless one of the
+/// FRACTIONAL SEG (tests/data/make_dicom_compressed.py) read as the uncompressed files; a broken
+/// frame is refused.
+#[test]
+fn compressed_segs_read_as_the_uncompressed_ones() {
+    for (name, twin) in [
+        ("labelmap", "labelmap_rle"),
+        ("fractional", "fractional_rle"),
+        ("fractional", "fractional_jpeg"),
+    ] {
+        let plain = load_named(&seg(&format!("{name}.dcm")), "plain.dcm");
+        let compressed = load_named(&seg(&format!("{twin}.dcm")), "twin.dcm");
+        assert_eq!(compressed, plain, "{twin}");
+    }
+    let rle = seg("labelmap_rle.dcm");
+    refused(
+        &dicom::with_rle_word(&rle, 0, 2),
+        "2 segments for samples of 1 byte(s)",
+    );
+    refused(&rle[..rle.len() - 2000], "bytes");
 }

@@ -1,0 +1,173 @@
+//! DICOM's JPEG transfer syntaxes (baseline, extended and lossless, PS3.5 A.4.1): each frame a
+//! JPEG codestream, decoded by the `jpeg-decoder` crate (image-rs, pure Rust) into the
+//! little-endian pixel data an uncompressed file would hold.
+//!
+//! The frame header is read here first, because the crate sizes its buffers from it before
+//! its own size limit applies, and its metadata call panics on a precision or component count
+//! it does not take: a grey frame of the rows, columns and bits the DICOM header declares is
+//! all that reaches the decoder, and only when the codestream is long enough to hold it.
+
+use super::dicom_lengths::FrameShape;
+use super::{Format, LoadError};
+
+/// Pixels a byte of JPEG can hold at most: an 8 x 8 block of one value codes in 2 bits.
+const MOST_EXPANSION: usize = 256;
+
+/// What a codestream's frame header (SOFn) says.
+#[derive(Debug, PartialEq)]
+struct FrameHeader {
+    precision: u8,
+    rows: u16,
+    columns: u16,
+    components: u8,
+}
+
+/// The frames `codestreams` (one each) hold, back to back, little endian; `size` is the
+/// frame's columns and rows.
+pub(super) fn decode(
+    codestreams: &[&[u8]],
+    shape: FrameShape,
+    size: [usize; 2],
+    format: Format,
+) -> Result<Vec<u8>, LoadError> {
+    let mut out = Vec::new();
+    for (index, stream) in codestreams.iter().enumerate() {
+        let bad = |detail: String| LoadError::Unsupported {
+            format,
+            detail: format!("JPEG frame {}: {detail}", index + 1),
+        };
+        let header = frame_header(stream).map_err(bad)?;
+        let bytes = if header.precision <= 8 { 1 } else { 2 };
+        let declared = [header.columns as usize, header.rows as usize];
+        if declared != size || header.components != 1 || bytes > shape.bytes {
+            return Err(bad(format!(
+                "{} x {} pixels of {} component(s) and {} bits, where the header declares {} x \
+                 {} grey pixels of {} bytes",
+                header.columns,
+                header.rows,
+                header.components,
+                header.precision,
+                size[0],
+                size[1],
+                shape.bytes
+            )));
+        }
+        let what = "bytes in a JPEG frame";
+        shape.bytes_within(stream.len(), MOST_EXPANSION, what, format)?;
+        let mut decoder = jpeg_decoder::Decoder::new(*stream);
+        decoder.set_max_decoding_buffer_size(shape.pixels);
+        let pixels = decoder.decode().map_err(|e| bad(e.to_string()))?;
+        if pixels.len() != shape.pixels * bytes {
+            return Err(bad(format!(
+                "decodes to {} bytes, not the frame's {}",
+                pixels.len(),
+                shape.pixels * bytes
+            )));
+        }
+        match (bytes, shape.bytes) {
+            (1, 2) => out.extend(pixels.iter().flat_map(|&v| [v, 0])),
+            // The decoder gives 16-bit samples in the machine's order.
+            _ if bytes == 2 => out.extend(
+                (pixels.chunks_exact(2))
+                    .flat_map(|p| u16::from_ne_bytes([p[0], p[1]]).to_le_bytes()),
+            ),
+            _ => out.extend_from_slice(&pixels),
+        }
+    }
+    Ok(out)
+}
+
+/// The first frame header (SOF0..SOF15 but DHT, JPG and DAC) before the first scan.
+fn frame_header(stream: &[u8]) -> Result<FrameHeader, String> {
+    if !stream.starts_with(&[0xFF, 0xD8]) {
+        return Err("the codestream does not start with a JPEG start of image".into());
+    }
+    let mut at = 2;
+    loop {
+        let byte = |i: usize| {
+            stream
+                .get(i)
+                .copied()
+                .ok_or("no frame header before its end")
+        };
+        if byte(at)? != 0xFF {
+            return Err(format!("no JPEG marker at byte {at}"));
+        }
+        let marker = byte(at + 1)?;
+        match marker {
+            // Fill bytes, and markers without a length.
+            0xFF => at += 1,
+            0x01 | 0xD0..=0xD7 => at += 2,
+            0xC0..=0xCF if !matches!(marker, 0xC4 | 0xC8 | 0xCC) => {
+                let word = |i: usize| -> Result<u16, &str> {
+                    Ok(u16::from_be_bytes([byte(at + i)?, byte(at + i + 1)?]))
+                };
+                return Ok(FrameHeader {
+                    precision: byte(at + 4)?,
+                    rows: word(5)?,
+                    columns: word(7)?,
+                    components: byte(at + 9)?,
+                });
+            }
+            0xDA | 0xD9 => return Err("a scan or the end before any frame header".into()),
+            _ => {
+                let length = u16::from_be_bytes([byte(at + 2)?, byte(at + 3)?]);
+                at += 2 + length as usize;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_frame_header_is_found_past_other_segments() {
+        let mut stream = vec![0xFF, 0xD8, 0xFF, 0xE0, 0x00, 0x04, 0xAA, 0xBB];
+        stream.extend([
+            0xFF, 0xC3, 0x00, 0x0B, 16, 0x00, 0x14, 0x00, 0x18, 1, 1, 0x11, 0,
+        ]);
+        let header = frame_header(&stream).unwrap();
+        let want = FrameHeader {
+            precision: 16,
+            rows: 20,
+            columns: 24,
+            components: 1,
+        };
+        assert_eq!(header, want);
+        assert!(frame_header(&stream[..12])
+            .unwrap_err()
+            .contains("before its end"));
+        assert!(frame_header(b"GIF89a")
+            .unwrap_err()
+            .contains("start of image"));
+    }
+
+    #[test]
+    fn frames_unlike_the_header_or_too_short_are_refused() {
+        let mut stream = vec![0xFF, 0xD8];
+        stream.extend([
+            0xFF, 0xC0, 0x00, 0x0B, 8, 0x00, 0x14, 0x00, 0x18, 3, 1, 0x11, 0,
+        ]);
+        let shape = FrameShape {
+            pixels: 24 * 20,
+            bytes: 1,
+        };
+        let e = decode(&[&stream], shape, [24, 20], Format::DicomImage).unwrap_err();
+        assert!(e.to_string().contains("3 component(s)"), "{e}");
+        stream[11] = 1;
+        let e = decode(&[&stream], shape, [20, 24], Format::DicomImage).unwrap_err();
+        assert!(e.to_string().contains("24 x 20 pixels"), "{e}");
+        let big = [4000, 4000];
+        stream[7..11].copy_from_slice(&[0x0F, 0xA0, 0x0F, 0xA0]);
+        let huge = FrameShape {
+            pixels: 4000 * 4000,
+            bytes: 1,
+        };
+        assert!(matches!(
+            decode(&[&stream], huge, big, Format::DicomImage),
+            Err(LoadError::CountTooLarge { .. })
+        ));
+    }
+}
