@@ -245,6 +245,12 @@ fn jpeg_series_read_as_the_uncompressed_ones() {
         &read(&slices("oblique_jpeg"), ALL).expect("lossless"),
         &twin(ALL),
     );
+    // A frame over two fragments reads as over one.
+    let mut split = slices("oblique_jpeg");
+    for (_, bytes) in &mut split {
+        *bytes = dicom::with_first_fragment_split(bytes, 100);
+    }
+    assert_same(&read(&split, ALL).expect("split"), &twin(ALL));
     let plain = read(&slices("phantom_ct"), ALL).expect("uncompressed");
     let lossy = read(&slices("phantom_ct_jpeg"), ALL).expect("baseline");
     assert_eq!(lossy.dims, plain.dims);

@@ -23,3 +23,17 @@ pub fn with_rle_word(bytes: &[u8], index: usize, value: u32) -> Vec<u8> {
     out[at..at + 4].copy_from_slice(&value.to_le_bytes());
     out
 }
+
+/// `bytes` with its first fragment split in two at `at` bytes into it: a frame over two
+/// fragments, as some encoders write a large JPEG.
+pub fn with_first_fragment_split(bytes: &[u8], at: usize) -> Vec<u8> {
+    let start = first_fragment(bytes);
+    let len = u32::from_le_bytes(bytes[start - 4..start].try_into().unwrap()) as usize;
+    let item = |len: usize| [[0xFE, 0xFF, 0x00, 0xE0], (len as u32).to_le_bytes()].concat();
+    let mut out = bytes[..start - 8].to_vec();
+    out.extend(item(at));
+    out.extend(&bytes[start..start + at]);
+    out.extend(item(len - at));
+    out.extend(&bytes[start + at..]);
+    out
+}
