@@ -86,20 +86,12 @@ fn phantom_with_lesson() -> Case {
             distance: 320.0,
         },
     );
-    let labels = vec![
-        Label {
-            structure: "liver".into(),
-            point: at("liver", 100),
-            text: "Liver".into(),
-            note: "The largest solid organ of the abdomen.".into(),
-        },
-        Label {
-            structure: "tumor".into(),
-            point: at("tumor", 7),
-            text: "Tumour".into(),
-            note: String::new(),
-        },
-    ];
+    let mut liver = Label::new("liver", at("liver", 100), "Liver");
+    liver.note = "The largest solid organ of the abdomen.".into();
+    liver.notes = [("de".into(), "Das größte feste Organ des Bauches.".into())].into();
+    let mut tumor = Label::new("tumor", at("tumor", 7), "Tumour");
+    tumor.texts = [("de".into(), "Tumor".into())].into();
+    let labels = vec![liver, tumor];
     case.lesson = Lesson {
         steps: vec![first, second, third],
         labels,
@@ -377,6 +369,20 @@ fn checks_refuse_numbers_and_texts_no_viewer_can_show() {
         l.steps[0].captions.insert("fr".into(), "x".repeat(5000));
     });
     assert!(e.contains("the caption in 'fr' has 5000 characters"), "{e}");
+    let e = refused(&|l| {
+        l.labels[1].texts.insert("english".into(), "Tumour".into());
+    });
+    assert!(
+        e.contains("label 2 ('Tumour'): its texts: 'english' is not a language tag"),
+        "{e}"
+    );
+    let e = refused(&|l| {
+        l.labels[0].notes.insert("de".into(), "x".repeat(5000));
+    });
+    assert!(
+        e.contains("label 1 ('Liver'): the note in 'de' has 5000"),
+        "{e}"
+    );
     let e = refused(&|l| l.steps[1].planes.as_mut().expect("planes").axial = 1.5);
     assert!(
         e.contains("step 2 ('the tumour'): one of the image's planes lies outside"),

@@ -145,7 +145,8 @@ impl Document {
             return &label.text;
         };
         let languages = self.reader_languages();
-        crate::case::names::label_text(&label.text, (&s.name, &s.names), languages)
+        let text = (label.text.as_str(), &label.texts);
+        crate::case::names::label_text(text, (&s.name, &s.names), languages)
     }
 
     /// What guidance, Suggest all and the checks found.

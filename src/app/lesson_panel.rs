@@ -29,12 +29,9 @@ impl Document {
             .map(|s| s.name.clone())
             .ok_or(format!("the case has no structure {index}"))?;
         let mut lesson = self.case().lesson().clone();
-        lesson.labels.push(Label {
-            structure: name.clone(),
-            point: point.to_array(),
-            text: name,
-            note: String::new(),
-        });
+        lesson
+            .labels
+            .push(Label::new(&name, point.to_array(), &name));
         self.case_mut().set_lesson(lesson)
     }
 

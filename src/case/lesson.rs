@@ -101,6 +101,25 @@ pub struct Label {
     /// A longer note, shown on asking.
     #[serde(default)]
     pub note: String,
+    /// The text and note in other languages, by language tag, as a step's title and caption.
+    #[serde(default)]
+    pub texts: Names,
+    #[serde(default)]
+    pub notes: Names,
+}
+
+impl Label {
+    /// A label saying `text`, with no note and no other languages.
+    pub fn new(structure: &str, point: [f32; 3], text: &str) -> Self {
+        Label {
+            structure: structure.into(),
+            point,
+            text: text.into(),
+            note: String::new(),
+            texts: Names::new(),
+            notes: Names::new(),
+        }
+    }
 }
 
 /// The quiz: which structures are asked, how, and the share of right answers that passes.
@@ -193,6 +212,13 @@ impl Lesson {
             known(&what, &label.structure)?;
             text(&what, "text", &label.text, MAX_SHORT_TEXT, false)?;
             text(&what, "note", &label.note, MAX_LONG_TEXT, true)?;
+            translations(
+                &what,
+                &[
+                    ("text", &label.texts, MAX_SHORT_TEXT),
+                    ("note", &label.notes, MAX_LONG_TEXT),
+                ],
+            )?;
             finite(&what, "point", &label.point)?;
         }
         if let Some(quiz) = &self.quiz {
@@ -214,6 +240,18 @@ impl Lesson {
     }
 }
 
+/// Refuses a text's other languages (`field`, the texts by tag, their longest) whose tags are not
+/// language tags or whose texts are empty or too long.
+fn translations(what: &str, fields: &[(&str, &Names, usize)]) -> Result<(), String> {
+    for &(field, texts, max) in fields {
+        names::checked(texts).map_err(|e| format!("{what}: its {field}s: {e}"))?;
+        for (tag, t) in texts {
+            text(what, &format!("{field} in '{tag}'"), t, max, false)?;
+        }
+    }
+    Ok(())
+}
+
 fn check_step(
     step: &Step,
     what: &str,
@@ -221,15 +259,13 @@ fn check_step(
 ) -> Result<(), String> {
     text(what, "title", &step.title, MAX_SHORT_TEXT, false)?;
     text(what, "caption", &step.caption, MAX_LONG_TEXT, true)?;
-    for (field, texts, max) in [
-        ("title", &step.titles, MAX_SHORT_TEXT),
-        ("caption", &step.captions, MAX_LONG_TEXT),
-    ] {
-        names::checked(texts).map_err(|e| format!("{what}: its {field}s: {e}"))?;
-        for (tag, t) in texts {
-            text(what, &format!("{field} in '{tag}'"), t, max, false)?;
-        }
-    }
+    translations(
+        what,
+        &[
+            ("title", &step.titles, MAX_SHORT_TEXT),
+            ("caption", &step.captions, MAX_LONG_TEXT),
+        ],
+    )?;
     let c = &step.camera;
     finite(
         what,

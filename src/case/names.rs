@@ -155,14 +155,18 @@ fn found<'a>(names: &'a Names, languages: &[String]) -> Option<&'a str> {
     None
 }
 
-/// A lesson label's `text` as a reader of `languages` sees it on a structure named `own` with
-/// `names`: a text that names the structure (its own name or one of its names, in any case) is
-/// its name in the reader's language where it has one; any other text is the author's own.
+/// A lesson label's `text` (with its `texts` in other languages) as a reader of `languages` sees
+/// it on a structure named `own` with `names`: the label's own text in the reader's language
+/// where it has one; else a text that names the structure (its own name or one of its names, in
+/// any case) is its name in the reader's language where it has one; else the author's own.
 pub fn label_text<'a>(
-    text: &'a str,
+    (text, texts): (&'a str, &'a Names),
     (own, names): (&'a str, &'a Names),
     languages: &[String],
 ) -> &'a str {
+    if let Some(translated) = found(texts, languages) {
+        return translated;
+    }
     let said = text.trim().to_lowercase();
     let names_it = std::iter::once(own)
         .chain(names.values().map(String::as_str))
@@ -228,15 +232,36 @@ mod tests {
     #[test]
     fn a_label_naming_its_structure_follows_the_reader_and_other_words_stay() {
         let n = names(&[("en", "Liver"), ("de", "Leber")]);
-        let de = langs(&["de"]);
-        assert_eq!(label_text("Liver", ("liver", &n), &de), "Leber");
-        assert_eq!(label_text("liver ", ("liver", &n), &de), "Leber");
-        assert_eq!(label_text("LEBER", ("liver", &n), &langs(&["en"])), "Liver");
-        assert_eq!(label_text("Liver", ("liver", &n), &[]), "Liver");
-        assert_eq!(label_text("Liver", ("liver", &n), &langs(&["ja"])), "Liver");
+        let (de, none) = (langs(&["de"]), Names::new());
+        assert_eq!(label_text(("Liver", &none), ("liver", &n), &de), "Leber");
+        assert_eq!(label_text(("liver ", &none), ("liver", &n), &de), "Leber");
+        let english = langs(&["en"]);
+        assert_eq!(
+            label_text(("LEBER", &none), ("liver", &n), &english),
+            "Liver"
+        );
+        assert_eq!(label_text(("Liver", &none), ("liver", &n), &[]), "Liver");
+        assert_eq!(
+            label_text(("Liver", &none), ("liver", &n), &langs(&["ja"])),
+            "Liver"
+        );
         let words = "Segment VIII of the liver";
-        assert_eq!(label_text(words, ("liver", &n), &de), words);
-        assert_eq!(label_text("Liver", ("liver", &Names::new()), &de), "Liver");
+        assert_eq!(label_text((words, &none), ("liver", &n), &de), words);
+        assert_eq!(label_text(("Liver", &none), ("liver", &none), &de), "Liver");
+        // The label's own text in the reader's language comes first.
+        let own = names(&[("de", "Segment VIII der Leber")]);
+        let segment = (words, &own);
+        assert_eq!(
+            label_text(segment, ("liver", &n), &de),
+            "Segment VIII der Leber"
+        );
+        assert_eq!(label_text(segment, ("liver", &n), &english), words);
+        let liver = ("Liver", &own);
+        assert_eq!(
+            label_text(liver, ("liver", &n), &de),
+            "Segment VIII der Leber"
+        );
+        assert_eq!(label_text(liver, ("liver", &n), &langs(&["fr"])), "Liver");
     }
 
     #[test]

@@ -87,12 +87,7 @@ mod tests {
     use super::*;
 
     fn label(structure: &str, point: [f32; 3]) -> Label {
-        Label {
-            structure: structure.into(),
-            point,
-            text: structure.into(),
-            note: String::new(),
-        }
+        Label::new(structure, point, structure)
     }
 
     #[test]

@@ -121,7 +121,7 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
     }, await viewingTheLesson());
 });
 
-testIn(EVERY_RUN, "L7 a step's title and caption in the reader's language, the English ones where it has none", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "L7 a step's title and caption and a label's text in the reader's language, the English ones where it has none", { timeout: TIMEOUT }, async () => {
     const de = { title: lesson.steps[0].titles.de, caption: lesson.steps[0].captions.de };
     const viewing = await viewingTheLesson();
     await withApp(async (app) => {
@@ -129,6 +129,8 @@ testIn(EVERY_RUN, "L7 a step's title and caption in the reader's language, the E
         await app.call("showStep", 0);
         const s = await app.stateWhen((s) => s.tour.step === 0, "the first step");
         assert.deepEqual([s.tour.title, s.tour.caption], [de.title, de.caption]);
+        const german = await app.stateWhen((s) => s.view.labels.length === 2, "the labels drawn");
+        assert.equal(german.view.labels[1].text, lesson.labels[1].texts.de, "the tumour's label in German");
         await app.screenshot("L7-step-in-german");
         await app.call("showStep", 1);
         const next = await app.stateWhen((s) => s.tour.step === 1, "the second step");
@@ -139,6 +141,8 @@ testIn(EVERY_RUN, "L7 a step's title and caption in the reader's language, the E
         await app.call("showStep", 0);
         const s = await app.stateWhen((s) => s.tour.step === 0, "the first step");
         assert.equal(s.tour.title, lesson.steps[0].title, "a French reader gets the English one");
+        const french = await app.stateWhen((s) => s.view.labels.length === 2, "the labels drawn");
+        assert.equal(french.view.labels[1].text, lesson.labels[1].text, "and the English label");
     }, { ...viewing, query: `${viewing.query}&lang=fr` });
 });
 
