@@ -88,9 +88,17 @@ fn lesson_lines(doc: &Document) -> Vec<String> {
         }
         lines.push(line);
     }
-    for (text, _, faded) in &doc.view.labels {
-        let behind = if *faded { " (behind a surface)" } else { "" };
-        lines.push(format!("Label: {text}{behind}"));
+    for label in &doc.view.labels {
+        let behind = if label.faded {
+            " (behind a surface)"
+        } else {
+            ""
+        };
+        let note = match label.note.is_empty() {
+            true => String::new(),
+            false => format!(". Note: {}", label.note),
+        };
+        lines.push(format!("Label: {}{behind}{note}", label.text));
     }
     let words = doc.quiz_words();
     if !words.heading.is_empty() {

@@ -10,7 +10,7 @@ use crate::view::{Clip, Planes, StandardView, ViewLink};
 use crate::worker::NamedFile;
 
 use super::backend::{Backend, EngineTimings};
-use super::layout::{PanelLayout, ViewReport};
+use super::layout::{DrawnLabel, PanelLayout, ViewReport};
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -147,6 +147,11 @@ impl Document {
         let languages = self.reader_languages();
         let text = (label.text.as_str(), &label.texts);
         crate::case::names::label_text(text, (&s.name, &s.names), languages)
+    }
+
+    /// A lesson label's note in the reader's language, else the author's words.
+    pub fn label_note<'a>(&'a self, label: &'a crate::case::Label) -> &'a str {
+        crate::case::names::pick(&label.note, &label.notes, self.reader_languages())
     }
 
     /// What guidance, Suggest all and the checks found.
@@ -443,9 +448,7 @@ impl Document {
         state["view"]["clip_plane"] = serde_json::json!(v.clip_plane);
         state["view"]["planes"] = serde_json::to_value(self.view_asks.planes).unwrap_or_default();
         state["view"]["pointed"] = serde_json::json!(self.pointed);
-        state["view"]["labels"] = (v.labels.iter())
-            .map(|(text, [x, y], faded)| serde_json::json!({"text": text, "x": x, "y": y, "faded": faded}))
-            .collect();
+        state["view"]["labels"] = v.labels.iter().map(DrawnLabel::to_json).collect();
         state["view"]["toward_segmentation"] =
             serde_json::json!(self.view_asks.toward_segmentation);
         state["view"]["link"] = serde_json::json!(self.view_link_url());

@@ -14,6 +14,11 @@ pub struct PageRect {
 }
 
 impl PageRect {
+    pub fn contains(self, [x, y]: [f32; 2]) -> bool {
+        (self.left..=self.left + self.width).contains(&x)
+            && (self.top..=self.top + self.height).contains(&y)
+    }
+
     pub fn to_json(self) -> serde_json::Value {
         serde_json::json!({"x": self.left, "y": self.top, "width": self.width, "height": self.height})
     }
@@ -41,8 +46,32 @@ pub struct ViewReport {
     pub clip_plane: [f32; 4],
     pub brush_on: bool,
     pub pick_ms: Option<f64>,
-    /// Each label drawn: its text and where its point is on the page.
-    pub labels: Vec<(String, [f32; 2], bool)>,
+    pub labels: Vec<DrawnLabel>,
+}
+
+/// A lesson label as the view drew it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DrawnLabel {
+    /// Its text in the reader's language.
+    pub text: String,
+    /// Where its point is on the page.
+    pub point: [f32; 2],
+    /// A surface lies in front of its point.
+    pub faded: bool,
+    /// The plate its text is on, which shows or hides its note when clicked.
+    pub plate: PageRect,
+    /// Its note in the reader's language, empty when it has none.
+    pub note: String,
+    /// Whether the note is shown.
+    pub open: bool,
+}
+
+impl DrawnLabel {
+    pub fn to_json(&self) -> serde_json::Value {
+        let [x, y] = self.point;
+        serde_json::json!({"text": self.text, "x": x, "y": y, "faded": self.faded,
+            "plate": self.plate.to_json(), "note": self.note, "open": self.open})
+    }
 }
 
 /// Where the bottom panel's clickable parts were drawn in the latest frame (points), for

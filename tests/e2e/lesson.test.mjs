@@ -30,6 +30,13 @@ async function lessonCaseBytes() {
 }
 
 const viewingTheLesson = async () => ({ query: "?mode=viewer&case=cases/lesson.glb", routes: { "cases/lesson.glb": await lessonCaseBytes() } });
+/** Whether `state` shows tour step `i` with its camera arrived. */
+function arrived(state, i) {
+    const c = state.view.camera;
+    const want = lesson.steps[i].camera;
+    const close = (a, b) => Math.abs(a - b) <= 1e-3 * Math.max(1, Math.abs(b));
+    return state.tour?.step === i && c && close(c.yaw, want.yaw) && close(c.pitch, want.pitch) && close(c.distance, want.distance) && c.target.every((x, k) => close(x, want.target[k]));
+}
 const phantomShown = (app) => app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.layout.structures.length === 4, "the phantom's four structures");
 
 testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, clip, caption and camera, by button and by call", { timeout: TIMEOUT }, async () => {
@@ -42,13 +49,7 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
             await app.page.mouse.click(r.x + r.width / 2, r.y + r.height / 2);
         };
         // At a step: its title and caption, and the camera arrived at its view.
-        const atStep = (i) =>
-            app.stateWhen((s) => {
-                const c = s.view.camera;
-                const want = lesson.steps[i].camera;
-                const close = (a, b) => Math.abs(a - b) <= 1e-3 * Math.max(1, Math.abs(b));
-                return s.tour?.step === i && c && close(c.yaw, want.yaw) && close(c.pitch, want.pitch) && close(c.distance, want.distance) && c.target.every((x, k) => close(x, want.target[k]));
-            }, `step ${i + 1} shown, its camera arrived`);
+        const atStep = (i) => app.stateWhen((s) => arrived(s, i), `step ${i + 1} shown, its camera arrived`);
         const shown = (s) => s.structures.structures.map((x) => [x.name, x.visible, Number(x.opacity.toFixed(3))]);
 
         await press("start");
@@ -62,7 +63,7 @@ testIn(EVERY_RUN, "L1 the viewer plays the case's tour: each step's structures, 
         assert.ok(s.view.labels.every(inView), `the labels' points lie in the view: ${JSON.stringify(s.view.labels)}`);
         // The same for a screen reader, read out as it changes.
         const mirror = () => app.page.locator("#case_lesson li").allTextContents();
-        assert.deepEqual(await mirror(), [`Tour step 1 of 3: ${lesson.steps[0].title}. ${lesson.steps[0].caption}`, "Label: Liver", "Label: Tumour (behind a surface)"]);
+        assert.deepEqual(await mirror(), [`Tour step 1 of 3: ${lesson.steps[0].title}. ${lesson.steps[0].caption}`, `Label: Liver. Note: ${lesson.labels[0].note}`, "Label: Tumour (behind a surface)"]);
         const first = drawn(await app.screenshot("L1-step-1"), s.view);
         // The labels' switch takes them away and brings them back.
         await press("labels");
@@ -129,9 +130,21 @@ testIn(EVERY_RUN, "L7 a step's title and caption and a label's text in the reade
         await app.call("showStep", 0);
         const s = await app.stateWhen((s) => s.tour.step === 0, "the first step");
         assert.deepEqual([s.tour.title, s.tour.caption], [de.title, de.caption]);
-        const german = await app.stateWhen((s) => s.view.labels.length === 2, "the labels drawn");
+        const german = await app.stateWhen((s) => arrived(s, 0) && s.view.labels.length === 2, "the labels drawn, the camera arrived");
         assert.equal(german.view.labels[1].text, lesson.labels[1].texts.de, "the tumour's label in German");
         await app.screenshot("L7-step-in-german");
+        // The liver's note, in German, shown by a click on its label and hidden by another.
+        const liver = german.view.labels[0];
+        assert.deepEqual([liver.note, liver.open, german.view.labels[1].note], [lesson.labels[0].notes.de, false, ""]);
+        const clickPlate = (p) => app.page.mouse.click(p.x + p.width / 2, p.y + p.height / 2);
+        await clickPlate(liver.plate);
+        const open = await app.stateWhen((s) => s.view.labels[0]?.open, "the liver's note shown");
+        assert.equal(open.tour.step, 0, "the tour stays at its step");
+        assert.equal(open.structures.current, german.structures.current, "the click selects nothing");
+        assert.equal(open.view.pointed, null, "nor names the liver behind the label");
+        await app.screenshot("L7-label-note-in-german");
+        await clickPlate(open.view.labels[0].plate);
+        await app.stateWhen((s) => s.view.labels.length === 2 && !s.view.labels[0].open, "the note hidden again");
         await app.call("showStep", 1);
         const next = await app.stateWhen((s) => s.tour.step === 1, "the second step");
         assert.equal(next.tour.title, lesson.steps[1].title, "no German title there: the English one");

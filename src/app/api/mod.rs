@@ -103,8 +103,10 @@
 //!   staying; `state().tour` is `{step, steps, title, caption, left}` (`step` null outside
 //!   the tour, `left` the step it was left at), or null when the case has no tour;
 //!   `state().layout.lesson` where its buttons, the quiz's and the labels' switch are;
-//!   `state().view.labels` the labels drawn (`[{text, x, y, faded}]`, their points on the
-//!   page, `faded` where a surface lies in front of the point)
+//!   `state().view.labels` the labels drawn (`[{text, x, y, faded, plate, note, open}]`, their
+//!   points on the page, `faded` where a surface lies in front of the point, `plate` the
+//!   rectangle of the text, a click on which shows or hides the `note` (in the reader's
+//!   language; empty when it has none), `open` while it is shown)
 //! - `startQuiz()` starts the case's quiz (again; the tour left, the structures it asks shown):
 //!   "Find it" questions are answered by clicking the structure in the view, "Name it" ones
 //!   by one of the offered names; `nextQuestion()` moves on once the question is answered;

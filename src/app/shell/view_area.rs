@@ -41,7 +41,10 @@ impl Shell {
                         viewer.show(ui)
                     })
                     .inner;
-                if !self.brush.active && !self.picture.pending {
+                // A label's plate takes the pointer: the structure behind it is not named.
+                let on_label = (response.hover_pos())
+                    .is_some_and(|p| doc.view.labels.iter().any(|l| l.plate.contains(p.into())));
+                if !self.brush.active && !self.picture.pending && !on_label {
                     let at = (viewer.camera(), viewer.clip_plane());
                     point(&mut self.pointing, reads, ui, &response, at, doc);
                 } else {
