@@ -11,7 +11,8 @@ use crate::mesh::Topology;
 use crate::metrics::{measure_vertices, smooth_drifting, Original};
 use crate::smooth::{Filter, Params};
 use crate::suggest::{
-    search_evaluator, suggest_for_goal, suggest_from, Goal, SearchMethod, SuggestError, Suggestion,
+    search_evaluator, suggest_for_goal, suggest_from, Evaluator, Goal, Patches, SearchMethod,
+    SuggestError, Suggestion,
 };
 
 /// Smooths a structure from its original with its parameters and weights and measures the
@@ -221,16 +222,36 @@ pub fn suggest_structure(
     let topology = Topology::build(&s.original);
     let original = Original::new(&s.original, &topology);
     let weights = s.weights.as_deref();
-    let mut evaluator = search_evaluator(&original, weights, s.params.filter, options.method)?;
     let goal = Goal {
         tau: options.tau,
         max_volume_change: options.max_volume_change,
     };
-    let suggestion = match options.method {
+    let (filter, method) = (s.params.filter, options.method);
+    let mut search = |evaluator: &mut dyn Evaluator, starts: &[Params]| match method {
         SearchMethod::Local if !starts.is_empty() => {
-            suggest_from(&mut evaluator, &s.params, goal, starts, on_progress)?
+            suggest_from(evaluator, &s.params, goal, starts, on_progress)
         }
-        method => suggest_for_goal(&mut evaluator, &s.params, goal, method, on_progress)?,
+        method => suggest_for_goal(evaluator, &s.params, goal, method, on_progress),
+    };
+    let mut whole = search_evaluator(&original, weights, filter, method)?;
+    // A large surface's local search runs on patches of it first, and the search on the whole
+    // starts where that one ended: most often its minimum already, so it measures only the
+    // neighbours. The grid stays whole, the reference the searches are measured against.
+    let patches = match method {
+        SearchMethod::Local => Patches::of(&original, weights),
+        SearchMethod::Grid => None,
+    };
+    let suggestion = match &patches {
+        Some(p) => {
+            let mut on_patches = search_evaluator(&p.original, Some(&p.weights), filter, method)?;
+            let rough = search(&mut on_patches, starts)?;
+            let found = search(&mut whole, &[rough.params])?;
+            Suggestion {
+                evaluations: found.evaluations + rough.evaluations,
+                ..found
+            }
+        }
+        None => search(&mut whole, starts)?,
     };
     s.set_params(suggestion.params);
     s.set_tau(options.tau);

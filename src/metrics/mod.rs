@@ -16,6 +16,7 @@ pub mod reference;
 mod report;
 mod roughness;
 mod score;
+mod stand_in;
 #[cfg(target_arch = "x86_64")]
 mod wide;
 

@@ -3,6 +3,7 @@
 
 use super::curvature::{fan_corners, CornerCode};
 use super::prism_rows::PrismRows;
+use super::stand_in::StandIn;
 use crate::mesh::{Mesh, Topology};
 
 /// The original mesh with what the measures precompute from it: the triangle fans in the order
@@ -32,19 +33,34 @@ pub struct Original {
     roughness: f64,
     /// Vertices some triangle uses: the ones the local error averages over.
     referenced: usize,
+    /// What it measures with where it stands in for a larger surface ([`Self::standing_in`]).
+    #[serde(default)]
+    stand_in: Option<StandIn>,
 }
 
 impl Original {
     /// Precomputes the original's measures. `topology` must be `Topology::build(mesh)`.
     pub fn new(mesh: &Mesh, topology: &Topology) -> Self {
+        Self::build(mesh, topology, None)
+    }
+
+    /// [`Self::new`], or with `stand_in` and the whole's volume, an original standing in for
+    /// a larger surface.
+    pub(super) fn build(
+        mesh: &Mesh,
+        topology: &Topology,
+        stand_in: Option<(StandIn, f64)>,
+    ) -> Self {
         let mut o = Self::bare(mesh.clone(), topology.clone());
         (o.fan_corners, o.corner_codes) = fan_corners(&o.mesh.triangles, &o.topology);
         o.prism_rows = PrismRows::new(o.mesh.vertex_count(), |r| o.fan_corners(r));
         o.stay_radius2 = stay_radius2(&o.mesh.positions, &o.topology);
         o.roughness = super::roughness(&o, &o.mesh.positions);
+        let volume0 = stand_in.as_ref().map(|(_, v)| *v);
+        o.stand_in = stand_in.map(|(s, _)| s);
         // The volume and curvature need no reference: the local error of the original is 0.
         let sums = super::report::measure_pass(&o, &o.mesh.positions, None);
-        o.volume = o.is_closed().then(|| sums.volume());
+        o.volume = volume0.or_else(|| o.is_closed().then(|| sums.volume()));
         o.curvature = sums.curvature();
         o
     }
@@ -70,6 +86,7 @@ impl Original {
             curvature: 0.0,
             roughness: 0.0,
             referenced,
+            stand_in: None,
         }
     }
 
@@ -137,6 +154,16 @@ impl Original {
 
     pub(crate) fn stay_radius2(&self) -> &[f32] {
         &self.stay_radius2
+    }
+
+    /// What it measures with where it stands in for a larger surface.
+    pub(crate) fn stand_in(&self) -> Option<&StandIn> {
+        self.stand_in.as_ref()
+    }
+
+    /// Whether it stands in for a larger surface ([`Self::standing_in`]).
+    pub fn is_standing_in(&self) -> bool {
+        self.stand_in.is_some()
     }
 
     /// Number of vertices some triangle uses.

@@ -182,7 +182,10 @@ pub fn exact_distances(bvh: &TriangleBvh, original: &Original, positions: &[[f32
 /// partial sums and reports through here, so both engines derive the numbers alike).
 pub(crate) fn metrics(original: &Original, sums: &Sums, tau: f64) -> Metrics {
     let volume0 = original.volume();
-    let volume = volume0.map(|_| sums.volume());
+    let volume = match original.stand_in() {
+        Some(s) => volume0.map(|v0| v0 + s.volume_change(sums.swept)),
+        None => volume0.map(|_| sums.volume()),
+    };
     let volume_change = match (volume, volume0) {
         (Some(v), Some(v0)) if v0 != 0.0 => Some((v - v0) / v0),
         _ => None,
@@ -222,6 +225,8 @@ pub(crate) struct Sums {
     error_sum: f64,
     error_max: f64,
     error_count: usize,
+    /// The volume the measured vertices swept, standing in for a larger surface.
+    swept: f64,
 }
 
 impl Sums {
@@ -239,6 +244,7 @@ impl Sums {
             error_sum,
             error_max,
             error_count,
+            swept: 0.0,
         }
     }
 
@@ -249,6 +255,7 @@ impl Sums {
         self.error_sum += o.error_sum;
         self.error_max = self.error_max.max(o.error_max);
         self.error_count += o.error_count;
+        self.swept += o.swept;
     }
 
     pub(crate) fn volume(&self) -> f64 {
@@ -333,10 +340,15 @@ impl Pass<'_> {
         let topology = self.original.topology();
         let end = (start + CHUNK).min(mesh.vertex_count());
         let mut s = Sums::default();
+        let stand_in = self.original.stand_in();
+        let measured = |i: usize| stand_in.is_none_or(|p| p.measures(i));
         for i in start..end {
             let fan = topology.triangles_of(i);
-            if fan.is_empty() {
+            if fan.is_empty() || !measured(i) {
                 continue;
+            }
+            if let Some(p) = stand_in {
+                s.swept += p.swept(i, mesh.positions[i], self.positions[i]);
             }
             let codes = self.original.corner_codes(i).iter();
             let c = VertexCurvature::of_fan(self.corners, codes.map(|c| c.index()));
@@ -360,6 +372,9 @@ impl Pass<'_> {
                 reference,
                 start..end,
                 |i, e| {
+                    if !measured(i) {
+                        return;
+                    }
                     s.error_sum += e;
                     s.error_max = s.error_max.max(e);
                     s.error_count += 1;

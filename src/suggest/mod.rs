@@ -15,6 +15,7 @@ mod grid;
 mod local;
 mod memo;
 mod mesh_evaluator;
+mod patches;
 mod points;
 mod run_states;
 mod space;
@@ -29,6 +30,7 @@ pub use grid::{EvaluatedGrid, GridSearch};
 pub use local::{LocalOutcome, LocalSearch};
 pub use memo::{Memoized, TermsMemo};
 pub use mesh_evaluator::{check_weights, MeshEvaluator, WeightsError};
+pub use patches::{Patches, PATCHES_ABOVE};
 pub use space::{Axis, GridPoint, Param, ParamSpace};
 pub use sweep::{Curve, QualityGraphs, QualitySweep, Sample};
 
