@@ -11,6 +11,7 @@
 //! share faces exactly, so points within a tolerance of the other surface count as inside it,
 //! and depths up to the tolerance are not crossings.
 
+mod cells;
 mod rays;
 #[cfg(test)]
 mod tests;
@@ -21,6 +22,7 @@ use rayon::prelude::*;
 
 use crate::mesh::{to_f64, Mesh};
 use crate::metrics::{build_tree, TriangleBvh};
+use cells::Cells;
 use rays::{Location, RayBvh};
 
 /// What one pair of structures does, in one state (original or smoothed).
@@ -307,9 +309,11 @@ impl<'a> From<&'a Mesh> for Surface<'a> {
     }
 }
 
-/// A structure made ready to be asked about points: rays for inside, a tree for distances.
+/// A structure made ready to be asked about points: cells and rays for inside, a tree for
+/// distances.
 struct Solid {
     bounds: Box3,
+    cells: Cells,
     rays: RayBvh,
     distance: TriangleBvh,
 }
@@ -322,6 +326,7 @@ impl Solid {
         let distance = TriangleBvh::from_tree(p, t, tree, order);
         Self {
             bounds,
+            cells: Cells::new(p, t, bounds.min, bounds.max, &rays),
             rays,
             distance,
         }
@@ -402,7 +407,7 @@ impl<'a> Against<'a> {
                 depth: 0.0,
             };
         }
-        match other.rays.locate(p) {
+        match other.cells.locate(p, &other.rays) {
             Location::OnSurface => Reach {
                 outside: 0.0,
                 depth: 0.0,

@@ -435,3 +435,45 @@ fn marks_are_the_vertices_that_left_or_reach_too_deep() {
     let marked = marks(&[&a, &into], &[0.5, 4.0], &before, &changed);
     assert_eq!(marked, vec![Vec::<u32>::new(); 2]);
 }
+
+#[test]
+fn cells_place_points_as_the_rays_do_in_material_cavity_and_a_notch() {
+    // A block with a cavity and a notch down one edge: the notch is outside but in the box.
+    let voxels = grid(30, |x, y, z| {
+        let block = [x, y, z].iter().all(|&c| (2..28).contains(&c));
+        let cavity = [x, y, z].iter().all(|&c| (9..21).contains(&c));
+        let notch = x >= 22 && y >= 22;
+        u8::from(block && !cavity && !notch)
+    });
+    let mesh = voxel_surface(&voxels, 1);
+    let rays = RayBvh::new(&mesh.positions, &mesh.triangles);
+    let bounds = Box3::of(&mesh.positions).unwrap();
+    let cells = super::cells::Cells::new(
+        &mesh.positions,
+        &mesh.triangles,
+        bounds.min,
+        bounds.max,
+        &rays,
+    );
+    // Every half voxel: on faces, edges and corners of the staircase as well as between.
+    let mut placed = [0usize; 3];
+    let steps = (-2..=62).map(|i| f64::from(i) * 0.5);
+    for x in steps.clone() {
+        for y in steps.clone() {
+            for z in steps.clone() {
+                let p = [x, y, z];
+                let by_rays = rays.locate(p);
+                assert_eq!(cells.locate(p, &rays), by_rays, "at {p:?}");
+                if let (true, Location::Within { shells }) = (cells.placed(p), by_rays) {
+                    placed[shells] += 1;
+                }
+            }
+        }
+    }
+    // Outside (the notch), in the material and in the cavity, most points went without rays.
+    assert!(placed.iter().all(|&n| n > 500), "{placed:?}");
+    assert!(
+        placed.iter().sum::<usize>() > 65 * 65 * 65 / 5,
+        "{placed:?}"
+    );
+}

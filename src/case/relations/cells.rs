@@ -1,0 +1,222 @@
+//! A coarse grid over a closed surface's box that says where most points lie without casting
+//! rays for each. A cell that no triangle touches lies wholly within the same shells (a segment
+//! inside it crosses no triangle), and so does every untouched cell that shares a face with it
+//! (the segment between their centres stays in the two): one location, found by rays, holds
+//! for each connected region of untouched cells. Points in cells a triangle touches are left
+//! to the rays.
+//!
+//! Most points the checks ask about lie in the other structure's box but away from its surface
+//! (a rib beside a lung, an organ in the box of a curved vessel); the points near the surface,
+//! where two structures meet, still get rays of their own.
+
+use super::rays::{Location, RayBvh, ON_SURFACE};
+
+/// The most cells one surface's grid has: a byte each.
+const MAX_CELLS: usize = 1 << 22;
+/// A cell's edge in mean triangle edges: small enough that few points share a cell with the
+/// surface, large enough that the grid stays small.
+const EDGES_PER_CELL: f64 = 2.0;
+/// A triangle marks every cell within this of its box (mm, plus a fraction of the
+/// coordinates), more than [`ON_SURFACE`]: no point of an unmarked cell is on the surface.
+const MARK_PAD: f64 = 1e-4;
+
+/// A cell a triangle touches (or one whose region the rays could not place): its points get
+/// rays.
+const TOUCHED: u8 = 0;
+/// A cell not reached yet while the grid is built.
+const UNKNOWN: u8 = 1;
+/// Cells placed hold `LOCATED + shells`; a region within more shells than a byte holds stays
+/// with the rays.
+const LOCATED: u8 = 2;
+
+/// Which cells of the grid a surface touches, and where the others lie.
+#[derive(Debug, Default)]
+pub(super) struct Cells {
+    min: [f64; 3],
+    size: f64,
+    dims: [usize; 3],
+    /// Per cell, x fastest: [`TOUCHED`] or `LOCATED + shells`.
+    state: Vec<u8>,
+}
+
+impl Cells {
+    /// The grid over the box `min`..`max` of the closed surface `triangles` (indices into
+    /// `positions`, which must be in range), its regions placed by `rays` (built over the same
+    /// surface). A surface without triangles or with a box that is not finite gets no cells:
+    /// every point goes to the rays.
+    pub(super) fn new(
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        min: [f64; 3],
+        max: [f64; 3],
+        rays: &RayBvh,
+    ) -> Self {
+        let Some((size, dims)) = layout(positions, triangles, min, max) else {
+            return Self::default();
+        };
+        let mut cells = Self {
+            min,
+            size,
+            dims,
+            state: vec![UNKNOWN; dims[0] * dims[1] * dims[2]],
+        };
+        cells.mark(positions, triangles);
+        cells.place(rays);
+        cells
+    }
+
+    /// Marks every cell that a triangle's box (padded) meets.
+    fn mark(&mut self, positions: &[[f32; 3]], triangles: &[[u32; 3]]) {
+        let pad = |x: f64| MARK_PAD + 1e-9 * x.abs();
+        for tri in triangles {
+            let corners = tri.map(|v| positions[v as usize].map(f64::from));
+            let (mut lo, mut hi) = ([0; 3], [0; 3]);
+            for k in 0..3 {
+                let (a, b) = (corners.iter())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| {
+                        (a.min(c[k]), b.max(c[k]))
+                    });
+                lo[k] = self.axis_cell(k, a - pad(a));
+                hi[k] = self.axis_cell(k, b + pad(b));
+            }
+            for z in lo[2]..=hi[2] {
+                for y in lo[1]..=hi[1] {
+                    let row = (z * self.dims[1] + y) * self.dims[0];
+                    self.state[row + lo[0]..=row + hi[0]].fill(TOUCHED);
+                }
+            }
+        }
+    }
+
+    /// Places each connected region of untouched cells by one location of a cell's centre.
+    fn place(&mut self, rays: &RayBvh) {
+        let [nx, ny, nz] = self.dims;
+        let mut stack: Vec<usize> = Vec::new();
+        for seed in 0..self.state.len() {
+            if self.state[seed] != UNKNOWN {
+                continue;
+            }
+            let value = match rays.locate(self.centre(seed)) {
+                Location::Within { shells } if shells < usize::from(u8::MAX - LOCATED) => {
+                    LOCATED + shells as u8
+                }
+                // A centre on the surface cannot be in an untouched cell; should the rays
+                // say so, the region's points get rays of their own.
+                _ => TOUCHED,
+            };
+            self.state[seed] = value;
+            stack.push(seed);
+            while let Some(i) = stack.pop() {
+                let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
+                let mut visit = |j: usize| {
+                    if self.state[j] == UNKNOWN {
+                        self.state[j] = value;
+                        stack.push(j);
+                    }
+                };
+                if x > 0 {
+                    visit(i - 1);
+                }
+                if x + 1 < nx {
+                    visit(i + 1);
+                }
+                if y > 0 {
+                    visit(i - nx);
+                }
+                if y + 1 < ny {
+                    visit(i + nx);
+                }
+                if z > 0 {
+                    visit(i - nx * ny);
+                }
+                if z + 1 < nz {
+                    visit(i + nx * ny);
+                }
+            }
+        }
+    }
+
+    /// Where `p` lies against the surface `rays` was built over (the one these cells were).
+    pub(super) fn locate(&self, p: [f64; 3], rays: &RayBvh) -> Location {
+        match self.cell_of(p).map(|i| self.state[i]) {
+            Some(s) if s >= LOCATED => Location::Within {
+                shells: usize::from(s - LOCATED),
+            },
+            _ => rays.locate(p),
+        }
+    }
+
+    /// Whether the cells answer for `p` without rays.
+    #[cfg(test)]
+    pub(super) fn placed(&self, p: [f64; 3]) -> bool {
+        self.cell_of(p).is_some_and(|i| self.state[i] >= LOCATED)
+    }
+
+    /// The cell along axis `k` holding coordinate `x`, clamped to the grid.
+    fn axis_cell(&self, k: usize, x: f64) -> usize {
+        let c = ((x - self.min[k]) / self.size).floor();
+        if c <= 0.0 {
+            0
+        } else {
+            (c as usize).min(self.dims[k] - 1)
+        }
+    }
+
+    /// The cell holding `p`, `None` outside the grid.
+    fn cell_of(&self, p: [f64; 3]) -> Option<usize> {
+        if self.state.is_empty() {
+            return None;
+        }
+        let mut at = [0usize; 3];
+        for k in 0..3 {
+            let c = ((p[k] - self.min[k]) / self.size).floor();
+            if !(c >= 0.0 && c < self.dims[k] as f64) {
+                return None;
+            }
+            at[k] = c as usize;
+        }
+        Some((at[2] * self.dims[1] + at[1]) * self.dims[0] + at[0])
+    }
+
+    fn centre(&self, i: usize) -> [f64; 3] {
+        let at = [
+            i % self.dims[0],
+            (i / self.dims[0]) % self.dims[1],
+            i / (self.dims[0] * self.dims[1]),
+        ];
+        std::array::from_fn(|k| self.min[k] + (at[k] as f64 + 0.5) * self.size)
+    }
+}
+
+/// The cell edge and the cells along each axis for a surface with box `min`..`max`: a few
+/// mean triangle edges, larger where the box would need more than [`MAX_CELLS`].
+fn layout(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    min: [f64; 3],
+    max: [f64; 3],
+) -> Option<(f64, [usize; 3])> {
+    let edges: f64 = (triangles.iter())
+        .map(|t| {
+            let (a, b) = (positions[t[0] as usize], positions[t[1] as usize]);
+            (0..3)
+                .map(|k| (f64::from(a[k]) - f64::from(b[k])).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .sum();
+    let mean_edge = edges / triangles.len().max(1) as f64;
+    let extent: [f64; 3] = std::array::from_fn(|k| max[k] - min[k]);
+    let volume: f64 = extent.iter().product();
+    let mut size = (EDGES_PER_CELL * mean_edge).max((volume / MAX_CELLS as f64).cbrt());
+    if !(size.is_finite() && size > ON_SURFACE && extent.iter().all(|e| e.is_finite())) {
+        return None;
+    }
+    loop {
+        let along = extent.map(|e| (e / size).floor() + 1.0);
+        if along.iter().product::<f64>() <= MAX_CELLS as f64 {
+            return Some((size, along.map(|n| n as usize)));
+        }
+        size *= 1.25;
+    }
+}
