@@ -21,7 +21,6 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use crate::mesh::{to_f64, Mesh};
-use crate::metrics::{build_tree, TriangleBvh};
 use cells::Cells;
 use rays::{Location, RayBvh};
 
@@ -309,26 +308,22 @@ impl<'a> From<&'a Mesh> for Surface<'a> {
     }
 }
 
-/// A structure made ready to be asked about points: cells and rays for inside, a tree for
-/// distances.
+/// A structure made ready to be asked about points: cells and rays for inside, the rays' tree
+/// for distances.
 struct Solid {
     bounds: Box3,
     cells: Cells,
     rays: RayBvh,
-    distance: TriangleBvh,
 }
 
 impl Solid {
     fn new(mesh: &Surface, bounds: Box3) -> Self {
         let (p, t) = (mesh.positions, mesh.triangles);
-        let (tree, order) = build_tree(p, t);
-        let rays = RayBvh::from_tree(p, t, &tree, &order);
-        let distance = TriangleBvh::from_tree(p, t, tree, order);
+        let rays = RayBvh::new(p, t);
         Self {
             bounds,
             cells: Cells::new(p, t, bounds.min, bounds.max, &rays),
             rays,
-            distance,
         }
     }
 }
@@ -392,7 +387,7 @@ impl<'a> Against<'a> {
             if !self.may_enclose {
                 return f64::INFINITY;
             }
-            match other.distance.closest_within(p, self.cap.next_up()) {
+            match other.rays.tree().closest_within(p, self.cap.next_up()) {
                 Some(c) => c.distance,
                 None => f64::INFINITY,
             }
@@ -414,7 +409,7 @@ impl<'a> Against<'a> {
             },
             Location::Within { shells } if shells % 2 == 1 => Reach {
                 outside: 0.0,
-                depth: other.distance.distance(p).unwrap_or(0.0),
+                depth: other.rays.tree().distance(p).unwrap_or(0.0),
             },
             Location::Within { shells } => Reach {
                 outside: if shells > 0 { 0.0 } else { outside(p) },

@@ -25,9 +25,8 @@ pub(crate) struct Node {
 }
 
 /// The median-split tree over `triangles` (indices into `positions`, which must be in range):
-/// its nodes, root first, and the mesh's triangle indices in leaf order. Shared by the distance
-/// queries here and the ray casts of the checks between a case's structures.
-pub(crate) fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec<u32>) {
+/// its nodes, root first, and the mesh's triangle indices in leaf order.
+fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec<u32>) {
     // Each triangle's centroid and box, read from the mesh once: the build then walks these
     // in order at every level instead of gathering corners from all over the positions.
     let mut items: Vec<Item> = triangles
@@ -97,8 +96,7 @@ impl TriangleBvh {
         Self::from_tree(positions, triangles, nodes, ids)
     }
 
-    /// The tree of [`build_tree`] over the same mesh, built once for another use too.
-    pub(crate) fn from_tree(
+    fn from_tree(
         positions: &[[f32; 3]],
         triangles: &[[u32; 3]],
         nodes: Vec<Node>,
@@ -113,6 +111,21 @@ impl TriangleBvh {
             corners,
             ids,
         }
+    }
+
+    /// The tree's nodes, root first, for other walks over the same triangles (rays).
+    pub(crate) fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The triangles' corners in leaf order (the order the nodes' ranges index).
+    pub(crate) fn corners(&self) -> &[[[f32; 3]; 3]] {
+        &self.corners
+    }
+
+    /// The mesh's triangle index of each entry of [`Self::corners`].
+    pub(crate) fn ids(&self) -> &[u32] {
+        &self.ids
     }
 
     /// Closest point of the triangle set to `p`; `None` when there are no triangles.

@@ -22,7 +22,7 @@ mod wide;
 
 pub use curvature::{vertex_curvatures, VertexCurvature};
 pub use drift::{identity, smooth_drifting, DriftState, DriftingReference};
-pub(crate) use exact_distance::{build_tree, Node as TreeNode};
+pub(crate) use exact_distance::Node as TreeNode;
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
 pub use original::Original;
 pub use report::{

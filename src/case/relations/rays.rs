@@ -9,7 +9,7 @@
 //! edge signs are too close to call (it grazes an edge or a vertex) is thrown away and another
 //! one cast; a ray that meets the surface at its start means the point is on the surface.
 
-use crate::metrics::TreeNode;
+use crate::metrics::{TreeNode, TriangleBvh};
 
 /// Deeper than any median-split tree over `u32` triangle counts can grow.
 const STACK_DEPTH: usize = 64;
@@ -44,23 +44,12 @@ pub(super) enum Location {
     Within { shells: usize },
 }
 
-#[derive(Clone, Copy, Debug)]
-struct Node {
-    min: [f64; 3],
-    max: [f64; 3],
-    /// Leaf: first triangle in leaf order. Inner node: index of the left child (right = left + 1).
-    first: u32,
-    /// Triangles in a leaf; 0 marks an inner node.
-    count: u32,
-}
-
-/// A closed surface made ready for rays: its triangles in a tree, each knowing its shell.
+/// A closed surface made ready for rays and distances: its triangles in a tree, each knowing
+/// its shell. Rays walk the distance tree's nodes and corners, so a structure is held once.
 #[derive(Clone, Debug, Default)]
 pub(super) struct RayBvh {
-    nodes: Vec<Node>,
-    /// Triangle corners in leaf order.
-    corners: Vec<[[f32; 3]; 3]>,
-    /// Connected shell of each entry of `corners`.
+    tree: TriangleBvh,
+    /// Connected shell of each entry of the tree's corners.
     shells: Vec<u32>,
 }
 
@@ -85,51 +74,23 @@ enum Hit {
 
 impl RayBvh {
     /// Builds the tree over `triangles` (indices into `positions`, which must be in range).
-    #[cfg(test)]
     pub(super) fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
-        let (tree, order) = crate::metrics::build_tree(positions, triangles);
-        Self::from_tree(positions, triangles, &tree, &order)
+        let tree = TriangleBvh::new(positions, triangles);
+        let shell_of = triangle_shells(positions.len(), triangles);
+        let shells = tree.ids().iter().map(|&t| shell_of[t as usize]).collect();
+        Self { tree, shells }
     }
 
-    /// Over the tree `build_tree` made of the same mesh (`tree` and the triangles in leaf
-    /// `order`), built once for the distances too.
-    pub(super) fn from_tree(
-        positions: &[[f32; 3]],
-        triangles: &[[u32; 3]],
-        tree: &[TreeNode],
-        order: &[u32],
-    ) -> Self {
-        let shell_of = triangle_shells(positions.len(), triangles);
-        // The shared tree's boxes, widened a hair so that a ray along a box face is not lost
-        // to rounding.
-        let nodes = tree
-            .iter()
-            .map(|n| Node {
-                min: n
-                    .min
-                    .map(|x| f64::from(x) - BOX_PAD * (1.0 + f64::from(x).abs())),
-                max: n
-                    .max
-                    .map(|x| f64::from(x) + BOX_PAD * (1.0 + f64::from(x).abs())),
-                first: n.first,
-                count: n.count,
-            })
-            .collect();
-        Self {
-            nodes,
-            corners: order
-                .iter()
-                .map(|&t| triangles[t as usize].map(|v| positions[v as usize]))
-                .collect(),
-            shells: order.iter().map(|&t| shell_of[t as usize]).collect(),
-        }
+    /// The tree, for distances to the surface.
+    pub(super) fn tree(&self) -> &TriangleBvh {
+        &self.tree
     }
 
     /// Where `p` lies: inside how many shells, by the majority of three rays (two that agree
     /// suffice), each shell counted by its own parity. Rays leave along the axis whose side of
     /// the surface's box is nearest, so they cross little of the tree.
     pub(super) fn locate(&self, p: [f64; 3]) -> Location {
-        let Some(root) = self.nodes.first() else {
+        let Some(root) = self.tree.nodes().first() else {
             return Location::Within { shells: 0 };
         };
         let (axis, sign) = nearest_side(root, p);
@@ -164,16 +125,14 @@ impl RayBvh {
         let mut stack = [0u32; STACK_DEPTH];
         let mut top = 0usize;
         let mut index = 0usize;
+        let (nodes, corners) = (self.tree.nodes(), self.tree.corners());
         loop {
-            let node = &self.nodes[index];
+            let node = &nodes[index];
             if ray.enters(node) {
                 if node.count > 0 {
                     let start = node.first as usize;
                     let end = start + node.count as usize;
-                    for (tri, &shell) in self.corners[start..end]
-                        .iter()
-                        .zip(&self.shells[start..end])
-                    {
+                    for (tri, &shell) in corners[start..end].iter().zip(&self.shells[start..end]) {
                         match ray.hit(tri) {
                             Hit::Miss | Hit::Behind => {}
                             Hit::OnSurface => return Cast::OnSurface,
@@ -243,11 +202,12 @@ impl Ray {
     /// Whether the ray (from slightly behind its origin, to catch a surface through it) meets
     /// the node's box.
     #[inline]
-    fn enters(&self, node: &Node) -> bool {
+    fn enters(&self, node: &TreeNode) -> bool {
+        let (min, max) = padded(node);
         let (mut near, mut far) = (-ON_SURFACE, f64::INFINITY);
         for k in 0..3 {
-            let a = (node.min[k] - self.origin[k]) * self.inverse[k];
-            let b = (node.max[k] - self.origin[k]) * self.inverse[k];
+            let a = (min[k] - self.origin[k]) * self.inverse[k];
+            let b = (max[k] - self.origin[k]) * self.inverse[k];
             near = near.max(a.min(b));
             far = far.min(a.max(b));
         }
@@ -321,9 +281,10 @@ pub(super) fn direction(axis: usize, sign: f64, tilt: [f64; 2]) -> [f64; 3] {
 }
 
 /// The axis and sign of the side of `node`'s box nearest to `p`.
-fn nearest_side(node: &Node, p: [f64; 3]) -> (usize, f64) {
+fn nearest_side(node: &TreeNode, p: [f64; 3]) -> (usize, f64) {
+    let (min, max) = padded(node);
     let mut best = (2, 1.0, f64::INFINITY);
-    for (k, ((&x, &lo), &hi)) in p.iter().zip(&node.min).zip(&node.max).enumerate() {
+    for (k, ((&x, &lo), &hi)) in p.iter().zip(&min).zip(&max).enumerate() {
         for (sign, gap) in [(-1.0, x - lo), (1.0, hi - x)] {
             if gap.abs() < best.2 {
                 best = (k, sign, gap.abs());
@@ -331,6 +292,17 @@ fn nearest_side(node: &Node, p: [f64; 3]) -> (usize, f64) {
         }
     }
     (best.0, best.1)
+}
+
+/// The tree's box of `node`, widened a hair so that a ray along a box face is not lost to
+/// rounding.
+#[inline]
+fn padded(node: &TreeNode) -> ([f64; 3], [f64; 3]) {
+    let pad = |x: f64| BOX_PAD * (1.0 + x.abs());
+    (
+        node.min.map(|x| f64::from(x) - pad(f64::from(x))),
+        node.max.map(|x| f64::from(x) + pad(f64::from(x))),
+    )
 }
 
 /// The connected shell of each triangle (triangles sharing a vertex are one shell), numbered
