@@ -91,7 +91,8 @@ impl Original {
     }
 
     /// V0, by the divergence theorem; `None` for an open mesh (or one without triangles), where
-    /// an enclosed volume means nothing.
+    /// an enclosed volume means nothing. Patches standing in for a closed surface (open
+    /// themselves) give the whole surface's.
     pub fn volume(&self) -> Option<f64> {
         self.volume
     }

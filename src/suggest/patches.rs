@@ -1,14 +1,16 @@
-//! Searching a large surface on patches of it. A search smooths the surface some sixty times;
-//! on a structure of a quarter million vertices that is most of a whole-body case's time. Its
-//! measures are means over the surface (curvature, local error) and a volume change, which a
-//! dozen patches spread over the surface estimate well: the search runs on the patches, and
-//! the parameters it finds are then measured on the whole surface.
+//! Searching a large surface on patches of it first. A search smooths the surface some sixty
+//! times; on a structure of a quarter million vertices that is most of a whole-body case's
+//! time. Its measures are means over the surface (curvature, local error) and a volume change,
+//! which a few patches spread over the surface estimate well: the search runs on the patches,
+//! and the search on the whole surface then starts where theirs ended, so it measures few sets
+//! before it stops at a local minimum of the whole.
 //!
 //! A patch is every vertex within a number of edge rings of a seed, the seeds spread by
 //! farthest-point sampling. Smoothing moves information a few rings per iteration at most, so
-//! the patches' rims are locked and only the vertices well inside them are measured
-//! ([`Original::standing_in`]): the rim's lock does not reach them in the grid's iterations
-//! for the smoothing the searches pick.
+//! the patches' rims get weight 0 and only the vertices well inside them are measured
+//! ([`Original::standing_in`]): the rims hold the patches in place, and what reaches the
+//! measured vertices from them in the grid's iterations is small for the smoothing the
+//! searches pick.
 
 use crate::mesh::{cross, dot, sub, to_f64, Mesh, Topology};
 use crate::metrics::Original;
