@@ -74,22 +74,28 @@ impl Mesh {
                 *m = true;
             }
         }
-        let touched = |t: &&[u32; 3]| t.iter().any(|&v| marked[v as usize]);
+        self.part(|t| t.iter().any(|&v| marked[v as usize])).0
+    }
+
+    /// The triangles `keep` keeps, over only the vertices those use, and the index in this
+    /// mesh of each of the part's vertices.
+    pub fn part(&self, keep: impl Fn(&[u32; 3]) -> bool) -> (Mesh, Vec<u32>) {
         let mut new_index = vec![u32::MAX; self.positions.len()];
-        let mut positions = Vec::new();
-        let triangles = (self.triangles.iter().filter(touched))
+        let mut kept: Vec<u32> = Vec::new();
+        let triangles = (self.triangles.iter().filter(|t| keep(t)))
             .map(|t| {
                 t.map(|v| {
                     let slot = &mut new_index[v as usize];
                     if *slot == u32::MAX {
-                        *slot = positions.len() as u32;
-                        positions.push(self.positions[v as usize]);
+                        *slot = kept.len() as u32;
+                        kept.push(v);
                     }
                     *slot
                 })
             })
             .collect();
-        Mesh::new(positions, triangles)
+        let positions = kept.iter().map(|&v| self.positions[v as usize]).collect();
+        (Mesh::new(positions, triangles), kept)
     }
 }
 

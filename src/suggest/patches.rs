@@ -42,22 +42,7 @@ impl Patches {
         }
         let rings = ring_distances(topology, &seeds(mesh, topology, PATCHES));
         let keep = |v: u32| rings[v as usize] <= MEASURED_RINGS + MARGIN_RINGS;
-        let mut index = vec![u32::MAX; mesh.vertex_count()];
-        let mut kept: Vec<u32> = Vec::new();
-        let triangles: Vec<[u32; 3]> = (mesh.triangles.iter())
-            .filter(|t| t.iter().all(|&v| keep(v)))
-            .map(|t| {
-                t.map(|v| {
-                    if index[v as usize] == u32::MAX {
-                        index[v as usize] = kept.len() as u32;
-                        kept.push(v);
-                    }
-                    index[v as usize]
-                })
-            })
-            .collect();
-        let positions = kept.iter().map(|&v| mesh.positions[v as usize]).collect();
-        let part = Mesh::new(positions, triangles);
+        let (part, kept) = mesh.part(|t| t.iter().all(|&v| keep(v)));
         let part_topology = Topology::build(&part);
         let measured: Vec<bool> = (kept.iter().enumerate())
             .map(|(j, &v)| rings[v as usize] <= MEASURED_RINGS && !part_topology.is_boundary[j])
