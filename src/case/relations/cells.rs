@@ -11,7 +11,10 @@
 
 use super::rays::{Location, RayBvh, ON_SURFACE};
 
-/// The most cells one surface's grid has: a byte each.
+/// The most cells one surface's grid has, a byte each: this many per triangle (a tenth of
+/// what the trees hold per triangle), within these bounds.
+const CELLS_PER_TRIANGLE: usize = 8;
+const MIN_CELLS: usize = 1 << 12;
 const MAX_CELLS: usize = 1 << 22;
 /// A cell's edge in mean triangle edges: small enough that few points share a cell with the
 /// surface, large enough that the grid stays small.
@@ -189,7 +192,7 @@ impl Cells {
 }
 
 /// The cell edge and the cells along each axis for a surface with box `min`..`max`: a few
-/// mean triangle edges, larger where the box would need more than [`MAX_CELLS`].
+/// mean triangle edges, larger where the box would need more cells than the surface may have.
 fn layout(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
@@ -208,13 +211,14 @@ fn layout(
     let mean_edge = edges / triangles.len().max(1) as f64;
     let extent: [f64; 3] = std::array::from_fn(|k| max[k] - min[k]);
     let volume: f64 = extent.iter().product();
-    let mut size = (EDGES_PER_CELL * mean_edge).max((volume / MAX_CELLS as f64).cbrt());
+    let most = (CELLS_PER_TRIANGLE * triangles.len()).clamp(MIN_CELLS, MAX_CELLS);
+    let mut size = (EDGES_PER_CELL * mean_edge).max((volume / most as f64).cbrt());
     if !(size.is_finite() && size > ON_SURFACE && extent.iter().all(|e| e.is_finite())) {
         return None;
     }
     loop {
         let along = extent.map(|e| (e / size).floor() + 1.0);
-        if along.iter().product::<f64>() <= MAX_CELLS as f64 {
+        if along.iter().product::<f64>() <= most as f64 {
             return Some((size, along.map(|n| n as usize)));
         }
         size *= 1.25;
