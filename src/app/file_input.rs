@@ -7,6 +7,7 @@ use eframe::egui;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
+use super::folder_drop::{FolderDrops, Listed};
 use super::read_bytes::{self, OnProgress};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsCast;
@@ -39,16 +40,46 @@ pub struct Arrived {
     pub purpose: FilesFor,
 }
 
-/// A file to read: its name and the read, which starts when awaited.
-type PendingRead = (
-    String,
-    Box<
-        dyn FnOnce(
-            OnProgress,
-        )
-            -> std::pin::Pin<Box<dyn std::future::Future<Output = Result<Vec<u8>, String>>>>,
-    >,
-);
+/// A file's read, which starts when awaited.
+type PendingReadFn = Box<
+    dyn FnOnce(
+        OnProgress,
+    )
+        -> std::pin::Pin<Box<dyn std::future::Future<Output = Result<Vec<u8>, String>>>>,
+>;
+
+/// A file to read: its name and the read.
+type PendingRead = (String, PendingReadFn);
+
+/// The read of a file of this machine's.
+fn local_read(file: web_sys::File) -> PendingReadFn {
+    Box::new(move |progress| {
+        Box::pin(async move { read_bytes::read_file(&file, progress).await })
+            as std::pin::Pin<Box<dyn std::future::Future<Output = _>>>
+    })
+}
+
+/// Where [`FolderDrops`] hands a drop's listed files: read together as a new case, or the
+/// item that could not be listed reported as a file that failed.
+fn deliver_folders(inbox: &Inbox, ctx: &egui::Context) -> std::rc::Rc<dyn Fn(Listed)> {
+    let (inbox, ctx) = (inbox.clone(), ctx.clone());
+    std::rc::Rc::new(move |listed: Listed| match listed {
+        Ok(files) => {
+            let reads = (files.into_iter())
+                .map(|(name, file)| (name, local_read(file)))
+                .collect();
+            inbox.read_together(reads, FilesFor::NewCase, &ctx);
+        }
+        Err((name, error)) => {
+            let files = vec![ArrivedFile {
+                name,
+                bytes: Err(error),
+            }];
+            let purpose = FilesFor::NewCase;
+            inbox.deliver(Arrived { files, purpose }, &ctx);
+        }
+    })
+}
 
 /// A file being read: bytes so far, and the total when known.
 #[derive(Clone, Debug, PartialEq)]
@@ -164,16 +195,22 @@ pub struct FileInput {
     picker: Result<web_sys::HtmlInputElement, String>,
     /// Kept alive as long as the input element may fire `change`.
     _on_change: Option<ChangeListener>,
+    /// Drops that hold a folder, which this takes from eframe.
+    folders: Option<FolderDrops>,
 }
 
 impl FileInput {
     pub fn new(ctx: &egui::Context) -> Self {
         let inbox = Inbox::default();
+        let folders = FolderDrops::listen(deliver_folders(&inbox, ctx))
+            .map_err(|e| log::error!("dropped folders will not be read: {e}"))
+            .ok();
         match create_picker(&inbox, ctx) {
             Ok((input, on_change)) => Self {
                 inbox,
                 picker: Ok(input),
                 _on_change: Some(on_change),
+                folders,
             },
             Err(e) => {
                 log::error!("no file picker: {e}");
@@ -181,6 +218,7 @@ impl FileInput {
                     inbox,
                     picker: Err(e),
                     _on_change: None,
+                    folders,
                 }
             }
         }
@@ -200,15 +238,16 @@ impl FileInput {
     /// Starts reading the files dropped on the page this frame, to open together as one case.
     pub fn collect_dropped(&self, ctx: &egui::Context) {
         let dropped = ctx.input(|i| i.raw.dropped_files.clone());
-        let files: Vec<PendingRead> = dropped
-            .into_iter()
+        // Those of drops that held a folder come through `folders`.
+        let skipped = self.folders.as_ref().map_or(0, FolderDrops::take_skipped);
+        let files: Vec<PendingRead> = (dropped.into_iter().skip(skipped))
             .map(|file| {
                 let name = file
                     .path()
                     .file_name()
                     .map(|n| n.to_string_lossy().into_owned())
                     .unwrap_or_else(|| file.path().to_string_lossy().into_owned());
-                let read: Box<dyn FnOnce(OnProgress) -> _> = Box::new(move |progress| {
+                let read: PendingReadFn = Box::new(move |progress| {
                     Box::pin(async move {
                         match file.web_file() {
                             Some(web_file) => read_bytes::read_file(web_file, progress).await,
@@ -291,14 +330,7 @@ fn create_picker(
             };
             let files: Vec<PendingRead> = (0..list.length())
                 .filter_map(|i| list.get(i))
-                .map(|file| {
-                    let name = file.name();
-                    let read: Box<dyn FnOnce(OnProgress) -> _> = Box::new(move |progress| {
-                        Box::pin(async move { read_bytes::read_file(&file, progress).await })
-                            as std::pin::Pin<Box<dyn std::future::Future<Output = _>>>
-                    });
-                    (name, read)
-                })
+                .map(|file| (file.name(), local_read(file)))
                 .collect();
             if !files.is_empty() {
                 inbox.read_together(files, inbox.picking_for.get(), &ctx);

@@ -32,6 +32,7 @@ mod document;
 mod download;
 mod drag_params;
 mod file_input;
+mod folder_drop;
 mod gallery;
 mod gallery_view;
 mod gpu_engine;

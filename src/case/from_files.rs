@@ -154,6 +154,14 @@ pub fn surface_structure(path: &str, mesh: Mesh, ordinal: usize) -> CaseStructur
     s
 }
 
+/// Whether a file found in a folder opens with the folder's others: every file but hidden ones
+/// (a file manager's `.DS_Store`) and a DICOMDIR index, which holds no slice or segment. The
+/// CLI's folders and the page's dropped folders are read alike.
+pub fn read_in_folder(name: &str) -> bool {
+    let name = file_name(name);
+    !name.starts_with('.') && !name.eq_ignore_ascii_case("DICOMDIR")
+}
+
 /// A path's last component: all of a path a case keeps.
 pub fn file_name(path: &str) -> &str {
     path.rsplit(['/', '\\']).next().unwrap_or(path)

@@ -20,8 +20,8 @@ pub mod xapi;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
 pub use from_files::{
-    file_name, first_structure_file, open, open_staged, reading_stages, split_color_table,
-    surface_structure, CaseOpenError,
+    file_name, first_structure_file, open, open_staged, read_in_folder, reading_stages,
+    split_color_table, surface_structure, CaseOpenError,
 };
 pub use image::{check_frame, CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
 pub use lesson::{Camera, Label, Lesson, Quiz, QuizMode, Step};

@@ -195,3 +195,23 @@ fn a_list_shows_the_ungrouped_first_then_each_group_and_filters_by_name_or_group
     assert_eq!(listed("vessel"), vec![(Some("Vessels"), vec![0, 3])]);
     assert!(listed("spleen").is_empty());
 }
+
+#[test]
+fn a_folders_hidden_files_and_dicomdir_are_not_read_with_its_others() {
+    for kept in [
+        "liver.nii.gz",
+        "masks/kidney_left.nii.gz",
+        "IM0001",
+        "dicomdir.txt",
+    ] {
+        assert!(read_in_folder(kept), "{kept}");
+    }
+    for skipped in [
+        ".DS_Store",
+        "masks/._liver.nii.gz",
+        "DICOMDIR",
+        "series\\dicomdir",
+    ] {
+        assert!(!read_in_folder(skipped), "{skipped}");
+    }
+}

@@ -13,16 +13,15 @@ fn read(path: &Path) -> Result<(String, Vec<u8>), String> {
     Ok((path.display().to_string(), bytes))
 }
 
-/// The files of a folder (a DICOM series' slices), sorted by name: every regular file but
-/// hidden ones and a DICOMDIR index, which holds no slice.
+/// The files of a folder (a DICOM series' slices), sorted by name: every regular file that
+/// [`crate::case::read_in_folder`] keeps.
 pub(super) fn read_folder(dir: &Path) -> Result<Vec<(String, Vec<u8>)>, String> {
     let failed = |e: std::io::Error| format!("{}: {e}", dir.display());
     let mut paths = Vec::new();
     for entry in std::fs::read_dir(dir).map_err(failed)? {
         let entry = entry.map_err(failed)?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        let skipped = name.starts_with('.') || name.eq_ignore_ascii_case("DICOMDIR");
-        if !skipped && entry.file_type().map_err(failed)?.is_file() {
+        if crate::case::read_in_folder(&name) && entry.file_type().map_err(failed)?.is_file() {
             paths.push(entry.path());
         }
     }

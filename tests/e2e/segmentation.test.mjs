@@ -612,6 +612,32 @@ testIn(EVERY_RUN, "S9b a label map with its colour table, and four masks, droppe
     });
 });
 
+testIn(EVERY_RUN, "S9c a folder of masks dropped on the page opens as the CLI opens its files; an empty one is reported", { timeout: TIMEOUT }, async () => {
+    await withApp(async (app) => {
+        // In the order of their names, hidden files and subfolders not read.
+        const masks = ["bent_tube_r3.5_mask.nii.gz", "ellipsoid_30_20_12_mask.nii.gz", "sphere_r20_mask.nii.gz", "torus_R24_r8_mask.nii.gz"];
+        const paths = masks.map((m) => meshPath(`synthetic/${m}`));
+        const shuffled = [2, 0, 3, 1].map((i) => ({ bytes: readFileSync(paths[i]), name: masks[i] }));
+        await app.dropFolder("masks", [...shuffled, { bytes: Buffer.from("Bud1"), name: ".DS_Store" }]);
+        let state = await app.stateWhen((s) => s.structures?.file === "masks/bent_tube_r3.5_mask.nii.gz and 3 more files" && s.loading === null && s.model !== null, "the folder to open");
+        const native = await cli.cliJson("extract", ...paths, "-o", join(E2E_OUT, `extract-folder-${MODE}/`), "--json");
+        assertSameStructures(state.structures.structures, native.structures);
+        assert.deepEqual(state.structures.structures.map((s) => s.source), masks);
+        assert.equal(state.error, null, "the folder's own entry among the drop's files is not opened");
+        await app.screenshot("S9c-folder-of-masks");
+
+        // A folder with nothing to read: its name and why, and the case stays.
+        await app.dropFolder("empty", [{ bytes: Buffer.from("Bud1"), name: ".DS_Store" }]);
+        state = await app.stateWhen((s) => s.error !== null, "the empty folder's error");
+        assert.match(state.error, /empty.*the folder holds no file/);
+        assert.equal(state.structures.structures.length, 4);
+
+        // A file dropped after them opens as before.
+        state = await dropAsOneCase(app, [{ bytes: readFileSync(PHANTOM_NRRD), name: "case_phantom_shared.seg.nrrd" }], "case_phantom_shared.seg.nrrd");
+        assert.equal(state.structures.structures.length, 4);
+    });
+});
+
 testIn(WEBGPU_RUN, "S10 the Structures list by mouse and keyboard: select, show alone, hide, rename", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd");

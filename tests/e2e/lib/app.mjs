@@ -365,4 +365,42 @@ export class AppPage {
         }
         await dataTransfer.dispose();
     }
+
+    /**
+     * Drops a folder `name` of `files` (`[{bytes, name}]`) and an empty subfolder on the
+     * canvas, as the browser's File and Directory Entries API shows a dropped folder: listed in
+     * batches of two, the folder also among the drop's files as Chromium gives it. Playwright
+     * cannot drop a real folder, so the entries are made here; the files are real ones.
+     */
+    async dropFolder(name, files) {
+        const encoded = files.map(({ bytes, name }) => [Buffer.from(bytes).toString("base64"), name]);
+        await this.page.evaluate(([folder, files]) => {
+            const bytesOf = (base64) => Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
+            const fileEntry = (file) => ({ isFile: true, isDirectory: false, name: file.name, file: (ok) => setTimeout(() => ok(file)) });
+            const folderEntry = (name, entries) => ({
+                isFile: false,
+                isDirectory: true,
+                name,
+                createReader() {
+                    let at = 0;
+                    return {
+                        readEntries(ok) {
+                            const batch = entries.slice(at, at + 2);
+                            at += batch.length;
+                            setTimeout(() => ok(batch));
+                        },
+                    };
+                },
+            });
+            const entries = files.map(([base64, name]) => fileEntry(new File([bytesOf(base64)], name)));
+            entries.push(folderEntry("nested", [fileEntry(new File(["not read"], "nested.nii.gz"))]));
+            const root = folderEntry(folder, entries);
+            const asFile = new DataTransfer();
+            asFile.items.add(new File([], folder));
+            const transfer = { items: { length: 1, 0: { kind: "file", type: "", webkitGetAsEntry: () => root } }, files: asFile.files };
+            const drop = new DragEvent("drop", { bubbles: true, cancelable: true });
+            Object.defineProperty(drop, "dataTransfer", { value: transfer });
+            document.getElementById("meshsmooth_canvas").dispatchEvent(drop);
+        }, [name, encoded]);
+    }
 }

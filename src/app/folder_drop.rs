@@ -1,0 +1,158 @@
+//! Folders dropped on the page. eframe hands the app every dropped item as a file, a folder as
+//! one it cannot read; so a listener on the window, which the browser calls before eframe's on
+//! the canvas, takes each drop that holds a folder and lists the folder with the browser's File
+//! and Directory Entries API. A folder's files open as the CLI reads a folder
+//! ([`crate::case::read_in_folder`], in the order of their names, subfolders not read), with the
+//! files dropped beside it, as one case.
+
+use std::cell::Cell;
+use std::rc::Rc;
+
+use js_sys::{Array, Function, Promise};
+use wasm_bindgen::closure::Closure;
+use wasm_bindgen::{JsCast, JsValue};
+use wasm_bindgen_futures::JsFuture;
+use web_sys::{FileSystemDirectoryEntry, FileSystemEntry, FileSystemFileEntry};
+
+/// A folder of more entries than this is refused: the listing stays bounded.
+const MAX_ENTRIES: usize = 20_000;
+
+/// A drop's files in order, each named by its path in the drop (`masks/liver.nii.gz`); or the
+/// item that could not be listed and why.
+pub type Listed = Result<Vec<(String, web_sys::File)>, (String, String)>;
+
+/// The `drop` listener, and how many of eframe's dropped files belong to drops it took.
+pub struct FolderDrops {
+    _listener: Closure<dyn FnMut(web_sys::DragEvent)>,
+    taken: Rc<Cell<usize>>,
+}
+
+impl FolderDrops {
+    /// Listens on the window; `deliver` gets each taken drop's files once listed.
+    pub fn listen(deliver: Rc<dyn Fn(Listed)>) -> Result<FolderDrops, String> {
+        let window = web_sys::window().ok_or("no window")?;
+        let taken = Rc::new(Cell::new(0));
+        let listener = {
+            let taken = taken.clone();
+            Closure::<dyn FnMut(web_sys::DragEvent)>::new(move |event: web_sys::DragEvent| {
+                let Some(transfer) = event.data_transfer() else {
+                    return;
+                };
+                let entries = entries_of(&transfer);
+                if !entries.iter().any(|e| e.is_directory()) {
+                    return;
+                }
+                // eframe still sees the drop (it ends its hover hint) and hands on its files;
+                // the app skips as many.
+                let files = transfer.files().map_or(0, |f| f.length() as usize);
+                taken.set(taken.get() + files);
+                event.prevent_default();
+                let deliver = deliver.clone();
+                wasm_bindgen_futures::spawn_local(async move { deliver(list(entries).await) });
+            })
+        };
+        window
+            .add_event_listener_with_callback_and_bool(
+                "drop",
+                listener.as_ref().unchecked_ref(),
+                true,
+            )
+            .map_err(|e| super::page::js_error_text(&e))?;
+        Ok(FolderDrops {
+            _listener: listener,
+            taken,
+        })
+    }
+
+    /// How many of the files eframe hands on next belong to taken drops (then 0 again).
+    pub fn take_skipped(&self) -> usize {
+        self.taken.replace(0)
+    }
+}
+
+/// The drop's items as entries; the browser gives them only while the drop is handled.
+fn entries_of(transfer: &web_sys::DataTransfer) -> Vec<FileSystemEntry> {
+    let items = transfer.items();
+    (0..items.length())
+        .filter_map(|i| items.get(i))
+        .filter_map(|item| item.webkit_get_as_entry().ok().flatten())
+        .collect()
+}
+
+/// Every file of the dropped items: loose files as they are, each folder's files after their
+/// names.
+async fn list(entries: Vec<FileSystemEntry>) -> Listed {
+    let mut files = Vec::new();
+    for entry in entries {
+        let name = entry.name();
+        let failed = |e: String| (name.clone(), e);
+        if entry.is_directory() {
+            let folder: FileSystemDirectoryEntry = entry.unchecked_into();
+            files.extend(files_of(&folder, &name).await.map_err(failed)?);
+        } else if entry.is_file() {
+            let file = file_of(entry.unchecked_into()).await.map_err(failed)?;
+            files.push((name, file));
+        }
+    }
+    Ok(files)
+}
+
+/// The files `folder` holds that open with the others, by name.
+async fn files_of(
+    folder: &FileSystemDirectoryEntry,
+    name: &str,
+) -> Result<Vec<(String, web_sys::File)>, String> {
+    let reader = folder.create_reader();
+    let mut entries: Vec<FileSystemEntry> = Vec::new();
+    // Each call gives the next batch of entries, an empty one at the end.
+    loop {
+        let batch: Array = called_back(|ok, fail| {
+            if let Err(e) = reader.read_entries_with_callback_and_callback(ok, fail) {
+                let _ = fail.call1(&JsValue::NULL, &e);
+            }
+        })
+        .await?
+        .unchecked_into();
+        if batch.length() == 0 {
+            break;
+        }
+        entries.extend(batch.iter().map(|e| e.unchecked_into::<FileSystemEntry>()));
+        if entries.len() > MAX_ENTRIES {
+            return Err(format!("the folder holds more than {MAX_ENTRIES} entries"));
+        }
+    }
+    let mut kept: Vec<FileSystemEntry> = (entries.into_iter())
+        .filter(|e| e.is_file() && crate::case::read_in_folder(&e.name()))
+        .collect();
+    kept.sort_by_key(|e| e.name());
+    let mut files = Vec::with_capacity(kept.len());
+    for entry in kept {
+        let path = format!("{name}/{}", entry.name());
+        files.push((path, file_of(entry.unchecked_into()).await?));
+    }
+    if files.is_empty() {
+        return Err("the folder holds no file".to_string());
+    }
+    Ok(files)
+}
+
+async fn file_of(entry: FileSystemFileEntry) -> Result<web_sys::File, String> {
+    let file = called_back(|ok, fail| entry.file_with_callback_and_callback(ok, fail)).await?;
+    Ok(file.unchecked_into())
+}
+
+/// The value an API of success and error callbacks gives: `start` is called with both.
+async fn called_back(start: impl FnOnce(&Function, &Function)) -> Result<JsValue, String> {
+    let mut start = Some(start);
+    let promise = Promise::new(&mut |ok, fail| {
+        if let Some(start) = start.take() {
+            start(&ok, &fail);
+        }
+    });
+    JsFuture::from(promise).await.map_err(|e| {
+        format!(
+            "the browser could not list it: {}",
+            super::page::js_error_text(&e)
+        )
+    })
+}
