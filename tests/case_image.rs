@@ -480,3 +480,66 @@ fn the_slice_edges_lie_on_the_surfaces_cut_outline_within_a_voxel() {
         }
     }
 }
+
+/// The phantom's CT with every slice twice, at half the slice spacing, over the same field of
+/// view; `slices` of those kept (the origin moved with the first).
+fn phantom_ct_half_slices(slices: std::ops::Range<usize>) -> Vec<u8> {
+    let map = phantom_map();
+    let sform: [[f32; 4]; 3] = std::array::from_fn(|r| {
+        let m = &map.affine.0[r];
+        // The first thin slice's centre lies a quarter of a slice below the first slice's.
+        let origin = m[3] - 0.25 * m[2] + slices.start as f64 * 0.5 * m[2];
+        [m[0], m[1], 0.5 * m[2], origin].map(|v| v as f32)
+    });
+    let [i, j, _] = map.dims;
+    let spacing = map.spacing();
+    let pixdim = [spacing[0], spacing[1], spacing[2] / 2.0].map(|s| s as f32);
+    let mut bytes = nifti::nifti_header([i, j, slices.len()], sform, pixdim);
+    bytes[70..72].copy_from_slice(&4i16.to_le_bytes()); // int16
+    bytes[72..74].copy_from_slice(&16i16.to_le_bytes());
+    let (plane, hu) = (i * j * 2, phantom_hu(&map));
+    for thin in slices {
+        let k = thin / 2;
+        bytes.extend(&hu[k * plane..(k + 1) * plane]);
+    }
+    bytes
+}
+
+#[test]
+fn an_image_on_another_grid_is_added_where_it_covers_the_structures() {
+    let on_grid = phantom_with_image();
+    let on_grid = on_grid.image.as_ref().expect("added");
+    let mut case = label_maps::phantom_case();
+    let slices = 2 * phantom_map().dims[2];
+    let thin = phantom_ct_half_slices(0..slices);
+    let preset = WindowPreset::CtSoftTissue;
+    (add_one(&mut case, &thin, "thin.nii", preset, 1 << 24)).expect("covers the structures");
+    let image = case.image.as_ref().expect("added");
+    assert_eq!(image.dims[2], slices);
+    // At the segmentation's voxel centres, between two thin slices of the same level, the grey
+    // levels are those of the CT on the segmentation's grid.
+    let map = phantom_map();
+    let mut levels = std::collections::BTreeSet::new();
+    for k in 0..map.dims[2] {
+        for (i, j) in [(40, 50), (80, 70), (100, 60), (120, 90)] {
+            let at = map.affine.apply([i as f64, j as f64, k as f64]);
+            let (a, b) = (image.sample(at), on_grid.sample(at));
+            assert_eq!(a, b, "voxel ({i}, {j}, {k})");
+            levels.insert(a.map(|a| a as u8));
+        }
+    }
+    assert!(
+        levels.len() >= 3,
+        "{levels:?}: more than the background compared"
+    );
+    // Half the thin slices leave the structures outside: refused, the case kept.
+    let before = case.clone();
+    let half = phantom_ct_half_slices(0..slices / 2);
+    let error = add_one(&mut case, &half, "half.nii", preset, 1 << 24).expect_err("half");
+    assert!(
+        error.starts_with("the image, on another voxel grid")
+            && error.contains("does not cover the segmentation"),
+        "{error}"
+    );
+    assert_eq!(case, before);
+}

@@ -1,6 +1,6 @@
 //! The image under the surfaces: the CT or MRI a segmentation was drawn on, carried in the case
 //! as a student needs it (8-bit after a window the author chose), on the segmentation's own
-//! world frame (checked when the image is added).
+//! world frame (`image_frame` checks it belongs there when it is added).
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -8,6 +8,7 @@ use serde_json::{json, Value};
 use std::sync::Arc;
 
 use super::file_name;
+use super::image_frame::{check_frame, StructureGrid};
 use crate::io::{load_image, load_image_series, Affine, ImageVolume};
 
 /// The voxels an image is reduced to by default: what a phone's browser takes with the case.
@@ -205,7 +206,7 @@ impl CaseImage {
         name: &str,
         preset: WindowPreset,
         max_voxels: usize,
-        grids: &[(String, Affine)],
+        grids: &[StructureGrid],
     ) -> Result<Self, String> {
         if grids.is_empty() {
             return Err(
@@ -225,12 +226,12 @@ impl CaseImage {
         image: &ImageVolume,
         name: &str,
         preset: WindowPreset,
-        grids: &[(String, Affine)],
+        grids: &[StructureGrid],
     ) -> Result<Self, String> {
-        for (structure, grid) in grids {
-            check_frame(image, grid).map_err(|e| match grids.len() {
+        for on in grids {
+            check_frame(image, on).map_err(|e| match grids.len() {
                 1 => e,
-                _ => format!("{e}; the grid is {structure}'s"),
+                _ => format!("{e}; the grid is {}'s", on.structure),
             })?;
         }
         Ok(CaseImage::new(image, file_name(name), preset))
@@ -238,14 +239,23 @@ impl CaseImage {
 }
 
 impl super::Case {
-    /// Each distinct grid the structures were extracted on, with the first structure on it (a
-    /// case may join label maps on different grids: an image must lie on each).
-    pub fn image_grids(&self) -> Vec<(String, Affine)> {
-        let mut grids: Vec<(String, Affine)> = Vec::new();
+    /// Each distinct grid the structures were extracted on, with the first structure on it and
+    /// where they all lie (a case may join label maps on different grids: an image must fit
+    /// each).
+    pub fn image_grids(&self) -> Vec<StructureGrid> {
+        let mut grids: Vec<StructureGrid> = Vec::new();
         for s in &self.structures {
-            if let Some(grid) = s.grid.filter(|g| grids.iter().all(|(_, seen)| seen != g)) {
-                grids.push((s.name.clone(), grid));
-            }
+            let Some(grid) = s.grid else {
+                continue;
+            };
+            let at = match grids.iter().position(|g| g.grid == grid) {
+                Some(at) => at,
+                None => {
+                    grids.push(StructureGrid::new(&s.name, grid));
+                    grids.len() - 1
+                }
+            };
+            grids[at].span(&s.original.positions);
         }
         grids
     }
@@ -264,52 +274,6 @@ impl super::Case {
         self.image = Some(Arc::new(image));
         Ok(())
     }
-}
-
-/// Refuses an image whose voxels are not the segmentation's: `grid` is the voxel grid the case's
-/// structures were extracted on. The image may cover more or less than the segmentation (a CT
-/// cropped to the body, a 3D Slicer segmentation cropped to its segments) as long as its lattice
-/// is the grid's shifted by whole voxels. Names the largest offset found at the image's corners
-/// from the grid's nearest voxels.
-pub fn check_frame(image: &ImageVolume, grid: &Affine) -> Result<(), String> {
-    let [di, dj, dk] = image.source_dims.map(|d| d.saturating_sub(1) as f64);
-    let corners = [
-        [0.0, 0.0, 0.0],
-        [di, 0.0, 0.0],
-        [0.0, dj, 0.0],
-        [0.0, 0.0, dk],
-        [di, dj, dk],
-    ];
-    let smallest = (image.source_affine.spacing().into_iter())
-        .chain(grid.spacing())
-        .fold(f64::INFINITY, f64::min);
-    let tolerance = 0.05 * smallest;
-    // Where the image's first voxel falls on the grid, to the nearest whole voxel.
-    let shift = (grid.inverse_apply(image.source_affine.apply([0.0; 3])))
-        .filter(|at| at.iter().all(|x| x.is_finite()))
-        .map_or([0.0; 3], |at| at.map(f64::round));
-    let (worst, corner, offset) = (corners.iter())
-        .map(|c| {
-            let a = image.source_affine.apply(*c);
-            let b = grid.apply(std::array::from_fn(|k| c[k] + shift[k]));
-            let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-            ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), *c, d)
-        })
-        .fold((0.0, [0.0; 3], [0.0; 3]), |best, x| {
-            if x.0 > best.0 {
-                x
-            } else {
-                best
-            }
-        });
-    if worst <= tolerance {
-        return Ok(());
-    }
-    Err(format!(
-        "the image does not lie on the segmentation's voxel grid: its voxel ({}, {}, {}) is \
-         {worst:.3} mm from the segmentation's (offset {:.3}, {:.3}, {:.3} mm, RAS)",
-        corner[0], corner[1], corner[2], offset[0], offset[1], offset[2]
-    ))
 }
 
 /// The values at two quantiles (`low < high` in [0, 1]), ignoring non-finite ones; two
@@ -378,46 +342,5 @@ mod tests {
         assert_eq!(grey.sample([9.5, 0.0, 0.0]), Some(0.0));
         assert_eq!(grey.sample([8.0, 0.0, 0.0]), None);
         assert_eq!(grey.sample([12.0, 0.0, 2.0]), None);
-    }
-
-    #[test]
-    fn an_image_off_the_segmentation_lattice_is_refused_with_its_offset_a_crop_is_not() {
-        let grid = Affine::scaled([1.5, 1.5, 3.0], [-100.0, -80.0, 20.0]);
-        let same = volume([10, 10, 5], grid, vec![0.0; 500]);
-        assert_eq!(check_frame(&same, &grid), Ok(()));
-        let moved = volume(
-            [10, 10, 5],
-            Affine::scaled([1.5, 1.5, 3.0], [-100.0, -67.5, 20.0]),
-            vec![0.0; 500],
-        );
-        let error = check_frame(&moved, &grid).expect_err("moved");
-        // 12.5 mm is 8 1/3 voxels: a third of a voxel from the nearest.
-        assert!(
-            error.starts_with("the image does not lie on") && error.contains("0.500 mm"),
-            "{error}"
-        );
-        assert!(error.contains("offset 0.000, 0.500, 0.000 mm"), "{error}");
-        // A crop of the grid (or the grid a crop of the image) lies on it: whole voxels apart.
-        let cropped = volume(
-            [4, 6, 2],
-            Affine::scaled([1.5, 1.5, 3.0], [-97.0, -74.0, 26.0]),
-            vec![0.0; 48],
-        );
-        assert_eq!(check_frame(&cropped, &grid), Ok(()));
-        assert_eq!(check_frame(&same, &cropped.source_affine), Ok(()));
-        // Half a voxel off the lattice, or of another spacing, it does not.
-        let half = volume(
-            [4, 6, 2],
-            Affine::scaled([1.5, 1.5, 3.0], [-97.75, -74.0, 26.0]),
-            vec![0.0; 48],
-        );
-        let error = check_frame(&half, &grid).expect_err("half a voxel");
-        assert!(error.contains("0.750 mm"), "{error}");
-        let finer = volume(
-            [10, 10, 5],
-            Affine::scaled([1.5, 1.5, 2.0], [-100.0, -80.0, 20.0]),
-            vec![0.0; 500],
-        );
-        assert!(check_frame(&finer, &grid).is_err());
     }
 }

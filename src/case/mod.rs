@@ -10,6 +10,7 @@
 mod checks;
 mod from_files;
 mod image;
+mod image_frame;
 mod lesson;
 pub mod names;
 mod pipeline;
@@ -23,7 +24,8 @@ pub use from_files::{
     file_name, first_structure_file, open, open_staged, read_in_folder, reading_stages,
     split_color_table, surface_structure, CaseOpenError,
 };
-pub use image::{check_frame, CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
+pub use image::{CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
+pub use image_frame::{check_frame, StructureGrid};
 pub use lesson::{Camera, Label, Lesson, Quiz, QuizMode, Step};
 pub use pipeline::{
     smooth_structure, starts_from, suggest_all, suggest_structure, SuggestAllOptions,

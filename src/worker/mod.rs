@@ -44,7 +44,7 @@ pub enum Input {
     Image {
         files: Vec<NamedFile>,
         preset: String,
-        grids: Vec<(String, crate::io::Affine)>,
+        grids: Vec<case::StructureGrid>,
     },
 }
 
@@ -451,7 +451,7 @@ fn read_image(
     name: &str,
     files: &[NamedFile],
     preset: &str,
-    grids: &[(String, crate::io::Affine)],
+    grids: &[case::StructureGrid],
 ) -> Result<Case, String> {
     let preset = (case::WindowPreset::from_name(preset))
         .ok_or_else(|| format!("{name}: no window preset named {preset:?}"))?;
