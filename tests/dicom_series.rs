@@ -288,6 +288,22 @@ fn jpeg_series_read_as_the_uncompressed_ones() {
         b[at..at + 2].copy_from_slice(b"GI");
     };
     refused(&not_jpeg, "JPEG frame 1: the codestream does not start");
+    // Cut short: the fragment's last bytes, its end of image, gone (zeros in their place, as
+    // a copy that stopped early would leave them).
+    let cut = |b: &mut Vec<u8>| {
+        let at = dicom::first_fragment(b);
+        let length = u32::from_le_bytes(b[at - 4..at].try_into().unwrap()) as usize;
+        let end = at + length;
+        assert!(
+            b[at..end].ends_with(&[0xFF, 0xD9]),
+            "the fragment ends the codestream"
+        );
+        b[end - 64..end].fill(0);
+    };
+    refused(
+        &cut,
+        "JPEG frame 1: the codestream ends without a JPEG end of image",
+    );
 }
 
 /// `case build --image FOLDER`: the series' image in the case, the same as from its twin; a

@@ -54,6 +54,11 @@ pub(super) fn decode(
         }
         let what = "bytes in a JPEG frame";
         shape.bytes_within(stream.len(), MOST_EXPANSION, what, format)?;
+        // The decoder's own word for a codestream cut short is an I/O error of its reader.
+        if !ends_with_end_of_image(stream) {
+            let cut = "the codestream ends without a JPEG end of image: it is cut short";
+            return Err(bad(cut.into()));
+        }
         let mut decoder = jpeg_decoder::Decoder::new(*stream);
         decoder.set_max_decoding_buffer_size(shape.pixels);
         let pixels = decoder.decode().map_err(|e| bad(e.to_string()))?;
@@ -75,6 +80,13 @@ pub(super) fn decode(
         }
     }
     Ok(out)
+}
+
+/// Whether a codestream ends with its end-of-image marker, before the zero byte DICOM may pad
+/// a fragment with to an even length.
+fn ends_with_end_of_image(stream: &[u8]) -> bool {
+    let unpadded = stream.strip_suffix(&[0]).unwrap_or(stream);
+    unpadded.ends_with(&[0xFF, 0xD9])
 }
 
 /// The first frame header (SOF0..SOF15 but DHT, JPG and DAC) before the first scan.
@@ -142,6 +154,17 @@ mod tests {
         assert!(frame_header(b"GIF89a")
             .unwrap_err()
             .contains("start of image"));
+    }
+
+    #[test]
+    fn a_codestream_ends_with_its_end_of_image_padded_or_not() {
+        assert!(ends_with_end_of_image(&[0xFF, 0xD8, 0x12, 0xFF, 0xD9]));
+        assert!(ends_with_end_of_image(&[0xFF, 0xD8, 0xFF, 0xD9, 0x00]));
+        assert!(!ends_with_end_of_image(&[0xFF, 0xD8, 0x12, 0x34]));
+        assert!(!ends_with_end_of_image(&[
+            0xFF, 0xD8, 0xFF, 0xD9, 0x00, 0x00
+        ]));
+        assert!(!ends_with_end_of_image(&[0xFF, 0xD9, 0x12]));
     }
 
     #[test]
