@@ -389,3 +389,18 @@ fn the_page_session_adds_a_series_under_the_phantom() {
     );
     assert_eq!(session.case().case_image(), Some(&image), "kept");
 }
+
+/// The oblique series in Deflated Explicit VR Little Endian reads as the uncompressed one; a
+/// slice whose stream is cut short is refused naming its file.
+#[test]
+fn a_deflated_series_reads_as_the_uncompressed_one() {
+    let files = slices("oblique_deflated");
+    assert_eq!(files.len(), 12);
+    assert_same(&read(&files, ALL).expect("the deflated series"), &twin(ALL));
+    let mut cut = slices("oblique_deflated");
+    let len = cut[5].1.len();
+    cut[5].1.truncate(len - 100);
+    let e = refusal(&cut);
+    assert!(e.starts_with(&format!("{}: DICOM image:", cut[5].0)), "{e}");
+    assert!(e.contains("does not inflate"), "{e}");
+}

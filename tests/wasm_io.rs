@@ -207,8 +207,8 @@ macro_rules! oblique_slices {
     };
 }
 
-/// DICOM slices compressed as RLE Lossless and as JPEG Lossless decode in the browser to the
-/// voxels of the series' NIfTI twin.
+/// DICOM slices compressed as RLE Lossless, as JPEG Lossless and deflated decode in the browser
+/// to the voxels of the series' NIfTI twin.
 #[wasm_bindgen_test]
 fn compressed_dicom_series_read_as_their_nifti_twin() {
     let twin = include_bytes!("data/dicom_series/oblique.nii.gz");
@@ -216,6 +216,7 @@ fn compressed_dicom_series_read_as_their_nifti_twin() {
     for files in [
         oblique_slices!("oblique_rle", "rle_"),
         oblique_slices!("oblique_jpeg", "jpeg_"),
+        oblique_slices!("oblique_deflated", "deflated_"),
     ] {
         let image = io::load_image_series(&files, usize::MAX).expect("the series");
         assert_eq!(image.dims, want.dims);

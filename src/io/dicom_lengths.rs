@@ -2,13 +2,15 @@
 //! bytes left, before `dicom-object` parses it: that parser reserves each value's declared
 //! length (up to 4 GiB) before reading it, so a lying length in a small file would otherwise
 //! cost gigabytes. The walk also finds the transfer syntax and refuses the encodings the reader
-//! does not take (big-endian, deflated, compressions other than RLE and JPEG). The walk reads
+//! does not take (big-endian, compressions other than RLE and JPEG); a deflated file is walked
+//! once inflated ([`dicom_deflate`]). The walk reads
 //! headers exactly as dicom-rs does (an unknown VR has a 32-bit length, as UN), so that every
 //! value it will allocate has been measured; what the two would read differently is refused.
 
 use std::borrow::Cow;
 use std::ops::Range;
 
+use super::dicom_deflate::{self, MetaGroup, DEFLATED_EXPLICIT_LE};
 use super::{dicom_jpeg, dicom_rle};
 use super::{Format, LoadError};
 
@@ -32,11 +34,13 @@ const GROUP_LENGTH: (u16, u16) = (0x0002, 0x0000);
 
 /// What the walk found: where the DICOM stream starts (after the 128-byte preamble, or at 0 when
 /// a file has none) and where the last Pixel Data value lies, so that the pixels are read from
-/// the file's bytes rather than copied into the parsed object.
+/// the file's bytes rather than copied into the parsed object. A deflated file's positions are
+/// in its inflated bytes, which the layout holds.
 #[derive(Debug)]
 pub(super) struct Layout {
     pub start: usize,
     pub pixel_data: Option<PixelData>,
+    inflated: Option<Vec<u8>>,
 }
 
 /// Where the pixels lie in the file.
@@ -111,7 +115,7 @@ impl Layout {
     /// decoded; refused when there is none, or less than `frames` declare (`what` says what
     /// the bytes are for).
     pub(super) fn pixels<'a>(
-        &self,
+        self,
         bytes: &'a [u8],
         frames: Frames,
         what: &'static str,
@@ -121,26 +125,34 @@ impl Layout {
             format,
             detail: "no Pixel Data".into(),
         };
-        match self.pixel_data.as_ref().ok_or_else(no_pixels)? {
+        let inflated = self.inflated;
+        match self.pixel_data.ok_or_else(no_pixels)? {
             PixelData::Native(range) => {
-                let data = &bytes[range.clone()];
                 // Checked: usize is 32 bits in the browser, and the sizes come from the file.
                 let needed = (frames.count.checked_mul(frames.pixels()))
                     .and_then(|n| n.checked_mul(frames.bits))
                     .map_or(usize::MAX, |n| n.div_ceil(8));
-                if data.len() < needed {
+                if range.len() < needed {
                     return Err(LoadError::CountTooLarge {
                         format,
                         what,
                         claimed: needed as u64,
-                        possible: data.len() as u64,
+                        possible: range.len() as u64,
                     });
                 }
-                Ok(Cow::Borrowed(data))
+                Ok(match inflated {
+                    Some(mut inflated) => {
+                        inflated.truncate(range.end);
+                        inflated.drain(..range.start);
+                        Cow::Owned(inflated)
+                    }
+                    None => Cow::Borrowed(&bytes[range]),
+                })
             }
             PixelData::Encapsulated { codec, fragments } => {
-                let fragments: Vec<&[u8]> = fragments.iter().map(|r| &bytes[r.clone()]).collect();
-                decode(*codec, &fragments, frames, format).map(Cow::Owned)
+                let source = inflated.as_deref().unwrap_or(bytes);
+                let fragments: Vec<&[u8]> = fragments.iter().map(|r| &source[r.clone()]).collect();
+                decode(codec, &fragments, frames, format).map(Cow::Owned)
             }
         }
     }
@@ -194,10 +206,11 @@ pub(super) fn open(
 ) -> Result<(Layout, dicom_object::DefaultDicomObject), LoadError> {
     use dicom_object::file::{OpenFileOptions, ReadPreamble};
     let layout = check(bytes, format)?;
+    let walked = layout.inflated.as_deref().unwrap_or(bytes);
     let object = OpenFileOptions::new()
         .read_preamble(ReadPreamble::Never)
         .read_until(dicom_dictionary_std::tags::PIXEL_DATA)
-        .from_reader(&bytes[layout.start..])
+        .from_reader(&walked[layout.start..])
         .map_err(|e| LoadError::Unsupported {
             format,
             detail: format!("the DICOM object does not parse: {e}"),
@@ -223,7 +236,15 @@ pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
         at: start,
         pixel_data: None,
     };
-    let syntax = walk.meta_group()?;
+    let (syntax, meta) = walk.meta_group()?;
+    if syntax == DEFLATED_EXPLICIT_LE {
+        let explicit = dicom_deflate::as_explicit(bytes, &meta, format)?;
+        let layout = check(&explicit, format)?;
+        return Ok(Layout {
+            inflated: Some(explicit),
+            ..layout
+        });
+    }
     let (implicit, codec) = match syntax.as_str() {
         EXPLICIT_LE => (false, None),
         IMPLICIT_LE => (true, None),
@@ -235,20 +256,20 @@ pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
     Ok(Layout {
         start: start - 4,
         pixel_data: walk.pixel_data,
+        inflated: None,
     })
 }
 
 fn unsupported_syntax(uid: &str, format: Format) -> LoadError {
     let what = match uid {
         "1.2.840.10008.1.2.2" => "explicit VR big endian",
-        "1.2.840.10008.1.2.1.99" => "deflated explicit VR little endian",
         _ => "a compressed or unknown encoding",
     };
     LoadError::Unsupported {
         format,
         detail: format!(
-            "transfer syntax {uid} ({what}): uncompressed little-endian, RLE Lossless and JPEG \
-             files are read"
+            "transfer syntax {uid} ({what}): uncompressed and deflated little-endian, RLE \
+             Lossless and JPEG files are read"
         ),
     }
 }
@@ -289,7 +310,8 @@ impl Walk<'_> {
     /// The file meta group (always explicit VR little endian); returns the transfer syntax.
     /// Its elements are those within the length (0002,0000) declares, whatever their group:
     /// so dicom-rs reads them, and the data set starts where it says.
-    fn meta_group(&mut self) -> Result<String, LoadError> {
+    fn meta_group(&mut self) -> Result<(String, MetaGroup), LoadError> {
+        let group_start = self.at;
         let first = self.header(false)?;
         if first.tag != GROUP_LENGTH || first.len != 4 {
             return Err(self.bad("the file meta group does not open with its length (0002,0000)"));
@@ -298,7 +320,9 @@ impl Walk<'_> {
         let declared = u32::from_le_bytes([value[0], value[1], value[2], value[3]]);
         let end = self.at.saturating_add(declared as usize);
         let mut syntax = None;
+        let mut syntax_element = 0..0;
         while self.at < end {
+            let element_start = self.at;
             let header = self.header(false)?;
             if header.nested {
                 return Err(self.bad("a sequence in the file meta group"));
@@ -307,9 +331,16 @@ impl Walk<'_> {
             if header.tag == TRANSFER_SYNTAX {
                 let text = String::from_utf8_lossy(value);
                 syntax = Some(text.trim_end_matches(['\0', ' ']).to_string());
+                syntax_element = element_start..self.at;
             }
         }
-        syntax.ok_or_else(|| self.bad("no transfer syntax (0002,0010) in the file meta group"))
+        let syntax = syntax
+            .ok_or_else(|| self.bad("no transfer syntax (0002,0010) in the file meta group"))?;
+        let meta = MetaGroup {
+            group: group_start..self.at,
+            syntax: syntax_element,
+        };
+        Ok((syntax, meta))
     }
 
     /// `codec`: how the pixels are compressed, if they are (then encapsulated).

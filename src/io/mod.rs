@@ -4,6 +4,7 @@
 
 mod codes;
 mod color_table;
+mod dicom_deflate;
 mod dicom_jpeg;
 mod dicom_lengths;
 mod dicom_rle;

@@ -20,6 +20,10 @@ name):
   frames) and fractional.dcm (FRACTIONAL, 8-bit, 10 frames) as RLE Lossless.
 - tests/data/dicom_seg/fractional_jpeg.dcm: fractional.dcm as JPEG Lossless SV1 (GDCM's
   codestreams, one fragment a frame; GDCM does not read the LABELMAP SOP class).
+- tests/data/dicom_seg/phantom_deflated.dcm and tests/data/dicom_series/oblique_deflated/
+  deflated_*.dcm: phantom.dcm (BINARY) and the slices of oblique/ in Deflated Explicit VR Little
+  Endian (1.2.840.10008.1.2.1.99): the whole data set after the file meta group one raw deflate
+  stream, as pydicom writes it.
 
 BINARY SEGs have no RLE twin: highdicom refuses RLE for 1-bit segmentations. Each lossless twin
 is decoded back with pydicom (GDCM for JPEG) and compared with the original's pixels.
@@ -34,7 +38,12 @@ import numpy as np
 import pydicom
 from PIL import Image
 from pydicom.encaps import encapsulate, generate_frames
-from pydicom.uid import JPEGBaseline8Bit, JPEGLosslessSV1, RLELossless
+from pydicom.uid import (
+    DeflatedExplicitVRLittleEndian,
+    JPEGBaseline8Bit,
+    JPEGLosslessSV1,
+    RLELossless,
+)
 
 SERIES = "tests/data/dicom_series"
 
@@ -97,6 +106,14 @@ def encapsulated_twin(source, target, syntax, frames, lossy=False):
         check_same(target, original, syntax)
 
 
+def deflated_twin(source, target):
+    ds = pydicom.dcmread(source)
+    original = ds.pixel_array.copy()
+    ds.file_meta.TransferSyntaxUID = DeflatedExplicitVRLittleEndian
+    ds.save_as(target, enforce_file_format=True)
+    check_same(target, original, DeflatedExplicitVRLittleEndian)
+
+
 def twins_of(folder, prefix, make):
     os.makedirs(f"{SERIES}/{folder}_{prefix}", exist_ok=True)
     for name in sorted(os.listdir(f"{SERIES}/{folder}")):
@@ -117,7 +134,9 @@ def main():
             s, t, JPEGBaseline8Bit, pillow_jpeg_baseline(pydicom.dcmread(s)), lossy=True
         ),
     )
+    twins_of("oblique", "deflated", deflated_twin)
     seg = "tests/data/dicom_seg"
+    deflated_twin(f"{seg}/phantom.dcm", f"{seg}/phantom_deflated.dcm")
     for name in ("labelmap", "fractional"):
         rle_twin(f"{seg}/{name}.dcm", f"{seg}/{name}_rle.dcm")
     fractional = f"{seg}/fractional.dcm"

@@ -576,3 +576,19 @@ fn compressed_segs_read_as_the_uncompressed_ones() {
     );
     refused(&rle[..rle.len() - 2000], "bytes");
 }
+
+/// The BINARY phantom SEG in Deflated Explicit VR Little Endian (the data set one deflate
+/// stream, tests/data/make_dicom_compressed.py) reads as the uncompressed file; a stream cut
+/// short or corrupt is refused within the memory and time of any broken file.
+#[test]
+fn a_deflated_seg_reads_as_the_uncompressed_one() {
+    let plain = load_named(&seg("phantom.dcm"), "plain.dcm");
+    let deflated = seg("phantom_deflated.dcm");
+    assert_eq!(load_named(&deflated, "twin.dcm"), plain);
+    refused(&deflated[..deflated.len() - 500], "does not inflate");
+    let mut corrupt = deflated.clone();
+    let middle = corrupt.len() / 2;
+    corrupt[middle..middle + 8].copy_from_slice(&[0xFF; 8]);
+    // Still a deflate stream, of other bytes: the length walk refuses what it inflates to.
+    refused(&corrupt, "bytes in an element");
+}
