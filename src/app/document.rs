@@ -86,6 +86,8 @@ pub struct Document {
     pub quiz: Option<crate::view::QuizRun>,
     /// The author's next click in the view places a label.
     pub placing_label: bool,
+    /// The language tag the Lesson panel's words are edited in; empty: the own (English) words.
+    pub lesson_language: String,
     /// The author sees the case as the student will, in the viewer's panel, without exporting.
     pub previewing: bool,
     /// What the lesson's player tells the embedding page (event, detail), in order.
@@ -190,6 +192,7 @@ impl Document {
             tour_left: None,
             quiz: None,
             placing_label: false,
+            lesson_language: String::new(),
             previewing: false,
             lesson_events: Vec::new(),
             waiting: Vec::new(),

@@ -1,12 +1,15 @@
 //! The authoring page's Lesson panel: the tour's steps recorded from the view as it stands,
 //! their titles and captions edited, reordered, deleted and shown again; labels placed by
 //! clicking a structure in the view, their texts edited; the quiz's modes, structures and pass
-//! mark. Every edit goes through `CaseDocument::set_lesson`, which checks it against the case.
+//! mark. Titles, captions and texts are edited in the own (English) words or in another language
+//! the author picks. Every edit goes through `CaseDocument::set_lesson`, which checks it
+//! against the case.
 
 use eframe::egui;
 use glam::Vec3;
 
 use super::document::Document;
+use crate::case::names::{self, Names};
 use crate::case::{Label, Lesson, Quiz, QuizMode};
 use crate::view::recorded_step;
 
@@ -68,14 +71,23 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     let record = ui.button("Record the view as a step");
     drawn.push(("record".into(), record.rect));
     asked.record = record.clicked();
-    steps(ui, &mut lesson, &mut drawn, &mut asked);
+    let language = language(ui, &lesson, &mut doc.lesson_language, &mut drawn);
+    // While the field holds no language, nothing is edited: not the English words by mistake.
+    let editable = language.is_ok();
+    let language = language.unwrap_or_default();
+    let language = language.as_deref();
+    ui.add_enabled_ui(editable, |ui| {
+        steps(ui, &mut lesson, language, &mut drawn, &mut asked);
+    });
     ui.separator();
     let place = ui.toggle_value(&mut doc.placing_label, "Place a label");
     drawn.push(("place-label".into(), place.rect));
     if doc.placing_label {
         ui.small("Click a structure in the view where the label points.");
     }
-    labels(ui, &mut lesson, &mut drawn, &mut asked);
+    ui.add_enabled_ui(editable, |ui| {
+        labels(ui, &mut lesson, language, &mut drawn, &mut asked);
+    });
     ui.separator();
     let names = doc.case().structure_names();
     quiz(ui, &mut lesson, &names, &mut drawn, &mut asked);
@@ -97,10 +109,103 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     }
 }
 
+/// The language the words below are edited in, typed or picked among those the lesson has:
+/// `None` for the own (English) words; an error (said there) while the field holds no language
+/// tag.
+fn language(
+    ui: &mut egui::Ui,
+    lesson: &Lesson,
+    typed: &mut String,
+    drawn: &mut Vec<(String, egui::Rect)>,
+) -> Result<Option<String>, ()> {
+    let mut known: Vec<&String> = (lesson.steps.iter())
+        .flat_map(|s| s.titles.keys().chain(s.captions.keys()))
+        .chain((lesson.labels.iter()).flat_map(|l| l.texts.keys().chain(l.notes.keys())))
+        .collect();
+    known.sort();
+    known.dedup();
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Words in");
+        let field = egui::TextEdit::singleline(typed)
+            .hint_text("English")
+            .desired_width(60.0);
+        drawn.push(("lesson-language".into(), ui.add(field).rect));
+        let english = ui.selectable_label(typed.trim().is_empty(), "English");
+        drawn.push(("lesson-language-own".into(), english.rect));
+        if english.clicked() {
+            typed.clear();
+        }
+        for tag in known {
+            let picked = ui.selectable_label(typed.trim() == tag.as_str(), tag.as_str());
+            drawn.push((format!("lesson-language-{tag}"), picked.rect));
+            if picked.clicked() {
+                typed.clone_from(tag);
+            }
+        }
+    });
+    if typed.trim().is_empty() {
+        return Ok(None);
+    }
+    match names::tag(typed) {
+        Ok(tag) => Ok(Some(tag)),
+        Err(e) => {
+            ui.colored_label(ui.visuals().error_fg_color, e);
+            Err(())
+        }
+    }
+}
+
+/// The kind of a field of words.
+#[derive(Clone, Copy)]
+enum Field {
+    /// One line, this wide.
+    Line(f32),
+    /// A caption, with this hint while empty.
+    Caption(&'static str),
+}
+
+/// A field editing the own words `own`, or with `language` those in that language in `others`
+/// (the own words as its hint; emptied, the language's words are removed and the own stand).
+fn words(
+    ui: &mut egui::Ui,
+    own: &mut String,
+    others: &mut Names,
+    language: Option<&str>,
+    field: Field,
+) -> egui::Response {
+    let mut edit = |text: &mut String, hint: &str| {
+        let edit = match field {
+            Field::Line(width) => egui::TextEdit::singleline(text).desired_width(width),
+            Field::Caption(hint) => egui::TextEdit::multiline(text)
+                .desired_rows(1)
+                .hint_text(hint),
+        };
+        if hint.is_empty() {
+            ui.add(edit)
+        } else {
+            ui.add(edit.hint_text(hint))
+        }
+    };
+    let Some(tag) = language else {
+        return edit(own, "");
+    };
+    let mut text = others.get(tag).cloned().unwrap_or_default();
+    let response = edit(&mut text, own.as_str());
+    if response.changed() {
+        if text.trim().is_empty() {
+            others.remove(tag);
+        } else {
+            others.insert(tag.to_string(), text);
+        }
+    }
+    response
+}
+
 /// Each step's title and caption, with its buttons: up, down, delete, show.
 fn steps(
     ui: &mut egui::Ui,
     lesson: &mut Lesson,
+    language: Option<&str>,
     drawn: &mut Vec<(String, egui::Rect)>,
     asked: &mut Asked,
 ) {
@@ -110,7 +215,8 @@ fn steps(
     for (i, step) in lesson.steps.iter_mut().enumerate() {
         ui.horizontal(|ui| {
             ui.label(format!("{}.", i + 1));
-            let title = ui.add(egui::TextEdit::singleline(&mut step.title).desired_width(130.0));
+            let (own, others) = (&mut step.title, &mut step.titles);
+            let title = words(ui, own, others, language, Field::Line(130.0));
             asked.edited |= title.changed();
             drawn.push((format!("step-title-{i}"), title.rect));
             let up = ui.add_enabled(i > 0, egui::Button::new("▲").small());
@@ -127,11 +233,9 @@ fn steps(
             deleted = deleted.or(delete.clicked().then_some(i));
             asked.show_step = asked.show_step.or(show.clicked().then_some(i));
         });
-        let caption = ui.add(
-            egui::TextEdit::multiline(&mut step.caption)
-                .desired_rows(1)
-                .hint_text("Caption: what the student sees here"),
-        );
+        let (own, others) = (&mut step.caption, &mut step.captions);
+        let hint = Field::Caption("Caption: what the student sees here");
+        let caption = words(ui, own, others, language, hint);
         drawn.push((format!("step-caption-{i}"), caption.rect));
         asked.edited |= caption.changed();
     }
@@ -148,6 +252,7 @@ fn steps(
 fn labels(
     ui: &mut egui::Ui,
     lesson: &mut Lesson,
+    language: Option<&str>,
     drawn: &mut Vec<(String, egui::Rect)>,
     asked: &mut Asked,
 ) {
@@ -155,7 +260,8 @@ fn labels(
     for (i, label) in lesson.labels.iter_mut().enumerate() {
         ui.horizontal(|ui| {
             ui.small(&label.structure);
-            let text = ui.add(egui::TextEdit::singleline(&mut label.text).desired_width(120.0));
+            let (own, others) = (&mut label.text, &mut label.texts);
+            let text = words(ui, own, others, language, Field::Line(120.0));
             let delete = ui.small_button("✕").on_hover_text("Delete the label");
             asked.edited |= text.changed();
             drawn.push((format!("label-text-{i}"), text.rect));

@@ -400,6 +400,32 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         await press("quiz-structure-0");
         lesson = await lessonWhen((l) => l.quiz.structures.length === 2, "two structures asked");
         assert.deepEqual(lesson.quiz.structures, ["right_kidney", "liver"]);
+
+        // The first step's title and caption and the kidney's label in German, the English
+        // words kept; a German title emptied again falls back on the English one.
+        await typeInto("lesson-language", "de");
+        await typeInto("step-title-0", "Der ganze Bauch");
+        await typeInto("step-caption-0", "Vier Strukturen des Phantoms.");
+        await typeInto(`label-text-${kidney}`, "Rechte Niere");
+        await typeInto("step-title-1", "Von oben");
+        lesson = await lessonWhen((l) => l.steps[0].titles.de === "Der ganze Bauch" && l.steps[0].captions.de === "Vier Strukturen des Phantoms." && l.labels[kidney].texts.de === "Rechte Niere" && l.steps[1].titles.de === "Von oben", "the German words");
+        assert.deepEqual([lesson.steps[0].title, lesson.steps[0].caption, lesson.labels[kidney].text, lesson.steps[1].title], ["The whole abdomen", "Four structures of the phantom.", "Right kidney", "Step 2"], "the English words stay");
+        await press("step-title-1");
+        await app.page.keyboard.press("Control+A");
+        await app.page.keyboard.press("Backspace");
+        lesson = await lessonWhen((l) => l.steps[1].titles.de === undefined, "the emptied German title gone");
+        assert.equal(lesson.steps[1].title, "Step 2");
+        await app.screenshot("L5-lesson-panel-german");
+        // What is no language tag edits nothing; English picked again edits the English words.
+        await typeInto("lesson-language", "Deutsch!");
+        await typeInto("step-title-0", "Nichts");
+        await frames(app);
+        lesson = await lessonNow();
+        assert.deepEqual([lesson.steps[0].title, lesson.steps[0].titles.de], ["The whole abdomen", "Der ganze Bauch"], "nothing edited without a language");
+        await press("lesson-language-own");
+        await typeInto("step-title-0", "The abdomen");
+        lesson = await lessonWhen((l) => l.steps[0].title === "The abdomen", "the English title edited");
+        assert.equal(lesson.steps[0].titles.de, "Der ganze Bauch");
         await app.screenshot("L5-lesson-panel");
         exported = Buffer.from(await app.call("exportCase", "glb"));
     });
@@ -418,6 +444,14 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         await app.stateWhen((s) => s.tour.step === 2 && s.view.clip?.axis === "axial", "the third step, cut");
         await app.screenshot("L5-authored-step-3");
     }, { query: "?mode=viewer&case=cases/authored.glb", routes: { "cases/authored.glb": exported } });
+    // A German reader gets the German words the author gave.
+    await withApp(async (app) => {
+        await app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null, "the authored case in the viewer");
+        await app.call("showStep", 0);
+        const s = await app.stateWhen((s) => s.tour.step === 0 && s.view.labels.length === 2, "the first step, its labels drawn");
+        assert.deepEqual([s.tour.title, s.tour.caption], ["Der ganze Bauch", "Vier Strukturen des Phantoms."]);
+        assert.deepEqual(s.view.labels.map((l) => l.text).sort(), ["Rechte Niere", "liver"]);
+    }, { query: "?mode=viewer&case=cases/authored.glb&lang=de", routes: { "cases/authored.glb": exported } });
 });
 
 testIn(EVERY_RUN, "L6 the author previews the sample's lesson as the student sees it, without exporting, and comes back", { timeout: TIMEOUT }, async () => {
