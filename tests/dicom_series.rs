@@ -307,7 +307,8 @@ fn jpeg_series_read_as_the_uncompressed_ones() {
 }
 
 /// `case build --image FOLDER`: the series' image in the case, the same as from its twin; a
-/// tilted series refused naming the slice, with no case written.
+/// tilted series refused naming the slice, and a folder of subfolders only, with no case
+/// written.
 #[test]
 fn case_build_takes_a_series_folder_as_the_image() {
     let twin_path = folder("oblique.nii.gz").display().to_string();
@@ -340,6 +341,17 @@ fn case_build_takes_a_series_folder_as_the_image() {
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert!(
         stderr.contains("tilted") && stderr.contains("gantry tilt"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+
+    // A DICOM export's folder above the series' own: said, not "no file" alone.
+    let above = common_cli::tmp("export_above_the_series");
+    std::fs::create_dir_all(above.join("SERIES1")).expect("a temporary folder");
+    let refused = build(&above, &out);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("export_above_the_series: the folder holds no file, only 1 subfolder"),
         "{stderr}"
     );
     assert!(!out.exists());

@@ -3,7 +3,8 @@
 //! the canvas, takes each drop that holds a folder and lists the folder with the browser's File
 //! and Directory Entries API. A folder's files open as the CLI reads a folder
 //! ([`crate::case::read_in_folder`], in the order of their names, subfolders not read), with the
-//! files dropped beside it, as one case.
+//! files dropped beside it, as one case. What cannot be read is named: the folder, or the file
+//! by its path in it.
 
 use std::cell::Cell;
 use std::rc::Rc;
@@ -85,23 +86,24 @@ async fn list(entries: Vec<FileSystemEntry>) -> Listed {
     let mut files = Vec::new();
     for entry in entries {
         let name = entry.name();
-        let failed = |e: String| (name.clone(), e);
         if entry.is_directory() {
             let folder: FileSystemDirectoryEntry = entry.unchecked_into();
-            files.extend(files_of(&folder, &name).await.map_err(failed)?);
+            files.extend(files_of(&folder, &name).await?);
         } else if entry.is_file() {
-            let file = file_of(entry.unchecked_into()).await.map_err(failed)?;
-            files.push((name, file));
+            let file = file_of(entry.unchecked_into()).await;
+            files.push((name.clone(), file.map_err(|e| (name, e))?));
         }
     }
     Ok(files)
 }
 
-/// The files `folder` holds that open with the others, by name.
+/// The files `folder` holds that open with the others, by name; or what could not be read
+/// (the folder, or one of its files by its path) and why.
 async fn files_of(
     folder: &FileSystemDirectoryEntry,
     name: &str,
-) -> Result<Vec<(String, web_sys::File)>, String> {
+) -> Result<Vec<(String, web_sys::File)>, (String, String)> {
+    let in_folder = |e: String| (name.to_string(), e);
     let reader = folder.create_reader();
     let mut entries: Vec<FileSystemEntry> = Vec::new();
     // Each call gives the next batch of entries, an empty one at the end.
@@ -111,16 +113,19 @@ async fn files_of(
                 let _ = fail.call1(&JsValue::NULL, &e);
             }
         })
-        .await?
+        .await
+        .map_err(|e| in_folder(format!("the browser could not list it: {e}")))?
         .unchecked_into();
         if batch.length() == 0 {
             break;
         }
         entries.extend(batch.iter().map(|e| e.unchecked_into::<FileSystemEntry>()));
         if entries.len() > MAX_ENTRIES {
-            return Err(format!("the folder holds more than {MAX_ENTRIES} entries"));
+            let e = format!("the folder holds more than {MAX_ENTRIES} entries");
+            return Err(in_folder(e));
         }
     }
+    let subfolders = entries.iter().filter(|e| e.is_directory()).count();
     let mut kept: Vec<FileSystemEntry> = (entries.into_iter())
         .filter(|e| e.is_file() && crate::case::read_in_folder(&e.name()))
         .collect();
@@ -128,20 +133,25 @@ async fn files_of(
     let mut files = Vec::with_capacity(kept.len());
     for entry in kept {
         let path = format!("{name}/{}", entry.name());
-        files.push((path, file_of(entry.unchecked_into()).await?));
+        match file_of(entry.unchecked_into()).await {
+            Ok(file) => files.push((path, file)),
+            Err(e) => return Err((path, e)),
+        }
     }
     if files.is_empty() {
-        return Err("the folder holds no file".to_string());
+        return Err(in_folder(crate::case::no_file_in_folder(subfolders)));
     }
     Ok(files)
 }
 
 async fn file_of(entry: FileSystemFileEntry) -> Result<web_sys::File, String> {
-    let file = called_back(|ok, fail| entry.file_with_callback_and_callback(ok, fail)).await?;
+    let file = called_back(|ok, fail| entry.file_with_callback_and_callback(ok, fail)).await;
+    let file = file.map_err(|e| format!("the browser could not read it: {e}"))?;
     Ok(file.unchecked_into())
 }
 
-/// The value an API of success and error callbacks gives: `start` is called with both.
+/// The value an API of success and error callbacks gives (`start` is called with both), or the
+/// error's text.
 async fn called_back(start: impl FnOnce(&Function, &Function)) -> Result<JsValue, String> {
     let mut start = Some(start);
     let promise = Promise::new(&mut |ok, fail| {
@@ -149,10 +159,5 @@ async fn called_back(start: impl FnOnce(&Function, &Function)) -> Result<JsValue
             start(&ok, &fail);
         }
     });
-    JsFuture::from(promise).await.map_err(|e| {
-        format!(
-            "the browser could not list it: {}",
-            super::page::js_error_text(&e)
-        )
-    })
+    (JsFuture::from(promise).await).map_err(|e| super::page::js_error_text(&e))
 }

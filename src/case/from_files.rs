@@ -162,6 +162,17 @@ pub fn read_in_folder(name: &str) -> bool {
     !name.starts_with('.') && !name.eq_ignore_ascii_case("DICOMDIR")
 }
 
+/// Why a folder with no file [`read_in_folder`] keeps opens nothing; `subfolders` it holds.
+pub fn no_file_in_folder(subfolders: usize) -> String {
+    match subfolders {
+        0 => "the folder holds no file".to_string(),
+        n => format!(
+            "the folder holds no file, only {n} subfolder(s), which are not read: open the \
+             folder that holds the files"
+        ),
+    }
+}
+
 /// A path's last component: all of a path a case keeps.
 pub fn file_name(path: &str) -> &str {
     path.rsplit(['/', '\\']).next().unwrap_or(path)

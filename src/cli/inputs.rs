@@ -17,16 +17,19 @@ fn read(path: &Path) -> Result<(String, Vec<u8>), String> {
 /// [`crate::case::read_in_folder`] keeps.
 pub(super) fn read_folder(dir: &Path) -> Result<Vec<(String, Vec<u8>)>, String> {
     let failed = |e: std::io::Error| format!("{}: {e}", dir.display());
-    let mut paths = Vec::new();
+    let (mut paths, mut subfolders) = (Vec::new(), 0);
     for entry in std::fs::read_dir(dir).map_err(failed)? {
         let entry = entry.map_err(failed)?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        if crate::case::read_in_folder(&name) && entry.file_type().map_err(failed)?.is_file() {
+        let kind = entry.file_type().map_err(failed)?;
+        subfolders += usize::from(kind.is_dir());
+        if crate::case::read_in_folder(&name) && kind.is_file() {
             paths.push(entry.path());
         }
     }
     if paths.is_empty() {
-        return Err(format!("{}: the folder holds no file", dir.display()));
+        let why = crate::case::no_file_in_folder(subfolders);
+        return Err(format!("{}: {why}", dir.display()));
     }
     paths.sort();
     paths.iter().map(|p| read(p)).collect()

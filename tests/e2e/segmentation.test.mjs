@@ -612,7 +612,7 @@ testIn(EVERY_RUN, "S9b a label map with its colour table, and four masks, droppe
     });
 });
 
-testIn(EVERY_RUN, "S9c a folder of masks dropped on the page opens as the CLI opens its files; an empty one is reported", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "S9c a folder of masks dropped on the page opens as the CLI opens its files; an empty one and an unreadable file are reported", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
         // In the order of their names, hidden files and subfolders not read.
         const masks = ["bent_tube_r3.5_mask.nii.gz", "ellipsoid_30_20_12_mask.nii.gz", "sphere_r20_mask.nii.gz", "torus_R24_r8_mask.nii.gz"];
@@ -629,7 +629,13 @@ testIn(EVERY_RUN, "S9c a folder of masks dropped on the page opens as the CLI op
         // A folder with nothing to read: its name and why, and the case stays.
         await app.dropFolder("empty", [{ bytes: Buffer.from("Bud1"), name: ".DS_Store" }]);
         state = await app.stateWhen((s) => s.error !== null, "the empty folder's error");
-        assert.match(state.error, /empty.*the folder holds no file/);
+        assert.match(state.error, /empty.*the folder holds no file, only 1 subfolder/);
+        assert.equal(state.structures.structures.length, 4);
+
+        // A file the browser cannot read is named by its path in the folder.
+        await app.dropFolder("masks", [shuffled[0], { bytes: Buffer.from(""), name: "gone.nii.gz", fails: true }]);
+        state = await app.stateWhen((s) => s.error?.includes("gone"), "the unreadable file's error");
+        assert.match(state.error, /masks\/gone\.nii\.gz.*the browser could not read it/);
         assert.equal(state.structures.structures.length, 4);
 
         // A file dropped after them opens as before.

@@ -373,10 +373,12 @@ export class AppPage {
      * cannot drop a real folder, so the entries are made here; the files are real ones.
      */
     async dropFolder(name, files) {
-        const encoded = files.map(({ bytes, name }) => [Buffer.from(bytes).toString("base64"), name]);
+        const encoded = files.map(({ bytes, name, fails }) => [Buffer.from(bytes).toString("base64"), name, Boolean(fails)]);
         await this.page.evaluate(([folder, files]) => {
             const bytesOf = (base64) => Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
-            const fileEntry = (file) => ({ isFile: true, isDirectory: false, name: file.name, file: (ok) => setTimeout(() => ok(file)) });
+            // A file that `fails` is one the browser cannot read (gone since the drop, say).
+            const gone = () => new DOMException("A requested file or directory could not be found", "NotFoundError");
+            const fileEntry = (file, fails) => ({ isFile: true, isDirectory: false, name: file.name, file: (ok, fail) => setTimeout(() => (fails ? fail(gone()) : ok(file))) });
             const folderEntry = (name, entries) => ({
                 isFile: false,
                 isDirectory: true,
@@ -392,7 +394,7 @@ export class AppPage {
                     };
                 },
             });
-            const entries = files.map(([base64, name]) => fileEntry(new File([bytesOf(base64)], name)));
+            const entries = files.map(([base64, name, fails]) => fileEntry(new File([bytesOf(base64)], name), fails));
             entries.push(folderEntry("nested", [fileEntry(new File(["not read"], "nested.nii.gz"))]));
             const root = folderEntry(folder, entries);
             const asFile = new DataTransfer();
