@@ -175,3 +175,75 @@ fn extract_refuses_what_it_cannot_do_naming_the_file() {
     ]);
     assert!(e.contains("several mask files"), "{e}");
 }
+
+/// A folder given as input opens its files and its subfolders' (hidden files and a DICOMDIR
+/// left out) in the order of their paths, as the page opens a dropped folder; a colour table
+/// in it names the label map beside it; subfolders nested past the limit are refused.
+#[test]
+fn extract_reads_a_folder_with_its_subfolders() {
+    let masks = tmp("masks");
+    let _ = std::fs::remove_dir_all(&masks);
+    std::fs::create_dir_all(masks.join("ring")).expect("a temporary folder");
+    let placed = [
+        ("sphere_r20_mask.nii.gz", "sphere_r20_mask.nii.gz"),
+        (
+            "ellipsoid_30_20_12_mask.nii.gz",
+            "ellipsoid_30_20_12_mask.nii.gz",
+        ),
+        ("torus_R24_r8_mask.nii.gz", "ring/torus_R24_r8_mask.nii.gz"),
+    ];
+    for (file, at) in placed {
+        let from = common_cli::data(&format!("synthetic/{file}"));
+        std::fs::copy(from, masks.join(at)).expect("a copy");
+    }
+    std::fs::write(masks.join(".DS_Store"), b"Bud1").expect("a file");
+    std::fs::write(masks.join("ring/DICOMDIR"), b"an index").expect("a file");
+    let extract = |inputs: &[String], out: &str| {
+        let mut args = vec!["extract"];
+        args.extend(inputs.iter().map(String::as_str));
+        let out = tmp(out).display().to_string();
+        json(&meshsmooth(&[&args[..], &["-o", &out, "--json"]].concat()))
+    };
+    let from_folder = extract(&[masks.display().to_string()], "from_folder/");
+    let in_order = [
+        "ellipsoid_30_20_12_mask.nii.gz",
+        "ring/torus_R24_r8_mask.nii.gz",
+    ];
+    let files: Vec<String> = (in_order.iter().chain(["sphere_r20_mask.nii.gz"].iter()))
+        .map(|at| masks.join(at).display().to_string())
+        .collect();
+    let from_files = extract(&files, "from_files/");
+    let summary = |v: &serde_json::Value| -> Vec<(serde_json::Value, serde_json::Value)> {
+        (v["structures"].as_array().expect("structures").iter())
+            .map(|s| (s["name"].clone(), s["vertices"].clone()))
+            .collect()
+    };
+    assert_eq!(summary(&from_folder).len(), 3);
+    assert_eq!(summary(&from_folder), summary(&from_files));
+    assert_eq!(from_folder["structures"][1]["name"], "Torus R24 r8 mask");
+
+    let labelled = tmp("labelled");
+    std::fs::create_dir_all(&labelled).expect("a temporary folder");
+    for file in [
+        "case_phantom_shared.nii.gz",
+        "case_phantom_shared_labels.txt",
+    ] {
+        let from = common_cli::data(&format!("labelmaps/{file}"));
+        std::fs::copy(from, labelled.join(file)).expect("a copy");
+    }
+    let named = extract(&[labelled.display().to_string()], "labelled_out/");
+    assert_eq!(named["structures"][1]["name"], "portal_vein");
+
+    let deep = tmp("deep");
+    let deepest = deep.join("1/2/3/4/5/6/7/8/9");
+    std::fs::create_dir_all(&deepest).expect("a temporary folder");
+    std::fs::write(deepest.join("mask.nii.gz"), b"never read").expect("a file");
+    let deep_out = tmp("deep_out/").display().to_string();
+    let out = meshsmooth(&["extract", &deep.display().to_string(), "-o", &deep_out]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("deep: its subfolders go more than 8 levels down"),
+        "{stderr}"
+    );
+}

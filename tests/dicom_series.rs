@@ -306,9 +306,9 @@ fn jpeg_series_read_as_the_uncompressed_ones() {
     );
 }
 
-/// `case build --image FOLDER`: the series' image in the case, the same as from its twin; a
-/// tilted series refused naming the slice, and a folder of subfolders only, with no case
-/// written.
+/// `case build --image FOLDER`: the series' image in the case, the same as from its twin and
+/// from a DICOM export's folder above it; a tilted series, an export of two series and
+/// subfolders without files refused naming the slice or folder, with no case written.
 #[test]
 fn case_build_takes_a_series_folder_as_the_image() {
     let twin_path = folder("oblique.nii.gz").display().to_string();
@@ -345,16 +345,52 @@ fn case_build_takes_a_series_folder_as_the_image() {
     );
     assert!(!out.exists());
 
-    // A DICOM export's folder above the series' own: said, not "no file" alone.
-    let above = common_cli::tmp("export_above_the_series");
-    std::fs::create_dir_all(above.join("SERIES1")).expect("a temporary folder");
-    let refused = build(&above, &out);
+    // A DICOM export's folder above the series' own, with its DICOMDIR and a hidden file: the
+    // series read from its subfolder as from its own folder.
+    let export = common_cli::tmp("export_above_the_series");
+    let _ = std::fs::remove_dir_all(&export);
+    copy_series(&folder("oblique"), &export.join("PATIENT/STUDY/SERIES1"));
+    std::fs::write(export.join("DICOMDIR"), b"an index, not read").expect("a file");
+    std::fs::write(export.join(".DS_Store"), b"Bud1").expect("a file");
+    let from_export = common_cli::json(&build(&export, &common_cli::tmp("e.glb")));
+    let c = &from_export["image"];
+    assert_eq!(c["source"], "export_above_the_series");
+    for key in ["dims", "preset", "window", "bytes"] {
+        assert_eq!(c[key], a[key], "{key}");
+    }
+
+    // Two series in it: refused, naming a slice of each by its path in the export.
+    copy_series(&folder("tilted"), &export.join("PATIENT/STUDY/SERIES2"));
+    let refused = build(&export, &out);
     let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
     assert!(
-        stderr.contains("export_above_the_series: the folder holds no file, only 1 subfolder"),
+        stderr.contains("PATIENT/STUDY/SERIES1/") && stderr.contains("PATIENT/STUDY/SERIES2/"),
         "{stderr}"
     );
     assert!(!out.exists());
+
+    // Subfolders that hold no file: said, not "no file" alone.
+    let empty = common_cli::tmp("export_without_files");
+    std::fs::create_dir_all(empty.join("SERIES1/.hidden")).expect("a temporary folder");
+    let refused = build(&empty, &out);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains(
+            "export_without_files: neither the folder nor its 1 subfolder(s) hold a file"
+        ),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
+
+/// Copies the files of the series folder `from` into `to`, made with its parents.
+fn copy_series(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("a temporary folder");
+    for entry in std::fs::read_dir(from).expect("the series") {
+        let path = entry.expect("an entry").path();
+        std::fs::copy(&path, to.join(path.file_name().expect("a name"))).expect("a copy");
+    }
 }
 
 /// The page's session reads a series chosen together (its worker on this thread): the

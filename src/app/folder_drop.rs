@@ -2,9 +2,9 @@
 //! one it cannot read; so a listener on the window, which the browser calls before eframe's on
 //! the canvas, takes each drop that holds a folder and lists the folder with the browser's File
 //! and Directory Entries API. A folder's files open as the CLI reads a folder
-//! ([`crate::case::read_in_folder`], in the order of their names, subfolders not read), with the
-//! files dropped beside it, as one case. What cannot be read is named: the folder, or the file
-//! by its path in it.
+//! ([`crate::case::read_in_folder`], with its subfolders, in the order of their paths), with
+//! the files dropped beside it, as one case. What cannot be read is named: the folder, or the
+//! subfolder or file by its path in it.
 
 use std::cell::Cell;
 use std::rc::Rc;
@@ -14,9 +14,6 @@ use wasm_bindgen::closure::Closure;
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_futures::JsFuture;
 use web_sys::{FileSystemDirectoryEntry, FileSystemEntry, FileSystemFileEntry};
-
-/// A folder of more entries than this is refused: the listing stays bounded.
-const MAX_ENTRIES: usize = 20_000;
 
 /// A drop's files in order, each named by its path in the drop (`masks/liver.nii.gz`); or the
 /// item that could not be listed and why.
@@ -80,15 +77,14 @@ fn entries_of(transfer: &web_sys::DataTransfer) -> Vec<FileSystemEntry> {
         .collect()
 }
 
-/// Every file of the dropped items: loose files as they are, each folder's files after their
-/// names.
+/// Every file of the dropped items: loose files as they are, each folder's files (its
+/// subfolders' too) in [`crate::case::folder_order`].
 async fn list(entries: Vec<FileSystemEntry>) -> Listed {
     let mut files = Vec::new();
     for entry in entries {
         let name = entry.name();
         if entry.is_directory() {
-            let folder: FileSystemDirectoryEntry = entry.unchecked_into();
-            files.extend(files_of(&folder, &name).await?);
+            files.extend(files_of(entry.unchecked_into(), &name).await?);
         } else if entry.is_file() {
             let file = file_of(entry.unchecked_into()).await;
             files.push((name.clone(), file.map_err(|e| (name, e))?));
@@ -97,51 +93,77 @@ async fn list(entries: Vec<FileSystemEntry>) -> Listed {
     Ok(files)
 }
 
-/// The files `folder` holds that open with the others, by name; or what could not be read
-/// (the folder, or one of its files by its path) and why.
+/// The files `folder` and its subfolders hold that open with the others, by their paths; or
+/// what could not be read (the folder, a subfolder or a file, by its path) and why.
 async fn files_of(
-    folder: &FileSystemDirectoryEntry,
+    folder: FileSystemDirectoryEntry,
     name: &str,
 ) -> Result<Vec<(String, web_sys::File)>, (String, String)> {
-    let in_folder = |e: String| (name.to_string(), e);
+    let refused = |e: String| (name.to_string(), e);
+    let mut found: Vec<(String, FileSystemFileEntry)> = Vec::new();
+    let mut folders = vec![(folder, name.to_string(), 0)];
+    let (mut seen, mut subfolders) = (0, 0);
+    while let Some((folder, path, depth)) = folders.pop() {
+        let entries = entries_in(&folder, &mut seen).await;
+        let entries = entries.map_err(|e| (path.clone(), e))?;
+        if seen > crate::case::FOLDER_ENTRIES {
+            return Err(refused(crate::case::folder_too_large()));
+        }
+        for entry in entries {
+            if !crate::case::read_in_folder(&entry.name()) {
+                continue;
+            }
+            let at = format!("{path}/{}", entry.name());
+            if entry.is_directory() {
+                if depth == crate::case::FOLDER_DEPTH {
+                    return Err(refused(crate::case::folder_too_deep()));
+                }
+                subfolders += 1;
+                folders.push((entry.unchecked_into(), at, depth + 1));
+            } else if entry.is_file() {
+                found.push((at, entry.unchecked_into()));
+            }
+        }
+    }
+    if found.is_empty() {
+        return Err(refused(crate::case::no_file_in_folder(subfolders)));
+    }
+    found.sort_by(|a, b| crate::case::folder_order(&a.0, &b.0));
+    let mut files = Vec::with_capacity(found.len());
+    for (path, entry) in found {
+        match file_of(entry).await {
+            Ok(file) => files.push((path, file)),
+            Err(e) => return Err((path, e)),
+        }
+    }
+    Ok(files)
+}
+
+/// The entries `folder` holds, each counted in `seen`; the listing stops early once `seen`
+/// passes [`crate::case::FOLDER_ENTRIES`].
+async fn entries_in(
+    folder: &FileSystemDirectoryEntry,
+    seen: &mut usize,
+) -> Result<Vec<FileSystemEntry>, String> {
     let reader = folder.create_reader();
-    let mut entries: Vec<FileSystemEntry> = Vec::new();
+    let mut entries = Vec::new();
     // Each call gives the next batch of entries, an empty one at the end.
-    loop {
+    while *seen <= crate::case::FOLDER_ENTRIES {
         let batch: Array = called_back(|ok, fail| {
             if let Err(e) = reader.read_entries_with_callback_and_callback(ok, fail) {
                 let _ = fail.call1(&JsValue::NULL, &e);
             }
         })
         .await
-        .map_err(|e| in_folder(format!("the browser could not list it: {e}")))?
+        .map_err(|e| format!("the browser could not list it: {e}"))?
         .unchecked_into();
         if batch.length() == 0 {
             break;
         }
+        *seen += batch.length() as usize;
         entries.extend(batch.iter().map(|e| e.unchecked_into::<FileSystemEntry>()));
-        if entries.len() > MAX_ENTRIES {
-            let e = format!("the folder holds more than {MAX_ENTRIES} entries");
-            return Err(in_folder(e));
-        }
     }
-    let subfolders = entries.iter().filter(|e| e.is_directory()).count();
-    let mut kept: Vec<FileSystemEntry> = (entries.into_iter())
-        .filter(|e| e.is_file() && crate::case::read_in_folder(&e.name()))
-        .collect();
-    kept.sort_by_key(|e| e.name());
-    let mut files = Vec::with_capacity(kept.len());
-    for entry in kept {
-        let path = format!("{name}/{}", entry.name());
-        match file_of(entry.unchecked_into()).await {
-            Ok(file) => files.push((path, file)),
-            Err(e) => return Err((path, e)),
-        }
-    }
-    if files.is_empty() {
-        return Err(in_folder(crate::case::no_file_in_folder(subfolders)));
-    }
-    Ok(files)
+    Ok(entries)
 }
 
 async fn file_of(entry: FileSystemFileEntry) -> Result<web_sys::File, String> {

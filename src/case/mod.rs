@@ -21,8 +21,9 @@ pub mod xapi;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
 pub use from_files::{
-    file_name, first_structure_file, no_file_in_folder, open, open_staged, read_in_folder,
-    reading_stages, split_color_table, surface_structure, CaseOpenError,
+    file_name, first_structure_file, folder_order, folder_too_deep, folder_too_large,
+    no_file_in_folder, open, open_staged, read_in_folder, reading_stages, split_color_table,
+    surface_structure, CaseOpenError, FOLDER_DEPTH, FOLDER_ENTRIES,
 };
 pub use image::{CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
 pub use image_frame::{check_frame, StructureGrid};

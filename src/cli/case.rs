@@ -204,14 +204,18 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// Adds the image at `path`: one file, or a folder of a DICOM series' slices.
+/// Adds the image at `path`: one file, or a folder of a DICOM series' slices (in subfolders,
+/// as a DICOM export keeps them).
 fn add_image(case: &mut Case, path: &Path, args: &BuildArgs) -> Result<(), String> {
     let name = path.display().to_string();
     let added = if path.is_dir() {
         let files = super::inputs::read_folder(path)?;
-        // Each slice by its file name: the error's prefix names the folder.
-        let slices: Vec<(&str, &[u8])> = (files.iter())
-            .map(|(n, b)| (case::file_name(n), b.as_slice()))
+        // Each slice by its path in the folder: the error's prefix names the folder.
+        let names: Vec<String> = (files.iter())
+            .map(|(n, _)| Path::new(n).strip_prefix(path).map_or(n.clone(), path_text))
+            .collect();
+        let slices: Vec<(&str, &[u8])> = (names.iter().zip(&files))
+            .map(|(n, (_, b))| (n.as_str(), b.as_slice()))
             .collect();
         let folder = name.trim_end_matches(['/', '\\']);
         case.add_image(&slices, folder, args.window, args.image_voxels)
@@ -220,6 +224,10 @@ fn add_image(case: &mut Case, path: &Path, args: &BuildArgs) -> Result<(), Strin
         case.add_image(&[(&name, &bytes)], &name, args.window, args.image_voxels)
     };
     added.map_err(|e| format!("{name}: {e}"))
+}
+
+fn path_text(path: &Path) -> String {
+    path.display().to_string()
 }
 
 /// What the author adds to the structures opened: the image, title, description, lesson,
@@ -357,7 +365,8 @@ fn open(args: &BuildArgs) -> Result<Case, String> {
         },
         level: args.level,
     };
-    case::open(&inputs.files(), inputs.table(), &options).map_err(|e| e.to_string())
+    let (files, table) = inputs.named()?;
+    case::open(&files, table, &options).map_err(|e| e.to_string())
 }
 
 fn info(file: &Path, json: bool) -> Result<(), String> {

@@ -62,8 +62,8 @@ pub(super) fn run(args: &ExtractArgs) -> Result<(), String> {
         _ => None,
     };
     let started = Instant::now();
-    let structures =
-        segmentation::open(&inputs.files(), inputs.table(), &options).map_err(|e| e.to_string())?;
+    let (files, table) = inputs.named()?;
+    let structures = segmentation::open(&files, table, &options).map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     let written = match &destination {
         Destination::Folder(dir) => write_folder(dir, &structures)?,

@@ -3,9 +3,9 @@
 //
 //   E2E_MODE=webgpu|cpu node --test tests/e2e/segmentation.test.mjs   (tests/e2e/run.sh runs both)
 import assert from "node:assert/strict";
-import { appendFileSync, readFileSync, writeFileSync } from "node:fs";
+import { appendFileSync, mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { gunzipSync, gzipSync } from "node:zlib";
-import { join } from "node:path";
+import { dirname, join } from "node:path";
 
 import * as cli from "./lib/cli.mjs";
 import { metricDifferences } from "./lib/compare.mjs";
@@ -612,24 +612,32 @@ testIn(EVERY_RUN, "S9b a label map with its colour table, and four masks, droppe
     });
 });
 
-testIn(EVERY_RUN, "S9c a folder of masks dropped on the page opens as the CLI opens its files; an empty one and an unreadable file are reported", { timeout: TIMEOUT }, async () => {
+testIn(EVERY_RUN, "S9c a folder of masks dropped on the page opens as the CLI opens the folder, subfolders too; an empty one and an unreadable file are reported", { timeout: TIMEOUT }, async () => {
     await withApp(async (app) => {
-        // In the order of their names, hidden files and subfolders not read.
+        // In the order of their paths, hidden files and a DICOMDIR not read: the same folder on
+        // disk given to the CLI.
         const masks = ["bent_tube_r3.5_mask.nii.gz", "ellipsoid_30_20_12_mask.nii.gz", "sphere_r20_mask.nii.gz", "torus_R24_r8_mask.nii.gz"];
+        const placed = ["bent_tube_r3.5_mask.nii.gz", "more/ellipsoid_30_20_12_mask.nii.gz", "sphere_r20_mask.nii.gz", "more/ring/torus_R24_r8_mask.nii.gz"];
         const paths = masks.map((m) => meshPath(`synthetic/${m}`));
-        const shuffled = [2, 0, 3, 1].map((i) => ({ bytes: readFileSync(paths[i]), name: masks[i] }));
-        await app.dropFolder("masks", [...shuffled, { bytes: Buffer.from("Bud1"), name: ".DS_Store" }]);
+        const shuffled = [2, 0, 3, 1].map((i) => ({ bytes: readFileSync(paths[i]), name: placed[i] }));
+        const extras = [{ bytes: Buffer.from("Bud1"), name: ".DS_Store" }, { bytes: Buffer.from("an index"), name: "more/DICOMDIR" }];
+        await app.dropFolder("masks", [...shuffled, ...extras]);
         let state = await app.stateWhen((s) => s.structures?.file === "masks/bent_tube_r3.5_mask.nii.gz and 3 more files" && s.loading === null && s.model !== null, "the folder to open");
-        const native = await cli.cliJson("extract", ...paths, "-o", join(E2E_OUT, `extract-folder-${MODE}/`), "--json");
+        const onDisk = join(E2E_OUT, `folder-${MODE}`, "masks");
+        for (const { bytes, name } of [...shuffled, ...extras]) {
+            mkdirSync(dirname(join(onDisk, name)), { recursive: true });
+            writeFileSync(join(onDisk, name), bytes);
+        }
+        const native = await cli.cliJson("extract", onDisk, "-o", join(E2E_OUT, `extract-folder-${MODE}/`), "--json");
         assertSameStructures(state.structures.structures, native.structures);
-        assert.deepEqual(state.structures.structures.map((s) => s.source), masks);
+        assert.deepEqual(state.structures.structures.map((s) => s.source), [masks[0], masks[1], masks[3], masks[2]], "in the order of their paths");
         assert.equal(state.error, null, "the folder's own entry among the drop's files is not opened");
         await app.screenshot("S9c-folder-of-masks");
 
-        // A folder with nothing to read: its name and why, and the case stays.
-        await app.dropFolder("empty", [{ bytes: Buffer.from("Bud1"), name: ".DS_Store" }]);
+        // A folder with nothing to read in it or its subfolders: its name and why, and the case stays.
+        await app.dropFolder("empty", [{ bytes: Buffer.from("Bud1"), name: ".DS_Store" }, { bytes: Buffer.from("Bud1"), name: "series/.DS_Store" }]);
         state = await app.stateWhen((s) => s.error !== null, "the empty folder's error");
-        assert.match(state.error, /empty.*the folder holds no file, only 1 subfolder/);
+        assert.match(state.error, /empty.*neither the folder nor its 1 subfolder\(s\) hold a file/);
         assert.equal(state.structures.structures.length, 4);
 
         // A file the browser cannot read is named by its path in the folder.

@@ -367,9 +367,9 @@ export class AppPage {
     }
 
     /**
-     * Drops a folder `name` of `files` (`[{bytes, name}]`) and an empty subfolder on the
-     * canvas, as the browser's File and Directory Entries API shows a dropped folder: listed in
-     * batches of two, the folder also among the drop's files as Chromium gives it. Playwright
+     * Drops a folder `name` of `files` (`[{bytes, name}]`, a name with slashes in subfolders)
+     * on the canvas, as the browser's File and Directory Entries API shows a dropped folder:
+     * listed in batches of two, the folder also among the drop's files as Chromium gives it. Playwright
      * cannot drop a real folder, so the entries are made here; the files are real ones.
      */
     async dropFolder(name, files) {
@@ -383,6 +383,7 @@ export class AppPage {
                 isFile: false,
                 isDirectory: true,
                 name,
+                entries,
                 createReader() {
                     let at = 0;
                     return {
@@ -394,9 +395,23 @@ export class AppPage {
                     };
                 },
             });
-            const entries = files.map(([base64, name, fails]) => fileEntry(new File([bytesOf(base64)], name), fails));
-            entries.push(folderEntry("nested", [fileEntry(new File(["not read"], "nested.nii.gz"))]));
-            const root = folderEntry(folder, entries);
+            // A name with slashes is a file in subfolders, made as the paths need them.
+            const root = folderEntry(folder, []);
+            const folders = new Map([["", root]]);
+            const folderAt = (path) => {
+                if (!folders.has(path)) {
+                    const cut = path.lastIndexOf("/");
+                    const made = folderEntry(path.slice(cut + 1), []);
+                    folderAt(cut < 0 ? "" : path.slice(0, cut)).entries.push(made);
+                    folders.set(path, made);
+                }
+                return folders.get(path);
+            };
+            for (const [base64, path, fails] of files) {
+                const cut = path.lastIndexOf("/");
+                const name = path.slice(cut + 1);
+                folderAt(cut < 0 ? "" : path.slice(0, cut)).entries.push(fileEntry(new File([bytesOf(base64)], name), fails));
+            }
             const asFile = new DataTransfer();
             asFile.items.add(new File([], folder));
             const transfer = { items: { length: 1, 0: { kind: "file", type: "", webkitGetAsEntry: () => root } }, files: asFile.files };
