@@ -28,12 +28,17 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     assert!(session
         .start_suggest_all(1.5, SearchMethod::Local, false, 0.0)
         .is_err());
+    let version = session.case().case_version();
     session
         .start_suggest_all(0.5, SearchMethod::Local, false, 0.0)
         .unwrap();
     // Workers on this thread answer at once.
     assert!(session.step_suggest_all());
     assert!(!session.background().suggesting_all());
+    // The three structures besides the model took new surfaces, each a new case version (the
+    // model takes its parameters, and its surface comes from the view's engine).
+    assert_eq!(session.background().suggest_all_applied(), 3);
+    assert!(session.case().case_version() >= version + 3);
     let outcome = session.background().suggest_all().unwrap();
     assert_eq!((outcome.done, outcome.total), (4, 4));
     let suggested: Vec<meshsmooth::smooth::Params> = (outcome.structures.iter())

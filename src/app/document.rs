@@ -394,12 +394,15 @@ impl Document {
         true
     }
 
-    /// Between frames (an API call, a worker's reply): with the CPU engine in workers, sends
-    /// the current parameters' smoothing or takes its result now, moves the background work
-    /// on, and answers the calls waiting, rather than a frame of a large mesh later. True when
-    /// what the page shows changed (a result taken, a search or graph finished): a frame is due.
+    /// Between frames (an API call, a worker's reply): takes the structures "Suggest all" got
+    /// and hands out the next; with the CPU engine in workers, sends the current parameters'
+    /// smoothing or takes its result now, moves the background work on, and answers the calls
+    /// waiting, rather than a frame of a large mesh later. True when what the page shows
+    /// changed (a result taken, a search or graph finished): a frame is due.
     pub fn step_cpu_engine(&mut self) -> bool {
         self.session.pump_cpu_engine();
+        // Its surfaces show with the next paced frame; the workers need not wait for it.
+        self.session.step_suggest_all();
         if self.backend != Backend::Cpu || !self.session.cpu_engine().threaded() {
             return false;
         }

@@ -124,8 +124,9 @@ fn reply_handler(
 ) -> Closure<dyn FnMut(web_sys::MessageEvent)> {
     Closure::new(move |event: web_sys::MessageEvent| {
         let data = event.data();
-        // Progress and the runs of background work (graphs, searches) only move a bar on; a
-        // frame for each would take a core from the workers with a software GPU.
+        // Progress, the runs of background work (graphs, searches) and the structures of
+        // "Suggest all" (taken between frames) only move a bar on and change surfaces a second
+        // later: a frame for each would take a core from the workers with a software GPU.
         let mut paced = false;
         if let Some(buffer) = data.dyn_ref::<js_sys::ArrayBuffer>() {
             let bytes = js_sys::Uint8Array::new(buffer).to_vec();
@@ -133,7 +134,10 @@ fn reply_handler(
                 Ok(reply) => {
                     paced = matches!(
                         reply,
-                        Reply::Progress { .. } | Reply::Terms { .. } | Reply::Memory { .. }
+                        Reply::Progress { .. }
+                            | Reply::Terms { .. }
+                            | Reply::Memory { .. }
+                            | Reply::Suggested { .. }
                     );
                     inbox.borrow_mut().push((index, reply))
                 }

@@ -29,6 +29,9 @@ pub struct SuggestAll {
     /// When it started, in the caller's milliseconds (the session keeps no clock).
     started_ms: f64,
     cancelled: bool,
+    /// How many structures other than the model took their new surface: each a new version of
+    /// the case's looks that came from here.
+    applied: u64,
 }
 
 /// A structure's expected share of the work, in vertices: its vertices plus as many again as a
@@ -265,6 +268,7 @@ impl Session {
                 Some(suggested.local_error),
             ));
             self.doc.case_version += 1;
+            self.suggest_all.applied += 1;
         }
         summary
     }
@@ -281,6 +285,12 @@ impl<'a> Background<'a> {
         let s = &self.suggest_all;
         self.suggesting_all()
             .then(|| (s.total - s.waiting.len() - s.queued.len(), s.total))
+    }
+
+    /// How many structures besides the model the last "Suggest all" gave a new surface (each a
+    /// new case version): a view may show them in groups while it runs.
+    pub fn suggest_all_applied(&self) -> u64 {
+        self.suggest_all.applied
     }
 
     /// The fraction of the work of "Suggest all" done, by [`structure_work`], while it is under

@@ -41,7 +41,7 @@ mod view_sync;
 
 use first_paint::FirstPaint;
 use start::{embed, gpu_engine, open_start_model, set_style, start_workers};
-use view_sync::Shown;
+use view_sync::{Shown, LOOKS_EVERY_MS, LOOKS_EVERY_MS_SOFTWARE};
 
 /// Milliseconds of a frame the case glTF being written may take on this thread: the view
 /// stays usable (about ten frames a second) and the file is written at nearly full speed.
@@ -72,6 +72,8 @@ pub struct Shell {
     view: Option<(Viewer, egui_wgpu::RenderState)>,
     /// What the view shows now, so it is re-uploaded only when that changes.
     shown: Shown,
+    /// How far apart the new surfaces of "Suggest all" are shown (see `view_sync`).
+    looks_every_ms: f64,
     /// The segmentation the view framed whole (its file and structure count).
     framed_case: Option<(String, usize)>,
     structures: StructureList,
@@ -197,6 +199,10 @@ impl Shell {
             gpu_fallback: None,
             view,
             shown: Shown::default(),
+            looks_every_ms: match software {
+                true => LOOKS_EVERY_MS_SOFTWARE,
+                false => LOOKS_EVERY_MS,
+            },
             framed_case: None,
             structures: StructureList::default(),
             reading,

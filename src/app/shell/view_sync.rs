@@ -11,6 +11,11 @@ use crate::app::viewer;
 use crate::session::{ColorField, Legend, Session};
 use crate::view;
 
+/// How far apart the view shows the new surfaces of "Suggest all" ([`holds_looks`]): on a
+/// software GPU a redraw of a whole-body case costs seconds of CPU, on a graphics card little.
+pub(super) const LOOKS_EVERY_MS_SOFTWARE: f64 = 10_000.0;
+pub(super) const LOOKS_EVERY_MS: f64 = 1000.0;
+
 /// Where the view's positions come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Positions {
@@ -37,9 +42,13 @@ pub(super) struct Shown {
     /// The version of the structures' looks and the slide towards the segmentation the other
     /// structures were uploaded for.
     pub(super) looks: Option<(u64, u32)>,
+    /// When the looks were last uploaded (the page's clock), and how many of the structures'
+    /// new surfaces from "Suggest all" they held.
+    pub(super) looks_at_ms: f64,
+    pub(super) looks_applied: u64,
     /// The structure singled out (by the quiz) when the colours were last set.
     pub(super) highlight: Option<Option<usize>>,
-    /// The checks' marks and the looks' version they were uploaded for.
+    /// The checks' marks and the version of the looks shown they were uploaded for.
     pub(super) marks: (Option<u64>, u64),
 }
 
@@ -92,9 +101,14 @@ impl Shell {
         }
         let highlight = doc.quiz_highlight();
         let looks = (session.case().case_version(), toward.to_bits());
-        if shown.looks != Some(looks) {
+        let now = crate::app::document::now_ms();
+        if shown.looks != Some(looks)
+            && !holds_looks(shown, session, looks, now, self.looks_every_ms)
+        {
             upload_looks(viewer, rs, session, (toward, highlight));
             shown.looks = Some(looks);
+            shown.looks_at_ms = now;
+            shown.looks_applied = session.background().suggest_all_applied();
             shown.highlight = Some(highlight);
         } else if shown.highlight != Some(highlight) {
             // Only the colours change: the surfaces stay where they are on the GPU.
@@ -102,15 +116,39 @@ impl Shell {
             set_model_look(viewer, session, highlight);
             shown.highlight = Some(highlight);
         }
+        // On the surfaces as shown (which may be held back), not as the case has them.
         let marks = (
             session.background().marks_key(),
-            session.case().case_version(),
+            shown.looks.map_or(0, |(version, _)| version),
         );
         if shown.marks != marks {
             upload_marks(viewer, rs, session);
             shown.marks = marks;
         }
     }
+}
+
+/// Whether the view keeps the looks it shows although the case has `looks` now: while "Suggest
+/// all" runs and every change since the last upload is a structure's new surface from it, the
+/// surfaces show in groups, `every_ms` apart. Each upload redraws every structure, which a
+/// software GPU pays for with CPU time the workers need; the author's own edits show at once.
+fn holds_looks(
+    shown: &Shown,
+    session: &Session,
+    looks: (u64, u32),
+    now: f64,
+    every_ms: f64,
+) -> bool {
+    let Some((version, toward)) = shown.looks else {
+        return false;
+    };
+    let background = session.background();
+    let applied = background.suggest_all_applied();
+    background.suggesting_all()
+        && toward == looks.1
+        && applied >= shown.looks_applied
+        && looks.0.checked_sub(version) == Some(applied - shown.looks_applied)
+        && now - shown.looks_at_ms < every_ms
 }
 
 /// A new model in the view: framed when it is a new case's first, else where the view was.
