@@ -215,3 +215,27 @@ fn a_folders_hidden_files_and_dicomdir_are_not_read_with_its_others() {
         assert!(!read_in_folder(skipped), "{skipped}");
     }
 }
+
+#[test]
+fn a_folders_files_open_in_the_order_of_their_paths_folder_by_folder() {
+    let mut paths = vec![
+        "export/SE2/IM1",
+        "export/a-c.nii.gz",
+        "export\\a\\z.nii.gz",
+        "export/SE10/IM1",
+        "export/a/b.nii.gz",
+        "export/SE1/IM2",
+        "export/SE1/IM10",
+    ];
+    paths.sort_by(|a, b| folder_order(a, b));
+    let want = [
+        "export/SE1/IM10",
+        "export/SE1/IM2",
+        "export/SE10/IM1",
+        "export/SE2/IM1",
+        "export/a/b.nii.gz",
+        "export\\a\\z.nii.gz",
+        "export/a-c.nii.gz",
+    ];
+    assert_eq!(paths, want);
+}
