@@ -306,6 +306,73 @@ fn jpeg_series_read_as_the_uncompressed_ones() {
     );
 }
 
+/// The oblique series (signed 16-bit) as JPEG 2000 Lossless (GDCM's OpenJPEG codestreams)
+/// reads as the uncompressed one; the phantom CT's slices as lossy JPEG 2000 within a few stored
+/// units of theirs. A frame whose size is not the header's, that is no JPEG 2000 or that is cut
+/// short is refused naming its file.
+#[test]
+fn jpeg_2000_series_read_as_the_uncompressed_ones() {
+    assert_same(
+        &read(&slices("oblique_j2k"), ALL).expect("lossless"),
+        &twin(ALL),
+    );
+    let mut split = slices("oblique_j2k");
+    for (_, bytes) in &mut split {
+        *bytes = dicom::with_first_fragment_split(bytes, 100);
+    }
+    assert_same(&read(&split, ALL).expect("split"), &twin(ALL));
+    let plain = read(&slices("phantom_ct"), ALL).expect("uncompressed");
+    let lossy = read(&slices("phantom_ct_j2k"), ALL).expect("lossy");
+    assert_eq!(lossy.dims, plain.dims);
+    assert_eq!(lossy.affine, plain.affine);
+    let off: Vec<f32> = (lossy.values.iter().zip(&plain.values))
+        .map(|(a, b)| (a - b).abs())
+        .collect();
+    let mean = off.iter().sum::<f32>() / off.len() as f32;
+    let most = off.iter().copied().fold(0.0, f32::max);
+    eprintln!("JPEG 2000 at 20:1: mean {mean} HU, most {most} HU off");
+    // A stored unit is 10 HU.
+    assert!(
+        mean < 2.0 && most <= 150.0,
+        "mean {mean} HU, most {most} HU"
+    );
+
+    let refused = |change: &dyn Fn(&mut Vec<u8>), words: &str| {
+        let mut files = slices("oblique_j2k");
+        change(&mut files[3].1);
+        let e = refusal(&files);
+        assert!(
+            e.starts_with(&format!("{}: DICOM image:", files[3].0)),
+            "{e}"
+        );
+        assert!(e.contains(words), "wanted '{words}' in: {e}");
+    };
+    let columns = |b: &mut Vec<u8>| {
+        let at = dicom::first_fragment(b) + 8;
+        b[at..at + 4].copy_from_slice(&25u32.to_be_bytes());
+    };
+    refused(&columns, "25 x 20 pixels of 1 component(s) and 16 bits");
+    let not_j2k = |b: &mut Vec<u8>| {
+        let at = dicom::first_fragment(b);
+        b[at..at + 2].copy_from_slice(b"GI");
+    };
+    refused(&not_j2k, "JPEG 2000 frame 1: no JPEG 2000 codestream");
+    let cut = |b: &mut Vec<u8>| {
+        let at = dicom::first_fragment(b);
+        let length = u32::from_le_bytes(b[at - 4..at].try_into().unwrap()) as usize;
+        let end = at + length;
+        assert!(
+            b[at..end].ends_with(&[0xFF, 0xD9]),
+            "the fragment ends the codestream"
+        );
+        b[end - 64..end].fill(0);
+    };
+    refused(
+        &cut,
+        "JPEG 2000 frame 1: the codestream ends without its end of codestream marker",
+    );
+}
+
 /// `case build --image FOLDER`: the series' image in the case, the same as from its twin and
 /// from a DICOM export's folder above it; a tilted series, an export of two series and
 /// subfolders without files refused naming the slice or folder, with no case written.

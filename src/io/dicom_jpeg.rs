@@ -82,9 +82,9 @@ pub(super) fn decode(
     Ok(out)
 }
 
-/// Whether a codestream ends with its end-of-image marker, before the zero byte DICOM may pad
-/// a fragment with to an even length.
-fn ends_with_end_of_image(stream: &[u8]) -> bool {
+/// Whether a codestream ends with its end-of-image marker (JPEG 2000's end of codestream is the
+/// same two bytes), before the zero byte DICOM may pad a fragment with to an even length.
+pub(super) fn ends_with_end_of_image(stream: &[u8]) -> bool {
     let unpadded = stream.strip_suffix(&[0]).unwrap_or(stream);
     unpadded.ends_with(&[0xFF, 0xD9])
 }

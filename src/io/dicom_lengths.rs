@@ -2,16 +2,16 @@
 //! bytes left, before `dicom-object` parses it: that parser reserves each value's declared
 //! length (up to 4 GiB) before reading it, so a lying length in a small file would otherwise
 //! cost gigabytes. The walk also finds the transfer syntax and refuses the encodings the reader
-//! does not take (big-endian, compressions other than RLE and JPEG); a deflated file is walked
-//! once inflated ([`dicom_deflate`]). The walk reads
-//! headers exactly as dicom-rs does (an unknown VR has a 32-bit length, as UN), so that every
-//! value it will allocate has been measured; what the two would read differently is refused.
+//! does not take (big-endian, compressions other than RLE, JPEG and JPEG 2000); a deflated file
+//! is walked once inflated ([`dicom_deflate`]). The walk reads headers exactly as dicom-rs does
+//! (an unknown VR has a 32-bit length, as UN), so that every value it will allocate has been
+//! measured; what the two would read differently is refused.
 
 use std::borrow::Cow;
 use std::ops::Range;
 
 use super::dicom_deflate::{self, MetaGroup, DEFLATED_EXPLICIT_LE};
-use super::{dicom_jpeg, dicom_rle};
+use super::{dicom_jpeg, dicom_jpeg2000, dicom_rle};
 use super::{Format, LoadError};
 
 const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
@@ -24,6 +24,8 @@ const JPEG: [&str; 4] = [
     "1.2.840.10008.1.2.4.57",
     "1.2.840.10008.1.2.4.70",
 ];
+/// JPEG 2000 lossless only, and lossless or lossy.
+const JPEG_2000: [&str; 2] = ["1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91"];
 const UNDEFINED: u32 = u32::MAX;
 
 const ITEM: (u16, u16) = (0xFFFE, 0xE000);
@@ -60,6 +62,7 @@ pub(super) enum PixelData {
 pub(super) enum Codec {
     Rle,
     Jpeg,
+    Jpeg2000,
 }
 
 /// The frames a file declares: how many, their columns and rows, and `bits` a pixel (1, 8, 16
@@ -158,8 +161,8 @@ impl Layout {
     }
 }
 
-/// Encapsulated frames, decoded: one fragment a frame, or for a single frame (JPEG) all of
-/// them, in order.
+/// Encapsulated frames, decoded: one fragment a frame, or for a single frame (JPEG, JPEG 2000)
+/// all of them, in order.
 fn decode(
     codec: Codec,
     fragments: &[&[u8]],
@@ -175,7 +178,7 @@ fn decode(
     }
     let joined;
     let streams = match (codec, frames.count) {
-        (Codec::Jpeg, 1) if fragments.len() > 1 => {
+        (Codec::Jpeg | Codec::Jpeg2000, 1) if fragments.len() > 1 => {
             joined = fragments.concat();
             vec![joined.as_slice()]
         }
@@ -195,6 +198,7 @@ fn decode(
     match codec {
         Codec::Rle => dicom_rle::decode(&streams, shape, format),
         Codec::Jpeg => dicom_jpeg::decode(&streams, shape, frames.size, format),
+        Codec::Jpeg2000 => dicom_jpeg2000::decode(&streams, shape, frames.size, format),
     }
 }
 
@@ -250,6 +254,7 @@ pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
         IMPLICIT_LE => (true, None),
         RLE_LOSSLESS => (false, Some(Codec::Rle)),
         jpeg if JPEG.contains(&jpeg) => (false, Some(Codec::Jpeg)),
+        j2k if JPEG_2000.contains(&j2k) => (false, Some(Codec::Jpeg2000)),
         other => return Err(unsupported_syntax(other, format)),
     };
     walk.data_set(implicit, codec)?;
@@ -269,7 +274,7 @@ fn unsupported_syntax(uid: &str, format: Format) -> LoadError {
         format,
         detail: format!(
             "transfer syntax {uid} ({what}): uncompressed and deflated little-endian, RLE \
-             Lossless and JPEG files are read"
+             Lossless, JPEG and JPEG 2000 files are read"
         ),
     }
 }
@@ -562,9 +567,9 @@ mod tests {
 
     #[test]
     fn other_encodings_are_named() {
-        let error = check(&file("1.2.840.10008.1.2.4.90", &[]), Format::DicomSeg).unwrap_err();
+        let error = check(&file("1.2.840.10008.1.2.4.80", &[]), Format::DicomSeg).unwrap_err();
         assert!(
-            error.to_string().contains("1.2.840.10008.1.2.4.90"),
+            error.to_string().contains("1.2.840.10008.1.2.4.80"),
             "{error}"
         );
         let error = check(&file("1.2.840.10008.1.2.2", &[]), Format::DicomSeg).unwrap_err();

@@ -6,6 +6,7 @@ mod codes;
 mod color_table;
 mod dicom_deflate;
 mod dicom_jpeg;
+mod dicom_jpeg2000;
 mod dicom_lengths;
 mod dicom_rle;
 mod dicom_seg;

@@ -12,14 +12,21 @@ name):
   Lossless (1.2.840.10008.1.2.5, pydicom's own encoder): two segments a frame, high bytes first.
 - tests/data/dicom_series/oblique_jpeg/jpeg_*.dcm: the same slices as JPEG Lossless, first-order
   prediction (1.2.840.10008.1.2.4.70), the codestream GDCM's encoder writes.
+- tests/data/dicom_series/oblique_j2k/j2k_*.dcm: the same slices as JPEG 2000 Lossless
+  (1.2.840.10008.1.2.4.90), the codestream GDCM's encoder (OpenJPEG) writes: signed samples.
 - tests/data/dicom_series/phantom_ct_jpeg/jpeg_*.dcm: the slices of phantom_ct/ (unsigned 8-bit)
   as JPEG Baseline (1.2.840.10008.1.2.4.50, lossy, Pillow at quality 95, no chroma: one grey
   component), marked Lossy Image Compression 01. Its values differ from the original's by a few
   stored units near edges.
+- tests/data/dicom_series/phantom_ct_j2k/j2k_*.dcm: the same slices as JPEG 2000
+  (1.2.840.10008.1.2.4.91, lossy: Pillow's OpenJPEG, the irreversible 9/7 wavelet at 20:1),
+  marked Lossy Image Compression 01.
 - tests/data/dicom_seg/labelmap_rle.dcm, fractional_rle.dcm: labelmap.dcm (LABELMAP, 8-bit, 22
   frames) and fractional.dcm (FRACTIONAL, 8-bit, 10 frames) as RLE Lossless.
 - tests/data/dicom_seg/fractional_jpeg.dcm: fractional.dcm as JPEG Lossless SV1 (GDCM's
   codestreams, one fragment a frame; GDCM does not read the LABELMAP SOP class).
+- tests/data/dicom_seg/fractional_j2k.dcm: fractional.dcm as JPEG 2000 Lossless (GDCM's
+  codestreams, one fragment a frame).
 - tests/data/dicom_seg/phantom_deflated.dcm and tests/data/dicom_series/oblique_deflated/
   deflated_*.dcm: phantom.dcm (BINARY) and the slices of oblique/ in Deflated Explicit VR Little
   Endian (1.2.840.10008.1.2.1.99): the whole data set after the file meta group one raw deflate
@@ -40,6 +47,8 @@ from PIL import Image
 from pydicom.encaps import encapsulate, generate_frames
 from pydicom.uid import (
     DeflatedExplicitVRLittleEndian,
+    JPEG2000,
+    JPEG2000Lossless,
     JPEGBaseline8Bit,
     JPEGLosslessSV1,
     RLELossless,
@@ -62,13 +71,13 @@ def check_same(target, original, syntax):
     assert np.array_equal(back.pixel_array, original), f"{target} decodes differently"
 
 
-def gdcm_jpeg_lossless(source):
-    """The JPEG Lossless SV1 codestreams GDCM writes for `source`'s frames."""
+def gdcm_frames(source, syntax):
+    """The codestreams GDCM writes for `source`'s frames in the transfer syntax `syntax`."""
     reader = gdcm.ImageReader()
     reader.SetFileName(source)
     assert reader.Read(), source
     change = gdcm.ImageChangeTransferSyntax()
-    change.SetTransferSyntax(gdcm.TransferSyntax(gdcm.TransferSyntax.JPEGLosslessProcess14_1))
+    change.SetTransferSyntax(gdcm.TransferSyntax(syntax))
     change.SetInput(reader.GetImage())
     assert change.Change(), source
     with tempfile.TemporaryDirectory() as folder:
@@ -91,7 +100,20 @@ def pillow_jpeg_baseline(ds):
     return [out.getvalue()]
 
 
-def encapsulated_twin(source, target, syntax, frames, lossy=False):
+def gdcm_jpeg_lossless(source):
+    return gdcm_frames(source, gdcm.TransferSyntax.JPEGLosslessProcess14_1)
+
+
+def pillow_jpeg_2000(ds):
+    out = io.BytesIO()
+    Image.fromarray(ds.pixel_array.astype(np.uint8), mode="L").save(
+        out, format="JPEG2000", no_jp2=True, irreversible=True,
+        quality_mode="rates", quality_layers=[20],
+    )
+    return [out.getvalue()]
+
+
+def encapsulated_twin(source, target, syntax, frames, lossy=None):
     ds = pydicom.dcmread(source)
     original = ds.pixel_array.copy()
     ds.file_meta.TransferSyntaxUID = syntax
@@ -100,7 +122,7 @@ def encapsulated_twin(source, target, syntax, frames, lossy=False):
     ds["PixelData"].is_undefined_length = True
     if lossy:
         ds.LossyImageCompression = "01"
-        ds.LossyImageCompressionMethod = "ISO_10918_1"
+        ds.LossyImageCompressionMethod = lossy
     ds.save_as(target, enforce_file_format=True)
     if not lossy:
         check_same(target, original, syntax)
@@ -131,7 +153,21 @@ def main():
         "phantom_ct",
         "jpeg",
         lambda s, t: encapsulated_twin(
-            s, t, JPEGBaseline8Bit, pillow_jpeg_baseline(pydicom.dcmread(s)), lossy=True
+            s, t, JPEGBaseline8Bit, pillow_jpeg_baseline(pydicom.dcmread(s)), "ISO_10918_1"
+        ),
+    )
+    twins_of(
+        "oblique",
+        "j2k",
+        lambda s, t: encapsulated_twin(
+            s, t, JPEG2000Lossless, gdcm_frames(s, gdcm.TransferSyntax.JPEG2000Lossless)
+        ),
+    )
+    twins_of(
+        "phantom_ct",
+        "j2k",
+        lambda s, t: encapsulated_twin(
+            s, t, JPEG2000, pillow_jpeg_2000(pydicom.dcmread(s)), "ISO_15444_1"
         ),
     )
     twins_of("oblique", "deflated", deflated_twin)
@@ -142,6 +178,12 @@ def main():
     fractional = f"{seg}/fractional.dcm"
     encapsulated_twin(
         fractional, f"{seg}/fractional_jpeg.dcm", JPEGLosslessSV1, gdcm_jpeg_lossless(fractional)
+    )
+    encapsulated_twin(
+        fractional,
+        f"{seg}/fractional_j2k.dcm",
+        JPEG2000Lossless,
+        gdcm_frames(fractional, gdcm.TransferSyntax.JPEG2000Lossless),
     )
 
 

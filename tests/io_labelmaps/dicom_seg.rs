@@ -555,15 +555,16 @@ fn a_labelmap_seg_reads_as_the_binary_one() {
     );
 }
 
-/// RLE Lossless twins of the LABELMAP and FRACTIONAL SEGs and a JPEG Lossless one of the
-/// FRACTIONAL SEG (tests/data/make_dicom_compressed.py) read as the uncompressed files; a broken
-/// frame is refused.
+/// RLE Lossless twins of the LABELMAP and FRACTIONAL SEGs and JPEG Lossless and JPEG 2000
+/// Lossless ones of the FRACTIONAL SEG (tests/data/make_dicom_compressed.py) read as the
+/// uncompressed files; a broken frame is refused.
 #[test]
 fn compressed_segs_read_as_the_uncompressed_ones() {
     for (name, twin) in [
         ("labelmap", "labelmap_rle"),
         ("fractional", "fractional_rle"),
         ("fractional", "fractional_jpeg"),
+        ("fractional", "fractional_j2k"),
     ] {
         let plain = load_named(&seg(&format!("{name}.dcm")), "plain.dcm");
         let compressed = load_named(&seg(&format!("{twin}.dcm")), "twin.dcm");
