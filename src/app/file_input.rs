@@ -7,10 +7,11 @@ use eframe::egui;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
-use super::folder_drop::{FolderDrops, Listed};
+use super::folder_drop::{self, FolderDrops};
 use super::read_bytes::{self, OnProgress};
 use wasm_bindgen::closure::Closure;
 use wasm_bindgen::JsCast;
+use web_sys::FileSystemEntry;
 
 /// The extensions `io::load` and `io::load_label_map` understand, for the picker's filter
 /// (`.gz` for `.nii.gz`, which the filter cannot name as one extension).
@@ -59,32 +60,53 @@ fn local_read(file: web_sys::File) -> PendingReadFn {
     })
 }
 
-/// Where [`FolderDrops`] hands a drop's listed files: read together as a new case, or the
-/// item that could not be listed reported as a file that failed.
-fn deliver_folders(inbox: &Inbox, ctx: &egui::Context) -> std::rc::Rc<dyn Fn(Listed)> {
+/// Where [`FolderDrops`] hands a drop that holds a folder: listed (the entries counted shown
+/// as the folder's reading), then its files read together as a new case, or the item that
+/// could not be listed reported as a file that failed.
+fn take_folder_drops(inbox: &Inbox, ctx: &egui::Context) -> Rc<dyn Fn(Vec<FileSystemEntry>)> {
     let (inbox, ctx) = (inbox.clone(), ctx.clone());
-    std::rc::Rc::new(move |listed: Listed| match listed {
-        Ok(files) => {
-            let reads = (files.into_iter())
-                .map(|(name, file)| (name, local_read(file)))
-                .collect();
-            inbox.read_together(reads, FilesFor::NewCase, &ctx);
-        }
-        Err((name, error)) => {
-            let files = vec![ArrivedFile {
-                name,
-                bytes: Err(error),
-            }];
-            let purpose = FilesFor::NewCase;
-            inbox.deliver(Arrived { files, purpose }, &ctx);
-        }
+    Rc::new(move |entries: Vec<FileSystemEntry>| {
+        let folder = entries.iter().find(|e| e.is_directory());
+        let name = folder.map(FileSystemEntry::name).unwrap_or_default();
+        let (id, progress) = inbox.begin(&name, Unit::Entries, &ctx);
+        let (inbox, ctx) = (inbox.clone(), ctx.clone());
+        wasm_bindgen_futures::spawn_local(async move {
+            let listed = folder_drop::list(entries, progress).await;
+            inbox.reading.borrow_mut().retain(|(i, _)| *i != id);
+            match listed {
+                Ok(files) => {
+                    let reads = (files.into_iter())
+                        .map(|(name, file)| (name, local_read(file)))
+                        .collect();
+                    inbox.read_together(reads, FilesFor::NewCase, &ctx);
+                }
+                Err((name, error)) => {
+                    let files = vec![ArrivedFile {
+                        name,
+                        bytes: Err(error),
+                    }];
+                    let purpose = FilesFor::NewCase;
+                    inbox.deliver(Arrived { files, purpose }, &ctx);
+                }
+            }
+        });
     })
 }
 
-/// A file being read: bytes so far, and the total when known.
+/// What a [`Reading`] counts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Unit {
+    /// A file's bytes.
+    Bytes,
+    /// A dropped folder's entries, listed before its files are read.
+    Entries,
+}
+
+/// A file being read (or a folder listed): bytes (entries) so far, and the total when known.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reading {
     pub name: String,
+    pub unit: Unit,
     pub read: u64,
     pub total: Option<u64>,
 }
@@ -93,6 +115,9 @@ impl Reading {
     /// What the page says about it.
     pub fn describe(&self) -> String {
         let mb = |b: u64| b as f64 / 1e6;
+        if self.unit == Unit::Entries {
+            return format!("Listing {}: {} entries", self.name, self.read);
+        }
         match self.total {
             Some(t) if t > 0 => format!(
                 "Reading {}: {:.1} of {:.1} MB",
@@ -130,11 +155,12 @@ pub type ArrivalHook = Box<dyn FnMut(&mut Vec<Arrived>)>;
 
 impl Inbox {
     /// Registers a read of `name`; the returned callback reports its progress.
-    fn begin(&self, name: &str, ctx: &egui::Context) -> (u64, OnProgress) {
+    fn begin(&self, name: &str, unit: Unit, ctx: &egui::Context) -> (u64, OnProgress) {
         let id = self.next.get();
         self.next.set(id + 1);
         let reading = Reading {
             name: name.to_string(),
+            unit,
             read: 0,
             total: None,
         };
@@ -169,7 +195,7 @@ impl Inbox {
     fn read_together(&self, files: Vec<PendingRead>, purpose: FilesFor, ctx: &egui::Context) {
         let reads: Vec<_> = (files.into_iter())
             .map(|(name, read)| {
-                let (id, progress) = self.begin(&name, ctx);
+                let (id, progress) = self.begin(&name, Unit::Bytes, ctx);
                 (id, name, read(progress))
             })
             .collect();
@@ -202,7 +228,7 @@ pub struct FileInput {
 impl FileInput {
     pub fn new(ctx: &egui::Context) -> Self {
         let inbox = Inbox::default();
-        let folders = FolderDrops::listen(deliver_folders(&inbox, ctx))
+        let folders = FolderDrops::listen(take_folder_drops(&inbox, ctx))
             .map_err(|e| log::error!("dropped folders will not be read: {e}"))
             .ok();
         match create_picker(&inbox, ctx) {
@@ -268,7 +294,7 @@ impl FileInput {
     pub fn fetch(&self, url: String, name: String, ctx: &egui::Context) {
         let inbox = self.inbox.clone();
         let ctx = ctx.clone();
-        let (id, progress) = inbox.begin(&name, &ctx);
+        let (id, progress) = inbox.begin(&name, Unit::Bytes, &ctx);
         wasm_bindgen_futures::spawn_local(async move {
             let bytes = read_bytes::fetch(&url, progress).await;
             inbox.reading.borrow_mut().retain(|(i, _)| *i != id);

@@ -1,9 +1,9 @@
 //! Folders dropped on the page. eframe hands the app every dropped item as a file, a folder as
 //! one it cannot read; so a listener on the window, which the browser calls before eframe's on
 //! the canvas, takes each drop that holds a folder and lists the folder with the browser's File
-//! and Directory Entries API. A folder's files open as the CLI reads a folder
-//! ([`crate::case::read_in_folder`], with its subfolders, in the order of their paths), with
-//! the files dropped beside it, as one case. What cannot be read is named: the folder, or the
+//! and Directory Entries API. A folder's files open as the CLI reads a folder (a
+//! [`FolderListing`]: with its subfolders, in the order of their paths), with the files dropped
+//! beside it, as one case. What cannot be read is named: the folder, or the
 //! subfolder or file by its path in it.
 
 use std::cell::Cell;
@@ -14,6 +14,9 @@ use wasm_bindgen::closure::Closure;
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_futures::JsFuture;
 use web_sys::{FileSystemDirectoryEntry, FileSystemEntry, FileSystemFileEntry};
+
+use super::read_bytes::OnProgress;
+use crate::case::{EntryKind, FolderListing};
 
 /// A drop's files in order, each named by its path in the drop (`masks/liver.nii.gz`); or the
 /// item that could not be listed and why.
@@ -26,8 +29,8 @@ pub struct FolderDrops {
 }
 
 impl FolderDrops {
-    /// Listens on the window; `deliver` gets each taken drop's files once listed.
-    pub fn listen(deliver: Rc<dyn Fn(Listed)>) -> Result<FolderDrops, String> {
+    /// Listens on the window; `take` gets each taken drop's items, to [`list`].
+    pub fn listen(take: Rc<dyn Fn(Vec<FileSystemEntry>)>) -> Result<FolderDrops, String> {
         let window = web_sys::window().ok_or("no window")?;
         let taken = Rc::new(Cell::new(0));
         let listener = {
@@ -45,8 +48,7 @@ impl FolderDrops {
                 let files = transfer.files().map_or(0, |f| f.length() as usize);
                 taken.set(taken.get() + files);
                 event.prevent_default();
-                let deliver = deliver.clone();
-                wasm_bindgen_futures::spawn_local(async move { deliver(list(entries).await) });
+                take(entries);
             })
         };
         window
@@ -78,13 +80,13 @@ fn entries_of(transfer: &web_sys::DataTransfer) -> Vec<FileSystemEntry> {
 }
 
 /// Every file of the dropped items: loose files as they are, each folder's files (its
-/// subfolders' too) in [`crate::case::folder_order`].
-async fn list(entries: Vec<FileSystemEntry>) -> Listed {
+/// subfolders' too) as a [`FolderListing`] keeps them; `progress` hears the entries listed.
+pub async fn list(entries: Vec<FileSystemEntry>, mut progress: OnProgress) -> Listed {
     let mut files = Vec::new();
     for entry in entries {
         let name = entry.name();
         if entry.is_directory() {
-            files.extend(files_of(entry.unchecked_into(), &name).await?);
+            files.extend(files_of(entry.unchecked_into(), &name, &mut progress).await?);
         } else if entry.is_file() {
             let file = file_of(entry.unchecked_into()).await;
             files.push((name.clone(), file.map_err(|e| (name, e))?));
@@ -95,43 +97,38 @@ async fn list(entries: Vec<FileSystemEntry>) -> Listed {
 
 /// The files `folder` and its subfolders hold that open with the others, by their paths; or
 /// what could not be read (the folder, a subfolder or a file, by its path) and why.
+/// `progress` hears the entries listed so far.
 async fn files_of(
     folder: FileSystemDirectoryEntry,
     name: &str,
+    progress: &mut OnProgress,
 ) -> Result<Vec<(String, web_sys::File)>, (String, String)> {
     let refused = |e: String| (name.to_string(), e);
-    let mut found: Vec<(String, FileSystemFileEntry)> = Vec::new();
+    let mut listing = FolderListing::default();
     let mut folders = vec![(folder, name.to_string(), 0)];
-    let (mut seen, mut subfolders) = (0, 0);
     while let Some((folder, path, depth)) = folders.pop() {
-        let entries = entries_in(&folder, &mut seen).await;
+        let entries = entries_in(&folder, listing.room(), progress, listing.entries()).await;
         let entries = entries.map_err(|e| (path.clone(), e))?;
-        if seen > crate::case::FOLDER_ENTRIES {
-            return Err(refused(crate::case::folder_too_large()));
-        }
+        listing.count(entries.len()).map_err(refused)?;
         for entry in entries {
-            if !crate::case::read_in_folder(&entry.name()) {
-                continue;
-            }
             let at = format!("{path}/{}", entry.name());
-            if entry.is_directory() {
-                if depth == crate::case::FOLDER_DEPTH {
-                    return Err(refused(crate::case::folder_too_deep()));
-                }
-                subfolders += 1;
-                folders.push((entry.unchecked_into(), at, depth + 1));
-            } else if entry.is_file() {
-                found.push((at, entry.unchecked_into()));
+            let kind = match (entry.is_directory(), entry.is_file()) {
+                (true, _) => EntryKind::Folder,
+                (_, true) => EntryKind::File,
+                _ => EntryKind::Other,
+            };
+            if let Some(sub) = listing
+                .take(at.clone(), kind, depth, entry)
+                .map_err(refused)?
+            {
+                folders.push((sub.unchecked_into(), at, depth + 1));
             }
         }
     }
-    if found.is_empty() {
-        return Err(refused(crate::case::no_file_in_folder(subfolders)));
-    }
-    found.sort_by(|a, b| crate::case::folder_order(&a.0, &b.0));
+    let found = listing.files().map_err(refused)?;
     let mut files = Vec::with_capacity(found.len());
     for (path, entry) in found {
-        match file_of(entry).await {
+        match file_of(entry.unchecked_into()).await {
             Ok(file) => files.push((path, file)),
             Err(e) => return Err((path, e)),
         }
@@ -139,16 +136,18 @@ async fn files_of(
     Ok(files)
 }
 
-/// The entries `folder` holds, each counted in `seen`; the listing stops early once `seen`
-/// passes [`crate::case::FOLDER_ENTRIES`].
+/// The entries `folder` holds, up to a batch past `room`; `progress` hears them counted on
+/// from `listed`.
 async fn entries_in(
     folder: &FileSystemDirectoryEntry,
-    seen: &mut usize,
+    room: usize,
+    progress: &mut OnProgress,
+    listed: usize,
 ) -> Result<Vec<FileSystemEntry>, String> {
     let reader = folder.create_reader();
     let mut entries = Vec::new();
     // Each call gives the next batch of entries, an empty one at the end.
-    while *seen <= crate::case::FOLDER_ENTRIES {
+    while entries.len() < room {
         let batch: Array = called_back(|ok, fail| {
             if let Err(e) = reader.read_entries_with_callback_and_callback(ok, fail) {
                 let _ = fail.call1(&JsValue::NULL, &e);
@@ -160,8 +159,8 @@ async fn entries_in(
         if batch.length() == 0 {
             break;
         }
-        *seen += batch.length() as usize;
         entries.extend(batch.iter().map(|e| e.unchecked_into::<FileSystemEntry>()));
+        progress((listed + entries.len()) as u64, None);
     }
     Ok(entries)
 }

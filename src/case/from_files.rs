@@ -154,51 +154,6 @@ pub fn surface_structure(path: &str, mesh: Mesh, ordinal: usize) -> CaseStructur
     s
 }
 
-/// Whether a file or subfolder found in a folder opens with the folder's others: every one but
-/// hidden ones (a file manager's `.DS_Store`) and a DICOMDIR index, which holds no slice or
-/// segment. The CLI's folders and the page's dropped folders are read alike.
-pub fn read_in_folder(name: &str) -> bool {
-    let name = file_name(name);
-    !name.starts_with('.') && !name.eq_ignore_ascii_case("DICOMDIR")
-}
-
-/// A folder is read with its subfolders (a DICOM export keeps each series some levels below
-/// the folder a user picks) down to this many levels below it...
-pub const FOLDER_DEPTH: usize = 8;
-/// ...and up to this many entries in all: the listing stays bounded.
-pub const FOLDER_ENTRIES: usize = 20_000;
-
-/// Why a folder is not read: its subfolders go deeper than [`FOLDER_DEPTH`].
-pub fn folder_too_deep() -> String {
-    format!(
-        "its subfolders go more than {FOLDER_DEPTH} levels down: open the folder that holds \
-         the files"
-    )
-}
-
-/// Why a folder is not read: it holds more than [`FOLDER_ENTRIES`] entries.
-pub fn folder_too_large() -> String {
-    format!(
-        "the folder and its subfolders hold more than {FOLDER_ENTRIES} entries: open the \
-         folder of one series or one set of masks"
-    )
-}
-
-/// Why a folder whose subfolders (`subfolders` of them, all levels) hold no file that
-/// [`read_in_folder`] keeps opens nothing.
-pub fn no_file_in_folder(subfolders: usize) -> String {
-    match subfolders {
-        0 => "the folder holds no file".to_string(),
-        n => format!("neither the folder nor its {n} subfolder(s) hold a file"),
-    }
-}
-
-/// The order a folder's files open in: by their paths, folder by folder (`a/b` before `a-c`),
-/// on the page and in the CLI alike.
-pub fn folder_order(a: &str, b: &str) -> std::cmp::Ordering {
-    a.split(['/', '\\']).cmp(b.split(['/', '\\']))
-}
-
 /// A path's last component: all of a path a case keeps.
 pub fn file_name(path: &str) -> &str {
     path.rsplit(['/', '\\']).next().unwrap_or(path)

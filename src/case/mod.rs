@@ -2,12 +2,13 @@
 //! ordered list of structures (liver, vessels, tumour), each with its own filter, parameters
 //! and measures, smoothed independently and written as one glTF.
 //!
-//! Layout: the document here; opening files as a case in `from_files`; smoothing and "Suggest all" in `pipeline`; the quality record
-//! the glTF carries (and reads back) in `record`; checks between structures in `relations`; the
-//! tour, labels and quiz in `lesson`, and what a student did with them as xAPI statements in
-//! `xapi`.
+//! Layout: the document here; opening files as a case in `from_files` (a folder's listing in
+//! `folder`); smoothing and "Suggest all" in `pipeline`; the quality record the glTF carries
+//! (and reads back) in `record`; checks between structures in `relations`; the tour, labels and
+//! quiz in `lesson`, and what a student did with them as xAPI statements in `xapi`.
 
 mod checks;
+mod folder;
 mod from_files;
 mod image;
 mod image_frame;
@@ -20,10 +21,12 @@ mod voxel_grid;
 pub mod xapi;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
+pub use folder::{
+    folder_order, read_in_folder, EntryKind, FolderListing, FOLDER_DEPTH, FOLDER_ENTRIES,
+};
 pub use from_files::{
-    file_name, first_structure_file, folder_order, folder_too_deep, folder_too_large,
-    no_file_in_folder, open, open_staged, read_in_folder, reading_stages, split_color_table,
-    surface_structure, CaseOpenError, FOLDER_DEPTH, FOLDER_ENTRIES,
+    file_name, first_structure_file, open, open_staged, reading_stages, split_color_table,
+    surface_structure, CaseOpenError,
 };
 pub use image::{CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
 pub use image_frame::{check_frame, StructureGrid};

@@ -1,5 +1,6 @@
 //! The files a segmentation command reads: its inputs and the colour table, named as given.
 
+use crate::case::{EntryKind, FolderListing};
 use crate::segmentation::NamedBytes;
 use std::path::{Path, PathBuf};
 
@@ -14,58 +15,34 @@ fn read(path: &Path) -> Result<(String, Vec<u8>), String> {
 }
 
 /// The files of a folder and of its subfolders (a DICOM export's series folders, a folder of
-/// masks), each named by its path, in [`crate::case::folder_order`]: every regular file in a
-/// folder that [`crate::case::read_in_folder`] keeps. Links are not followed.
+/// masks), each named by its path, as a [`FolderListing`] keeps them. Links are not followed.
 pub(super) fn read_folder(dir: &Path) -> Result<Vec<(String, Vec<u8>)>, String> {
-    let mut walk = Walk::default();
+    let mut listing = FolderListing::default();
     let at = |e: String| format!("{}: {e}", dir.display());
-    walk.folder(dir, 0).map_err(at)?;
-    if walk.files.is_empty() {
-        return Err(at(crate::case::no_file_in_folder(walk.subfolders)));
-    }
-    walk.files
-        .sort_by(|a, b| crate::case::folder_order(&a.0, &b.0));
-    (walk.files.iter()).map(|(_, p)| read(p)).collect()
+    list(&mut listing, dir, 0).map_err(at)?;
+    let files = listing.files().map_err(at)?;
+    (files.into_iter()).map(|(_, path)| read(&path)).collect()
 }
 
-/// What a folder's listing found so far: files (by their path's text, and path), entries seen
-/// and subfolders walked.
-#[derive(Default)]
-struct Walk {
-    files: Vec<(String, PathBuf)>,
-    entries: usize,
-    subfolders: usize,
-}
-
-impl Walk {
-    /// Lists `dir`, `depth` levels below the folder given; an error names a subfolder that
-    /// cannot be listed by its path, and says when the limits are passed.
-    fn folder(&mut self, dir: &Path, depth: usize) -> Result<(), String> {
-        let failed = |e: std::io::Error| format!("{}: {e}", dir.display());
-        for entry in std::fs::read_dir(dir).map_err(failed)? {
-            let entry = entry.map_err(failed)?;
-            self.entries += 1;
-            if self.entries > crate::case::FOLDER_ENTRIES {
-                return Err(crate::case::folder_too_large());
-            }
-            let name = entry.file_name().to_string_lossy().into_owned();
-            if !crate::case::read_in_folder(&name) {
-                continue;
-            }
-            let kind = entry.file_type().map_err(failed)?;
-            if kind.is_dir() {
-                if depth == crate::case::FOLDER_DEPTH {
-                    return Err(crate::case::folder_too_deep());
-                }
-                self.subfolders += 1;
-                self.folder(&entry.path(), depth + 1)?;
-            } else if kind.is_file() {
-                let path = entry.path();
-                self.files.push((path.display().to_string(), path));
-            }
+/// Lists `dir`, `depth` levels below the folder given, into `listing`; an error names a
+/// subfolder that cannot be listed by its path.
+fn list(listing: &mut FolderListing<PathBuf>, dir: &Path, depth: usize) -> Result<(), String> {
+    let failed = |e: std::io::Error| format!("{}: {e}", dir.display());
+    for entry in std::fs::read_dir(dir).map_err(failed)? {
+        let entry = entry.map_err(failed)?;
+        listing.count(1)?;
+        let kind = entry.file_type().map_err(failed)?;
+        let kind = match (kind.is_dir(), kind.is_file()) {
+            (true, _) => EntryKind::Folder,
+            (_, true) => EntryKind::File,
+            _ => EntryKind::Other,
+        };
+        let path = entry.path();
+        if let Some(sub) = listing.take(path.display().to_string(), kind, depth, path)? {
+            list(listing, &sub, depth + 1)?;
         }
-        Ok(())
     }
+    Ok(())
 }
 
 impl Inputs {

@@ -621,7 +621,10 @@ testIn(EVERY_RUN, "S9c a folder of masks dropped on the page opens as the CLI op
         const paths = masks.map((m) => meshPath(`synthetic/${m}`));
         const shuffled = [2, 0, 3, 1].map((i) => ({ bytes: readFileSync(paths[i]), name: placed[i] }));
         const extras = [{ bytes: Buffer.from("Bud1"), name: ".DS_Store" }, { bytes: Buffer.from("an index"), name: "more/DICOMDIR" }];
-        await app.dropFolder("masks", [...shuffled, ...extras]);
+        // Listed slowly, as a large export on a slow disk is: the page says how far the listing got.
+        await app.dropFolder("masks", [...shuffled, ...extras], { batchMs: 500 });
+        await new Promise((r) => setTimeout(r, 1200));
+        await app.screenshot("S9c-folder-being-listed");
         let state = await app.stateWhen((s) => s.structures?.file === "masks/bent_tube_r3.5_mask.nii.gz and 3 more files" && s.loading === null && s.model !== null, "the folder to open");
         const onDisk = join(E2E_OUT, `folder-${MODE}`, "masks");
         for (const { bytes, name } of [...shuffled, ...extras]) {

@@ -369,12 +369,13 @@ export class AppPage {
     /**
      * Drops a folder `name` of `files` (`[{bytes, name}]`, a name with slashes in subfolders)
      * on the canvas, as the browser's File and Directory Entries API shows a dropped folder:
-     * listed in batches of two, the folder also among the drop's files as Chromium gives it. Playwright
-     * cannot drop a real folder, so the entries are made here; the files are real ones.
+     * listed in batches of two (each `batchMs` after it is asked for), the folder also among the
+     * drop's files as Chromium gives it. Playwright cannot drop a real folder, so the entries are
+     * made here; the files are real ones.
      */
-    async dropFolder(name, files) {
+    async dropFolder(name, files, { batchMs = 0 } = {}) {
         const encoded = files.map(({ bytes, name, fails }) => [Buffer.from(bytes).toString("base64"), name, Boolean(fails)]);
-        await this.page.evaluate(([folder, files]) => {
+        await this.page.evaluate(([folder, files, batchMs]) => {
             const bytesOf = (base64) => Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
             // A file that `fails` is one the browser cannot read (gone since the drop, say).
             const gone = () => new DOMException("A requested file or directory could not be found", "NotFoundError");
@@ -390,7 +391,7 @@ export class AppPage {
                         readEntries(ok) {
                             const batch = entries.slice(at, at + 2);
                             at += batch.length;
-                            setTimeout(() => ok(batch));
+                            setTimeout(() => ok(batch), batchMs);
                         },
                     };
                 },
@@ -418,6 +419,6 @@ export class AppPage {
             const drop = new DragEvent("drop", { bubbles: true, cancelable: true });
             Object.defineProperty(drop, "dataTransfer", { value: transfer });
             document.getElementById("meshsmooth_canvas").dispatchEvent(drop);
-        }, [name, encoded]);
+        }, [name, encoded, batchMs]);
     }
 }
