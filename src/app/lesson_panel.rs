@@ -1,9 +1,9 @@
 //! The authoring page's Lesson panel: the tour's steps recorded from the view as it stands,
 //! their titles and captions edited, reordered, deleted and shown again; labels placed by
-//! clicking a structure in the view, their texts edited; the quiz's modes, structures and pass
-//! mark. Titles, captions and texts are edited in the own (English) words or in another language
-//! the author picks. Every edit goes through `CaseDocument::set_lesson`, which checks it
-//! against the case.
+//! clicking a structure in the view, their texts and notes edited; the quiz's modes, structures
+//! and pass mark. Titles, captions, texts and notes are edited in the own (English) words or in
+//! another language the author picks. Every edit goes through `CaseDocument::set_lesson`, which
+//! checks it against the case.
 
 use eframe::egui;
 use glam::Vec3;
@@ -58,7 +58,8 @@ struct Asked {
 pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     // The panel edits a copy: every edit must pass the case's checks before it lands.
     let mut lesson = doc.case().lesson().clone();
-    let mut drawn: Vec<(String, egui::Rect)> = Vec::new();
+    // What of the panel is in sight: its controls below scroll into view.
+    let mut drawn: Vec<(String, egui::Rect)> = vec![("in-sight".into(), ui.clip_rect())];
     let mut asked = Asked::default();
     let preview = ui.button("Preview as the student sees it");
     drawn.push(("preview".into(), preview.rect));
@@ -73,21 +74,19 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     asked.record = record.clicked();
     let language = language(ui, &lesson, &mut doc.lesson_language, &mut drawn);
     // While the field holds no language, nothing is edited: not the English words by mistake.
-    let editable = language.is_ok();
-    let language = language.unwrap_or_default();
-    let language = language.as_deref();
-    ui.add_enabled_ui(editable, |ui| {
-        steps(ui, &mut lesson, language, &mut drawn, &mut asked);
-    });
+    let editing = match &language {
+        Ok(None) => Editing::Own,
+        Ok(Some(tag)) => Editing::In(tag),
+        Err(()) => Editing::Nothing,
+    };
+    steps(ui, &mut lesson, editing, &mut drawn, &mut asked);
     ui.separator();
     let place = ui.toggle_value(&mut doc.placing_label, "Place a label");
     drawn.push(("place-label".into(), place.rect));
     if doc.placing_label {
         ui.small("Click a structure in the view where the label points.");
     }
-    ui.add_enabled_ui(editable, |ui| {
-        labels(ui, &mut lesson, language, &mut drawn, &mut asked);
-    });
+    labels(ui, &mut lesson, editing, &mut drawn, &mut asked);
     ui.separator();
     let names = doc.case().structure_names();
     quiz(ui, &mut lesson, &names, &mut drawn, &mut asked);
@@ -164,33 +163,34 @@ enum Field {
     Caption(&'static str),
 }
 
-/// A field editing the own words `own`, or with `language` those in that language in `others`
-/// (the own words as its hint; emptied, the language's words are removed and the own stand).
+/// Which words the fields edit.
+#[derive(Clone, Copy)]
+enum Editing<'a> {
+    /// The own (English) words.
+    Own,
+    /// Those in this language.
+    In(&'a str),
+    /// None, while the language field holds no tag: the own words are shown in fields that
+    /// take focus but no edit, so keys typed there do not reach the page's shortcuts.
+    Nothing,
+}
+
+/// A field editing the own words `own`, or those in a language in `others` (the own words as
+/// its hint; emptied, the language's words are removed and the own stand).
 fn words(
     ui: &mut egui::Ui,
     own: &mut String,
     others: &mut Names,
-    language: Option<&str>,
+    editing: Editing,
     field: Field,
 ) -> egui::Response {
-    let mut edit = |text: &mut String, hint: &str| {
-        let edit = match field {
-            Field::Line(width) => egui::TextEdit::singleline(text).desired_width(width),
-            Field::Caption(hint) => egui::TextEdit::multiline(text)
-                .desired_rows(1)
-                .hint_text(hint),
-        };
-        if hint.is_empty() {
-            ui.add(edit)
-        } else {
-            ui.add(edit.hint_text(hint))
-        }
-    };
-    let Some(tag) = language else {
-        return edit(own, "");
+    let tag = match editing {
+        Editing::Own => return ui.add(text_edit(own, field, None)),
+        Editing::Nothing => return ui.add(text_edit(&mut own.as_str(), field, None)),
+        Editing::In(tag) => tag,
     };
     let mut text = others.get(tag).cloned().unwrap_or_default();
-    let response = edit(&mut text, own.as_str());
+    let response = ui.add(text_edit(&mut text, field, Some(own.as_str())));
     if response.changed() {
         if text.trim().is_empty() {
             others.remove(tag);
@@ -201,11 +201,30 @@ fn words(
     response
 }
 
+/// The text field of a [`Field`] editing `text`, showing `own` words (when not empty) where it
+/// is empty, else the field's hint.
+fn text_edit<'t>(
+    text: &'t mut dyn egui::TextBuffer,
+    field: Field,
+    own: Option<&str>,
+) -> egui::TextEdit<'t> {
+    let edit = match field {
+        Field::Line(width) => egui::TextEdit::singleline(text).desired_width(width),
+        Field::Caption(hint) => egui::TextEdit::multiline(text)
+            .desired_rows(1)
+            .hint_text(hint),
+    };
+    match own.filter(|own| !own.is_empty()) {
+        Some(own) => edit.hint_text(own),
+        None => edit,
+    }
+}
+
 /// Each step's title and caption, with its buttons: up, down, delete, show.
 fn steps(
     ui: &mut egui::Ui,
     lesson: &mut Lesson,
-    language: Option<&str>,
+    editing: Editing,
     drawn: &mut Vec<(String, egui::Rect)>,
     asked: &mut Asked,
 ) {
@@ -216,7 +235,7 @@ fn steps(
         ui.horizontal(|ui| {
             ui.label(format!("{}.", i + 1));
             let (own, others) = (&mut step.title, &mut step.titles);
-            let title = words(ui, own, others, language, Field::Line(130.0));
+            let title = words(ui, own, others, editing, Field::Line(130.0));
             asked.edited |= title.changed();
             drawn.push((format!("step-title-{i}"), title.rect));
             let up = ui.add_enabled(i > 0, egui::Button::new("▲").small());
@@ -235,7 +254,7 @@ fn steps(
         });
         let (own, others) = (&mut step.caption, &mut step.captions);
         let hint = Field::Caption("Caption: what the student sees here");
-        let caption = words(ui, own, others, language, hint);
+        let caption = words(ui, own, others, editing, hint);
         drawn.push((format!("step-caption-{i}"), caption.rect));
         asked.edited |= caption.changed();
     }
@@ -248,11 +267,11 @@ fn steps(
     asked.edited |= moved.is_some() || deleted.is_some();
 }
 
-/// Each label's structure and text, and its delete button.
+/// Each label's structure, text and note, and its delete button.
 fn labels(
     ui: &mut egui::Ui,
     lesson: &mut Lesson,
-    language: Option<&str>,
+    editing: Editing,
     drawn: &mut Vec<(String, egui::Rect)>,
     asked: &mut Asked,
 ) {
@@ -261,13 +280,18 @@ fn labels(
         ui.horizontal(|ui| {
             ui.small(&label.structure);
             let (own, others) = (&mut label.text, &mut label.texts);
-            let text = words(ui, own, others, language, Field::Line(120.0));
+            let text = words(ui, own, others, editing, Field::Line(120.0));
             let delete = ui.small_button("✕").on_hover_text("Delete the label");
             asked.edited |= text.changed();
             drawn.push((format!("label-text-{i}"), text.rect));
             drawn.push((format!("label-delete-{i}"), delete.rect));
             deleted = deleted.or(delete.clicked().then_some(i));
         });
+        let (own, others) = (&mut label.note, &mut label.notes);
+        let hint = Field::Caption("Note: what the student reads on asking");
+        let note = words(ui, own, others, editing, hint);
+        asked.edited |= note.changed();
+        drawn.push((format!("label-note-{i}"), note.rect));
     }
     if let Some(i) = deleted {
         lesson.labels.remove(i);

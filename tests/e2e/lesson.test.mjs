@@ -316,7 +316,17 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         let s = await app.stateWhen((s) => s.loading === null && s.view.camera && s.layout.lesson?.["lesson-tab"], "the case open");
         const centreOf = (r) => [r.x + r.width / 2, r.y + r.height / 2];
         const press = async (key) => {
-            const state = await app.stateWhen((s) => s.layout.lesson?.[key], `the Lesson panel's ${key}`);
+            let state = await app.stateWhen((s) => s.layout.lesson?.[key], `the Lesson panel's ${key}`);
+            // A control out of the panel's sight is scrolled into it, as the author would.
+            for (let tries = 0; tries < 20 && state.layout.lesson["in-sight"]; tries++) {
+                const [r, v] = [state.layout.lesson[key], state.layout.lesson["in-sight"]];
+                const below = r.y + r.height > v.y + v.height;
+                if (!below && r.y >= v.y) break;
+                await app.page.mouse.move(...centreOf(v));
+                await app.page.mouse.wheel(0, below ? 100 : -100);
+                await frames(app);
+                state = await app.state();
+            }
             await app.page.mouse.click(...centreOf(state.layout.lesson[key]));
             await frames(app);
         };
@@ -366,7 +376,8 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         lesson = await lessonNow();
         const kidney = lesson.labels.findIndex((l) => l.structure === "right_kidney");
         await typeInto(`label-text-${kidney}`, "Right kidney");
-        await lessonWhen((l) => l.labels[kidney].text === "Right kidney", "the kidney's label text");
+        await typeInto(`label-note-${kidney}`, "Filters the blood.");
+        await lessonWhen((l) => l.labels[kidney].text === "Right kidney" && l.labels[kidney].note === "Filters the blood.", "the kidney's label text and note");
 
         // Steps 2 and 3 from above and cut; a fourth recorded, moved up and deleted.
         await app.call("setView", { from: "S" });
@@ -407,9 +418,10 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         await typeInto("step-title-0", "Der ganze Bauch");
         await typeInto("step-caption-0", "Vier Strukturen des Phantoms.");
         await typeInto(`label-text-${kidney}`, "Rechte Niere");
+        await typeInto(`label-note-${kidney}`, "Filtert das Blut.");
         await typeInto("step-title-1", "Von oben");
-        lesson = await lessonWhen((l) => l.steps[0].titles.de === "Der ganze Bauch" && l.steps[0].captions.de === "Vier Strukturen des Phantoms." && l.labels[kidney].texts.de === "Rechte Niere" && l.steps[1].titles.de === "Von oben", "the German words");
-        assert.deepEqual([lesson.steps[0].title, lesson.steps[0].caption, lesson.labels[kidney].text, lesson.steps[1].title], ["The whole abdomen", "Four structures of the phantom.", "Right kidney", "Step 2"], "the English words stay");
+        lesson = await lessonWhen((l) => l.steps[0].titles.de === "Der ganze Bauch" && l.steps[0].captions.de === "Vier Strukturen des Phantoms." && l.labels[kidney].texts.de === "Rechte Niere" && l.labels[kidney].notes.de === "Filtert das Blut." && l.steps[1].titles.de === "Von oben", "the German words");
+        assert.deepEqual([lesson.steps[0].title, lesson.steps[0].caption, lesson.labels[kidney].text, lesson.labels[kidney].note, lesson.steps[1].title], ["The whole abdomen", "Four structures of the phantom.", "Right kidney", "Filters the blood.", "Step 2"], "the English words stay");
         await press("step-title-1");
         await app.page.keyboard.press("Control+A");
         await app.page.keyboard.press("Backspace");
@@ -433,6 +445,7 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         const s = await app.stateWhen((s) => s.structures?.structures.length === 4 && s.loading === null && s.view.labels.length === 2, "the authored case in the viewer, its labels drawn");
         assert.equal(s.tour.steps, 3);
         assert.deepEqual(s.view.labels.map((l) => l.text).sort(), ["Right kidney", "liver"]);
+        assert.equal(s.view.labels.find((l) => l.text === "Right kidney").note, "Filters the blood.");
         assert.equal(s.quiz.running, false);
         assert.deepEqual(s.quiz.modes, ["find-it", "name-it"]);
         await app.call("startQuiz");
@@ -451,6 +464,7 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
         const s = await app.stateWhen((s) => s.tour.step === 0 && s.view.labels.length === 2, "the first step, its labels drawn");
         assert.deepEqual([s.tour.title, s.tour.caption], ["Der ganze Bauch", "Vier Strukturen des Phantoms."]);
         assert.deepEqual(s.view.labels.map((l) => l.text).sort(), ["Rechte Niere", "liver"]);
+        assert.equal(s.view.labels.find((l) => l.text === "Rechte Niere").note, "Filtert das Blut.");
     }, { query: "?mode=viewer&case=cases/authored.glb&lang=de", routes: { "cases/authored.glb": exported } });
 });
 
