@@ -236,72 +236,91 @@ fn an_rle_series_reads_as_the_uncompressed_one() {
     refused(2, 66, "segment 1 holds fewer than the frame's 480 pixels");
 }
 
-/// The oblique series as JPEG Lossless (GDCM's codestreams) reads as the uncompressed one; the
-/// phantom CT's slices as lossy JPEG Baseline (8-bit) within a few stored units of theirs. A
-/// frame whose size is not the header's, or that is no JPEG, is refused naming its file.
-#[test]
-fn jpeg_series_read_as_the_uncompressed_ones() {
-    assert_same(
-        &read(&slices("oblique_jpeg"), ALL).expect("lossless"),
-        &twin(ALL),
-    );
-    // A frame over two fragments reads as over one.
-    let mut split = slices("oblique_jpeg");
+/// The oblique series compressed losslessly in `folder` reads as the uncompressed one, a frame
+/// over two fragments as over one.
+fn assert_reads_as_the_twin(folder: &str) {
+    assert_same(&read(&slices(folder), ALL).expect("lossless"), &twin(ALL));
+    let mut split = slices(folder);
     for (_, bytes) in &mut split {
         *bytes = dicom::with_first_fragment_split(bytes, 100);
     }
     assert_same(&read(&split, ALL).expect("split"), &twin(ALL));
+}
+
+/// How far (mean, most; HU) the phantom CT's slices compressed with loss in `folder` read from
+/// the uncompressed ones, on the same grid.
+fn lossy_off(folder: &str) -> (f32, f32) {
     let plain = read(&slices("phantom_ct"), ALL).expect("uncompressed");
-    let lossy = read(&slices("phantom_ct_jpeg"), ALL).expect("baseline");
+    let lossy = read(&slices(folder), ALL).expect("lossy");
     assert_eq!(lossy.dims, plain.dims);
     assert_eq!(lossy.affine, plain.affine);
     let off: Vec<f32> = (lossy.values.iter().zip(&plain.values))
         .map(|(a, b)| (a - b).abs())
         .collect();
     let mean = off.iter().sum::<f32>() / off.len() as f32;
-    let most = off.iter().copied().fold(0.0, f32::max);
+    (mean, off.iter().copied().fold(0.0, f32::max))
+}
+
+/// The series in `folder` with its fourth slice changed by `change` is refused naming that
+/// slice, in `words`.
+fn assert_refused(folder: &str, change: &dyn Fn(&mut [u8]), words: &str) {
+    let mut files = slices(folder);
+    change(&mut files[3].1[..]);
+    let e = refusal(&files);
+    assert!(
+        e.starts_with(&format!("{}: DICOM image:", files[3].0)),
+        "{e}"
+    );
+    assert!(e.contains(words), "wanted '{words}' in: {e}");
+}
+
+/// Cuts a slice's first fragment short: its last bytes, the codestream's end marker, gone
+/// (zeros in their place, as a copy that stopped early would leave them).
+fn cut_short(b: &mut [u8]) {
+    let at = dicom::first_fragment(b);
+    let length = u32::from_le_bytes(b[at - 4..at].try_into().unwrap()) as usize;
+    let end = at + length;
+    assert!(
+        b[at..end].ends_with(&[0xFF, 0xD9]),
+        "the fragment ends the codestream"
+    );
+    b[end - 64..end].fill(0);
+}
+
+/// Its first fragment's first two bytes made those of a GIF.
+fn not_a_codestream(b: &mut [u8]) {
+    let at = dicom::first_fragment(b);
+    b[at..at + 2].copy_from_slice(b"GI");
+}
+
+/// The oblique series as JPEG Lossless (GDCM's codestreams) reads as the uncompressed one; the
+/// phantom CT's slices as lossy JPEG Baseline (8-bit) within a few stored units of theirs. A
+/// frame whose size is not the header's, that is no JPEG or that is cut short is refused naming
+/// its file.
+#[test]
+fn jpeg_series_read_as_the_uncompressed_ones() {
+    assert_reads_as_the_twin("oblique_jpeg");
+    let (mean, most) = lossy_off("phantom_ct_jpeg");
     eprintln!("JPEG baseline: mean {mean} HU, most {most} HU off");
     // A stored unit is 10 HU.
     assert!(mean < 2.0 && most <= 80.0, "mean {mean} HU, most {most} HU");
 
-    let refused = |change: &dyn Fn(&mut Vec<u8>), words: &str| {
-        let mut files = slices("oblique_jpeg");
-        change(&mut files[3].1);
-        let e = refusal(&files);
-        assert!(
-            e.starts_with(&format!("{}: DICOM image:", files[3].0)),
-            "{e}"
-        );
-        assert!(e.contains(words), "wanted '{words}' in: {e}");
-    };
     let frame_header = |bytes: &[u8]| {
         let start = dicom::first_fragment(bytes);
         start + (bytes[start..].windows(2).position(|w| w == [0xFF, 0xC3])).expect("SOF3")
     };
-    let columns = |b: &mut Vec<u8>| {
+    let columns = |b: &mut [u8]| {
         let at = frame_header(b) + 7;
         b[at..at + 2].copy_from_slice(&25u16.to_be_bytes());
     };
+    let refused = |change: &dyn Fn(&mut [u8]), words| assert_refused("oblique_jpeg", change, words);
     refused(&columns, "25 x 20 pixels of 1 component(s) and 16 bits");
-    let not_jpeg = |b: &mut Vec<u8>| {
-        let at = dicom::first_fragment(b);
-        b[at..at + 2].copy_from_slice(b"GI");
-    };
-    refused(&not_jpeg, "JPEG frame 1: the codestream does not start");
-    // Cut short: the fragment's last bytes, its end of image, gone (zeros in their place, as
-    // a copy that stopped early would leave them).
-    let cut = |b: &mut Vec<u8>| {
-        let at = dicom::first_fragment(b);
-        let length = u32::from_le_bytes(b[at - 4..at].try_into().unwrap()) as usize;
-        let end = at + length;
-        assert!(
-            b[at..end].ends_with(&[0xFF, 0xD9]),
-            "the fragment ends the codestream"
-        );
-        b[end - 64..end].fill(0);
-    };
     refused(
-        &cut,
+        &not_a_codestream,
+        "JPEG frame 1: the codestream does not start",
+    );
+    refused(
+        &cut_short,
         "JPEG frame 1: the codestream ends without a JPEG end of image",
     );
 }
@@ -312,63 +331,26 @@ fn jpeg_series_read_as_the_uncompressed_ones() {
 /// short is refused naming its file.
 #[test]
 fn jpeg_2000_series_read_as_the_uncompressed_ones() {
-    assert_same(
-        &read(&slices("oblique_j2k"), ALL).expect("lossless"),
-        &twin(ALL),
-    );
-    let mut split = slices("oblique_j2k");
-    for (_, bytes) in &mut split {
-        *bytes = dicom::with_first_fragment_split(bytes, 100);
-    }
-    assert_same(&read(&split, ALL).expect("split"), &twin(ALL));
-    let plain = read(&slices("phantom_ct"), ALL).expect("uncompressed");
-    let lossy = read(&slices("phantom_ct_j2k"), ALL).expect("lossy");
-    assert_eq!(lossy.dims, plain.dims);
-    assert_eq!(lossy.affine, plain.affine);
-    let off: Vec<f32> = (lossy.values.iter().zip(&plain.values))
-        .map(|(a, b)| (a - b).abs())
-        .collect();
-    let mean = off.iter().sum::<f32>() / off.len() as f32;
-    let most = off.iter().copied().fold(0.0, f32::max);
+    assert_reads_as_the_twin("oblique_j2k");
+    let (mean, most) = lossy_off("phantom_ct_j2k");
     eprintln!("JPEG 2000 at 20:1: mean {mean} HU, most {most} HU off");
-    // A stored unit is 10 HU.
     assert!(
         mean < 2.0 && most <= 150.0,
         "mean {mean} HU, most {most} HU"
     );
 
-    let refused = |change: &dyn Fn(&mut Vec<u8>), words: &str| {
-        let mut files = slices("oblique_j2k");
-        change(&mut files[3].1);
-        let e = refusal(&files);
-        assert!(
-            e.starts_with(&format!("{}: DICOM image:", files[3].0)),
-            "{e}"
-        );
-        assert!(e.contains(words), "wanted '{words}' in: {e}");
-    };
-    let columns = |b: &mut Vec<u8>| {
+    let columns = |b: &mut [u8]| {
         let at = dicom::first_fragment(b) + 8;
         b[at..at + 4].copy_from_slice(&25u32.to_be_bytes());
     };
+    let refused = |change: &dyn Fn(&mut [u8]), words| assert_refused("oblique_j2k", change, words);
     refused(&columns, "25 x 20 pixels of 1 component(s) and 16 bits");
-    let not_j2k = |b: &mut Vec<u8>| {
-        let at = dicom::first_fragment(b);
-        b[at..at + 2].copy_from_slice(b"GI");
-    };
-    refused(&not_j2k, "JPEG 2000 frame 1: no JPEG 2000 codestream");
-    let cut = |b: &mut Vec<u8>| {
-        let at = dicom::first_fragment(b);
-        let length = u32::from_le_bytes(b[at - 4..at].try_into().unwrap()) as usize;
-        let end = at + length;
-        assert!(
-            b[at..end].ends_with(&[0xFF, 0xD9]),
-            "the fragment ends the codestream"
-        );
-        b[end - 64..end].fill(0);
-    };
     refused(
-        &cut,
+        &not_a_codestream,
+        "JPEG 2000 frame 1: no JPEG 2000 codestream",
+    );
+    refused(
+        &cut_short,
         "JPEG 2000 frame 1: the codestream ends without its end of codestream marker",
     );
 }

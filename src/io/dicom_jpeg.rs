@@ -7,7 +7,7 @@
 //! it does not take: a grey frame of the rows, columns and bits the DICOM header declares is
 //! all that reaches the decoder, and only when the codestream is long enough to hold it.
 
-use super::dicom_lengths::FrameShape;
+use super::dicom_lengths::{frame_by_frame, Declared, FrameShape};
 use super::{Format, LoadError};
 
 /// Pixels a byte of JPEG can hold at most: an 8 x 8 block of one value codes in 2 bits.
@@ -30,28 +30,17 @@ pub(super) fn decode(
     size: [usize; 2],
     format: Format,
 ) -> Result<Vec<u8>, LoadError> {
-    let mut out = Vec::new();
-    for (index, stream) in codestreams.iter().enumerate() {
-        let bad = |detail: String| LoadError::Unsupported {
-            format,
-            detail: format!("JPEG frame {}: {detail}", index + 1),
-        };
+    frame_by_frame(codestreams, "JPEG", format, |stream, bad, out| {
         let header = frame_header(stream).map_err(bad)?;
+        let declared = Declared {
+            columns: header.columns.into(),
+            rows: header.rows.into(),
+            components: header.components.into(),
+            bits: header.precision.into(),
+            subsampled: false,
+        };
+        shape.check_declared(size, &declared).map_err(bad)?;
         let bytes = if header.precision <= 8 { 1 } else { 2 };
-        let declared = [header.columns as usize, header.rows as usize];
-        if declared != size || header.components != 1 || bytes > shape.bytes {
-            return Err(bad(format!(
-                "{} x {} pixels of {} component(s) and {} bits, where the header declares {} x \
-                 {} grey pixels of {} bytes",
-                header.columns,
-                header.rows,
-                header.components,
-                header.precision,
-                size[0],
-                size[1],
-                shape.bytes
-            )));
-        }
         let what = "bytes in a JPEG frame";
         shape.bytes_within(stream.len(), MOST_EXPANSION, what, format)?;
         // The decoder's own word for a codestream cut short is an I/O error of its reader.
@@ -59,7 +48,7 @@ pub(super) fn decode(
             let cut = "the codestream ends without a JPEG end of image: it is cut short";
             return Err(bad(cut.into()));
         }
-        let mut decoder = jpeg_decoder::Decoder::new(*stream);
+        let mut decoder = jpeg_decoder::Decoder::new(stream);
         decoder.set_max_decoding_buffer_size(shape.pixels);
         let pixels = decoder.decode().map_err(|e| bad(e.to_string()))?;
         if pixels.len() != shape.pixels * bytes {
@@ -78,8 +67,8 @@ pub(super) fn decode(
             ),
             _ => out.extend_from_slice(&pixels),
         }
-    }
-    Ok(out)
+        Ok(())
+    })
 }
 
 /// Whether a codestream ends with its end-of-image marker (JPEG 2000's end of codestream is the

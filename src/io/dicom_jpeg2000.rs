@@ -13,7 +13,7 @@
 use hayro_jpeg2000::{DecodeSettings, DecoderContext, Image};
 
 use super::dicom_jpeg::ends_with_end_of_image;
-use super::dicom_lengths::FrameShape;
+use super::dicom_lengths::{frame_by_frame, Declared, FrameShape};
 use super::{Format, LoadError};
 
 /// Pixels a byte of JPEG 2000 may hold: a frame of one value codes in an empty packet a
@@ -44,23 +44,16 @@ pub(super) fn decode(
     size: [usize; 2],
     format: Format,
 ) -> Result<Vec<u8>, LoadError> {
-    let mut out = Vec::new();
-    for (index, stream) in codestreams.iter().enumerate() {
-        let bad = |detail: String| LoadError::Unsupported {
-            format,
-            detail: format!("JPEG 2000 frame {}: {detail}", index + 1),
-        };
+    frame_by_frame(codestreams, "JPEG 2000", format, |stream, bad, out| {
         let header = size_header(stream).map_err(bad)?;
-        let declared = [header.columns as usize, header.rows as usize];
-        let bits = usize::from(header.precision);
-        if declared != size || header.components != 1 || header.subsampled || bits > 8 * shape.bytes
-        {
-            return Err(bad(format!(
-                "{} x {} pixels of {} component(s) and {bits} bits, where the header declares \
-                 {} x {} grey pixels of {} bytes",
-                header.columns, header.rows, header.components, size[0], size[1], shape.bytes
-            )));
-        }
+        let declared = Declared {
+            columns: header.columns as usize,
+            rows: header.rows as usize,
+            components: header.components.into(),
+            bits: header.precision.into(),
+            subsampled: header.subsampled,
+        };
+        shape.check_declared(size, &declared).map_err(bad)?;
         let expansion = MOST_PIXELS_PER_BYTE * shape.bytes;
         shape.bytes_within(
             stream.len(),
@@ -104,8 +97,8 @@ pub(super) fn decode(
         for &s in samples {
             out.extend_from_slice(&range.stored(s).to_le_bytes()[..shape.bytes]);
         }
-    }
-    Ok(out)
+        Ok(())
+    })
 }
 
 /// How a decoded sample becomes the stored value an uncompressed file would hold.

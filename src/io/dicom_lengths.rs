@@ -112,6 +112,52 @@ impl FrameShape {
     }
 }
 
+/// What a compressed frame's own header (a JPEG frame header, a JPEG 2000 size marker) says.
+pub(super) struct Declared {
+    pub columns: usize,
+    pub rows: usize,
+    pub components: usize,
+    pub bits: usize,
+    /// A component sampled more coarsely than the frame.
+    pub subsampled: bool,
+}
+
+impl FrameShape {
+    /// Refuses a codestream that declares other than one grey component of the DICOM header's
+    /// `size` (columns and rows) in bits its pixels hold.
+    pub(super) fn check_declared(&self, size: [usize; 2], d: &Declared) -> Result<(), String> {
+        let grey = d.components == 1 && !d.subsampled;
+        if [d.columns, d.rows] == size && grey && d.bits <= 8 * self.bytes {
+            return Ok(());
+        }
+        Err(format!(
+            "{} x {} pixels of {} component(s) and {} bits, where the header declares {} x {} \
+             grey pixels of {} bytes",
+            d.columns, d.rows, d.components, d.bits, size[0], size[1], self.bytes
+        ))
+    }
+}
+
+/// Each of `codestreams` (one a frame) decoded by `frame` onto the pixels before it; `frame`
+/// words an error about its codestream with the `bad` it is given, which names the frame
+/// (`codec` says whose).
+pub(super) fn frame_by_frame(
+    codestreams: &[&[u8]],
+    codec: &str,
+    format: Format,
+    mut frame: impl FnMut(&[u8], &dyn Fn(String) -> LoadError, &mut Vec<u8>) -> Result<(), LoadError>,
+) -> Result<Vec<u8>, LoadError> {
+    let mut out = Vec::new();
+    for (index, stream) in codestreams.iter().enumerate() {
+        let bad = |detail: String| LoadError::Unsupported {
+            format,
+            detail: format!("{codec} frame {}: {detail}", index + 1),
+        };
+        frame(stream, &bad, &mut out)?;
+    }
+    Ok(out)
+}
+
 /// The file's [`Layout`], once every element length has been checked.
 impl Layout {
     /// The frames' pixel data, uncompressed: in place within `bytes` (the file walked), or
