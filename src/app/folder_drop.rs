@@ -112,11 +112,7 @@ async fn files_of(
         listing.count(entries.len()).map_err(refused)?;
         for entry in entries {
             let at = format!("{path}/{}", entry.name());
-            let kind = match (entry.is_directory(), entry.is_file()) {
-                (true, _) => EntryKind::Folder,
-                (_, true) => EntryKind::File,
-                _ => EntryKind::Other,
-            };
+            let kind = EntryKind::of(entry.is_directory(), entry.is_file());
             if let Some(sub) = listing
                 .take(at.clone(), kind, depth, entry)
                 .map_err(refused)?

@@ -33,6 +33,17 @@ pub enum EntryKind {
     Other,
 }
 
+impl EntryKind {
+    /// The kind of an entry that is a folder, a regular file, or neither.
+    pub fn of(folder: bool, file: bool) -> Self {
+        match (folder, file) {
+            (true, _) => EntryKind::Folder,
+            (_, true) => EntryKind::File,
+            _ => EntryKind::Other,
+        }
+    }
+}
+
 /// What a folder's listing found so far: the files to open, each by its path and what the
 /// lister reads it by (`F`), the entries counted and the subfolders walked.
 #[derive(Debug)]
@@ -182,6 +193,12 @@ mod tests {
         assert!(deep.contains("more than 8 levels down"), "{deep}");
         let files = listing.files().unwrap();
         assert_eq!(files, vec![("x/SE1/IM2".into(), 9), ("x/a.nii".into(), 7)]);
+        let kinds =
+            [(true, false), (false, true), (false, false)].map(|(d, f)| EntryKind::of(d, f));
+        assert_eq!(
+            kinds,
+            [EntryKind::Folder, EntryKind::File, EntryKind::Other]
+        );
     }
 
     #[test]

@@ -32,11 +32,7 @@ fn list(listing: &mut FolderListing<PathBuf>, dir: &Path, depth: usize) -> Resul
         let entry = entry.map_err(failed)?;
         listing.count(1)?;
         let kind = entry.file_type().map_err(failed)?;
-        let kind = match (kind.is_dir(), kind.is_file()) {
-            (true, _) => EntryKind::Folder,
-            (_, true) => EntryKind::File,
-            _ => EntryKind::Other,
-        };
+        let kind = EntryKind::of(kind.is_dir(), kind.is_file());
         let path = entry.path();
         if let Some(sub) = listing.take(path.display().to_string(), kind, depth, path)? {
             list(listing, &sub, depth + 1)?;
