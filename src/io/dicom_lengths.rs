@@ -38,11 +38,21 @@ const GROUP_LENGTH: (u16, u16) = (0x0002, 0x0000);
 /// a file has none) and where the last Pixel Data value lies, so that the pixels are read from
 /// the file's bytes rather than copied into the parsed object. A deflated file's positions are
 /// in its inflated bytes, which the layout holds.
-#[derive(Debug)]
 pub(super) struct Layout {
     pub start: usize,
     pub pixel_data: Option<PixelData>,
     inflated: Option<Vec<u8>>,
+}
+
+/// The inflated data set by its length: a failing test prints the layout, not megabytes.
+impl std::fmt::Debug for Layout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Layout")
+            .field("start", &self.start)
+            .field("pixel_data", &self.pixel_data)
+            .field("inflated_bytes", &self.inflated.as_ref().map(Vec::len))
+            .finish()
+    }
 }
 
 /// Where the pixels lie in the file.
