@@ -111,6 +111,17 @@ pub(super) fn text(object: &InMemDicomObject, tag: Tag) -> Option<String> {
 }
 
 fn number(object: &InMemDicomObject, tag: Tag, name: &str) -> Result<usize, LoadError> {
+    whole_above_zero(object, tag, name, FORMAT)
+}
+
+/// A whole number element above 0 (Rows, say), `name` naming it in the error `format` says.
+pub(super) fn whole_above_zero(
+    object: &InMemDicomObject,
+    tag: Tag,
+    name: &str,
+    format: Format,
+) -> Result<usize, LoadError> {
+    let unsupported = |detail: String| LoadError::Unsupported { format, detail };
     let element = (object.element(tag).ok())
         .ok_or_else(|| unsupported(format!("no {name} ({:04X},{:04X})", tag.0, tag.1)))?;
     let value: u32 = (element.to_int().ok())

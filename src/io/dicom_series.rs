@@ -20,7 +20,7 @@ use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
 use super::dicom_lengths::{self, Frames};
-use super::dicom_seg::{floats, text};
+use super::dicom_seg::{floats, text, whole_above_zero};
 use super::dicom_seg_grid::{cross, dot, ras_affine};
 use super::image::{reduced_affine, ImageVolume};
 use super::intensity::IntensitySink;
@@ -161,8 +161,8 @@ fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError
         )));
     }
     let size = [
-        required(&object, tags::COLUMNS, "Columns")?,
-        required(&object, tags::ROWS, "Rows")?,
+        whole_above_zero(&object, tags::COLUMNS, "Columns", FORMAT)?,
+        whole_above_zero(&object, tags::ROWS, "Rows", FORMAT)?,
     ];
     let sample = sample_of(&object)?;
     let low_bits = stored_bits(&object, sample)?;
@@ -204,13 +204,6 @@ fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError
 fn whole(object: &InMemDicomObject, tag: Tag) -> Option<usize> {
     let value: u32 = object.element(tag).ok()?.to_int().ok()?;
     Some(value as usize)
-}
-
-fn required(object: &InMemDicomObject, tag: Tag, name: &str) -> Result<usize, LoadError> {
-    match whole(object, tag) {
-        Some(n) if n > 0 => Ok(n),
-        _ => Err(unsupported(format!("no {name} above 0"))),
-    }
 }
 
 /// `N` finite numbers of a decimal-string element (a direction, a spacing, a position).
