@@ -7,7 +7,7 @@
 //! it does not take: a grey frame of the rows, columns and bits the DICOM header declares is
 //! all that reaches the decoder, and only when the codestream is long enough to hold it.
 
-use super::dicom_lengths::{frame_by_frame, Declared, FrameShape};
+use super::dicom_frames::{frame_by_frame, Declared, FrameShape};
 use super::{Format, LoadError};
 
 /// Pixels a byte of JPEG can hold at most: an 8 x 8 block of one value codes in 2 bits.

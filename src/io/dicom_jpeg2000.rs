@@ -12,8 +12,8 @@
 
 use hayro_jpeg2000::{DecodeSettings, DecoderContext, Image};
 
+use super::dicom_frames::{frame_by_frame, Declared, FrameShape};
 use super::dicom_jpeg::ends_with_end_of_image;
-use super::dicom_lengths::{frame_by_frame, Declared, FrameShape};
 use super::{Format, LoadError};
 
 /// Pixels a byte of JPEG 2000 may hold: a frame of one value codes in an empty packet a

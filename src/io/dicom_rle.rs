@@ -7,7 +7,7 @@
 //! shorter than its header; these files come from users and must be refused with a reason,
 //! within memory the file's size bounds.
 
-use super::dicom_lengths::FrameShape;
+use super::dicom_frames::FrameShape;
 use super::{Format, LoadError};
 
 const HEADER: usize = 64;

@@ -14,7 +14,8 @@ use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
 use super::codes::{Code, StructureCodes};
-use super::dicom_lengths::{self, Frames};
+use super::dicom_frames::Frames;
+use super::dicom_lengths;
 use super::dicom_seg_grid::{self, FrameGeometry, Grid};
 use super::label_map::{LabelMap, LabelMapOptions, Segment, DEFAULT_LEVEL};
 use super::{Format, LoadError, Location};

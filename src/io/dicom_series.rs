@@ -19,7 +19,8 @@ use dicom_core::Tag;
 use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
-use super::dicom_lengths::{self, Frames};
+use super::dicom_frames::Frames;
+use super::dicom_lengths;
 use super::dicom_seg::{floats, text, whole_above_zero};
 use super::dicom_seg_grid::{cross, dot, ras_affine};
 use super::image::{reduced_affine, ImageVolume};

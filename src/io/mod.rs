@@ -5,6 +5,7 @@
 mod codes;
 mod color_table;
 mod dicom_deflate;
+mod dicom_frames;
 mod dicom_jpeg;
 mod dicom_jpeg2000;
 mod dicom_lengths;
