@@ -272,8 +272,18 @@ impl Walk<'_> {
 
     /// `codec`: how the pixels are compressed, if they are (then encapsulated).
     fn data_set(&mut self, implicit: bool, codec: Option<Codec>) -> Result<(), LoadError> {
+        // A sequence's value is items (PS3.5 7.5): dicom-rs reads what follows a sequence's
+        // header as an item's, so anything else would be read differently from this walk.
+        let mut items_next = false;
         while self.at < self.bytes.len() {
             let header = self.header(implicit)?;
+            if std::mem::take(&mut items_next) && header.tag.0 != 0xFFFE {
+                return Err(self.bad(&format!(
+                    "a sequence holds ({:04X},{:04X}) where an item should start",
+                    header.tag.0, header.tag.1
+                )));
+            }
+            items_next = header.nested && header.tag != ITEM && header.len != 0;
             if header.tag == PIXEL_DATA && (header.len == UNDEFINED) != codec.is_some() {
                 let detail = match codec {
                     Some(_) => "compressed pixel data that is not encapsulated",
@@ -485,6 +495,37 @@ mod tests {
                 ..
             })
         ));
+    }
+
+    /// An element of undefined length in implicit VR is a sequence; one that holds an element
+    /// where its first item should start (a fuzzed file dicom-rs then read a 4 GB value from)
+    /// is refused, and an empty sequence is no sequence to look into.
+    #[test]
+    fn a_sequence_that_does_not_start_with_an_item_is_refused() {
+        let implicit = |tag: (u16, u16), len: u32| {
+            let mut out = Vec::new();
+            out.extend(tag.0.to_le_bytes());
+            out.extend(tag.1.to_le_bytes());
+            out.extend(len.to_le_bytes());
+            out
+        };
+        let mut data_set = implicit((0x0009, 0x1001), UNDEFINED);
+        data_set.extend(implicit((0x0010, 0x0010), 0));
+        let error = check(&file(IMPLICIT_LE, &data_set), Format::DicomImage).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("a sequence holds (0010,0010) where an item"),
+            "{error}"
+        );
+        let mut items = implicit((0x0009, 0x1001), UNDEFINED);
+        items.extend(implicit(ITEM, 0));
+        items.extend(implicit(SEQUENCE_END, 0));
+        items.extend(implicit((0x0010, 0x0010), 0));
+        assert!(check(&file(IMPLICIT_LE, &items), Format::DicomImage).is_ok());
+        let mut empty = element((0x0062, 0x0002), b"SQ", &[]);
+        empty.extend(element((0x0010, 0x0010), b"PN", b"Anon"));
+        assert!(check(&file(EXPLICIT_LE, &empty), Format::DicomSeg).is_ok());
     }
 
     #[test]
