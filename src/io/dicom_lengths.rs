@@ -354,6 +354,9 @@ impl Walk<'_> {
             let len = self.u32_at(self.at + 4)?;
             self.at += 8;
             let nested = len == UNDEFINED || is_sequence(tag);
+            if let Some(vr) = dictionary_vr(tag) {
+                self.whole_values(tag, vr.to_string().as_bytes(), len)?;
+            }
             return Ok(Header { tag, len, nested });
         }
         let vr = self.bytes.get(self.at + 4..self.at + 6).unwrap_or_default();
@@ -372,6 +375,7 @@ impl Walk<'_> {
             self.at += 8;
             len
         };
+        self.whole_values(tag, vr, len)?;
         if vr != b"SQ" && len == UNDEFINED && tag != PIXEL_DATA {
             // dicom-rs reads such a value as a sequence in implicit VR; this walk does not.
             return Err(self.bad(&format!(
@@ -384,6 +388,28 @@ impl Walk<'_> {
             len,
             nested: vr == b"SQ",
         })
+    }
+
+    /// Refuses a value of binary numbers (`vr`) whose length is not a whole number of them:
+    /// dicom-rs reads the whole ones and steps on by the length without reading the rest, so
+    /// its reading would go out of step with this walk (a fuzzed file had it then allocate
+    /// gigabytes). The pixels are not read by dicom-rs.
+    fn whole_values(&self, tag: (u16, u16), vr: &[u8], len: u32) -> Result<(), LoadError> {
+        let size = match vr {
+            b"US" | b"SS" | b"OW" => 2,
+            b"UL" | b"SL" | b"FL" | b"AT" | b"OL" | b"OF" => 4,
+            b"FD" | b"OD" | b"SV" | b"UV" | b"OV" => 8,
+            _ => return Ok(()),
+        };
+        if len == UNDEFINED || len.is_multiple_of(size) || tag == PIXEL_DATA {
+            return Ok(());
+        }
+        Err(self.bad(&format!(
+            "({:04X},{:04X}) holds {len} bytes, not a whole number of {}'s {size} bytes",
+            tag.0,
+            tag.1,
+            String::from_utf8_lossy(vr)
+        )))
     }
 
     /// Steps past a value of defined length, returning it.
@@ -423,10 +449,14 @@ impl Walk<'_> {
 
 /// Whether the standard dictionary gives a tag the VR SQ (implicit VR files do not say).
 fn is_sequence(tag: (u16, u16)) -> bool {
+    dictionary_vr(tag) == Some(dicom_core::VR::SQ)
+}
+
+/// The VR the standard dictionary gives a tag, as dicom-rs reads it in implicit VR.
+fn dictionary_vr(tag: (u16, u16)) -> Option<dicom_core::VR> {
     use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
-    use dicom_core::{Tag, VR};
-    let entry = dicom_dictionary_std::StandardDataDictionary.by_tag(Tag(tag.0, tag.1));
-    entry.is_some_and(|e| e.vr().relaxed() == VR::SQ)
+    let entry = dicom_dictionary_std::StandardDataDictionary.by_tag(dicom_core::Tag(tag.0, tag.1));
+    entry.map(|e| e.vr().relaxed())
 }
 
 #[cfg(test)]
@@ -526,6 +556,31 @@ mod tests {
         let mut empty = element((0x0062, 0x0002), b"SQ", &[]);
         empty.extend(element((0x0010, 0x0010), b"PN", b"Anon"));
         assert!(check(&file(EXPLICIT_LE, &empty), Format::DicomSeg).is_ok());
+    }
+
+    /// A number whose length is not a whole number of its values (Samples per Pixel of 2 bytes
+    /// as UL, explicit; Rows of 3 bytes, implicit) is refused; whole ones pass.
+    #[test]
+    fn numbers_of_a_broken_length_are_refused() {
+        let explicit = element((0x0028, 0x0002), b"UL", &[1, 0]);
+        let error = check(&file(EXPLICIT_LE, &explicit), Format::DicomImage).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("(0028,0002) holds 2 bytes, not a whole number of UL's 4"),
+            "{error}"
+        );
+        let whole = element((0x0028, 0x0002), b"US", &[1, 0]);
+        assert!(check(&file(EXPLICIT_LE, &whole), Format::DicomImage).is_ok());
+        let mut implicit = Vec::new();
+        implicit.extend([0x28, 0x00, 0x10, 0x00, 3, 0, 0, 0, 20, 0, 0]);
+        let error = check(&file(IMPLICIT_LE, &implicit), Format::DicomImage).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("(0028,0010) holds 3 bytes, not a whole number of US's 2"),
+            "{error}"
+        );
     }
 
     #[test]
