@@ -274,15 +274,17 @@ fn assert_refused(folder: &str, change: &dyn Fn(&mut [u8]), words: &str) {
     assert!(e.contains(words), "wanted '{words}' in: {e}");
 }
 
-/// Cuts a slice's first fragment short: its last bytes, the codestream's end marker, gone
+/// Cuts a slice's first fragment short: its last bytes, the codestream's end marker (and the
+/// padding after it), gone
 /// (zeros in their place, as a copy that stopped early would leave them).
 fn cut_short(b: &mut [u8]) {
     let at = dicom::first_fragment(b);
     let length = u32::from_le_bytes(b[at - 4..at].try_into().unwrap()) as usize;
     let end = at + length;
+    let fragment = &b[at..end];
     assert!(
-        b[at..end].ends_with(&[0xFF, 0xD9]),
-        "the fragment ends the codestream"
+        (fragment.strip_suffix(&[0]).unwrap_or(fragment)).ends_with(&[0xFF, 0xD9]),
+        "the fragment ends the codestream (padded to an even length or not)"
     );
     b[end - 64..end].fill(0);
 }
@@ -353,6 +355,33 @@ fn jpeg_2000_series_read_as_the_uncompressed_ones() {
         &cut_short,
         "JPEG 2000 frame 1: the codestream ends without its end of codestream marker",
     );
+}
+
+/// The oblique series as JPEG-LS Lossless (GDCM's CharLS codestreams) reads as the uncompressed
+/// one; the phantom CT's slices as near-lossless JPEG-LS (an error bound of 2 stored units)
+/// within that bound of theirs. A frame whose size is not the header's, that is no JPEG-LS or
+/// that is cut short is refused naming its file.
+#[test]
+fn jpeg_ls_series_read_as_the_uncompressed_ones() {
+    assert_reads_as_the_twin("oblique_jls");
+    let (mean, most) = lossy_off("phantom_ct_jls");
+    eprintln!("JPEG-LS near-lossless: mean {mean} HU, most {most} HU off");
+    // A stored unit is 10 HU: off by the bound at most, and off somewhere (it is lossy).
+    assert!(most <= 20.0 && mean > 0.0, "mean {mean} HU, most {most} HU");
+
+    let columns = |b: &mut [u8]| {
+        let start = dicom::first_fragment(b);
+        let sof = (b[start..].windows(2).position(|w| w == [0xFF, 0xF7])).expect("SOF55");
+        let at = start + sof + 7;
+        b[at..at + 2].copy_from_slice(&25u16.to_be_bytes());
+    };
+    let refused = |change: &dyn Fn(&mut [u8]), words| assert_refused("oblique_jls", change, words);
+    refused(&columns, "25 x 20 pixels of 1 component(s) and 16 bits");
+    refused(
+        &not_a_codestream,
+        "JPEG-LS frame 1: the codestream does not start",
+    );
+    refused(&cut_short, "JPEG-LS frame 1: truncated JPEG-LS stream");
 }
 
 /// `case build --image FOLDER`: the series' image in the case, the same as from its twin and

@@ -1,10 +1,11 @@
 //! A DICOM file's frames of pixels once its lengths are checked ([`super::dicom_lengths`]):
 //! what the header declares of them, and encapsulated (compressed) frames decoded by their codec
-//! ([`super::dicom_rle`], [`super::dicom_jpeg`], [`super::dicom_jpeg2000`]), each refused
+//! ([`super::dicom_rle`], [`super::dicom_jpeg`], [`super::dicom_jpegls`],
+//! [`super::dicom_jpeg2000`]), each refused
 //! when it decodes to more than its bytes can hold or declares another frame than the header.
 
 use super::dicom_lengths::Codec;
-use super::{dicom_jpeg, dicom_jpeg2000, dicom_rle};
+use super::{dicom_jpeg, dicom_jpeg2000, dicom_jpegls, dicom_rle};
 use super::{Format, LoadError};
 
 /// The frames a file declares: how many, their columns and rows, and `bits` a pixel (1, 8, 16
@@ -100,8 +101,8 @@ pub(super) fn frame_by_frame(
     Ok(out)
 }
 
-/// Encapsulated frames, decoded: one fragment a frame, or for a single frame (JPEG, JPEG 2000)
-/// all of them, in order.
+/// Encapsulated frames, decoded: one fragment a frame, or for a single frame (JPEG, JPEG-LS,
+/// JPEG 2000) all of them, in order.
 pub(super) fn decode(
     codec: Codec,
     fragments: &[&[u8]],
@@ -117,7 +118,7 @@ pub(super) fn decode(
     }
     let joined;
     let streams = match (codec, frames.count) {
-        (Codec::Jpeg | Codec::Jpeg2000, 1) if fragments.len() > 1 => {
+        (Codec::Jpeg | Codec::Jpeg2000 | Codec::JpegLs, 1) if fragments.len() > 1 => {
             joined = fragments.concat();
             vec![joined.as_slice()]
         }
@@ -138,5 +139,6 @@ pub(super) fn decode(
         Codec::Rle => dicom_rle::decode(&streams, shape, format),
         Codec::Jpeg => dicom_jpeg::decode(&streams, shape, frames.size, format),
         Codec::Jpeg2000 => dicom_jpeg2000::decode(&streams, shape, frames.size, format),
+        Codec::JpegLs => dicom_jpegls::decode(&streams, shape, frames.size, format),
     }
 }

@@ -15,11 +15,16 @@ const MOST_EXPANSION: usize = 256;
 
 /// What a codestream's frame header (SOFn) says.
 #[derive(Debug, PartialEq)]
-struct FrameHeader {
-    precision: u8,
-    rows: u16,
-    columns: u16,
-    components: u8,
+pub(super) struct FrameHeader {
+    pub precision: u8,
+    pub rows: u16,
+    pub columns: u16,
+    pub components: u8,
+}
+
+/// Whether a marker starts a JPEG frame header: SOF0..SOF15 but DHT, JPG and DAC.
+fn starts_jpeg_frame(marker: u8) -> bool {
+    matches!(marker, 0xC0..=0xCF) && !matches!(marker, 0xC4 | 0xC8 | 0xCC)
 }
 
 /// The frames `codestreams` (one each) hold, back to back, little endian; `size` is the
@@ -31,7 +36,7 @@ pub(super) fn decode(
     format: Format,
 ) -> Result<Vec<u8>, LoadError> {
     frame_by_frame(codestreams, "JPEG", format, |stream, bad, out| {
-        let header = frame_header(stream).map_err(bad)?;
+        let header = frame_header(stream, starts_jpeg_frame).map_err(bad)?;
         let declared = Declared {
             columns: header.columns.into(),
             rows: header.rows.into(),
@@ -78,8 +83,12 @@ pub(super) fn ends_with_end_of_image(stream: &[u8]) -> bool {
     unpadded.ends_with(&[0xFF, 0xD9])
 }
 
-/// The first frame header (SOF0..SOF15 but DHT, JPG and DAC) before the first scan.
-fn frame_header(stream: &[u8]) -> Result<FrameHeader, String> {
+/// The first frame header before the first scan: the first marker segment `starts_frame` (a
+/// JPEG-LS frame header has the same fields as JPEG's).
+pub(super) fn frame_header(
+    stream: &[u8],
+    starts_frame: fn(u8) -> bool,
+) -> Result<FrameHeader, String> {
     if !stream.starts_with(&[0xFF, 0xD8]) {
         return Err("the codestream does not start with a JPEG start of image".into());
     }
@@ -99,7 +108,7 @@ fn frame_header(stream: &[u8]) -> Result<FrameHeader, String> {
             // Fill bytes, and markers without a length.
             0xFF => at += 1,
             0x01 | 0xD0..=0xD7 => at += 2,
-            0xC0..=0xCF if !matches!(marker, 0xC4 | 0xC8 | 0xCC) => {
+            frame if starts_frame(frame) => {
                 let word = |i: usize| -> Result<u16, &str> {
                     Ok(u16::from_be_bytes([byte(at + i)?, byte(at + i + 1)?]))
                 };
@@ -129,7 +138,7 @@ mod tests {
         stream.extend([
             0xFF, 0xC3, 0x00, 0x0B, 16, 0x00, 0x14, 0x00, 0x18, 1, 1, 0x11, 0,
         ]);
-        let header = frame_header(&stream).unwrap();
+        let header = frame_header(&stream, starts_jpeg_frame).unwrap();
         let want = FrameHeader {
             precision: 16,
             rows: 20,
@@ -137,10 +146,10 @@ mod tests {
             components: 1,
         };
         assert_eq!(header, want);
-        assert!(frame_header(&stream[..12])
+        assert!(frame_header(&stream[..12], starts_jpeg_frame)
             .unwrap_err()
             .contains("before its end"));
-        assert!(frame_header(b"GIF89a")
+        assert!(frame_header(b"GIF89a", starts_jpeg_frame)
             .unwrap_err()
             .contains("start of image"));
     }

@@ -2,7 +2,7 @@
 //! bytes left, before `dicom-object` parses it: that parser reserves each value's declared
 //! length (up to 4 GiB) before reading it, so a lying length in a small file would otherwise
 //! cost gigabytes. The walk also finds the transfer syntax and refuses the encodings the reader
-//! does not take (big-endian, compressions other than RLE, JPEG and JPEG 2000); a deflated file
+//! does not take (big-endian, compressions other than RLE, JPEG, JPEG-LS and JPEG 2000); a deflated file
 //! is walked once inflated ([`dicom_deflate`]). The walk reads headers exactly as dicom-rs does
 //! (an unknown VR has a 32-bit length, as UN), so that every value it will allocate has been
 //! measured; what the two would read differently is refused.
@@ -26,6 +26,8 @@ const JPEG: [&str; 4] = [
 ];
 /// JPEG 2000 lossless only, and lossless or lossy.
 const JPEG_2000: [&str; 2] = ["1.2.840.10008.1.2.4.90", "1.2.840.10008.1.2.4.91"];
+/// JPEG-LS lossless, and near-lossless.
+const JPEG_LS: [&str; 2] = ["1.2.840.10008.1.2.4.80", "1.2.840.10008.1.2.4.81"];
 const UNDEFINED: u32 = u32::MAX;
 
 const ITEM: (u16, u16) = (0xFFFE, 0xE000);
@@ -73,6 +75,7 @@ pub(super) enum Codec {
     Rle,
     Jpeg,
     Jpeg2000,
+    JpegLs,
 }
 
 /// The file's [`Layout`], once every element length has been checked.
@@ -177,6 +180,7 @@ pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
         RLE_LOSSLESS => (false, Some(Codec::Rle)),
         jpeg if JPEG.contains(&jpeg) => (false, Some(Codec::Jpeg)),
         j2k if JPEG_2000.contains(&j2k) => (false, Some(Codec::Jpeg2000)),
+        jls if JPEG_LS.contains(&jls) => (false, Some(Codec::JpegLs)),
         other => return Err(unsupported_syntax(other, format)),
     };
     walk.data_set(implicit, codec)?;
@@ -196,7 +200,7 @@ fn unsupported_syntax(uid: &str, format: Format) -> LoadError {
         format,
         detail: format!(
             "transfer syntax {uid} ({what}): uncompressed and deflated little-endian, RLE \
-             Lossless, JPEG and JPEG 2000 files are read"
+             Lossless, JPEG, JPEG-LS and JPEG 2000 files are read"
         ),
     }
 }
@@ -585,9 +589,9 @@ mod tests {
 
     #[test]
     fn other_encodings_are_named() {
-        let error = check(&file("1.2.840.10008.1.2.4.80", &[]), Format::DicomSeg).unwrap_err();
+        let error = check(&file("1.2.840.10008.1.2.4.201", &[]), Format::DicomSeg).unwrap_err();
         assert!(
-            error.to_string().contains("1.2.840.10008.1.2.4.80"),
+            error.to_string().contains("1.2.840.10008.1.2.4.201"),
             "{error}"
         );
         let error = check(&file("1.2.840.10008.1.2.2", &[]), Format::DicomSeg).unwrap_err();

@@ -8,6 +8,7 @@ mod dicom_deflate;
 mod dicom_frames;
 mod dicom_jpeg;
 mod dicom_jpeg2000;
+mod dicom_jpegls;
 mod dicom_lengths;
 mod dicom_rle;
 mod dicom_seg;

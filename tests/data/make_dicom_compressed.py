@@ -14,6 +14,8 @@ name):
   prediction (1.2.840.10008.1.2.4.70), the codestream GDCM's encoder writes.
 - tests/data/dicom_series/oblique_j2k/j2k_*.dcm: the same slices as JPEG 2000 Lossless
   (1.2.840.10008.1.2.4.90), the codestream GDCM's encoder (OpenJPEG) writes: signed samples.
+- tests/data/dicom_series/oblique_jls/jls_*.dcm: the same slices as JPEG-LS Lossless
+  (1.2.840.10008.1.2.4.80), the codestream GDCM's encoder (CharLS) writes.
 - tests/data/dicom_series/phantom_ct_jpeg/jpeg_*.dcm: the slices of phantom_ct/ (unsigned 8-bit)
   as JPEG Baseline (1.2.840.10008.1.2.4.50, lossy, Pillow at quality 95, no chroma: one grey
   component), marked Lossy Image Compression 01. Its values differ from the original's by a few
@@ -21,11 +23,16 @@ name):
 - tests/data/dicom_series/phantom_ct_j2k/j2k_*.dcm: the same slices as JPEG 2000
   (1.2.840.10008.1.2.4.91, lossy: Pillow's OpenJPEG, the irreversible 9/7 wavelet at 20:1),
   marked Lossy Image Compression 01.
+- tests/data/dicom_series/phantom_ct_jls/jls_*.dcm: the same slices as JPEG-LS near-lossless
+  (1.2.840.10008.1.2.4.81, GDCM's encoder with an error bound of 2 stored units), marked Lossy
+  Image Compression 01: every value within 2 of the original's.
 - tests/data/dicom_seg/labelmap_rle.dcm, fractional_rle.dcm: labelmap.dcm (LABELMAP, 8-bit, 22
   frames) and fractional.dcm (FRACTIONAL, 8-bit, 10 frames) as RLE Lossless.
 - tests/data/dicom_seg/fractional_jpeg.dcm: fractional.dcm as JPEG Lossless SV1 (GDCM's
   codestreams, one fragment a frame; GDCM does not read the LABELMAP SOP class).
 - tests/data/dicom_seg/fractional_j2k.dcm: fractional.dcm as JPEG 2000 Lossless (GDCM's
+  codestreams, one fragment a frame).
+- tests/data/dicom_seg/fractional_jls.dcm: fractional.dcm as JPEG-LS Lossless (GDCM's
   codestreams, one fragment a frame).
 - tests/data/dicom_seg/phantom_deflated.dcm and tests/data/dicom_series/oblique_deflated/
   deflated_*.dcm: phantom.dcm (BINARY) and the slices of oblique/ in Deflated Explicit VR Little
@@ -51,6 +58,8 @@ from pydicom.uid import (
     JPEG2000Lossless,
     JPEGBaseline8Bit,
     JPEGLosslessSV1,
+    JPEGLSLossless,
+    JPEGLSNearLossless,
     RLELossless,
 )
 
@@ -71,13 +80,16 @@ def check_same(target, original, syntax):
     assert np.array_equal(back.pixel_array, original), f"{target} decodes differently"
 
 
-def gdcm_frames(source, syntax):
-    """The codestreams GDCM writes for `source`'s frames in the transfer syntax `syntax`."""
+def gdcm_frames(source, syntax, codec=None):
+    """The codestreams GDCM writes for `source`'s frames in the transfer syntax `syntax`, with
+    `codec` when given."""
     reader = gdcm.ImageReader()
     reader.SetFileName(source)
     assert reader.Read(), source
     change = gdcm.ImageChangeTransferSyntax()
     change.SetTransferSyntax(gdcm.TransferSyntax(syntax))
+    if codec is not None:
+        change.SetUserCodec(codec)
     change.SetInput(reader.GetImage())
     assert change.Change(), source
     with tempfile.TemporaryDirectory() as folder:
@@ -102,6 +114,13 @@ def pillow_jpeg_baseline(ds):
 
 def gdcm_jpeg_lossless(source):
     return gdcm_frames(source, gdcm.TransferSyntax.JPEGLosslessProcess14_1)
+
+
+def gdcm_jpeg_ls_near(source, error):
+    codec = gdcm.JPEGLSCodec()
+    codec.SetLossless(False)
+    codec.SetLossyError(error)
+    return gdcm_frames(source, gdcm.TransferSyntax.JPEGLSNearLossless, codec)
 
 
 def pillow_jpeg_2000(ds):
@@ -170,6 +189,20 @@ def main():
             s, t, JPEG2000, pillow_jpeg_2000(pydicom.dcmread(s)), "ISO_15444_1"
         ),
     )
+    twins_of(
+        "oblique",
+        "jls",
+        lambda s, t: encapsulated_twin(
+            s, t, JPEGLSLossless, gdcm_frames(s, gdcm.TransferSyntax.JPEGLSLossless)
+        ),
+    )
+    twins_of(
+        "phantom_ct",
+        "jls",
+        lambda s, t: encapsulated_twin(
+            s, t, JPEGLSNearLossless, gdcm_jpeg_ls_near(s, 2), "ISO_14495_1"
+        ),
+    )
     twins_of("oblique", "deflated", deflated_twin)
     seg = "tests/data/dicom_seg"
     deflated_twin(f"{seg}/phantom.dcm", f"{seg}/phantom_deflated.dcm")
@@ -184,6 +217,12 @@ def main():
         f"{seg}/fractional_j2k.dcm",
         JPEG2000Lossless,
         gdcm_frames(fractional, gdcm.TransferSyntax.JPEG2000Lossless),
+    )
+    encapsulated_twin(
+        fractional,
+        f"{seg}/fractional_jls.dcm",
+        JPEGLSLossless,
+        gdcm_frames(fractional, gdcm.TransferSyntax.JPEGLSLossless),
     )
 
 

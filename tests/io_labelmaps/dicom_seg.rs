@@ -555,8 +555,8 @@ fn a_labelmap_seg_reads_as_the_binary_one() {
     );
 }
 
-/// RLE Lossless twins of the LABELMAP and FRACTIONAL SEGs and JPEG Lossless and JPEG 2000
-/// Lossless ones of the FRACTIONAL SEG (tests/data/make_dicom_compressed.py) read as the
+/// RLE Lossless twins of the LABELMAP and FRACTIONAL SEGs and JPEG Lossless, JPEG-LS Lossless
+/// and JPEG 2000 Lossless ones of the FRACTIONAL SEG (tests/data/make_dicom_compressed.py) read as the
 /// uncompressed files; a broken frame is refused.
 #[test]
 fn compressed_segs_read_as_the_uncompressed_ones() {
@@ -565,6 +565,7 @@ fn compressed_segs_read_as_the_uncompressed_ones() {
         ("fractional", "fractional_rle"),
         ("fractional", "fractional_jpeg"),
         ("fractional", "fractional_j2k"),
+        ("fractional", "fractional_jls"),
     ] {
         let plain = load_named(&seg(&format!("{name}.dcm")), "plain.dcm");
         let compressed = load_named(&seg(&format!("{twin}.dcm")), "twin.dcm");
