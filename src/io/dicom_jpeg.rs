@@ -35,19 +35,14 @@ pub(super) fn decode(
     size: [usize; 2],
     format: Format,
 ) -> Result<Vec<u8>, LoadError> {
+    let rules = FrameRules {
+        starts_frame: starts_jpeg_frame,
+        expansion: MOST_EXPANSION,
+        what: "bytes in a JPEG frame",
+    };
     frame_by_frame(codestreams, "JPEG", format, |stream, bad, out| {
-        let header = frame_header(stream, starts_jpeg_frame).map_err(bad)?;
-        let declared = Declared {
-            columns: header.columns.into(),
-            rows: header.rows.into(),
-            components: header.components.into(),
-            bits: header.precision.into(),
-            subsampled: false,
-        };
-        shape.check_declared(size, &declared).map_err(bad)?;
+        let header = checked_frame_header(stream, &rules, shape, size, format, bad)?;
         let bytes = if header.precision <= 8 { 1 } else { 2 };
-        let what = "bytes in a JPEG frame";
-        shape.bytes_within(stream.len(), MOST_EXPANSION, what, format)?;
         // The decoder's own word for a codestream cut short is an I/O error of its reader.
         if !ends_with_end_of_image(stream) {
             let cut = "the codestream ends without a JPEG end of image: it is cut short";
@@ -76,6 +71,38 @@ pub(super) fn decode(
     })
 }
 
+/// How a codec's frame header is found and how many pixels' bytes a byte of its codestream
+/// may hold.
+pub(super) struct FrameRules {
+    pub starts_frame: fn(u8) -> bool,
+    pub expansion: usize,
+    /// What the bytes are called when there are too few.
+    pub what: &'static str,
+}
+
+/// The frame header of `stream`, refused (in `bad`'s words) unless it declares the DICOM
+/// header's frame (`shape`, `size`) in bytes that can hold it.
+pub(super) fn checked_frame_header(
+    stream: &[u8],
+    rules: &FrameRules,
+    shape: FrameShape,
+    size: [usize; 2],
+    format: Format,
+    bad: &dyn Fn(String) -> LoadError,
+) -> Result<FrameHeader, LoadError> {
+    let header = frame_header(stream, rules.starts_frame).map_err(bad)?;
+    let declared = Declared {
+        columns: header.columns.into(),
+        rows: header.rows.into(),
+        components: header.components.into(),
+        bits: header.precision.into(),
+        subsampled: false,
+    };
+    shape.check_declared(size, &declared).map_err(bad)?;
+    shape.bytes_within(stream.len(), rules.expansion, rules.what, format)?;
+    Ok(header)
+}
+
 /// Whether a codestream ends with its end-of-image marker (JPEG 2000's end of codestream is the
 /// same two bytes), before the zero byte DICOM may pad a fragment with to an even length.
 pub(super) fn ends_with_end_of_image(stream: &[u8]) -> bool {
@@ -85,10 +112,7 @@ pub(super) fn ends_with_end_of_image(stream: &[u8]) -> bool {
 
 /// The first frame header before the first scan: the first marker segment `starts_frame` (a
 /// JPEG-LS frame header has the same fields as JPEG's).
-pub(super) fn frame_header(
-    stream: &[u8],
-    starts_frame: fn(u8) -> bool,
-) -> Result<FrameHeader, String> {
+fn frame_header(stream: &[u8], starts_frame: fn(u8) -> bool) -> Result<FrameHeader, String> {
     if !stream.starts_with(&[0xFF, 0xD8]) {
         return Err("the codestream does not start with a JPEG start of image".into());
     }

@@ -11,8 +11,8 @@
 //! values themselves (a signed stored value is coded as its bit pattern), so they go out as
 //! they come.
 
-use super::dicom_frames::{frame_by_frame, Declared, FrameShape};
-use super::dicom_jpeg::frame_header;
+use super::dicom_frames::{frame_by_frame, FrameShape};
+use super::dicom_jpeg::{checked_frame_header, FrameRules};
 use super::{Format, LoadError};
 
 /// Pixels a byte of JPEG-LS may hold: run mode codes a line of one value in a bit or more, so
@@ -32,18 +32,13 @@ pub(super) fn decode(
     size: [usize; 2],
     format: Format,
 ) -> Result<Vec<u8>, LoadError> {
+    let rules = FrameRules {
+        starts_frame: starts_ls_frame,
+        expansion: MOST_PIXELS_PER_BYTE * shape.bytes,
+        what: "bytes in a JPEG-LS frame",
+    };
     frame_by_frame(codestreams, "JPEG-LS", format, |stream, bad, out| {
-        let header = frame_header(stream, starts_ls_frame).map_err(bad)?;
-        let declared = Declared {
-            columns: header.columns.into(),
-            rows: header.rows.into(),
-            components: header.components.into(),
-            bits: header.precision.into(),
-            subsampled: false,
-        };
-        shape.check_declared(size, &declared).map_err(bad)?;
-        let expansion = MOST_PIXELS_PER_BYTE * shape.bytes;
-        shape.bytes_within(stream.len(), expansion, "bytes in a JPEG-LS frame", format)?;
+        let header = checked_frame_header(stream, &rules, shape, size, format, bad)?;
         check_presets_and_scan(stream).map_err(bad)?;
         let (columns, rows) = (u32::from(header.columns), u32::from(header.rows));
         let (samples, _, _) =
