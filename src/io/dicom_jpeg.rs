@@ -110,46 +110,55 @@ pub(super) fn ends_with_end_of_image(stream: &[u8]) -> bool {
     unpadded.ends_with(&[0xFF, 0xD9])
 }
 
-/// The first frame header before the first scan: the first marker segment `starts_frame` (a
-/// JPEG-LS frame header has the same fields as JPEG's).
-fn frame_header(stream: &[u8], starts_frame: fn(u8) -> bool) -> Result<FrameHeader, String> {
+/// Walks the marker segments after the start of image, giving `visit` each marker with the
+/// bytes from it on, until `visit` answers (fill bytes and markers without a length are
+/// stepped over); `missing` says what was sought when the codestream ends first.
+pub(super) fn find_segment<T>(
+    stream: &[u8],
+    missing: &str,
+    mut visit: impl FnMut(u8, &[u8]) -> Result<Option<T>, String>,
+) -> Result<T, String> {
     if !stream.starts_with(&[0xFF, 0xD8]) {
         return Err("the codestream does not start with a JPEG start of image".into());
     }
     let mut at = 2;
     loop {
-        let byte = |i: usize| {
-            stream
-                .get(i)
-                .copied()
-                .ok_or("no frame header before its end")
-        };
+        let byte = |i: usize| stream.get(i).copied().ok_or_else(|| missing.to_string());
         if byte(at)? != 0xFF {
             return Err(format!("no JPEG marker at byte {at}"));
         }
-        let marker = byte(at + 1)?;
-        match marker {
-            // Fill bytes, and markers without a length.
+        match byte(at + 1)? {
             0xFF => at += 1,
             0x01 | 0xD0..=0xD7 => at += 2,
-            frame if starts_frame(frame) => {
-                let word = |i: usize| -> Result<u16, &str> {
-                    Ok(u16::from_be_bytes([byte(at + i)?, byte(at + i + 1)?]))
-                };
-                return Ok(FrameHeader {
-                    precision: byte(at + 4)?,
-                    rows: word(5)?,
-                    columns: word(7)?,
-                    components: byte(at + 9)?,
-                });
-            }
-            0xDA | 0xD9 => return Err("a scan or the end before any frame header".into()),
-            _ => {
+            marker => {
+                if let Some(found) = visit(marker, &stream[at..])? {
+                    return Ok(found);
+                }
                 let length = u16::from_be_bytes([byte(at + 2)?, byte(at + 3)?]);
                 at += 2 + length as usize;
             }
         }
     }
+}
+
+/// The first frame header before the first scan: the first marker segment `starts_frame` (a
+/// JPEG-LS frame header has the same fields as JPEG's).
+fn frame_header(stream: &[u8], starts_frame: fn(u8) -> bool) -> Result<FrameHeader, String> {
+    const MISSING: &str = "no frame header before its end";
+    find_segment(stream, MISSING, |marker, segment| {
+        let byte = |i: usize| segment.get(i).copied().ok_or_else(|| MISSING.to_string());
+        let word = |i: usize| Ok::<_, String>(u16::from_be_bytes([byte(i)?, byte(i + 1)?]));
+        match marker {
+            frame if starts_frame(frame) => Ok(Some(FrameHeader {
+                precision: byte(4)?,
+                rows: word(5)?,
+                columns: word(7)?,
+                components: byte(9)?,
+            })),
+            0xDA | 0xD9 => Err("a scan or the end before any frame header".into()),
+            _ => Ok(None),
+        }
+    })
 }
 
 #[cfg(test)]

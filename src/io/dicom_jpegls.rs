@@ -12,7 +12,7 @@
 //! they come.
 
 use super::dicom_frames::{frame_by_frame, FrameShape};
-use super::dicom_jpeg::{checked_frame_header, FrameRules};
+use super::dicom_jpeg::{checked_frame_header, find_segment, FrameRules};
 use super::{Format, LoadError};
 
 /// Pixels a byte of JPEG-LS may hold: run mode codes a line of one value in a bit or more, so
@@ -65,35 +65,27 @@ const DEFAULT_RESET: u16 = 64;
 /// Refuses a preset-parameters segment (LSE, ID 1) with another RESET than the default, and a
 /// first scan header (SOS) with a point transform.
 fn check_presets_and_scan(stream: &[u8]) -> Result<(), String> {
-    let byte = |i: usize| (stream.get(i).copied()).ok_or("no scan before the codestream's end");
-    let word = |i: usize| -> Result<u16, &str> { Ok(u16::from_be_bytes([byte(i)?, byte(i + 1)?])) };
-    let mut at = 2;
-    loop {
-        if byte(at)? != 0xFF {
-            return Err(format!("no JPEG-LS marker at byte {at}"));
-        }
-        let length = usize::from(word(at + 2)?);
-        match byte(at + 1)? {
-            0xF8 if byte(at + 4)? == 1 => {
-                let reset = word(at + 13)?;
-                if reset != DEFAULT_RESET {
-                    return Err(format!(
-                        "a preset RESET of {reset}: only the default {DEFAULT_RESET} is read"
-                    ));
-                }
-            }
+    const MISSING: &str = "no scan before the codestream's end";
+    find_segment(stream, MISSING, |marker, segment| {
+        let byte = |i: usize| segment.get(i).copied().ok_or_else(|| MISSING.to_string());
+        let word = |i: usize| Ok::<_, String>(u16::from_be_bytes([byte(i)?, byte(i + 1)?]));
+        match marker {
+            0xF8 if byte(4)? == 1 => match word(13)? {
+                DEFAULT_RESET => Ok(None),
+                reset => Err(format!(
+                    "a preset RESET of {reset}: only the default {DEFAULT_RESET} is read"
+                )),
+            },
             0xDA => {
-                let components = usize::from(byte(at + 4)?);
-                let point_transform = byte(at + 4 + 2 * components + 3)? & 0x0F;
-                if point_transform != 0 {
-                    return Err(format!("a point transform of {point_transform} bits"));
+                let components = usize::from(byte(4)?);
+                match byte(4 + 2 * components + 3)? & 0x0F {
+                    0 => Ok(Some(())),
+                    bits => Err(format!("a point transform of {bits} bits")),
                 }
-                return Ok(());
             }
-            _ => {}
+            _ => Ok(None),
         }
-        at += 2 + length;
-    }
+    })
 }
 
 #[cfg(test)]
