@@ -2,8 +2,8 @@
 //! bytes left, before `dicom-object` parses it: that parser reserves each value's declared
 //! length (up to 4 GiB) before reading it, so a lying length in a small file would otherwise
 //! cost gigabytes. The walk also finds the transfer syntax and refuses the encodings the reader
-//! does not take (big-endian, compressions other than RLE, JPEG, JPEG-LS and JPEG 2000); a deflated file
-//! is walked once inflated ([`dicom_deflate`]). The walk reads headers exactly as dicom-rs does
+//! does not take (big-endian, compressions other than RLE, JPEG, JPEG-LS and JPEG 2000); a
+//! deflated file is walked once inflated ([`dicom_deflate`]). The walk reads headers exactly as dicom-rs does
 //! (an unknown VR has a 32-bit length, as UN), so that every value it will allocate has been
 //! measured; what the two would read differently is refused.
 
@@ -357,8 +357,9 @@ impl Walk<'_> {
         if implicit {
             let len = self.u32_at(self.at + 4)?;
             self.at += 8;
-            let nested = len == UNDEFINED || is_sequence(tag);
-            if let Some(vr) = dictionary_vr(tag) {
+            let vr = dictionary_vr(tag);
+            let nested = len == UNDEFINED || vr == Some(dicom_core::VR::SQ);
+            if let Some(vr) = vr {
                 self.whole_values(tag, vr.to_string().as_bytes(), len)?;
             }
             return Ok(Header { tag, len, nested });
@@ -451,12 +452,8 @@ impl Walk<'_> {
     }
 }
 
-/// Whether the standard dictionary gives a tag the VR SQ (implicit VR files do not say).
-fn is_sequence(tag: (u16, u16)) -> bool {
-    dictionary_vr(tag) == Some(dicom_core::VR::SQ)
-}
-
-/// The VR the standard dictionary gives a tag, as dicom-rs reads it in implicit VR.
+/// The VR the standard dictionary gives a tag, as dicom-rs reads it in implicit VR (whose files
+/// do not say).
 fn dictionary_vr(tag: (u16, u16)) -> Option<dicom_core::VR> {
     use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
     let entry = dicom_dictionary_std::StandardDataDictionary.by_tag(dicom_core::Tag(tag.0, tag.1));
