@@ -398,18 +398,22 @@ impl Document {
     /// and hands out the next; with the CPU engine in workers, sends the current parameters'
     /// smoothing or takes its result now, moves the background work on, and answers the calls
     /// waiting, rather than a frame of a large mesh later. True when what the page shows
-    /// changed (a result taken, a search or graph finished): a frame is due.
+    /// changed (a result taken, a search or graph finished, "Suggest all" ended): a frame is
+    /// due.
     pub fn step_cpu_engine(&mut self) -> bool {
         self.session.pump_cpu_engine();
-        // Its surfaces show with the next paced frame; the workers need not wait for it.
+        // Its surfaces show with the next paced frame; the workers need not wait for it. Its
+        // end shows at once.
+        let suggesting = self.session.background().suggesting_all();
         self.session.step_suggest_all();
+        let ended = suggesting && !self.session.background().suggesting_all();
         if self.backend != Backend::Cpu || !self.session.cpu_engine().threaded() {
-            return false;
+            return ended;
         }
         let took = self.compute_on_cpu();
         let finished = !self.guidance_on_gpu && self.compute_guidance(None);
         self.answer_waiting();
-        took || finished
+        took || finished || ended
     }
 
     /// The background work's share of this frame (graphs, suggestions, the gallery): hands

@@ -160,7 +160,7 @@ fn reply_handler(
             }
         }
         if paced && !shown_changed {
-            ctx.request_repaint_after(super::PROGRESS_REPAINT);
+            ctx.request_repaint_after(super::work_repaint(&ctx));
         } else {
             super::wake(&ctx);
         }

@@ -494,7 +494,7 @@ impl eframe::App for Shell {
             if self.repainting && doc.working_elsewhere() {
                 // The replies wake the page; this only moves the progress on. Frames drawn
                 // for nothing would take a core from the workers.
-                ctx.request_repaint_after(crate::app::PROGRESS_REPAINT);
+                ctx.request_repaint_after(crate::app::work_repaint(&ctx));
             } else if self.repainting {
                 ctx.request_repaint();
             }

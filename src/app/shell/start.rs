@@ -109,8 +109,9 @@ pub(super) fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Con
 /// interpreter and binning rasterises it at up to four offsets, work that lies on the first
 /// frame's path (compiled and then recompiled by the browser) for text that reads the same. On
 /// a `software` GPU each frame costs a whole canvas of CPU time, and comes a few times a second:
-/// widgets change at once rather than animate over frames.
+/// widgets change at once rather than animate over frames, and progress moves less often.
 pub(super) fn set_style(ctx: &egui::Context, software: bool) {
+    crate::app::set_software_gpu(ctx, software);
     ctx.set_theme(egui::Theme::Dark);
     ctx.all_styles_mut(|s| {
         s.visuals.text_options.font_hinting = false;

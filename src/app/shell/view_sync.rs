@@ -13,7 +13,7 @@ use crate::view;
 
 /// How far apart the view shows the new surfaces of "Suggest all" ([`holds_looks`]): on a
 /// software GPU a redraw of a whole-body case costs seconds of CPU, on a graphics card little.
-pub(super) const LOOKS_EVERY_MS_SOFTWARE: f64 = 10_000.0;
+pub(super) const LOOKS_EVERY_MS_SOFTWARE: f64 = 30_000.0;
 pub(super) const LOOKS_EVERY_MS: f64 = 1000.0;
 
 /// Where the view's positions come from.
