@@ -1,0 +1,79 @@
+//! The document between frames: opening, the workers' replies, the calls waiting.
+
+use super::*;
+use std::cell::Cell;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
+
+/// A voxelised bent tube: one small staircase surface.
+const TUBE_NAME: &str = "bent_tube_staircase.ply";
+const TUBE: &[u8] = include_bytes!("../../../tests/data/bent_tube_staircase.ply");
+
+#[wasm_bindgen_test]
+fn a_bad_file_keeps_the_previous_model_and_reports_why() {
+    let mut doc = Document::new(Backend::Cpu);
+    doc.open(TUBE_NAME, TUBE).unwrap();
+    let generation = doc.session.case().model_id();
+    let error = doc.open("notes.txt", b"not a mesh").unwrap_err();
+    assert!(error.starts_with("Cannot open notes.txt: "), "{error}");
+    assert!(error.contains(".stl .obj .ply"), "{error}");
+    assert_eq!(doc.session.case().model_id(), generation);
+    let state = doc.state_json();
+    assert_eq!(state["model"], TUBE_NAME);
+    assert_eq!(state["error"], error.as_str());
+    assert!(doc.open("empty.stl", b"").unwrap_err().contains("empty"));
+}
+
+#[wasm_bindgen_test]
+fn a_workers_reply_asks_for_a_frame_only_when_what_is_shown_changed() {
+    let mut doc = Document::new(Backend::Cpu);
+    let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
+    let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
+    doc.session.set_cpu_engine(pool);
+    doc.open(TUBE_NAME, TUBE).unwrap();
+    assert!(
+        !doc.step_cpu_engine(),
+        "the smoothing is asked, not answered"
+    );
+    assert!(doc.busy());
+    deliver.set(true);
+    assert!(doc.step_cpu_engine(), "the result came");
+    assert!(!doc.busy() && doc.timings.is_some());
+    assert!(!doc.step_cpu_engine(), "nothing new");
+
+    deliver.set(false);
+    doc.session.set_graphs_wanted(true);
+    assert!(!doc.step_cpu_engine(), "the graphs' runs are asked");
+    assert!(doc.session.background().guidance_busy());
+    deliver.set(true);
+    assert!(doc.step_cpu_engine(), "the graphs are done, between frames");
+    assert!(!doc.session.background().guidance_busy() && doc.session.background().graphs_current());
+}
+
+#[wasm_bindgen_test]
+fn waiting_calls_are_answered_once_the_result_is_computed() {
+    let mut doc = Document::new(Backend::Cpu);
+    doc.open(TUBE_NAME, TUBE).unwrap();
+    let answered = Rc::new(Cell::new(0));
+    let seen = answered.clone();
+    doc.when_current(Box::new(move |s| {
+        assert!(s.case().result().is_some());
+        seen.set(seen.get() + 1);
+    }));
+    doc.answer_waiting();
+    assert_eq!(answered.get(), 0, "nothing computed yet");
+    while doc.busy() {
+        doc.compute_on_cpu();
+    }
+    doc.answer_waiting();
+    assert_eq!(answered.get(), 1);
+    assert!(doc.timings.is_some());
+    assert_eq!(doc.state_json()["busy"], false);
+    let model = doc.session.case().model().unwrap();
+    assert_eq!(
+        (model.report.vertices, model.report.faces),
+        (2296, 4588),
+        "the tube"
+    );
+}
