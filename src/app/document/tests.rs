@@ -52,6 +52,26 @@ fn a_workers_reply_asks_for_a_frame_only_when_what_is_shown_changed() {
 }
 
 #[wasm_bindgen_test]
+fn the_end_of_suggest_all_asks_for_a_frame_at_once() {
+    // Replies come between frames; the bar moves with paced frames, its end must not wait.
+    let mut doc = Document::new(Backend::Cpu);
+    let (carrier, deliver) = crate::worker::deferred::Deferred::new(1);
+    doc.session
+        .set_cpu_engine(crate::worker::Pool::new(Box::new(carrier)));
+    doc.open(TUBE_NAME, TUBE).unwrap();
+    let method = crate::suggest::SearchMethod::Local;
+    doc.session
+        .start_suggest_all(0.5, method, false, 0.0)
+        .unwrap();
+    assert!(!doc.step_cpu_engine(), "the structure is handed out");
+    assert!(doc.session.background().suggesting_all());
+    deliver.set(true);
+    assert!(doc.step_cpu_engine(), "Suggest all ended");
+    assert!(!doc.session.background().suggesting_all());
+    assert!(!doc.step_cpu_engine(), "nothing new");
+}
+
+#[wasm_bindgen_test]
 fn waiting_calls_are_answered_once_the_result_is_computed() {
     let mut doc = Document::new(Backend::Cpu);
     doc.open(TUBE_NAME, TUBE).unwrap();
