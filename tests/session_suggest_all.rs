@@ -32,7 +32,7 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     session
         .start_suggest_all(0.5, SearchMethod::Local, false, 0.0)
         .unwrap();
-    // Workers on this thread answer at once.
+    // Workers on this thread answer at once: one step ends it.
     assert!(session.step_suggest_all());
     assert!(!session.background().suggesting_all());
     // The three structures besides the model took new surfaces, each a new case version (the
@@ -156,10 +156,13 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
             true => assert!((left.unwrap() - 10.0 * (1.0 - done) / done).abs() < 1e-9),
             false => assert_eq!(left, None),
         }
-        assert!(
-            session.step_suggest_all(),
-            "workers on this thread answer at once"
-        );
+        // Workers on this thread answer at once: each step takes a batch, and only the
+        // step that takes the last one says it ended.
+        let ended = session.step_suggest_all();
+        let answered = session.background().suggest_all().unwrap().structures;
+        let all = answered.iter().all(Option::is_some);
+        assert_eq!(ended, all, "ended only with every structure answered");
+        assert_eq!(ended, !session.background().suggesting_all());
     }
     assert!(done_before > 0.0, "some work was seen done before the end");
     assert_eq!(session.background().suggest_all_work_done(), None);

@@ -404,9 +404,7 @@ impl Document {
         self.session.pump_cpu_engine();
         // Its surfaces show with the next paced frame; the workers need not wait for it. Its
         // end shows at once.
-        let suggesting = self.session.background().suggesting_all();
-        self.session.step_suggest_all();
-        let ended = suggesting && !self.session.background().suggesting_all();
+        let ended = self.session.step_suggest_all();
         if self.backend != Backend::Cpu || !self.session.cpu_engine().threaded() {
             return ended;
         }

@@ -196,7 +196,8 @@ impl Session {
         }
     }
 
-    /// Takes the structures' answers that came; returns whether any did.
+    /// Takes the structures' answers that came and hands out the next; returns whether this
+    /// step ended "Suggest all" (its last answer came).
     pub fn step_suggest_all(&mut self) -> bool {
         let Some(options) = self.suggest_all.options else {
             return false;
@@ -219,7 +220,7 @@ impl Session {
             }
         }
         self.hand_out_structures();
-        any
+        any && !self.background().suggesting_all()
     }
 
     /// Applies structure `i`'s answer: the model's structure takes the parameters (its result
