@@ -43,6 +43,7 @@ mod layout;
 mod legend;
 mod lesson_panel;
 mod orientation_marker;
+mod pacing;
 mod page;
 mod picture;
 mod pointing;
@@ -61,33 +62,7 @@ mod workers;
 
 pub use backend::Backend;
 pub use document::Document;
-
-/// How often the page redraws only to move a progress on (bytes read, an opening's stage, the
-/// workers' jobs). Each frame draws the whole page and its model, which a software GPU pays
-/// for on the CPU the workers need: a bar moving once a second keeps that share small.
-const PROGRESS_REPAINT: std::time::Duration = std::time::Duration::from_millis(1000);
-/// The same while workers work, on a software GPU: there each frame of a large case costs
-/// more of the CPU the workers need, so the bar moves every few seconds.
-const WORK_REPAINT_SOFTWARE: std::time::Duration = std::time::Duration::from_millis(3000);
-
-/// How often the page redraws only to move the workers' progress on (their replies wake it
-/// when what it shows changes).
-fn work_repaint(ctx: &eframe::egui::Context) -> std::time::Duration {
-    let software = ctx.data(|d| d.get_temp::<bool>(software_gpu_id()));
-    match software {
-        Some(true) => WORK_REPAINT_SOFTWARE,
-        _ => PROGRESS_REPAINT,
-    }
-}
-
-/// Tells the page's pacing whether eframe draws on a software GPU (SwiftShader, llvmpipe).
-fn set_software_gpu(ctx: &eframe::egui::Context, software: bool) {
-    ctx.data_mut(|d| d.insert_temp(software_gpu_id(), software));
-}
-
-fn software_gpu_id() -> eframe::egui::Id {
-    eframe::egui::Id::unique("meshsmooth draws on a software GPU")
-}
+use pacing::{Pacing, PROGRESS_REPAINT};
 
 /// Asks for one frame, as soon as the browser draws the next, for a change made between frames
 /// (a worker's reply, a call of `window.meshsmooth`, a file read, a picture taken). egui

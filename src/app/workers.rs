@@ -160,7 +160,7 @@ fn reply_handler(
             }
         }
         if paced && !shown_changed {
-            ctx.request_repaint_after(super::work_repaint(&ctx));
+            ctx.request_repaint_after(super::Pacing::of(&ctx).work_repaint);
         } else {
             super::wake(&ctx);
         }

@@ -41,7 +41,7 @@ mod view_sync;
 
 use first_paint::FirstPaint;
 use start::{embed, gpu_engine, open_start_model, set_style, start_workers};
-use view_sync::{Shown, LOOKS_EVERY_MS, LOOKS_EVERY_MS_SOFTWARE};
+use view_sync::Shown;
 
 /// Milliseconds of a frame the case glTF being written may take on this thread: the view
 /// stays usable (about ten frames a second) and the file is written at nearly full speed.
@@ -72,8 +72,6 @@ pub struct Shell {
     view: Option<(Viewer, egui_wgpu::RenderState)>,
     /// What the view shows now, so it is re-uploaded only when that changes.
     shown: Shown,
-    /// How far apart the new surfaces of "Suggest all" are shown (see `view_sync`).
-    looks_every_ms: f64,
     /// The segmentation the view framed whole (its file and structure count).
     framed_case: Option<(String, usize)>,
     structures: StructureList,
@@ -199,10 +197,6 @@ impl Shell {
             gpu_fallback: None,
             view,
             shown: Shown::default(),
-            looks_every_ms: match software {
-                true => LOOKS_EVERY_MS_SOFTWARE,
-                false => LOOKS_EVERY_MS,
-            },
             framed_case: None,
             structures: StructureList::default(),
             reading,
@@ -479,7 +473,7 @@ impl eframe::App for Shell {
         // The view takes up a new model once the GPU engine has (a frame later); the CPU
         // engine's take-up is a message to a worker, so the view need not wait a frame.
         if (opening != Opening::Done || self.gpu.is_none()) && !uploading {
-            self.sync_view();
+            self.sync_view(&ctx);
         }
         {
             let mut doc = self.doc.borrow_mut();
@@ -494,7 +488,7 @@ impl eframe::App for Shell {
             if self.repainting && doc.working_elsewhere() {
                 // The replies wake the page; this only moves the progress on. Frames drawn
                 // for nothing would take a core from the workers.
-                ctx.request_repaint_after(crate::app::work_repaint(&ctx));
+                ctx.request_repaint_after(crate::app::Pacing::of(&ctx).work_repaint);
             } else if self.repainting {
                 ctx.request_repaint();
             }

@@ -111,7 +111,7 @@ pub(super) fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Con
 /// a `software` GPU each frame costs a whole canvas of CPU time, and comes a few times a second:
 /// widgets change at once rather than animate over frames, and progress moves less often.
 pub(super) fn set_style(ctx: &egui::Context, software: bool) {
-    crate::app::set_software_gpu(ctx, software);
+    crate::app::Pacing::for_gpu(software).keep(ctx);
     ctx.set_theme(egui::Theme::Dark);
     ctx.all_styles_mut(|s| {
         s.visuals.text_options.font_hinting = false;

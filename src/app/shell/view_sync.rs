@@ -11,11 +11,6 @@ use crate::app::viewer;
 use crate::session::{ColorField, Legend, Session};
 use crate::view;
 
-/// How far apart the view shows the new surfaces of "Suggest all" ([`holds_looks`]): on a
-/// software GPU a redraw of a whole-body case costs seconds of CPU, on a graphics card little.
-pub(super) const LOOKS_EVERY_MS_SOFTWARE: f64 = 30_000.0;
-pub(super) const LOOKS_EVERY_MS: f64 = 1000.0;
-
 /// Where the view's positions come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Positions {
@@ -56,7 +51,8 @@ impl Shell {
     /// Brings the view's buffers up to date with the document: a new model, new positions
     /// (the original, the CPU result or the GPU buffers), new colours, the other structures
     /// and the checks' marks.
-    pub(super) fn sync_view(&mut self) {
+    pub(super) fn sync_view(&mut self, ctx: &eframe::egui::Context) {
+        let looks_every_ms = crate::app::Pacing::of(ctx).looks_every_ms;
         let Some((viewer, rs)) = &mut self.view else {
             return;
         };
@@ -102,9 +98,7 @@ impl Shell {
         let highlight = doc.quiz_highlight();
         let looks = (session.case().case_version(), toward.to_bits());
         let now = crate::app::document::now_ms();
-        if shown.looks != Some(looks)
-            && !holds_looks(shown, session, looks, now, self.looks_every_ms)
-        {
+        if shown.looks != Some(looks) && !holds_looks(shown, session, looks, now, looks_every_ms) {
             upload_looks(viewer, rs, session, (toward, highlight));
             shown.looks = Some(looks);
             shown.looks_at_ms = now;
