@@ -14,6 +14,7 @@
 //! local error as the vertex attribute `_LOCAL_ERROR`.
 
 use base64::Engine as _;
+use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use super::case_lesson::{label_node, step_camera};
@@ -23,8 +24,7 @@ use super::glb::{
     MESHOPT, TRIANGLES, UNSIGNED_INT,
 };
 use super::simplified::{
-    record as simplification_record, simplify_case, simplify_structure, written, Simplification,
-    Written,
+    record as simplification_record, simplify_structure, written, Simplification, Written,
 };
 use super::{check, ExportError, ExportOptions};
 use crate::case::{structure_record, Case, CaseStructure, CASE_KEY};
@@ -166,27 +166,29 @@ impl CaseWriter {
 
     /// Writes the next structure, `s` (simplified first when the options say so).
     pub fn add(&mut self, s: &CaseStructure) -> Result<(), ExportError> {
-        let done =
-            (self.options.simplify).and_then(|how| simplify_structure(s, how, self.case_triangles));
-        self.add_simplified(s, done.as_ref())
+        let part = Part::of(s, self.meshes.len(), &self.options, self.case_triangles)?;
+        self.add_part(s, part);
+        Ok(())
     }
 
-    /// Writes the next structure, `s`, with its simplified triangles where it has them.
-    fn add_simplified(
-        &mut self,
-        s: &CaseStructure,
-        done: Option<&Simplified>,
-    ) -> Result<(), ExportError> {
-        let index = self.meshes.len();
+    /// Adds structure `s`'s part, written for the next structure's place.
+    fn add_part(&mut self, s: &CaseStructure, part: Part) {
+        let Part {
+            b,
+            mut mesh,
+            placement,
+            simplified,
+            triangles,
+        } = part;
         let options = self.options;
-        let surfaces = written(s, done, options.local_error);
-        let (mesh, placement) = structure_mesh(&mut self.b, s, &surfaces, index, &options)?;
-        self.triangles += surfaces.shown.triangle_count();
+        let index = self.meshes.len();
+        shift_accessors(&mut mesh, self.b.append(b));
+        self.triangles += triangles;
         self.meshes.push(mesh);
         self.materials.push(material(s, options.unlit));
         let mut record = structure_record(s);
         if let Some(how) = options.simplify {
-            record["simplification"] = simplification_record(s, how, done);
+            record["simplification"] = simplification_record(s, how, simplified.as_ref());
         }
         if let Some(color) = s.color.get(..3) {
             record["color"] = json!([color[0], color[1], color[2], s.color[3]]);
@@ -216,7 +218,6 @@ impl CaseWriter {
                 }
             },
         }
-        Ok(())
     }
 
     /// The file, once every structure of `case` is written.
@@ -298,15 +299,80 @@ impl CaseWriter {
     }
 }
 
-/// Serialises the case (its structures simplified in parallel where threads are).
+/// Serialises the case, its structures simplified and written in parallel where threads are.
 pub fn write_case(case: &Case, options: &CaseGltfOptions) -> Result<Vec<u8>, ExportError> {
     let mut writer = CaseWriter::new(case, options)?;
-    let simplified = options.simplify.map(|how| simplify_case(case, how));
-    for (i, s) in case.structures.iter().enumerate() {
-        let done = simplified.as_ref().and_then(|all| all[i].as_ref());
-        writer.add_simplified(s, done)?;
+    let parts: Vec<Result<Part, ExportError>> = (case.structures.par_iter().enumerate())
+        .map(|(i, s)| Part::of(s, i, options, writer.case_triangles))
+        .collect();
+    for (s, part) in case.structures.iter().zip(parts) {
+        writer.add_part(s, part?);
     }
     writer.finish(case)
+}
+
+/// A structure's share of the file, written on its own (on any thread): its arrays in a
+/// builder of their own, its mesh naming them, where its lattice places it, and what
+/// simplification made of it.
+struct Part {
+    b: Builder,
+    mesh: Value,
+    placement: Option<Placement>,
+    simplified: Option<Simplified>,
+    triangles: usize,
+}
+
+impl Part {
+    /// Structure `s`'s part, for the structure and material numbered `index`.
+    fn of(
+        s: &CaseStructure,
+        index: usize,
+        options: &CaseGltfOptions,
+        case_triangles: usize,
+    ) -> Result<Part, ExportError> {
+        let simplified =
+            (options.simplify).and_then(|how| simplify_structure(s, how, case_triangles));
+        let surfaces = written(s, simplified.as_ref(), options.local_error);
+        let mut b = Builder::default();
+        let (mesh, placement) = structure_mesh(&mut b, s, &surfaces, index, options)?;
+        Ok(Part {
+            b,
+            mesh,
+            placement,
+            simplified,
+            triangles: surfaces.shown.triangle_count(),
+        })
+    }
+}
+
+/// Moves the accessor indices a mesh's primitives name (attributes, indices, morph targets)
+/// on by `by`: its part's accessors now follow the structures' before it.
+fn shift_accessors(mesh: &mut Value, by: usize) {
+    let bump = |v: &mut Value| {
+        if let Some(i) = v.as_u64() {
+            *v = json!(i as usize + by);
+        }
+    };
+    let bump_all = |arrays: Option<&mut Value>| {
+        for v in arrays
+            .and_then(Value::as_object_mut)
+            .into_iter()
+            .flat_map(|m| m.values_mut())
+        {
+            bump(v);
+        }
+    };
+    let primitives = mesh.get_mut("primitives").and_then(Value::as_array_mut);
+    for primitive in primitives.into_iter().flatten() {
+        if let Some(indices) = primitive.get_mut("indices") {
+            bump(indices);
+        }
+        bump_all(primitive.get_mut("attributes"));
+        let targets = primitive.get_mut("targets").and_then(Value::as_array_mut);
+        for target in targets.into_iter().flatten() {
+            bump_all(Some(target));
+        }
+    }
 }
 
 /// The document with its extensions and buffers, in its container.

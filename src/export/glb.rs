@@ -66,6 +66,44 @@ impl Builder {
 }
 
 impl Builder {
+    /// Appends `part`, built on its own (a structure written on another thread): its bytes
+    /// after this builder's, 4-byte aligned as a push would place them, its views and
+    /// accessors after these. Returns how far its accessor indices moved.
+    pub(super) fn append(&mut self, part: Builder) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let (bin, fallback, views) = (self.bin.len(), self.fallback, self.views.len());
+        let shift = |v: &mut Value, by: usize| {
+            if let Some(offset) = v["byteOffset"].as_u64() {
+                v["byteOffset"] = json!(offset as usize + by);
+            }
+        };
+        for mut view in part.views {
+            let by = match view["buffer"].as_u64() {
+                Some(1) => fallback,
+                _ => bin,
+            };
+            shift(&mut view, by);
+            if let Some(compressed) = view.pointer_mut(&format!("/extensions/{MESHOPT}")) {
+                shift(compressed, bin);
+            }
+            self.views.push(view);
+        }
+        let accessors = self.accessors.len();
+        for mut accessor in part.accessors {
+            if let Some(view) = accessor["bufferView"].as_u64() {
+                accessor["bufferView"] = json!(view as usize + views);
+            }
+            self.accessors.push(accessor);
+        }
+        self.bin.extend_from_slice(&part.bin);
+        self.fallback += part.fallback;
+        accessors
+    }
+}
+
+impl Builder {
     /// Appends `raw` (elements of `stride` bytes) compressed as `EXT_meshopt_compression`'s
     /// attributes; returns the accessor index of `accessor`.
     pub(super) fn push_attributes(
@@ -300,6 +338,38 @@ pub(super) fn container(document: &Value, mut bin: Vec<u8>) -> Option<Vec<u8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Pushes of every kind, with lengths that leave the buffer unaligned.
+    fn push_some(b: &mut Builder, seed: u8) -> Vec<usize> {
+        let raw: Vec<u8> = (0..96u8).map(|i| i.wrapping_mul(seed)).collect();
+        let accessor = json!({"componentType": FLOAT, "count": 1, "type": "SCALAR"});
+        vec![
+            b.push(&raw[..7], ARRAY_BUFFER, accessor.clone()),
+            b.push_attributes(&raw[..48], 12, accessor.clone())
+                .expect("encodes"),
+            b.push_triangles(&[0, 1, 2, 2, 1, 3], 4).expect("encodes"),
+            b.push(&raw[..5], ELEMENT_ARRAY_BUFFER, accessor),
+        ]
+    }
+
+    /// A part built on its own and appended lays out bytes, views and accessors as pushing
+    /// the same arrays after the others would.
+    #[test]
+    fn an_appended_part_is_laid_out_as_if_pushed_in_turn() {
+        let mut in_turn = Builder::default();
+        push_some(&mut in_turn, 3);
+        let second = push_some(&mut in_turn, 7);
+        let mut joined = Builder::default();
+        push_some(&mut joined, 3);
+        let mut part = Builder::default();
+        let own = push_some(&mut part, 7);
+        let by = joined.append(part);
+        assert_eq!(own.iter().map(|i| i + by).collect::<Vec<_>>(), second);
+        assert_eq!(joined.bin, in_turn.bin);
+        assert_eq!(joined.views, in_turn.views);
+        assert_eq!(joined.accessors, in_turn.accessors);
+        assert_eq!(joined.fallback, in_turn.fallback);
+    }
 
     #[test]
     fn container_is_aligned_and_json_describes_the_bin_chunk() {

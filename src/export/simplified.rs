@@ -2,10 +2,9 @@
 //! download (see `crate::simplify`), its original and local error kept at the vertices the
 //! simplified surface keeps, and the record of what was done and how far it moved.
 
-use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use crate::case::{Case, CaseStructure};
+use crate::case::CaseStructure;
 use crate::mesh::Mesh;
 use crate::simplify::{simplify, Goal, Simplified};
 
@@ -37,17 +36,6 @@ impl Simplification {
             Simplification::TriangleBudget(n) => json!({ "case_triangles": n }),
         }
     }
-}
-
-/// Each structure's simplified triangles (in parallel where threads are), `None` where its
-/// surface is kept.
-pub(super) fn simplify_case(case: &Case, how: Simplification) -> Vec<Option<Simplified>> {
-    let total: usize = (case.structures.iter())
-        .map(|s| s.original.triangle_count())
-        .sum();
-    (case.structures.par_iter())
-        .map(|s| simplify_structure(s, how, total))
-        .collect()
 }
 
 /// A structure's simplified triangles (`case_triangles`: the case's, for a budget's share),
