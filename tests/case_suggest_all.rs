@@ -1,8 +1,7 @@
 //! "Suggest all" in the engine: each structure's own suggestion, cancelling, the surfaces
 //! against the phantom's analytic truth, and the learned search against the full grid.
 
-use meshsmooth::case::{self, suggest_all, SuggestAllOptions};
-use meshsmooth::suggest::SearchMethod;
+use meshsmooth::case::{self, suggest_all, SuggestAllOptions, SuggestAllSearch};
 use serde_json::Value;
 
 #[path = "common/label_maps.rs"]
@@ -17,9 +16,8 @@ fn suggest_all_gives_each_structure_its_own_parameters_and_can_be_cancelled() {
     let options = SuggestAllOptions {
         tau: 0.5,
         filter: None,
-        method: SearchMethod::Local,
+        search: SuggestAllSearch::Local,
         max_volume_change: None,
-        learn: false,
     };
     let cancelled = suggest_all(&mut case, &options, &|_| false).expect("no error");
     assert!(cancelled.iter().all(Option::is_none));
@@ -138,9 +136,8 @@ fn suggest_all_at_tau_half_brings_every_phantom_surface_closer_to_the_truth() {
     let options = SuggestAllOptions {
         tau: 0.5,
         filter: None,
-        method: SearchMethod::Grid,
+        search: SuggestAllSearch::Grid,
         max_volume_change: Some(0.05),
-        learn: false,
     };
     suggest_all(&mut case, &options, &|_| true).expect("suggests");
     let after = case::check(&case, true);
@@ -178,14 +175,13 @@ fn suggest_all_at_tau_half_brings_every_phantom_surface_closer_to_the_truth() {
 /// searches ended) finds each phantom structure's score within 1% of the full grid's minimum.
 #[test]
 fn the_learned_search_lands_within_one_percent_of_the_grid_on_the_phantom() {
-    let run = |method, learn| {
+    let run = |search| {
         let mut case = phantom();
         let options = SuggestAllOptions {
             tau: 0.5,
             filter: None,
-            method,
+            search,
             max_volume_change: Some(0.05),
-            learn,
         };
         let suggestions = suggest_all(&mut case, &options, &|_| true).expect("suggests");
         suggestions
@@ -193,8 +189,8 @@ fn the_learned_search_lands_within_one_percent_of_the_grid_on_the_phantom() {
             .map(|s| s.expect("every structure suggested"))
             .collect::<Vec<_>>()
     };
-    let grid = run(SearchMethod::Grid, false);
-    let learned = run(SearchMethod::Local, true);
+    let grid = run(SuggestAllSearch::Grid);
+    let learned = run(SuggestAllSearch::Learned);
     let (grid_sets, learned_sets): (usize, usize) = (
         grid.iter().map(|s| s.evaluations).sum(),
         learned.iter().map(|s| s.evaluations).sum(),

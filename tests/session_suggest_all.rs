@@ -12,9 +12,8 @@ use meshsmooth::session::StructureOutcome;
 /// with their smoothed surfaces; cancelling leaves the rest as they were.
 #[test]
 fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
-    use meshsmooth::case::{self, Case, SuggestAllOptions};
+    use meshsmooth::case::{self, Case, SuggestAllOptions, SuggestAllSearch};
     use meshsmooth::session::Session;
-    use meshsmooth::suggest::SearchMethod;
     let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
     let mut session = Session::default();
     session.begin_open("case_phantom_shared.seg.nrrd", bytes.clone());
@@ -26,11 +25,11 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     };
     assert_eq!(expected.structures[0].params, *session.case().params());
     assert!(session
-        .start_suggest_all(1.5, SearchMethod::Local, false, 0.0)
+        .start_suggest_all(1.5, SuggestAllSearch::Local, None, 0.0)
         .is_err());
     let version = session.case().case_version();
     session
-        .start_suggest_all(0.5, SearchMethod::Local, false, 0.0)
+        .start_suggest_all(0.5, SuggestAllSearch::Local, None, 0.0)
         .unwrap();
     // Workers on this thread answer at once: one step ends it.
     assert!(session.step_suggest_all());
@@ -51,9 +50,8 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
     let options = SuggestAllOptions {
         tau: 0.5,
         filter: None,
-        method: SearchMethod::Local,
+        search: SuggestAllSearch::Local,
         max_volume_change: Some(0.05),
-        learn: false,
     };
     let mut liver = expected.structures[0].clone();
     let first = case::suggest_structure(&mut liver, &options, &[], &mut |_| true)
@@ -105,9 +103,8 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
 /// structure's search starts at the same sets and every structure gets the CLI's suggestion.
 #[test]
 fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
-    use meshsmooth::case::{self, Case, SuggestAllOptions, LEARNING_BATCH};
+    use meshsmooth::case::{self, Case, SuggestAllOptions, SuggestAllSearch, LEARNING_BATCH};
     use meshsmooth::session::{structure_work, Session};
-    use meshsmooth::suggest::SearchMethod;
     let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
     let mut session = Session::default();
     session.begin_open("case_phantom_shared.seg.nrrd", bytes.clone());
@@ -124,7 +121,7 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
         ..Case::default()
     };
     session
-        .start_suggest_all(0.5, SearchMethod::Local, true, 5000.0)
+        .start_suggest_all(0.5, SuggestAllSearch::Learned, None, 5000.0)
         .unwrap();
     // The time estimate's fraction: the work of the structures answered, each weighed by its
     // size, rising batch by batch.
@@ -173,9 +170,8 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
     let options = SuggestAllOptions {
         tau: 0.5,
         filter: None,
-        method: SearchMethod::Local,
+        search: SuggestAllSearch::Learned,
         max_volume_change: Some(0.05),
-        learn: true,
     };
     let want = case::suggest_all(&mut expected, &options, &|_| true).unwrap();
     let outcome = session.background().suggest_all().unwrap();
@@ -192,8 +188,8 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
 /// parameters; an index past the case is refused.
 #[test]
 fn suggest_all_on_some_structures_leaves_the_others_as_they_were() {
+    use meshsmooth::case::SuggestAllSearch;
     use meshsmooth::session::Session;
-    use meshsmooth::suggest::SearchMethod;
     let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
     let mut session = Session::default();
     session.begin_open("case_phantom_shared.seg.nrrd", bytes);
@@ -201,10 +197,10 @@ fn suggest_all_on_some_structures_leaves_the_others_as_they_were() {
     let before: Vec<_> = (session.case().case_structures().iter())
         .map(|s| s.params)
         .collect();
-    let refused = session.start_suggest_some(0.5, (SearchMethod::Local, false), &[1, 4], 0.0);
+    let refused = session.start_suggest_all(0.5, SuggestAllSearch::Local, Some(&[1, 4]), 0.0);
     assert!(refused.unwrap_err().contains("structure 4 does not exist"));
     session
-        .start_suggest_some(0.5, (SearchMethod::Local, false), &[1, 3], 0.0)
+        .start_suggest_all(0.5, SuggestAllSearch::Local, Some(&[1, 3]), 0.0)
         .unwrap();
     while session.background().suggesting_all() {
         session.step_suggest_all();
@@ -221,6 +217,91 @@ fn suggest_all_on_some_structures_leaves_the_others_as_they_were() {
         match &outcome.structures[i] {
             Some(StructureOutcome::Suggested { params, .. }) => assert_eq!(after[i], *params),
             other => panic!("structure {i}: {other:?}"),
+        }
+    }
+}
+
+/// Workers on this thread that answer one request a step, the latest posted first: structures
+/// finish in another order than they were handed out, as a pool of real workers' may.
+struct OutOfOrder {
+    inner: meshsmooth::worker::InThread,
+    posted: Vec<(usize, meshsmooth::worker::Request)>,
+}
+
+impl meshsmooth::worker::Carrier for OutOfOrder {
+    fn workers(&self) -> usize {
+        meshsmooth::worker::Carrier::workers(&self.inner)
+    }
+
+    fn post(&mut self, worker: usize, request: &meshsmooth::worker::Request) {
+        self.posted.push((worker, request.clone()));
+    }
+
+    fn take_replies(&mut self) -> Vec<(usize, meshsmooth::worker::Reply)> {
+        if let Some((worker, request)) = self.posted.pop() {
+            self.inner.post(worker, &request);
+        }
+        self.inner.take_replies()
+    }
+
+    fn threaded(&self) -> bool {
+        false
+    }
+}
+
+/// The page's Suggest all, by default, gives every structure of the phantom and of the JHU atlas
+/// the parameters and score of `case build`'s default, on one worker and on three answering out
+/// of order: one plan, whoever runs it.
+#[test]
+fn the_pages_default_suggest_all_equals_the_clis_on_one_worker_and_several() {
+    use meshsmooth::case::{self, Case, SuggestAllOptions, SuggestAllSearch};
+    use meshsmooth::session::Session;
+    use meshsmooth::worker::{InThread, Pool};
+    for file in [
+        "case_phantom_shared.seg.nrrd",
+        "JHU-WhiteMatter-labels-1mm.nii.gz",
+    ] {
+        let bytes = read(&format!("labelmaps/{file}"));
+        let mut cli: Option<Case> = None;
+        for workers in [1, 3] {
+            let mut session = Session::default();
+            session.set_cpu_engine(Pool::new(Box::new(OutOfOrder {
+                inner: InThread::new(workers),
+                posted: Vec::new(),
+            })));
+            session.begin_open(file, bytes.clone());
+            let opened = (0..1000).find_map(|_| session.poll_opening());
+            opened.expect("done").expect("opens");
+            let cli = cli.get_or_insert_with(|| {
+                let mut case = Case {
+                    structures: session.case().case_structures().to_vec(),
+                    ..Case::default()
+                };
+                let options = SuggestAllOptions::new(0.5, SuggestAllSearch::default());
+                case::suggest_all(&mut case, &options, &|_| true).expect("suggests");
+                case
+            });
+            session
+                .start_suggest_all(0.5, SuggestAllSearch::default(), None, 0.0)
+                .unwrap();
+            while session.background().suggesting_all() {
+                session.step_suggest_all();
+            }
+            let outcome = session.background().suggest_all().unwrap();
+            assert_eq!(outcome.options.search, SuggestAllSearch::Learned);
+            assert_eq!(outcome.done, cli.structures.len(), "{file}");
+            for (i, (got, want)) in outcome.structures.iter().zip(&cli.structures).enumerate() {
+                let Some(StructureOutcome::Suggested {
+                    params, metrics, ..
+                }) = got
+                else {
+                    panic!("{file} structure {i}: {got:?}");
+                };
+                let what = format!("{file}, {workers} workers, structure {i}");
+                assert_eq!(*params, want.params, "{what}");
+                let smoothed = want.smoothed.as_ref().expect("smoothed");
+                assert_eq!(metrics.score, smoothed.metrics.score, "{what}");
+            }
         }
     }
 }

@@ -17,6 +17,7 @@ pub mod names;
 mod pipeline;
 mod record;
 pub mod relations;
+mod suggest_all;
 mod voxel_grid;
 pub mod xapi;
 
@@ -31,11 +32,12 @@ pub use from_files::{
 pub use image::{CaseImage, Window, WindowPreset, DEFAULT_IMAGE_VOXELS};
 pub use image_frame::{check_frame, StructureGrid};
 pub use lesson::{Camera, Label, Lesson, Quiz, QuizMode, Step};
-pub use pipeline::{
-    smooth_structure, starts_from, suggest_all, suggest_structure, SuggestAllOptions,
-    SuggestAllProgress, LEARNING_BATCH,
-};
+pub use pipeline::smooth_structure;
 pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
+pub use suggest_all::{
+    starts_from, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllPlan,
+    SuggestAllProgress, SuggestAllSearch, SuggestJob, DEFAULT_MAX_VOLUME_CHANGE, LEARNING_BATCH,
+};
 
 use std::sync::Arc;
 

@@ -139,10 +139,7 @@ fn structures_are_equal_when_they_would_be_written_the_same() {
 #[test]
 fn searches_start_where_the_structures_before_ended_most_often() {
     let s = CaseStructure::from_mesh("a", tetra(), [1.0, 0.0, 0.0]);
-    assert!(
-        pipeline::starts_from(&[], s.params.filter).is_empty(),
-        "the corners"
-    );
+    assert!(starts_from(&[], s.params.filter).is_empty(), "the corners");
     let hc = |alpha, iterations| Params {
         alpha,
         iterations,
@@ -156,7 +153,7 @@ fn searches_start_where_the_structures_before_ended_most_often() {
         hc(0.2, 30),
         hc(0.3, 40),
     ];
-    let starts = pipeline::starts_from(&learned, s.params.filter);
+    let starts = starts_from(&learned, s.params.filter);
     // The most frequent first, then the latest; Taubin's set is not HC's start.
     assert_eq!(starts, vec![hc(0.0, 20), hc(0.3, 40), hc(0.2, 30)]);
 }

@@ -8,12 +8,14 @@ use std::time::Instant;
 use super::inputs::Inputs;
 use super::params::filter as parse_filter;
 use super::progress::ProgressLine;
-use super::suggest::parse_search;
-use crate::case::{self, Case, SuggestAllOptions, SuggestAllProgress, WindowPreset};
+use crate::case::{
+    self, Case, SuggestAllOptions, SuggestAllProgress, SuggestAllSearch, WindowPreset,
+    DEFAULT_MAX_VOLUME_CHANGE,
+};
 use crate::export::{self, CaseGltfOptions, Container, SceneFrame, Simplification};
 use crate::segmentation::{ExtractOptions, OpenOptions};
 use crate::smooth::Filter;
-use crate::suggest::{Progress, SearchMethod, Suggestion};
+use crate::suggest::{Progress, Suggestion};
 
 #[derive(clap::Subcommand)]
 pub(super) enum CaseCommand {
@@ -46,12 +48,12 @@ pub(super) struct BuildArgs {
     filter: Option<Filter>,
     /// grid (every grid point), local (the paper's, from the corners) or learned (the local
     /// search from where the searches of smaller structures ended).
-    #[arg(long, default_value = "learned", value_parser = parse_case_search)]
-    search: (SearchMethod, bool),
+    #[arg(long, default_value_t = SuggestAllSearch::default(), value_parser = parse_case_search)]
+    search: SuggestAllSearch,
     /// The most volume a structure's suggestion may take off or add, in percent of its
     /// original volume, or `none`: thin structures (vessels) lose volume faster than the
     /// score weighs it.
-    #[arg(long, default_value = "5", value_parser = parse_percent)]
+    #[arg(long, default_value_t = Percent(Some(100.0 * DEFAULT_MAX_VOLUME_CHANGE)), value_parser = parse_percent)]
     max_volume_change: Percent,
     /// Lift the displacement bound label-map structures get (half their voxel diagonal).
     #[arg(long)]
@@ -156,9 +158,8 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     let options = SuggestAllOptions {
         tau: args.tau,
         filter: args.filter,
-        method: args.search.0,
+        search: args.search,
         max_volume_change: args.max_volume_change.0.map(|p| p / 100.0),
-        learn: args.search.1,
     };
     let suggest_started = Instant::now();
     let suggestions = suggest_all_shown(&mut case, &options)?;
@@ -322,14 +323,18 @@ fn parse_window(name: &str) -> Result<WindowPreset, String> {
 #[derive(Clone, Copy, Debug)]
 struct Percent(Option<f64>);
 
-/// A case's search: a [`SearchMethod`] and whether structures learn from each other.
-fn parse_case_search(name: &str) -> Result<(SearchMethod, bool), String> {
-    match name {
-        "learned" => Ok((SearchMethod::Local, true)),
-        _ => parse_search(name)
-            .map(|m| (m, false))
-            .map_err(|e| format!("{e}, or learned")),
+impl std::fmt::Display for Percent {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(p) => write!(f, "{p}"),
+            None => f.write_str("none"),
+        }
     }
+}
+
+fn parse_case_search(name: &str) -> Result<SuggestAllSearch, String> {
+    SuggestAllSearch::from_name(name)
+        .ok_or_else(|| format!("unknown search '{name}': use learned, local or grid"))
 }
 
 fn parse_percent(text: &str) -> Result<Percent, String> {

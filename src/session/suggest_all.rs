@@ -4,31 +4,24 @@
 //! and cancel; the structure that is the model takes its suggestion as new parameters.
 
 use super::{Background, Session};
-use crate::case::{starts_from, Smoothed, SuggestAllOptions, LEARNING_BATCH};
-use crate::mesh::Mesh;
+use crate::case::{Smoothed, SuggestAllOptions, SuggestAllPlan, SuggestAllSearch};
 use crate::metrics::Metrics;
 use crate::smooth::Params;
-use crate::suggest::SearchMethod;
 use crate::worker::{metrics_of, Reply, StructureJob};
 
-/// A "Suggest all" under way, or its outcome.
+/// A "Suggest all" under way, or its outcome: its plan ([`SuggestAllPlan`], the CLI's too) and
+/// the workers' jobs carrying it out.
 #[derive(Clone, Debug, Default)]
 pub struct SuggestAll {
-    options: Option<SuggestAllOptions>,
+    plan: Option<SuggestAllPlan>,
     /// Each structure's job still to answer.
     waiting: Vec<(usize, StructureJob)>,
-    /// The structures not yet handed to a worker.
-    queued: std::collections::VecDeque<Work>,
-    /// The structures in the order they are handed out (learning: smallest first).
-    order: Vec<usize>,
-    total: usize,
     /// Per structure, what it got (`None` until it answers).
     outcome: Vec<Option<StructureOutcome>>,
     /// Per structure, its share of the work ([`structure_work`]); 0 for those not asked.
     work: Vec<f64>,
     /// When it started, in the caller's milliseconds (the session keeps no clock).
     started_ms: f64,
-    cancelled: bool,
     /// How many structures other than the model took their new surface: each a new version of
     /// the case's looks that came from here.
     applied: u64,
@@ -47,9 +40,6 @@ pub fn structure_work(vertices: usize) -> f64 {
 fn seconds_left(elapsed: f64, done: f64) -> Option<f64> {
     (done > 0.0 && elapsed.is_finite()).then(|| elapsed * (1.0 - done.min(1.0)) / done)
 }
-
-/// One structure's part: its index, surface, parameters and weights.
-type Work = (usize, Mesh, Params, Option<Vec<f32>>);
 
 /// What one structure got from "Suggest all", under its name.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,30 +70,19 @@ pub struct SuggestAllReport<'a> {
 }
 
 impl Session {
-    /// Starts "Suggest all" at `tau` with `method` for every structure of the open case, each
-    /// from its own filter and parameters (bound included). Replaces one under way. `now_ms`
-    /// is the caller's clock, which the time left is measured by.
+    /// Starts "Suggest all" at `tau` with `search` for the structures `which` of the open case
+    /// (indices; `None`: every one), each from its own filter and parameters (bound included).
+    /// Replaces one under way. `now_ms` is the caller's clock, which the time left is measured
+    /// by.
     pub fn start_suggest_all(
         &mut self,
         tau: f64,
-        method: SearchMethod,
-        learn: bool,
-        now_ms: f64,
-    ) -> Result<(), String> {
-        let all: Vec<usize> = (0..self.doc.case.structures.len()).collect();
-        self.start_suggest_some(tau, (method, learn), &all, now_ms)
-    }
-
-    /// [`Self::start_suggest_all`] for the structures `which` (indices into the case).
-    pub fn start_suggest_some(
-        &mut self,
-        tau: f64,
-        (method, learn): (SearchMethod, bool),
-        which: &[usize],
+        search: SuggestAllSearch,
+        which: Option<&[usize]>,
         now_ms: f64,
     ) -> Result<(), String> {
         let count = self.doc.case.structures.len();
-        if let Some(i) = which.iter().find(|&&i| i >= count) {
+        if let Some(i) = which.into_iter().flatten().find(|&&i| i >= count) {
             return Err(format!(
                 "structure {i} does not exist: the case has {count}"
             ));
@@ -113,36 +92,14 @@ impl Session {
         }
         self.cancel_suggest_all();
         self.doc.model().ok_or("no mesh is open")?;
-        let options = SuggestAllOptions {
-            tau,
-            filter: None,
-            method,
-            // As `case build` does by default: thin structures lose volume faster than the
-            // score weighs it.
-            max_volume_change: Some(0.05),
-            learn: learn && method == SearchMethod::Local,
-        };
-        let structures = &self.doc.case.structures;
-        let mut work: Vec<Work> = (structures.iter().enumerate())
-            .filter(|(i, _)| which.contains(i))
-            .map(|(i, s)| (i, s.original.clone(), s.params, s.weights.clone()))
-            .collect();
-        // As `case build`: learning, the smallest first; else the largest first, so no worker
-        // is left with one big structure at the end.
-        work.sort_by_key(|w| w.1.vertex_count());
-        if !options.learn {
-            work.reverse();
-        }
-        let total = work.len();
+        let options = SuggestAllOptions::new(tau, search);
+        let plan = SuggestAllPlan::new(&self.doc.case, which, options);
         let mut shares = vec![0.0; count];
-        for (i, mesh, ..) in &work {
-            shares[*i] = structure_work(mesh.vertex_count());
+        for &i in plan.order() {
+            shares[i] = structure_work(self.doc.case.structures[i].original.vertex_count());
         }
         self.suggest_all = SuggestAll {
-            options: Some(options),
-            order: work.iter().map(|w| w.0).collect(),
-            queued: work.into(),
-            total,
+            plan: Some(plan),
             outcome: vec![None; count],
             work: shares,
             started_ms: now_ms,
@@ -152,54 +109,46 @@ impl Session {
         Ok(())
     }
 
-    /// Gives the workers the queued structures: all at once, or learning, as `case build`
-    /// does: batch by batch, each structure starting where the batches before ended.
+    /// Gives the workers each structure's part the plan lets start now.
     fn hand_out_structures(&mut self) {
-        let Some(options) = self.suggest_all.options else {
+        let Some(plan) = self.suggest_all.plan.as_mut() else {
             return;
         };
-        if options.learn && !self.suggest_all.waiting.is_empty() {
-            return;
-        }
-        let batch = if options.learn {
-            LEARNING_BATCH
-        } else {
-            usize::MAX
-        };
-        let all = &self.suggest_all;
-        let learned: Vec<Params> = (all.order.iter())
-            .filter_map(|&i| match all.outcome.get(i) {
-                Some(Some(StructureOutcome::Suggested { params, .. })) => Some(*params),
-                _ => None,
-            })
-            .collect();
-        for _ in 0..batch {
-            let Some((i, mesh, params, weights)) = self.suggest_all.queued.pop_front() else {
-                break;
+        let case = &self.doc.case;
+        while let Some(job) = plan.next_job(case) {
+            let Some(s) = case.structures.get(job.structure) else {
+                plan.finish(job.structure, None);
+                continue;
             };
-            let starts = match options.learn {
-                true => starts_from(&learned, params.filter),
-                false => Vec::new(),
-            };
-            let job = (self.cpu).suggest_structure(mesh, params, weights, options, starts);
-            self.suggest_all.waiting.push((i, job));
+            let (mesh, weights) = (s.original.clone(), s.weights.clone());
+            let options = *plan.options();
+            let sent = (self.cpu).suggest_structure(mesh, s.params, weights, options, job.starts);
+            self.suggest_all.waiting.push((job.structure, sent));
         }
     }
 
     /// Stops "Suggest all": structures already done keep what they got.
     pub fn cancel_suggest_all(&mut self) {
-        let jobs: Vec<StructureJob> = self.suggest_all.waiting.drain(..).map(|w| w.1).collect();
-        self.suggest_all.queued.clear();
+        let jobs: Vec<StructureJob> = self.suggest_all.waiting.iter().map(|w| w.1).collect();
+        let Some(plan) = self.suggest_all.plan.as_mut() else {
+            return;
+        };
+        if !plan.is_over() {
+            plan.cancel();
+        }
+        // The forgotten jobs never answer: they end here, with nothing.
+        for (i, _) in self.suggest_all.waiting.drain(..) {
+            plan.finish(i, None);
+        }
         if !jobs.is_empty() {
             self.cpu.forget_structures(&jobs);
-            self.suggest_all.cancelled = true;
         }
     }
 
     /// Takes the structures' answers that came and hands out the next; returns whether this
     /// step ended "Suggest all" (its last answer came).
     pub fn step_suggest_all(&mut self) -> bool {
-        let Some(options) = self.suggest_all.options else {
+        let Some(tau) = self.suggest_all.plan.as_ref().map(|p| p.options().tau) else {
             return false;
         };
         let mut came = Vec::new();
@@ -214,7 +163,14 @@ impl Session {
         self.suggest_all.waiting = waiting;
         let any = !came.is_empty();
         for (i, reply) in came {
-            let outcome = self.take_structure_suggestion(i, reply, options.tau);
+            let outcome = self.take_structure_suggestion(i, reply, tau);
+            let params = match &outcome {
+                StructureOutcome::Suggested { params, .. } => Some(*params),
+                StructureOutcome::Failed { .. } => None,
+            };
+            if let Some(plan) = self.suggest_all.plan.as_mut() {
+                plan.finish(i, params);
+            }
             if let Some(slot) = self.suggest_all.outcome.get_mut(i) {
                 *slot = Some(outcome);
             }
@@ -278,14 +234,27 @@ impl Session {
 impl<'a> Background<'a> {
     /// Whether "Suggest all" is under way.
     pub fn suggesting_all(&self) -> bool {
-        !self.suggest_all.waiting.is_empty() || !self.suggest_all.queued.is_empty()
+        (self.suggest_all.plan.as_ref()).is_some_and(|p| !p.is_over())
+    }
+
+    /// Structures that answered.
+    fn suggest_all_answered(&self) -> usize {
+        self.suggest_all
+            .outcome
+            .iter()
+            .filter(|o| o.is_some())
+            .count()
     }
 
     /// Structures done and in all, while "Suggest all" is under way.
     pub fn suggest_all_progress(&self) -> Option<(usize, usize)> {
         let s = &self.suggest_all;
-        self.suggesting_all()
-            .then(|| (s.total - s.waiting.len() - s.queued.len(), s.total))
+        self.suggesting_all().then(|| {
+            (
+                self.suggest_all_answered(),
+                s.plan.as_ref().map_or(0, |p| p.total()),
+            )
+        })
     }
 
     /// How many structures besides the model the last "Suggest all" gave a new surface (each a
@@ -316,12 +285,13 @@ impl<'a> Background<'a> {
     /// The last "Suggest all" since the case opened, as far as it got.
     pub fn suggest_all(&self) -> Option<SuggestAllReport<'a>> {
         let s = self.suggest_all;
+        let plan = s.plan.as_ref()?;
         Some(SuggestAllReport {
-            options: s.options?,
+            options: *plan.options(),
             structures: &s.outcome,
-            done: s.total - s.waiting.len() - s.queued.len(),
-            total: s.total,
-            cancelled: s.cancelled,
+            done: self.suggest_all_answered(),
+            total: plan.total(),
+            cancelled: plan.cancelled(),
         })
     }
 }

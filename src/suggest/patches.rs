@@ -291,9 +291,8 @@ mod tests {
         let options = SuggestAllOptions {
             tau: goal.tau,
             filter: None,
-            method: SearchMethod::Local,
+            search: crate::case::SuggestAllSearch::Learned,
             max_volume_change: goal.max_volume_change,
-            learn: true,
         };
         let base = Params::defaults(Filter::Hc);
         let mut s = CaseStructure::from_mesh("ellipsoid", mesh.clone(), [1.0; 3]);

@@ -139,9 +139,8 @@ fn the_view_worker_smooths_at_once_while_the_others_are_busy() {
         crate::case::SuggestAllOptions {
             tau: 0.5,
             filter: None,
-            method: crate::suggest::SearchMethod::Local,
+            search: crate::case::SuggestAllSearch::Local,
             max_volume_change: None,
-            learn: false,
         },
         Vec::new(),
     );
@@ -222,9 +221,8 @@ fn the_view_worker_takes_structures_and_is_restarted_when_the_view_needs_it() {
     let options = crate::case::SuggestAllOptions {
         tau: 0.5,
         filter: None,
-        method: crate::suggest::SearchMethod::Local,
+        search: crate::case::SuggestAllSearch::Local,
         max_volume_change: None,
-        learn: false,
     };
     let structures: Vec<StructureJob> = (0..2)
         .map(|_| {

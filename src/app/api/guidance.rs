@@ -8,6 +8,7 @@ use wasm_bindgen::JsValue;
 
 use super::{from_js, settled, started_work, to_js, when_ready, Api};
 use crate::app::document::SharedDocument;
+use crate::case::SuggestAllSearch;
 use crate::session::Session;
 use crate::suggest::SearchMethod;
 
@@ -75,13 +76,11 @@ fn suggest_all(
         let started = {
             let mut doc = d.borrow_mut();
             let which = which_structures(&options);
-            tau_and_search(doc.session(), &options, "suggestAll").and_then(|(tau, search)| {
-                let (method, learn) = search;
+            suggest_all_search(doc.session(), &options).and_then(|(tau, search)| {
                 let now = crate::app::document::now_ms();
-                match which? {
-                    Some(w) => doc.session_mut().start_suggest_some(tau, search, &w, now),
-                    None => doc.session_mut().start_suggest_all(tau, method, learn, now),
-                }
+                let which = which?;
+                doc.session_mut()
+                    .start_suggest_all(tau, search, which.as_deref(), now)
             })
         };
         started_work(
@@ -144,10 +143,15 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
 fn start_suggest(doc: &SharedDocument, options: &JsValue) -> Result<(f64, SearchMethod), String> {
     let mut doc = doc.borrow_mut();
     let session = doc.session_mut();
-    let (tau, (method, learned)) = tau_and_search(session, options, "suggest")?;
-    if learned {
-        return Err("suggest: the learned search is Suggest all's: use grid or local".into());
-    }
+    let (tau, search) = tau_and_search(session, options, "suggest")?;
+    let method = match search.as_deref() {
+        None => SearchMethod::Grid,
+        Some("learned") => {
+            return Err("suggest: the learned search is Suggest all's: use grid or local".into())
+        }
+        Some(name) => SearchMethod::from_name(name)
+            .ok_or_else(|| format!("suggest: unknown search {name}: use grid or local"))?,
+    };
     session.case_mut().set_tau(tau)?;
     session.start_suggest(method);
     Ok((tau, method))
@@ -171,11 +175,13 @@ fn which_structures(options: &JsValue) -> Result<Option<Vec<usize>>, String> {
     }
 }
 
+/// `{tau, search}` of `suggest` and `suggestAll`: tau (default: the session's) and the search's
+/// name, if given.
 fn tau_and_search(
     session: &Session,
     options: &JsValue,
     what: &str,
-) -> Result<(f64, (SearchMethod, bool)), String> {
+) -> Result<(f64, Option<String>), String> {
     let options = if options.is_undefined() || options.is_null() {
         serde_json::json!({})
     } else {
@@ -191,13 +197,24 @@ fn tau_and_search(
             .ok_or_else(|| format!("{what}: tau must be a number in [0, 1], got {v}"))?,
     };
     let search = match options.get("search") {
-        None | Some(serde_json::Value::Null) => (SearchMethod::Grid, false),
-        Some(v) if v.as_str() == Some("learned") => (SearchMethod::Local, true),
-        Some(v) => v
-            .as_str()
-            .and_then(SearchMethod::from_name)
-            .map(|m| (m, false))
-            .ok_or_else(|| format!("{what}: unknown search {v}: use grid, local or learned"))?,
+        None | Some(serde_json::Value::Null) => None,
+        Some(serde_json::Value::String(name)) => Some(name.clone()),
+        Some(v) => return Err(format!("{what}: search must be a name, got {v}")),
+    };
+    Ok((tau, search))
+}
+
+/// `{tau, search}` of `suggestAll`: the search by default is Suggest all's, as in `case build`.
+fn suggest_all_search(
+    session: &Session,
+    options: &JsValue,
+) -> Result<(f64, SuggestAllSearch), String> {
+    let (tau, search) = tau_and_search(session, options, "suggestAll")?;
+    let search = match search {
+        None => SuggestAllSearch::default(),
+        Some(name) => SuggestAllSearch::from_name(&name).ok_or_else(|| {
+            format!("suggestAll: unknown search {name}: use grid, local or learned")
+        })?,
     };
     Ok((tau, search))
 }

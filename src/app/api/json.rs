@@ -204,7 +204,7 @@ pub(crate) fn suggest_all(background: &Background, now_ms: f64) -> Option<Value>
     };
     Some(json!({
         "tau": report.options.tau,
-        "search": report.options.method,
+        "search": report.options.search,
         "structures": report.structures.iter().map(outcome).collect::<Vec<_>>(),
         "done": report.done,
         "total": report.total,

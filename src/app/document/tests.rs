@@ -59,9 +59,9 @@ fn the_end_of_suggest_all_asks_for_a_frame_at_once() {
     doc.session
         .set_cpu_engine(crate::worker::Pool::new(Box::new(carrier)));
     doc.open(TUBE_NAME, TUBE).unwrap();
-    let method = crate::suggest::SearchMethod::Local;
+    let search = crate::case::SuggestAllSearch::Local;
     doc.session
-        .start_suggest_all(0.5, method, false, 0.0)
+        .start_suggest_all(0.5, search, None, 0.0)
         .unwrap();
     assert!(!doc.step_cpu_engine(), "the structure is handed out");
     assert!(doc.session.background().suggesting_all());

@@ -360,11 +360,9 @@ impl Shell {
                 }
                 StructureAction::SuggestAll => {
                     let tau = doc.case().tau();
-                    // Local: each structure's search starts where smaller ones' ended.
-                    let method = self.guide.method;
-                    let learn = method == crate::suggest::SearchMethod::Local;
+                    let search = crate::case::SuggestAllSearch::default();
                     let now = crate::app::document::now_ms();
-                    doc.session_mut().start_suggest_all(tau, method, learn, now)
+                    doc.session_mut().start_suggest_all(tau, search, None, now)
                 }
                 StructureAction::Check => doc.session_mut().start_checks(),
                 StructureAction::CancelSuggestAll => {

@@ -1,0 +1,505 @@
+//! "Suggest all": the suggestion for every structure of a case at one target smoothness, each
+//! structure then smoothed with it. This file is its one description: which structures, in
+//! what order and batches, what each search starts from, and what a structure's part does.
+//! The runners only carry it out: [`suggest_all`] on rayon's threads (the CLI, the tests), the
+//! page's session on its worker pool, a [`SuggestAllPlan::next_job`] handed to each free worker.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+
+use super::pipeline::smooth_on;
+use super::{Case, CaseStructure};
+use crate::mesh::Topology;
+use crate::metrics::Original;
+use crate::smooth::{Filter, Params};
+use crate::suggest::{
+    search_evaluator, suggest_for_goal, suggest_from, Evaluator, Goal, Patches, SearchMethod,
+    SuggestError, Suggestion,
+};
+
+/// How "Suggest all" searches each structure's parameters.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum SuggestAllSearch {
+    /// Every grid point of each structure.
+    Grid,
+    /// The paper's local search, from the corners, for each structure.
+    Local,
+    /// The local search from where the searches of smaller structures ended: the default.
+    #[default]
+    Learned,
+}
+
+impl SuggestAllSearch {
+    pub const ALL: [SuggestAllSearch; 3] = [Self::Grid, Self::Local, Self::Learned];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Grid => "grid",
+            Self::Local => "local",
+            Self::Learned => "learned",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|s| s.name() == name)
+    }
+
+    /// The search each structure runs.
+    pub fn method(self) -> SearchMethod {
+        match self {
+            Self::Grid => SearchMethod::Grid,
+            Self::Local | Self::Learned => SearchMethod::Local,
+        }
+    }
+
+    /// Whether structures start where those searched before them ended.
+    pub fn learns(self) -> bool {
+        self == Self::Learned
+    }
+}
+
+impl std::fmt::Display for SuggestAllSearch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The most volume a structure's suggestion may change by, unless told: thin structures
+/// (vessels) lose volume faster than the score weighs it.
+pub const DEFAULT_MAX_VOLUME_CHANGE: f64 = 0.05;
+
+/// What "Suggest all" does.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SuggestAllOptions {
+    pub tau: f64,
+    /// Every structure's filter becomes this one first; `None` keeps each structure's own.
+    pub filter: Option<Filter>,
+    pub search: SuggestAllSearch,
+    /// Each structure's suggestion changes its volume by at most this fraction, when given.
+    pub max_volume_change: Option<f64>,
+}
+
+impl SuggestAllOptions {
+    /// At `tau` with `search`, each structure's own filter, the default volume bound.
+    pub fn new(tau: f64, search: SuggestAllSearch) -> Self {
+        Self {
+            tau,
+            filter: None,
+            search,
+            max_volume_change: Some(DEFAULT_MAX_VOLUME_CHANGE),
+        }
+    }
+}
+
+/// How many structures, smallest first, search at once when they learn from each other.
+pub const LEARNING_BATCH: usize = 4;
+
+/// One structure's part, ready to run: its index in the case and where its search starts
+/// (empty: the corners).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SuggestJob {
+    pub structure: usize,
+    pub starts: Vec<Params>,
+}
+
+/// The order, the batches and the learned starts of one "Suggest all", as its structures are
+/// handed out and finish. Learning, a batch is handed out only once the batches before it have
+/// finished, and its starts come from their suggestions in the plan's order: the same starts on
+/// one thread, several, or a pool of workers finishing in any order.
+#[derive(Clone, Debug)]
+pub struct SuggestAllPlan {
+    options: SuggestAllOptions,
+    /// Structure indices in the order they are handed out.
+    order: Vec<usize>,
+    /// How many of `order` have been handed out.
+    handed_out: usize,
+    /// Per position in `order`: finished, with its suggestion's parameters if it got one.
+    finished: Vec<Option<Option<Params>>>,
+    cancelled: bool,
+}
+
+impl SuggestAllPlan {
+    /// The plan for the structures `which` of `case` (indices; `None`: every one).
+    pub fn new(case: &Case, which: Option<&[usize]>, options: SuggestAllOptions) -> Self {
+        let mut order: Vec<usize> = match which {
+            Some(w) => w.to_vec(),
+            None => (0..case.structures.len()).collect(),
+        };
+        order.sort_unstable();
+        order.dedup();
+        let vertices = |i: usize| {
+            case.structures
+                .get(i)
+                .map_or(0, |s| s.original.vertex_count())
+        };
+        // Learning, the smallest first, so the large ones start where the small ones ended;
+        // else the largest first, so no thread is left with one big structure at the end.
+        order.sort_by_key(|&i| vertices(i));
+        if !options.search.learns() {
+            order.reverse();
+        }
+        Self {
+            options,
+            finished: vec![None; order.len()],
+            order,
+            handed_out: 0,
+            cancelled: false,
+        }
+    }
+
+    pub fn options(&self) -> &SuggestAllOptions {
+        &self.options
+    }
+
+    /// The structures in the order they are handed out.
+    pub fn order(&self) -> &[usize] {
+        &self.order
+    }
+
+    /// The next structure's part if it may start now: `None` when all are handed out, or
+    /// learning, while the batch before it runs. `case` gives each structure's filter.
+    pub fn next_job(&mut self, case: &Case) -> Option<SuggestJob> {
+        let position = self.handed_out;
+        let &structure = self.order.get(position)?;
+        if self.cancelled {
+            return None;
+        }
+        let learning = self.options.search.learns();
+        let batch_start = position - position % LEARNING_BATCH;
+        if learning && self.finished[..batch_start].iter().any(Option::is_none) {
+            return None;
+        }
+        let starts = match (learning, case.structures.get(structure)) {
+            (true, Some(s)) => {
+                let learned: Vec<Params> = (self.finished[..batch_start].iter())
+                    .filter_map(|f| f.flatten())
+                    .collect();
+                starts_from(&learned, self.options.filter.unwrap_or(s.params.filter))
+            }
+            _ => Vec::new(),
+        };
+        self.handed_out += 1;
+        Some(SuggestJob { structure, starts })
+    }
+
+    /// Structure `structure` finished, with its suggestion's parameters (`None`: none, as when
+    /// it failed or had nothing to smooth).
+    pub fn finish(&mut self, structure: usize, suggested: Option<Params>) {
+        let handed = &self.order[..self.handed_out];
+        if let Some(p) = handed.iter().position(|&i| i == structure) {
+            self.finished[p] = Some(suggested);
+        }
+    }
+
+    /// Hands nothing more out; parts already handed out still finish.
+    pub fn cancel(&mut self) {
+        self.cancelled = true;
+    }
+
+    pub fn cancelled(&self) -> bool {
+        self.cancelled
+    }
+
+    /// Handed out and not finished.
+    pub fn running(&self) -> usize {
+        self.finished[..self.handed_out]
+            .iter()
+            .filter(|f| f.is_none())
+            .count()
+    }
+
+    /// Structures finished.
+    pub fn done(&self) -> usize {
+        self.finished.iter().filter(|f| f.is_some()).count()
+    }
+
+    /// Structures in the plan.
+    pub fn total(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Whether nothing runs and nothing more will be handed out.
+    pub fn is_over(&self) -> bool {
+        self.running() == 0 && (self.cancelled || self.handed_out == self.order.len())
+    }
+}
+
+/// Where a structure's search starts, from the suggestions of the structures finished before
+/// it: the three `filter`'s searches ended at most often. None (the corners) before any.
+pub fn starts_from(learned: &[Params], filter: Filter) -> Vec<Params> {
+    let mut counted: Vec<(Params, usize)> = Vec::new();
+    for p in learned.iter().filter(|p| p.filter == filter) {
+        match counted.iter_mut().find(|(q, _)| same_point(q, p)) {
+            Some((_, n)) => *n += 1,
+            None => counted.push((*p, 1)),
+        }
+    }
+    // The most frequent first; among equals the latest (`learned` is in order of size: the
+    // nearest in size).
+    counted.reverse();
+    counted.sort_by_key(|&(_, n)| std::cmp::Reverse(n));
+    counted.into_iter().take(3).map(|(p, _)| p).collect()
+}
+
+/// The same grid point: every parameter equal but the bound, which each structure keeps.
+fn same_point(a: &Params, b: &Params) -> bool {
+    let unbound = |p: &Params| Params {
+        max_displacement: None,
+        ..*p
+    };
+    unbound(a) == unbound(b)
+}
+
+/// How far "Suggest all" has come: structures finished, of all, and parameter sets measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SuggestAllProgress {
+    pub structures_done: usize,
+    pub structures: usize,
+    pub evaluations: usize,
+}
+
+/// Runs the plan of every structure of `case` on rayon's threads: each structure's suggestion at
+/// `options.tau` with its own filter and bound, then smoothed with it. Structures run in
+/// parallel (most are small, and one structure's passes use few threads). `on_progress`
+/// returns `false` to cancel: structures already finished keep their new parameters, the others
+/// are left as they were. Returns each structure's suggestion, in order; a structure with
+/// nothing to smooth (no vertices) gets `None` and is left alone.
+pub fn suggest_all(
+    case: &mut Case,
+    options: &SuggestAllOptions,
+    on_progress: &(dyn Fn(SuggestAllProgress) -> bool + Sync),
+) -> Result<Vec<Option<Suggestion>>, SuggestError> {
+    let total = case.structures.len();
+    let cancelled = AtomicBool::new(false);
+    let done = AtomicUsize::new(0);
+    let evaluations = AtomicUsize::new(0);
+    let report = Mutex::new(());
+    let tell = |finished: bool| {
+        let _one_at_a_time = report.lock();
+        if finished {
+            done.fetch_add(1, Ordering::Relaxed);
+        }
+        let p = SuggestAllProgress {
+            structures_done: done.load(Ordering::Relaxed),
+            structures: total,
+            evaluations: evaluations.load(Ordering::Relaxed),
+        };
+        if !on_progress(p) {
+            cancelled.store(true, Ordering::Relaxed);
+        }
+        !cancelled.load(Ordering::Relaxed)
+    };
+    let mut plan = SuggestAllPlan::new(case, None, *options);
+    let mut suggestions = vec![None; total];
+    let mut first_error = None;
+    loop {
+        let jobs: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(case)).collect();
+        if jobs.is_empty() {
+            break;
+        }
+        // Copies of these structures only, each back in the case as it finishes: a case of
+        // millions of vertices is never held twice.
+        let copies: Vec<(SuggestJob, CaseStructure)> = (jobs.into_iter())
+            .map(|job| {
+                let s = case.structures[job.structure].clone();
+                (job, s)
+            })
+            .collect();
+        let outcomes: Vec<(usize, Outcome)> = (copies.into_par_iter())
+            .with_max_len(1)
+            .map(|(job, mut s)| {
+                if cancelled.load(Ordering::Relaxed) {
+                    return (job.structure, Ok(None));
+                }
+                let outcome = suggest_structure(&mut s, options, &job.starts, &mut |_| {
+                    evaluations.fetch_add(1, Ordering::Relaxed);
+                    tell(false)
+                });
+                if matches!(outcome, Ok(Some(_))) {
+                    tell(true);
+                }
+                (job.structure, outcome.map(|o| o.map(|sg| (sg, s))))
+            })
+            .collect();
+        for (i, outcome) in outcomes {
+            match outcome {
+                Ok(Some((suggestion, structure))) => {
+                    plan.finish(i, Some(suggestion.params));
+                    case.structures[i] = structure;
+                    suggestions[i] = Some(suggestion);
+                }
+                Ok(None) | Err(SuggestError::Cancelled) => plan.finish(i, None),
+                Err(e) => {
+                    plan.finish(i, None);
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+        if cancelled.load(Ordering::Relaxed) {
+            plan.cancel();
+        }
+    }
+    match first_error {
+        Some(e) => Err(e),
+        None => Ok(suggestions),
+    }
+}
+
+/// A structure's suggestion and the structure smoothed with it; `None` when cancelled or empty.
+type Outcome = Result<Option<(Suggestion, CaseStructure)>, SuggestError>;
+
+/// One structure's part: its suggestion (with `options.filter` first, when given), applied and
+/// smoothed; `None` when it has no vertices. `starts`, when not empty, are where its local
+/// search starts ([`SuggestAllPlan::next_job`]).
+pub fn suggest_structure(
+    s: &mut CaseStructure,
+    options: &SuggestAllOptions,
+    starts: &[Params],
+    on_progress: &mut dyn FnMut(crate::suggest::Progress) -> bool,
+) -> Result<Option<Suggestion>, SuggestError> {
+    if s.original.vertex_count() == 0 {
+        return Ok(None);
+    }
+    if let Some(filter) = options.filter {
+        s.set_filter(filter);
+    }
+    let topology = Topology::build(&s.original);
+    let original = Original::new(&s.original, &topology);
+    let weights = s.weights.as_deref();
+    let goal = Goal {
+        tau: options.tau,
+        max_volume_change: options.max_volume_change,
+    };
+    let (filter, method) = (s.params.filter, options.search.method());
+    let mut search = |evaluator: &mut dyn Evaluator, starts: &[Params]| match method {
+        SearchMethod::Local if !starts.is_empty() => {
+            suggest_from(evaluator, &s.params, goal, starts, on_progress)
+        }
+        method => suggest_for_goal(evaluator, &s.params, goal, method, on_progress),
+    };
+    let mut whole = search_evaluator(&original, weights, filter, method)?;
+    // A large surface's local search runs on patches of it first, and the search on the whole
+    // starts where that one ended: most often its minimum already, so it measures only the
+    // neighbours. The grid stays whole, the reference the searches are measured against.
+    let patches = match method {
+        SearchMethod::Local => Patches::of(&original, weights),
+        SearchMethod::Grid => None,
+    };
+    let suggestion = match &patches {
+        Some(p) => {
+            let mut on_patches = search_evaluator(&p.original, Some(&p.weights), filter, method)?;
+            let rough = search(&mut on_patches, starts)?;
+            let found = search(&mut whole, &[rough.params])?;
+            Suggestion {
+                evaluations: found.evaluations + rough.evaluations,
+                ..found
+            }
+        }
+        None => search(&mut whole, starts)?,
+    };
+    s.set_params(suggestion.params);
+    s.set_tau(options.tau);
+    let smoothed = smooth_on(s, &original);
+    s.keep(smoothed);
+    Ok(Some(suggestion))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Mesh;
+
+    fn case_of_sizes(sizes: &[usize]) -> Case {
+        let structure = |n: usize| {
+            let mesh = Mesh {
+                positions: vec![[0.0; 3]; n],
+                ..Mesh::default()
+            };
+            CaseStructure::from_mesh("s", mesh, [1.0; 3])
+        };
+        Case {
+            structures: sizes.iter().map(|&n| structure(n)).collect(),
+            ..Case::default()
+        }
+    }
+
+    #[test]
+    fn search_names_round_trip_and_learned_is_the_default() {
+        for s in SuggestAllSearch::ALL {
+            assert_eq!(SuggestAllSearch::from_name(s.name()), Some(s));
+        }
+        assert_eq!(SuggestAllSearch::from_name("random"), None);
+        assert_eq!(SuggestAllSearch::default(), SuggestAllSearch::Learned);
+        assert_eq!(SuggestAllSearch::Learned.method(), SearchMethod::Local);
+    }
+
+    #[test]
+    fn without_learning_every_structure_is_handed_out_at_once_the_largest_first() {
+        let case = case_of_sizes(&[10, 30, 20]);
+        let options = SuggestAllOptions::new(0.5, SuggestAllSearch::Local);
+        let mut plan = SuggestAllPlan::new(&case, None, options);
+        let jobs: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(&case)).collect();
+        let order: Vec<usize> = jobs.iter().map(|j| j.structure).collect();
+        assert_eq!(order, [1, 2, 0]);
+        assert!(jobs.iter().all(|j| j.starts.is_empty()));
+        assert_eq!((plan.running(), plan.done(), plan.total()), (3, 0, 3));
+        for i in [2, 0, 1] {
+            assert!(!plan.is_over());
+            plan.finish(i, None);
+        }
+        assert!(plan.is_over());
+    }
+
+    #[test]
+    fn learning_hands_out_batch_by_batch_the_smallest_first_starting_where_they_ended() {
+        let sizes: Vec<usize> = (0..LEARNING_BATCH + 2).rev().map(|n| 10 + n).collect();
+        let case = case_of_sizes(&sizes);
+        let options = SuggestAllOptions::new(0.5, SuggestAllSearch::Learned);
+        let mut plan = SuggestAllPlan::new(&case, None, options);
+        let first: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(&case)).collect();
+        assert_eq!(first.len(), LEARNING_BATCH);
+        let smallest_first: Vec<usize> = (0..sizes.len()).rev().collect();
+        let order: Vec<usize> = first.iter().map(|j| j.structure).collect();
+        assert_eq!(order, smallest_first[..LEARNING_BATCH]);
+        assert!(first.iter().all(|j| j.starts.is_empty()), "the corners");
+        let found = Params {
+            iterations: 17,
+            ..case.structures[0].params
+        };
+        // In any order; the next batch waits for the last of this one.
+        for (k, job) in first.iter().enumerate().rev() {
+            assert_eq!(plan.next_job(&case), None, "waits for the batch");
+            plan.finish(job.structure, (k != 1).then_some(found));
+        }
+        let second: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(&case)).collect();
+        assert_eq!(second.len(), 2);
+        for job in &second {
+            assert_eq!(job.starts, [found]);
+        }
+        plan.cancel();
+        assert!(!plan.is_over(), "the second batch still runs");
+        for job in &second {
+            plan.finish(job.structure, None);
+        }
+        assert!(plan.is_over());
+        assert_eq!(plan.done(), sizes.len());
+    }
+
+    #[test]
+    fn a_plan_for_some_structures_hands_out_only_those() {
+        let case = case_of_sizes(&[10, 30, 20, 40]);
+        let options = SuggestAllOptions::new(0.5, SuggestAllSearch::Grid);
+        let mut plan = SuggestAllPlan::new(&case, Some(&[0, 2]), options);
+        let order: Vec<usize> = std::iter::from_fn(|| plan.next_job(&case))
+            .map(|j| j.structure)
+            .collect();
+        assert_eq!(order, [2, 0]);
+        plan.cancel();
+        assert_eq!(plan.next_job(&case), None);
+    }
+}
