@@ -50,8 +50,6 @@ pub struct GpuMesh {
     pub(crate) result: Slot,
     pub(crate) step_stride: u64,
     pub(crate) steps: wgpu::Buffer,
-    pub(crate) offsets: wgpu::Buffer,
-    pub(crate) neighbors: wgpu::Buffer,
     pub(crate) original: wgpu::Buffer,
     pub(crate) weights: wgpu::Buffer,
     pub(crate) a: wgpu::Buffer,
@@ -247,6 +245,7 @@ impl GpuMesh {
             position_buffer(device, "meshsmooth positions b", n),
             position_buffer(device, "meshsmooth positions aux", n),
         );
+        // The ring's buffers live as long as the mesh group that binds them.
         let mesh_group = mesh_group(
             device,
             &layouts.mesh,
@@ -264,8 +263,6 @@ impl GpuMesh {
             result: Slot::Original,
             step_stride: stride,
             steps,
-            offsets,
-            neighbors,
             original,
             weights,
             a,
@@ -347,16 +344,6 @@ impl GpuMesh {
             Slot::B => &self.b,
             Slot::Aux => &self.aux,
         }
-    }
-
-    /// The original positions, the smoothing ring's CSR offsets and neighbour indices, as
-    /// uploaded (for further kernels on the same mesh).
-    pub fn original_buffer(&self) -> &wgpu::Buffer {
-        &self.original
-    }
-
-    pub fn ring_buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
-        (&self.offsets, &self.neighbors)
     }
 
     /// True when uploaded with [`super::GpuSmoother::upload_with_measures`]: runs can drift the

@@ -7,7 +7,6 @@ use super::{
     run, Cancelled, Evaluator, Goal, GridMinimum, LocalSearch, Progress, QualityGraphs,
     QualitySweep, SearchMethod, Suggestion,
 };
-use crate::mesh::{Mesh, Topology};
 use crate::metrics::Original;
 use crate::smooth::{Filter, ParamError, Params};
 
@@ -167,19 +166,6 @@ pub fn suggest_from(
     Ok(run(task, evaluator, on_progress)?.suggestion)
 }
 
-/// `smooth --auto`: the suggestion for a freshly loaded mesh, without progress reporting.
-pub fn suggest_for_mesh(
-    mesh: &Mesh,
-    topology: &Topology,
-    weights: Option<&[f32]>,
-    base: &Params,
-    tau: f64,
-    method: SearchMethod,
-) -> Result<Suggestion, SuggestError> {
-    let original = Original::new(mesh, topology);
-    suggest(&original, weights, base, tau, method, &mut |_| true)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -188,7 +174,7 @@ mod tests {
     fn only_hcs_local_search_resumes_runs_from_kept_states() {
         let bytes = include_bytes!("../../tests/data/bent_tube_staircase.ply");
         let mesh = crate::io::load(bytes, "tube.ply").expect("the sample");
-        let topology = Topology::build(&mesh);
+        let topology = crate::mesh::Topology::build(&mesh);
         let original = Original::new(&mesh, &topology);
         for filter in [Filter::Hc, Filter::Taubin, Filter::Laplace] {
             for method in [SearchMethod::Local, SearchMethod::Grid] {

@@ -22,8 +22,8 @@ mod space;
 mod sweep;
 
 pub use auto::{
-    quality_graphs, quality_graphs_on, search_evaluator, suggest, suggest_for_goal,
-    suggest_for_mesh, suggest_from, suggest_on, SuggestError, LOCAL_SEARCH_STATE_BYTES,
+    quality_graphs, quality_graphs_on, search_evaluator, suggest, suggest_for_goal, suggest_from,
+    suggest_on, SuggestError, LOCAL_SEARCH_STATE_BYTES,
 };
 pub use bounded::GridMinimum;
 pub use grid::{EvaluatedGrid, GridSearch};
