@@ -6,15 +6,18 @@
 //!
 //! Modules, from the page in to the pixels out:
 //! - the page and its inputs: `page` (canvas, loading text, crash message), `query`
-//!   (`?model=`, `?case=`), `file_input` and `read_bytes` (picker, drops, chunked reads),
-//!   `download` (bytes out), `api` (`window.meshsmooth` and the embedding's messages);
+//!   (`?model=`, `?case=`), `file_input`, `folder_drop` and `read_bytes` (picker, dropped files
+//!   and folders, chunked reads), `download` (bytes out), `api` (`window.meshsmooth` and the
+//!   embedding's messages), `layout` (where the page drew what, for `state()`);
 //! - the document and its engines: `document` (the session shared by the UI and the API, the
-//!   calls waiting on it), `workers` (the CPU engine's dedicated workers), `gpu_engine` (the
-//!   WebGPU engine's driver);
-//! - the authoring page's panels: `controls`, `guide`, `structure_list`, `report_view`,
-//!   `legend`, `status`, `shortcuts`, `bottom_panel` with `graphs` and `gallery` /
-//!   `gallery_view`;
+//!   calls waiting on it), `backend` (which engine smooths, and its timing), `workers` (the CPU
+//!   engine's dedicated workers), `gpu_engine` (the WebGPU engine's driver), `pacing` (how
+//!   often the page redraws for work it does not see);
+//! - the authoring page's panels: `controls`, `guide`, `structure_list` with
+//!   `case_export_view`, `lesson_panel`, `report_view`, `legend`, `status`, `shortcuts`,
+//!   `bottom_panel` with `graphs` and `gallery` / `gallery_view`;
 //! - the viewer's panel (`?mode=viewer`): `case_reader`, and `case_text` for screen readers;
+//!   the lesson as the student plays it: `tour`, `quiz`, and `labels` over the view;
 //! - over the view: `brush` and `drag_params` (painting weights, dragging parameters),
 //!   `pointing` (the name under the pointer), `view_tools` (standard views, clip),
 //!   `orientation_marker`, `picture` (the view as PNG);

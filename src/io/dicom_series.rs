@@ -3,8 +3,9 @@
 //!
 //! The parsing is `dicom-object`'s, after [`super::dicom_lengths`] has checked every declared
 //! length against the file's bytes. What is read: single-frame, single-sample (grey) slices of
-//! 8, 16 or 32 bits, little-endian, uncompressed, RLE Lossless or JPEG, each with its own
-//! Rescale Slope and Intercept; where fewer bits are stored than allocated, only the stored
+//! 8, 16 or 32 bits, little-endian, uncompressed (or the data set deflated), RLE Lossless, JPEG
+//! (baseline, extended or lossless), JPEG-LS or JPEG 2000 ([`super::dicom_frames`]), each with
+//! its own Rescale Slope and Intercept; where fewer bits are stored than allocated, only the stored
 //! (low) ones are read, so that old files' overlay bits above them are not taken for values.
 //! The slices are placed by Image Position (Patient) along the normal of their common Image
 //! Orientation, whatever the files' order or Instance Numbers. Refused, with the file or the
