@@ -1,10 +1,11 @@
 //! The image a segmentation was drawn on (CT or MRI), as a student sees it under the surfaces:
 //! one scalar volume in world RAS millimetres, reduced to a size a learning platform can carry.
 
-use super::dicom_series::{load_image_series, SeriesError};
+use super::dicom;
+use super::dicom::series::{load_image_series, SeriesError};
 use super::intensity::IntensitySink;
 use super::label_map::Affine;
-use super::{dicom_seg, mgh, nifti, nrrd, Format, LoadError};
+use super::{mgh, nifti, nrrd, Format, LoadError};
 
 /// An intensity volume on its (possibly reduced) grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,7 +28,7 @@ pub struct ImageVolume {
 /// `max_voxels` voxels.
 pub fn load_image(bytes: &[u8], name: &str, max_voxels: usize) -> Result<ImageVolume, LoadError> {
     let lower = name.to_ascii_lowercase();
-    if lower.ends_with(".dcm") || dicom_seg::is_dicom(bytes) {
+    if lower.ends_with(".dcm") || dicom::seg::is_dicom(bytes) {
         return load_image_series(&[(name, bytes)], max_voxels).map_err(|e| match e {
             SeriesError::File { error, .. } => error,
             SeriesError::Series(detail) => LoadError::Unsupported {

@@ -4,16 +4,7 @@
 
 mod codes;
 mod color_table;
-mod dicom_deflate;
-mod dicom_frames;
-mod dicom_jpeg;
-mod dicom_jpeg2000;
-mod dicom_jpegls;
-mod dicom_lengths;
-mod dicom_rle;
-mod dicom_seg;
-mod dicom_seg_grid;
-mod dicom_series;
+mod dicom;
 mod error;
 mod freesurfer_lut;
 mod gltf;
@@ -38,7 +29,7 @@ mod weld;
 
 pub use codes::{Code, StructureCodes};
 pub use color_table::{is_color_table, parse_color_table, LabelEntry};
-pub use dicom_series::{load_image_series, SeriesError};
+pub use dicom::series::{load_image_series, SeriesError};
 pub use error::{LoadError, Location};
 pub use gltf::{GltfNode, GltfScene, Mat4};
 pub use image::{load_image, reduced_affine, ImageVolume};

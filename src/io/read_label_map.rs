@@ -13,8 +13,9 @@
 //! image with other values (a probability map, a float mask) is read as a mask instead: value 1
 //! where the voxel is at least the level, background elsewhere and at NaN.
 
+use super::dicom;
 use super::label_map::{LabelMap, LabelMapOptions};
-use super::{dicom_seg, mgh, nifti, nrrd, Format, LoadError};
+use super::{mgh, nifti, nrrd, Format, LoadError};
 
 /// Whether a file name is a label map this module reads (`.nii`, `.nii.gz`, `.nrrd` including
 /// `.seg.nrrd`, `.mgh`, `.mgz`, DICOM SEG's `.dcm`, and detached `.nhdr` headers, which are refused with a reason),
@@ -61,7 +62,7 @@ pub fn load_label_map(
     match format {
         Format::Nrrd => nrrd::parse(bytes, options),
         Format::Mgh => mgh::parse(bytes, options),
-        Format::DicomSeg => dicom_seg::parse(bytes, options),
+        Format::DicomSeg => dicom::seg::parse(bytes, options),
         _ => nifti::parse(bytes, options),
     }
 }
@@ -80,7 +81,7 @@ fn sniff(bytes: &[u8], name: &str) -> Result<Format, LoadError> {
     let nifti_size = |s: Option<i32>| matches!(s, Some(348 | 540));
     if bytes.starts_with(b"NRRD") {
         Ok(Format::Nrrd)
-    } else if dicom_seg::is_dicom(bytes) {
+    } else if dicom::seg::is_dicom(bytes) {
         Ok(Format::DicomSeg)
     } else if bytes.starts_with(&[0, 0, 0, 1]) {
         Ok(Format::Mgh)

@@ -3,16 +3,16 @@
 //! length (up to 4 GiB) before reading it, so a lying length in a small file would otherwise
 //! cost gigabytes. The walk also finds the transfer syntax and refuses the encodings the reader
 //! does not take (big-endian, compressions other than RLE, JPEG, JPEG-LS and JPEG 2000); a
-//! deflated file is walked once inflated ([`dicom_deflate`]). The walk reads headers exactly as dicom-rs does
+//! deflated file is walked once inflated ([`deflate`]). The walk reads headers exactly as dicom-rs does
 //! (an unknown VR has a 32-bit length, as UN), so that every value it will allocate has been
 //! measured; what the two would read differently is refused.
 
 use std::borrow::Cow;
 use std::ops::Range;
 
-use super::dicom_deflate::{self, MetaGroup, DEFLATED_EXPLICIT_LE};
-use super::dicom_frames::{decode, Frames};
-use super::{Format, LoadError};
+use super::deflate::{self, MetaGroup, DEFLATED_EXPLICIT_LE};
+use super::frames::{decode, Frames};
+use crate::io::{Format, LoadError};
 
 const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
 const IMPLICIT_LE: &str = "1.2.840.10008.1.2";
@@ -40,7 +40,7 @@ const GROUP_LENGTH: (u16, u16) = (0x0002, 0x0000);
 /// a file has none) and where the last Pixel Data value lies, so that the pixels are read from
 /// the file's bytes rather than copied into the parsed object. A deflated file's positions are
 /// in its inflated bytes, which the layout holds.
-pub(super) struct Layout {
+pub(in crate::io) struct Layout {
     pub start: usize,
     pub pixel_data: Option<PixelData>,
     inflated: Option<Vec<u8>>,
@@ -59,7 +59,7 @@ impl std::fmt::Debug for Layout {
 
 /// Where the pixels lie in the file.
 #[derive(Debug, Clone, PartialEq)]
-pub(super) enum PixelData {
+pub(in crate::io) enum PixelData {
     /// Uncompressed, one value.
     Native(Range<usize>),
     /// Compressed: each fragment after the offset table.
@@ -71,7 +71,7 @@ pub(super) enum PixelData {
 
 /// How encapsulated pixels are compressed.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Codec {
+pub(in crate::io) enum Codec {
     Rle,
     Jpeg,
     Jpeg2000,
@@ -83,7 +83,7 @@ impl Layout {
     /// The frames' pixel data, uncompressed: in place within `bytes` (the file walked), or
     /// decoded; refused when there is none, or less than `frames` declare (`what` says what
     /// the bytes are for).
-    pub(super) fn pixels<'a>(
+    pub(in crate::io) fn pixels<'a>(
         self,
         bytes: &'a [u8],
         frames: Frames,
@@ -129,7 +129,7 @@ impl Layout {
 
 /// The file parsed up to its pixels (which stay in `bytes`, where [`Layout::pixel_data`]
 /// says), once [`check`] has measured every length; `format` names the file in errors.
-pub(super) fn open(
+pub(in crate::io) fn open(
     bytes: &[u8],
     format: Format,
 ) -> Result<(Layout, dicom_object::DefaultDicomObject), LoadError> {
@@ -148,7 +148,7 @@ pub(super) fn open(
 }
 
 /// `format` is what the errors call the file (a SEG, or a slice of an image series).
-pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
+pub(in crate::io) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
     let start = if bytes.get(128..132) == Some(b"DICM") {
         132
     } else if bytes.starts_with(b"DICM") {
@@ -167,7 +167,7 @@ pub(super) fn check(bytes: &[u8], format: Format) -> Result<Layout, LoadError> {
     };
     let (syntax, meta) = walk.meta_group()?;
     if syntax == DEFLATED_EXPLICIT_LE {
-        let explicit = dicom_deflate::as_explicit(bytes, &meta, format)?;
+        let explicit = deflate::as_explicit(bytes, &meta, format)?;
         let layout = check(&explicit, format)?;
         return Ok(Layout {
             inflated: Some(explicit),
@@ -461,5 +461,5 @@ fn dictionary_vr(tag: (u16, u16)) -> Option<dicom_core::VR> {
 }
 
 #[cfg(test)]
-#[path = "dicom_lengths_tests.rs"]
+#[path = "lengths_tests.rs"]
 mod tests;

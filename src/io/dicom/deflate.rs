@@ -10,19 +10,19 @@ use std::ops::Range;
 
 use flate2::bufread::DeflateDecoder;
 
-use super::gzip::MAX_RATIO;
-use super::{Format, LoadError};
+use crate::io::gzip::MAX_RATIO;
+use crate::io::{Format, LoadError};
 
-pub(super) const DEFLATED_EXPLICIT_LE: &str = "1.2.840.10008.1.2.1.99";
+pub(in crate::io) const DEFLATED_EXPLICIT_LE: &str = "1.2.840.10008.1.2.1.99";
 const EXPLICIT_LE_VALUE: &[u8; 20] = b"1.2.840.10008.1.2.1\0";
 
 /// The most a deflated data set is inflated to: past the size of any segmentation or slice
 /// meshsmooth opens, and within what the browser's 32-bit memory can hold twice.
-pub(super) const MAX_INFLATED: u64 = 1 << 30;
+pub(in crate::io) const MAX_INFLATED: u64 = 1 << 30;
 
 /// Where a file's meta group lies: `group` from its group length element (0002,0000) to its
 /// end, `syntax` the transfer syntax element (header and value).
-pub(super) struct MetaGroup {
+pub(in crate::io) struct MetaGroup {
     pub group: Range<usize>,
     pub syntax: Range<usize>,
 }
@@ -31,7 +31,7 @@ pub(super) struct MetaGroup {
 /// endian: "DICM", the meta group with its transfer syntax (and group length) rewritten, and
 /// the inflated data set. Refused when the stream is corrupt, or inflates past
 /// [`MAX_INFLATED`] or what deflate could expand the bytes to.
-pub(super) fn as_explicit(
+pub(in crate::io) fn as_explicit(
     bytes: &[u8],
     meta: &MetaGroup,
     format: Format,

@@ -12,9 +12,9 @@
 
 use hayro_jpeg2000::{DecodeSettings, DecoderContext, Image};
 
-use super::dicom_frames::{frame_by_frame, Declared, FrameShape};
-use super::dicom_jpeg::ends_with_end_of_image;
-use super::{Format, LoadError};
+use super::frames::{frame_by_frame, Declared, FrameShape};
+use super::jpeg::ends_with_end_of_image;
+use crate::io::{Format, LoadError};
 
 /// Pixels a byte of JPEG 2000 may hold: a frame of one value codes in an empty packet a
 /// resolution after its main header (512 x 512 in about 150 bytes). The decoder holds a few
@@ -38,7 +38,7 @@ struct SizeHeader {
 
 /// The frames `codestreams` (one each) hold, back to back, little endian; `size` is the
 /// frame's columns and rows.
-pub(super) fn decode(
+pub(in crate::io) fn decode(
     codestreams: &[&[u8]],
     shape: FrameShape,
     size: [usize; 2],

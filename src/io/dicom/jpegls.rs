@@ -11,9 +11,9 @@
 //! values themselves (a signed stored value is coded as its bit pattern), so they go out as
 //! they come.
 
-use super::dicom_frames::{frame_by_frame, FrameShape};
-use super::dicom_jpeg::{checked_frame_header, find_segment, FrameRules};
-use super::{Format, LoadError};
+use super::frames::{frame_by_frame, FrameShape};
+use super::jpeg::{checked_frame_header, find_segment, FrameRules};
+use crate::io::{Format, LoadError};
 
 /// Pixels a byte of JPEG-LS may hold: run mode codes a line of one value in a bit or more, so
 /// eight lines of 512 pixels a byte (a frame wider than that, all of one value, is refused).
@@ -26,7 +26,7 @@ fn starts_ls_frame(marker: u8) -> bool {
 
 /// The frames `codestreams` (one each) hold, back to back, little endian; `size` is the
 /// frame's columns and rows.
-pub(super) fn decode(
+pub(in crate::io) fn decode(
     codestreams: &[&[u8]],
     shape: FrameShape,
     size: [usize; 2],

@@ -3,22 +3,22 @@
 //! (CIELab) and coded category, type and type modifier.
 //!
 //! The parsing is `dicom-object`'s (dicom-rs, pure Rust, builds for wasm32), after
-//! [`super::dicom_lengths`] has checked every declared length against the bytes. What is read:
+//! [`super::lengths`] has checked every declared length against the bytes. What is read:
 //! little-endian files (explicit or implicit VR), uncompressed, RLE Lossless or JPEG (decoded
-//! in [`super::dicom_rle`] and [`super::dicom_jpeg`]). Refused with a reason: other objects than
+//! in [`super::rle`] and [`super::jpeg`]). Refused with a reason: other objects than
 //! SEG, other compressions, big-endian encodings. The grid comes from the functional groups
-//! ([`super::dicom_seg_grid`]).
+//! ([`super::seg_grid`]).
 
 use dicom_core::Tag;
 use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
-use super::codes::{Code, StructureCodes};
-use super::dicom_frames::Frames;
-use super::dicom_lengths;
-use super::dicom_seg_grid::{self, FrameGeometry, Grid};
-use super::label_map::{LabelMap, LabelMapOptions, Segment, DEFAULT_LEVEL};
-use super::{Format, LoadError, Location};
+use super::frames::Frames;
+use super::lengths;
+use super::seg_grid::{self, FrameGeometry, Grid};
+use crate::io::codes::{Code, StructureCodes};
+use crate::io::label_map::{LabelMap, LabelMapOptions, Segment, DEFAULT_LEVEL};
+use crate::io::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::DicomSeg;
 const SEGMENTATION_STORAGE: &str = "1.2.840.10008.5.1.4.1.1.66.4";
@@ -27,7 +27,7 @@ const LABEL_MAP_SEGMENTATION_STORAGE: &str = "1.2.840.10008.5.1.4.1.1.66.7";
 
 /// How a SEG stores its pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Pixels {
+pub(in crate::io) enum Pixels {
     /// One bit a pixel, frames packed back to back, least significant bit first.
     Binary,
     /// One byte a pixel: the segment's share of the voxel, out of `max`; in the segment when
@@ -49,9 +49,9 @@ impl Pixels {
     }
 }
 
-pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
+pub(in crate::io) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap, LoadError> {
     // The pixels are read in place, not copied into the object.
-    let (layout, object) = dicom_lengths::open(bytes, FORMAT)?;
+    let (layout, object) = lengths::open(bytes, FORMAT)?;
     let sop_class = text(&object, tags::SOP_CLASS_UID).unwrap_or_default();
     if sop_class != SEGMENTATION_STORAGE && sop_class != LABEL_MAP_SEGMENTATION_STORAGE {
         return Err(LoadError::BadMagic {
@@ -77,7 +77,7 @@ pub(super) fn parse(bytes: &[u8], options: &LabelMapOptions) -> Result<LabelMap,
     let shared = first_item(&object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE);
     let grid = Grid::place([columns, rows], shared, &per_frame)?;
     let numbers: Vec<u16> = segments.iter().map(segment_number).collect();
-    let (layers, placed) = dicom_seg_grid::fill(&grid, &per_frame, &numbers, &data, pixels)?;
+    let (layers, placed) = seg_grid::fill(&grid, &per_frame, &numbers, &data, pixels)?;
     Ok(LabelMap {
         dims: grid.dims,
         affine: grid.affine,
@@ -104,7 +104,7 @@ fn unsupported(detail: String) -> LoadError {
     }
 }
 
-pub(super) fn text(object: &InMemDicomObject, tag: Tag) -> Option<String> {
+pub(in crate::io) fn text(object: &InMemDicomObject, tag: Tag) -> Option<String> {
     let element = object.element(tag).ok()?;
     let value = element.to_str().ok()?;
     let value = value.trim_matches(|c: char| c == '\0' || c.is_whitespace());
@@ -116,7 +116,7 @@ fn number(object: &InMemDicomObject, tag: Tag, name: &str) -> Result<usize, Load
 }
 
 /// A whole number element above 0 (Rows, say), `name` naming it in the error `format` says.
-pub(super) fn whole_above_zero(
+pub(in crate::io) fn whole_above_zero(
     object: &InMemDicomObject,
     tag: Tag,
     name: &str,
@@ -133,17 +133,17 @@ pub(super) fn whole_above_zero(
     Ok(value as usize)
 }
 
-pub(super) fn items(object: &InMemDicomObject, tag: Tag) -> &[InMemDicomObject] {
+pub(in crate::io) fn items(object: &InMemDicomObject, tag: Tag) -> &[InMemDicomObject] {
     (object.element(tag).ok())
         .and_then(|e| e.items())
         .unwrap_or_default()
 }
 
-pub(super) fn first_item(object: &InMemDicomObject, tag: Tag) -> Option<&InMemDicomObject> {
+pub(in crate::io) fn first_item(object: &InMemDicomObject, tag: Tag) -> Option<&InMemDicomObject> {
     items(object, tag).first()
 }
 
-pub(super) fn floats(object: &InMemDicomObject, tag: Tag) -> Option<Vec<f64>> {
+pub(in crate::io) fn floats(object: &InMemDicomObject, tag: Tag) -> Option<Vec<f64>> {
     let element = object.element(tag).ok()?;
     element.to_multi_float64().ok()
 }
@@ -296,7 +296,7 @@ fn frame_geometry(
             if !labels && !segments.iter().any(|s| segment_number(s) == segment) {
                 return Err(at(&format!("segment {segment} is not declared")));
             }
-            let orientation = dicom_seg_grid::orientation_of(group);
+            let orientation = seg_grid::orientation_of(group);
             Ok(FrameGeometry {
                 position,
                 segment,
@@ -316,7 +316,7 @@ fn segment_of(group: &InMemDicomObject) -> Option<u16> {
 
 /// DICOM's scaled CIELab (PS3.3 C.10.7.1.1: L* 0..100, a* and b* -128..127 mapped onto
 /// 0..65535; D65 white) to display sRGB in [0, 1].
-pub(super) fn cielab_to_srgb(lab: [u16; 3]) -> [f32; 3] {
+pub(in crate::io) fn cielab_to_srgb(lab: [u16; 3]) -> [f32; 3] {
     let l = f64::from(lab[0]) * 100.0 / 65535.0;
     let a = f64::from(lab[1]) * 255.0 / 65535.0 - 128.0;
     let b = f64::from(lab[2]) * 255.0 / 65535.0 - 128.0;
@@ -344,7 +344,7 @@ pub(super) fn cielab_to_srgb(lab: [u16; 3]) -> [f32; 3] {
 }
 
 /// Whether bytes look like a DICOM file ('DICM' after the 128-byte preamble).
-pub(super) fn is_dicom(bytes: &[u8]) -> bool {
+pub(in crate::io) fn is_dicom(bytes: &[u8]) -> bool {
     bytes.get(128..132) == Some(b"DICM")
 }
 

@@ -7,15 +7,15 @@
 //! shorter than its header; these files come from users and must be refused with a reason,
 //! within memory the file's size bounds.
 
-use super::dicom_frames::FrameShape;
-use super::{Format, LoadError};
+use super::frames::FrameShape;
+use crate::io::{Format, LoadError};
 
 const HEADER: usize = 64;
 /// A PackBits replicate run: two bytes for at most 128.
 const MOST_EXPANSION: usize = 64;
 
 /// The frames `fragments` (one each) hold, back to back, little endian.
-pub(super) fn decode(
+pub(in crate::io) fn decode(
     fragments: &[&[u8]],
     shape: FrameShape,
     format: Format,

@@ -1,10 +1,10 @@
 //! A DICOM image series (CT or MR, one slice a file, as scanners and PACS exports write them)
 //! into an [`ImageVolume`]: the image a segmentation was drawn on.
 //!
-//! The parsing is `dicom-object`'s, after [`super::dicom_lengths`] has checked every declared
+//! The parsing is `dicom-object`'s, after [`super::lengths`] has checked every declared
 //! length against the file's bytes. What is read: single-frame, single-sample (grey) slices of
 //! 8, 16 or 32 bits, little-endian, uncompressed (or the data set deflated), RLE Lossless, JPEG
-//! (baseline, extended or lossless), JPEG-LS or JPEG 2000 ([`super::dicom_frames`]), each with
+//! (baseline, extended or lossless), JPEG-LS or JPEG 2000 ([`super::frames`]), each with
 //! its own Rescale Slope and Intercept; where fewer bits are stored than allocated, only the stored
 //! (low) ones are read, so that old files' overlay bits above them are not taken for values.
 //! The slices are placed by Image Position (Patient) along the normal of their common Image
@@ -20,15 +20,15 @@ use dicom_core::Tag;
 use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
-use super::dicom_frames::Frames;
-use super::dicom_lengths;
-use super::dicom_seg::{floats, text, whole_above_zero};
-use super::dicom_seg_grid::{cross, dot, ras_affine};
-use super::image::{reduced_affine, ImageVolume};
-use super::intensity::IntensitySink;
-use super::label_map_checks::{check_affine, Sample, VoxelLayout};
-use super::voxels::Feed;
-use super::{Format, LoadError, Location};
+use super::frames::Frames;
+use super::lengths;
+use super::seg::{floats, text, whole_above_zero};
+use super::seg_grid::{cross, dot, ras_affine};
+use crate::io::image::{reduced_affine, ImageVolume};
+use crate::io::intensity::IntensitySink;
+use crate::io::label_map_checks::{check_affine, Sample, VoxelLayout};
+use crate::io::voxels::Feed;
+use crate::io::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::DicomImage;
 const SEGMENTATION_STORAGE: &str = "1.2.840.10008.5.1.4.1.1.66.4";
@@ -142,7 +142,7 @@ fn unsupported(detail: String) -> LoadError {
 }
 
 fn read_slice<'a>(name: &'a str, bytes: &'a [u8]) -> Result<Slice<'a>, LoadError> {
-    let (layout, object) = dicom_lengths::open(bytes, FORMAT)?;
+    let (layout, object) = lengths::open(bytes, FORMAT)?;
     if text(&object, tags::SOP_CLASS_UID).as_deref() == Some(SEGMENTATION_STORAGE) {
         return Err(unsupported(
             "a segmentation (DICOM SEG), not an image: open it as the case's structures".into(),

@@ -1,31 +1,30 @@
-//! A DICOM file's frames of pixels once its lengths are checked ([`super::dicom_lengths`]):
+//! A DICOM file's frames of pixels once its lengths are checked ([`super::lengths`]):
 //! what the header declares of them, and encapsulated (compressed) frames decoded by their codec
-//! ([`super::dicom_rle`], [`super::dicom_jpeg`], [`super::dicom_jpegls`],
-//! [`super::dicom_jpeg2000`]), each refused
-//! when it decodes to more than its bytes can hold or declares another frame than the header.
+//! ([`super::rle`], [`super::jpeg`], [`super::jpegls`], [`super::jpeg2000`]), each refused when
+//! it decodes to more than its bytes can hold or declares another frame than the header.
 
-use super::dicom_lengths::Codec;
-use super::{dicom_jpeg, dicom_jpeg2000, dicom_jpegls, dicom_rle};
-use super::{Format, LoadError};
+use super::lengths::Codec;
+use super::{jpeg, jpeg2000, jpegls, rle};
+use crate::io::{Format, LoadError};
 
 /// The frames a file declares: how many, their columns and rows, and `bits` a pixel (1, 8, 16
 /// or 32).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Frames {
+pub(in crate::io) struct Frames {
     pub count: usize,
     pub size: [usize; 2],
     pub bits: usize,
 }
 
 impl Frames {
-    pub(super) fn pixels(&self) -> usize {
+    pub(in crate::io) fn pixels(&self) -> usize {
         self.size[0].saturating_mul(self.size[1])
     }
 }
 
 /// What a compressed frame decodes to: how many pixels, and how many bytes a pixel.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct FrameShape {
+pub(in crate::io) struct FrameShape {
     pub pixels: usize,
     pub bytes: usize,
 }
@@ -34,7 +33,7 @@ impl FrameShape {
     /// The frame's decoded bytes, refused when more than `expansion` times its `compressed`
     /// bytes could hold (`what` names the codec's frames): what bounds a decoder's memory by
     /// the file's size.
-    pub(super) fn bytes_within(
+    pub(in crate::io) fn bytes_within(
         &self,
         compressed: usize,
         expansion: usize,
@@ -56,7 +55,7 @@ impl FrameShape {
 }
 
 /// What a compressed frame's own header (a JPEG frame header, a JPEG 2000 size marker) says.
-pub(super) struct Declared {
+pub(in crate::io) struct Declared {
     pub columns: usize,
     pub rows: usize,
     pub components: usize,
@@ -68,7 +67,11 @@ pub(super) struct Declared {
 impl FrameShape {
     /// Refuses a codestream that declares other than one grey component of the DICOM header's
     /// `size` (columns and rows) in bits its pixels hold.
-    pub(super) fn check_declared(&self, size: [usize; 2], d: &Declared) -> Result<(), String> {
+    pub(in crate::io) fn check_declared(
+        &self,
+        size: [usize; 2],
+        d: &Declared,
+    ) -> Result<(), String> {
         let grey = d.components == 1 && !d.subsampled;
         if [d.columns, d.rows] == size && grey && d.bits <= 8 * self.bytes {
             return Ok(());
@@ -84,7 +87,7 @@ impl FrameShape {
 /// Each of `codestreams` (one a frame) decoded by `frame` onto the pixels before it; `frame`
 /// words an error about its codestream with the `bad` it is given, which names the frame
 /// (`codec` says whose).
-pub(super) fn frame_by_frame(
+pub(in crate::io) fn frame_by_frame(
     codestreams: &[&[u8]],
     codec: &str,
     format: Format,
@@ -103,7 +106,7 @@ pub(super) fn frame_by_frame(
 
 /// Encapsulated frames, decoded: one fragment a frame, or for a single frame (JPEG, JPEG-LS,
 /// JPEG 2000) all of them, in order.
-pub(super) fn decode(
+pub(in crate::io) fn decode(
     codec: Codec,
     fragments: &[&[u8]],
     frames: Frames,
@@ -136,9 +139,9 @@ pub(super) fn decode(
         bytes: frames.bits / 8,
     };
     match codec {
-        Codec::Rle => dicom_rle::decode(&streams, shape, format),
-        Codec::Jpeg => dicom_jpeg::decode(&streams, shape, frames.size, format),
-        Codec::Jpeg2000 => dicom_jpeg2000::decode(&streams, shape, frames.size, format),
-        Codec::JpegLs => dicom_jpegls::decode(&streams, shape, frames.size, format),
+        Codec::Rle => rle::decode(&streams, shape, format),
+        Codec::Jpeg => jpeg::decode(&streams, shape, frames.size, format),
+        Codec::Jpeg2000 => jpeg2000::decode(&streams, shape, frames.size, format),
+        Codec::JpegLs => jpegls::decode(&streams, shape, frames.size, format),
     }
 }

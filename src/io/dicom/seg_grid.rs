@@ -10,10 +10,10 @@
 use dicom_dictionary_std::tags;
 use dicom_object::mem::InMemDicomObject;
 
-use super::dicom_seg::{first_item, floats, Pixels};
-use super::label_map::{Affine, LabelLayer, MAX_LABELS};
-use super::label_map_checks::{check_affine, MAX_LAYERS, MAX_VOXEL_BYTES};
-use super::{Format, LoadError, Location};
+use super::seg::{first_item, floats, Pixels};
+use crate::io::label_map::{Affine, LabelLayer, MAX_LABELS};
+use crate::io::label_map_checks::{check_affine, MAX_LAYERS, MAX_VOXEL_BYTES};
+use crate::io::{Format, LoadError, Location};
 
 const FORMAT: Format = Format::DicomSeg;
 
@@ -31,7 +31,7 @@ const SLICES_PER_FRAME: usize = 64;
 
 /// What the per-frame functional groups say of one frame.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct FrameGeometry {
+pub(in crate::io) struct FrameGeometry {
     /// Image Position (Patient), LPS millimetres.
     pub position: [f64; 3],
     pub segment: u16,
@@ -41,7 +41,7 @@ pub(super) struct FrameGeometry {
 
 /// The grid and where each frame lies on it.
 #[derive(Debug)]
-pub(super) struct Grid {
+pub(in crate::io) struct Grid {
     pub dims: [usize; 3],
     /// Voxel index to RAS millimetres.
     pub affine: Affine,
@@ -52,7 +52,7 @@ pub(super) struct Grid {
 }
 
 /// A frame's Plane Orientation (Patient), if it has one.
-pub(super) fn orientation_of(group: &InMemDicomObject) -> Option<[f64; 6]> {
+pub(in crate::io) fn orientation_of(group: &InMemDicomObject) -> Option<[f64; 6]> {
     let plane = first_item(group, tags::PLANE_ORIENTATION_SEQUENCE)?;
     <[f64; 6]>::try_from(floats(plane, tags::IMAGE_ORIENTATION_PATIENT)?).ok()
 }
@@ -66,7 +66,11 @@ fn error(detail: String) -> LoadError {
 
 /// Voxel index to RAS millimetres for a grid whose `i, j, k` axes run along `axes` (unit, LPS)
 /// `spacing` apart, voxel 0 at `origin` (LPS): DICOM's patient frame is LPS.
-pub(super) fn ras_affine(axes: [[f64; 3]; 3], spacing: [f64; 3], origin: [f64; 3]) -> Affine {
+pub(in crate::io) fn ras_affine(
+    axes: [[f64; 3]; 3],
+    spacing: [f64; 3],
+    origin: [f64; 3],
+) -> Affine {
     Affine(std::array::from_fn(|r| {
         // LPS to RAS: the first two world axes change sign.
         let sign = if r < 2 { -1.0 } else { 1.0 };
@@ -79,11 +83,11 @@ pub(super) fn ras_affine(axes: [[f64; 3]; 3], spacing: [f64; 3], origin: [f64; 3
     }))
 }
 
-pub(super) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+pub(in crate::io) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-pub(super) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+pub(in crate::io) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -104,7 +108,7 @@ fn unit(v: [f64; 3], what: &str) -> Result<[f64; 3], LoadError> {
 impl Grid {
     /// Places the frames of a `[columns, rows]` image: orientation and pixel spacing from the
     /// shared functional groups (else the first frame's), slices from the frames' positions.
-    pub(super) fn place(
+    pub(in crate::io) fn place(
         size: [usize; 2],
         shared: Option<&InMemDicomObject>,
         frames: &[FrameGeometry],
@@ -231,7 +235,7 @@ fn whole_multiple(gap: f64, step: f64) -> bool {
 /// Writes every frame's pixels into label layers, one code per segment; a segment goes to the
 /// first layer where it overlaps no other (3D Slicer's rule for overlapping segments). Returns
 /// the layers and each segment's layer, in the order of `segments`.
-pub(super) fn fill(
+pub(in crate::io) fn fill(
     grid: &Grid,
     frames: &[FrameGeometry],
     segments: &[u16],

@@ -7,15 +7,15 @@
 //! it does not take: a grey frame of the rows, columns and bits the DICOM header declares is
 //! all that reaches the decoder, and only when the codestream is long enough to hold it.
 
-use super::dicom_frames::{frame_by_frame, Declared, FrameShape};
-use super::{Format, LoadError};
+use super::frames::{frame_by_frame, Declared, FrameShape};
+use crate::io::{Format, LoadError};
 
 /// Pixels a byte of JPEG can hold at most: an 8 x 8 block of one value codes in 2 bits.
 const MOST_EXPANSION: usize = 256;
 
 /// What a codestream's frame header (SOFn) says.
 #[derive(Debug, PartialEq)]
-pub(super) struct FrameHeader {
+pub(in crate::io) struct FrameHeader {
     pub precision: u8,
     pub rows: u16,
     pub columns: u16,
@@ -29,7 +29,7 @@ fn starts_jpeg_frame(marker: u8) -> bool {
 
 /// The frames `codestreams` (one each) hold, back to back, little endian; `size` is the
 /// frame's columns and rows.
-pub(super) fn decode(
+pub(in crate::io) fn decode(
     codestreams: &[&[u8]],
     shape: FrameShape,
     size: [usize; 2],
@@ -73,7 +73,7 @@ pub(super) fn decode(
 
 /// How a codec's frame header is found and how many pixels' bytes a byte of its codestream
 /// may hold.
-pub(super) struct FrameRules {
+pub(in crate::io) struct FrameRules {
     pub starts_frame: fn(u8) -> bool,
     pub expansion: usize,
     /// What the bytes are called when there are too few.
@@ -82,7 +82,7 @@ pub(super) struct FrameRules {
 
 /// The frame header of `stream`, refused (in `bad`'s words) unless it declares the DICOM
 /// header's frame (`shape`, `size`) in bytes that can hold it.
-pub(super) fn checked_frame_header(
+pub(in crate::io) fn checked_frame_header(
     stream: &[u8],
     rules: &FrameRules,
     shape: FrameShape,
@@ -105,7 +105,7 @@ pub(super) fn checked_frame_header(
 
 /// Whether a codestream ends with its end-of-image marker (JPEG 2000's end of codestream is the
 /// same two bytes), before the zero byte DICOM may pad a fragment with to an even length.
-pub(super) fn ends_with_end_of_image(stream: &[u8]) -> bool {
+pub(in crate::io) fn ends_with_end_of_image(stream: &[u8]) -> bool {
     let unpadded = stream.strip_suffix(&[0]).unwrap_or(stream);
     unpadded.ends_with(&[0xFF, 0xD9])
 }
@@ -113,7 +113,7 @@ pub(super) fn ends_with_end_of_image(stream: &[u8]) -> bool {
 /// Walks the marker segments after the start of image, giving `visit` each marker with the
 /// bytes from it on, until `visit` answers (fill bytes and markers without a length are
 /// stepped over); `missing` says what was sought when the codestream ends first.
-pub(super) fn find_segment<T>(
+pub(in crate::io) fn find_segment<T>(
     stream: &[u8],
     missing: &str,
     mut visit: impl FnMut(u8, &[u8]) -> Result<Option<T>, String>,
