@@ -55,6 +55,8 @@ stage install bash .ci/install.sh
 stage fmt cargo fmt --check
 stage clippy-native cargo clippy --all-targets -- -D warnings
 stage clippy-wasm32 cargo clippy --target wasm32-unknown-unknown --all-targets -- -D warnings
+# The library's documentation builds without a broken or private link.
+stage doc env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib
 # cargo-nextest runs the test binaries side by side (cargo test runs them one after another).
 stage test-native cargo nextest run --no-fail-fast
 # Every parser's fuzz target, a bounded time each (tests/fuzz/run.sh).

@@ -81,13 +81,13 @@ pub const FRAME_WORK_MS: f64 = 40.0;
 /// background's segments). The device runs its queue in order, so drawing waits for the work
 /// sent before it; the browser runs a frame or two ahead, so the wait shows in the interval of
 /// one of the next frames. What drawing alone takes is the lower quartile of the intervals of
-/// the recent frames with no work sent in the [`WINDOW`] frames before them; a frame's work is
-/// its interval beyond that, or beyond the lower quartile of the last [`RECENT_FRAMES`]
+/// the recent frames with no work sent in the `WINDOW` frames before them; a frame's work is
+/// its interval beyond that, or beyond the lower quartile of the last `RECENT_FRAMES`
 /// intervals of any frame where that is shorter (frames without work are rare while the
 /// background works, and the last ones may date from a file opening, which takes long). The
 /// size halves after a frame whose work is well over the
-/// target, and doubles once a frame that the size limited is [`WINDOW`] frames old and the
-/// last [`CALM_FRAMES`] frames all stayed well under it: quick to shrink, slow to grow. A
+/// target, and doubles once a frame that the size limited is `WINDOW` frames old and the
+/// last `CALM_FRAMES` frames all stayed well under it: quick to shrink, slow to grow. A
 /// piece larger than the size waits, the frames until then saving up for it. The size starts
 /// at about ten Laplace iterations of a 200k-vertex mesh (on a real GPU a whole run in a frame
 /// or two) and adapts from there.

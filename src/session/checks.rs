@@ -84,7 +84,7 @@ impl<'a> Background<'a> {
         self.checks.job.is_some()
     }
 
-    /// Whether every structure shows the surface the last checks found (as [`Session::to_case`]
+    /// Whether every structure shows the surface the last checks found (as [`CaseDocument::to_case`](super::CaseDocument::to_case)
     /// gives it: the model's current result, or its original while that is computed).
     pub fn checks_current(&self) -> bool {
         if self.checks.report.is_none() {
@@ -115,7 +115,7 @@ impl<'a> Background<'a> {
         same
     }
 
-    /// Which marks [`Session::marked_surfaces`] gives: changes when a report comes or the case
+    /// Which marks [`Self::marked_surfaces`] gives: changes when a report comes or the case
     /// changes since; `None` when there are none to show.
     pub fn marks_key(&self) -> Option<u64> {
         let any = self.checks.marks.iter().any(|m| !m.is_empty());

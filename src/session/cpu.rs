@@ -47,7 +47,7 @@ impl Session {
     }
 
     /// The CPU engine's share of a frame: asks the workers for the current revision's result
-    /// unless it is there or asked, and takes it once it came (then [`Self::result`] has it
+    /// unless it is there or asked, and takes it once it came (then [`CaseDocument::result`](super::CaseDocument::result) has it
     /// and its timings come back). A newer revision supersedes an older one still waiting.
     pub fn compute_cpu(&mut self) -> Option<Timings> {
         let mut done = None;

@@ -11,7 +11,7 @@ use crate::model;
 use crate::segmentation::default_color;
 use crate::smooth::Params;
 
-/// What [`Session::set_structure`] changes; `None` leaves a field as it is.
+/// What [`CaseDocument::set_structure`] changes; `None` leaves a field as it is.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StructureChange {
     pub name: Option<String>,

@@ -1,7 +1,7 @@
 //! Simplification of a smoothed surface for the student's download: fewer triangles, within a
 //! distance the author chooses (or a triangle count), the surface still closed and manifold.
 //!
-//! Half-edge collapses by quadric error ([`collapse`]): a collapse keeps one of the edge's
+//! Half-edge collapses by quadric error (`collapse`): a collapse keeps one of the edge's
 //! vertices where it is, so the simplified surface uses a subset of the smoothed surface's
 //! vertices, and each kept vertex keeps its original as its morph target. Written here because
 //! the simplifier of `meshopt-rs` (our glTF codec) is a port of an early meshoptimizer without

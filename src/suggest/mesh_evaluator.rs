@@ -62,7 +62,7 @@ impl<'a> MeshEvaluator<'a> {
     }
 
     /// Keeps the states of its runs every `every` iterations, within `budget_bytes`, and
-    /// resumes later runs of the same weights from them ([`RunStates`]): the same terms, fewer
+    /// resumes later runs of the same weights from them (`RunStates`): the same terms, fewer
     /// iterations, for searches that come back to the same weights at other counts (the
     /// local search; the grid never does).
     pub fn keeping_states(mut self, budget_bytes: usize, every: u32) -> Self {
