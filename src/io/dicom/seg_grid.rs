@@ -113,31 +113,7 @@ impl Grid {
         shared: Option<&InMemDicomObject>,
         frames: &[FrameGeometry],
     ) -> Result<Grid, LoadError> {
-        let orientation = shared
-            .and_then(orientation_of)
-            .or_else(|| frames.first().and_then(|f| f.orientation))
-            .ok_or_else(|| error("no Plane Orientation (Image Orientation (Patient))".into()))?;
-        for (index, frame) in frames.iter().enumerate() {
-            let differs = (frame.orientation).is_some_and(|o| {
-                o.iter()
-                    .zip(&orientation)
-                    .any(|(a, b)| (a - b).abs() > 1e-4)
-            });
-            if differs {
-                return Err(error(format!(
-                    "frame {}: its plane orientation differs from the others'; frames of one \
-                     segmentation must be parallel",
-                    index + 1
-                )));
-            }
-        }
-        let row = unit([orientation[0], orientation[1], orientation[2]], "row")?;
-        let column = unit([orientation[3], orientation[4], orientation[5]], "column")?;
-        if dot(row, column).abs() > 1e-3 {
-            return Err(error(
-                "the row and column directions are not perpendicular".into(),
-            ));
-        }
+        let [row, column] = plane_directions(shared, frames)?;
         let normal = cross(row, column);
         let measures = shared.and_then(|s| first_item(s, tags::PIXEL_MEASURES_SEQUENCE));
         let spacing = measures
@@ -153,19 +129,7 @@ impl Grid {
             .min_by(|a, b| dot(a.position, normal).total_cmp(&dot(b.position, normal)))
             .unwrap_or(first);
         let origin = lowest.position;
-        for (index, frame) in frames.iter().enumerate() {
-            let d: [f64; 3] = std::array::from_fn(|a| frame.position[a] - origin[a]);
-            let off = (dot(d, row) / along_row)
-                .abs()
-                .max((dot(d, column) / along_column).abs());
-            if off > OFF_GRID {
-                return Err(error(format!(
-                    "frame {}: its position is shifted within the image plane from the lowest \
-                     frame's by {off:.3} pixels",
-                    index + 1
-                )));
-            }
-        }
+        check_in_plane(frames, origin, [row, column], [along_row, along_column])?;
         let heights: Vec<f64> = (frames.iter())
             .map(|f| dot(f.position, normal) - dot(origin, normal))
             .collect();
@@ -203,6 +167,64 @@ impl Grid {
             budget,
         })
     }
+}
+
+/// The frames' row and column directions: the shared functional groups' plane orientation, else
+/// the first frame's; every frame that states its own must agree.
+fn plane_directions(
+    shared: Option<&InMemDicomObject>,
+    frames: &[FrameGeometry],
+) -> Result<[[f64; 3]; 2], LoadError> {
+    let orientation = shared
+        .and_then(orientation_of)
+        .or_else(|| frames.first().and_then(|f| f.orientation))
+        .ok_or_else(|| error("no Plane Orientation (Image Orientation (Patient))".into()))?;
+    for (index, frame) in frames.iter().enumerate() {
+        let differs = (frame.orientation).is_some_and(|o| {
+            o.iter()
+                .zip(&orientation)
+                .any(|(a, b)| (a - b).abs() > 1e-4)
+        });
+        if differs {
+            return Err(error(format!(
+                "frame {}: its plane orientation differs from the others'; frames of one \
+                     segmentation must be parallel",
+                index + 1
+            )));
+        }
+    }
+    let row = unit([orientation[0], orientation[1], orientation[2]], "row")?;
+    let column = unit([orientation[3], orientation[4], orientation[5]], "column")?;
+    if dot(row, column).abs() > 1e-3 {
+        return Err(error(
+            "the row and column directions are not perpendicular".into(),
+        ));
+    }
+    Ok([row, column])
+}
+
+/// Refuses a frame shifted within the image plane from `origin` by more than [`OFF_GRID`]
+/// pixels: the frames of one grid differ only along its normal.
+fn check_in_plane(
+    frames: &[FrameGeometry],
+    origin: [f64; 3],
+    [row, column]: [[f64; 3]; 2],
+    [along_row, along_column]: [f64; 2],
+) -> Result<(), LoadError> {
+    for (index, frame) in frames.iter().enumerate() {
+        let d: [f64; 3] = std::array::from_fn(|a| frame.position[a] - origin[a]);
+        let off = (dot(d, row) / along_row)
+            .abs()
+            .max((dot(d, column) / along_column).abs());
+        if off > OFF_GRID {
+            return Err(error(format!(
+                "frame {}: its position is shifted within the image plane from the lowest \
+                     frame's by {off:.3} pixels",
+                index + 1
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The slice spacing: `declared` (Spacing Between Slices), else the smallest gap between
