@@ -422,17 +422,7 @@ impl eframe::App for Shell {
         let ctx = ui.ctx().clone();
         self.sync_preview();
         self.receive_files(&ctx);
-        let keys = self.doc.borrow().shortcuts;
-        let pressed = if keys {
-            shortcuts::pressed(&ctx)
-        } else {
-            Vec::new()
-        };
-        for action in pressed {
-            if !self.reads() || shortcuts::reads(action) {
-                self.apply(action);
-            }
-        }
+        self.take_shortcuts(&ctx);
         // The frame a new model arrives in takes it up; uploading it to the GPU takes the next.
         // While a worker opens a file, the open model is worked on as before.
         self.pictures(&ctx);
@@ -445,17 +435,7 @@ impl eframe::App for Shell {
             self.take_up_step();
         }
         self.fly(&ctx);
-        {
-            let mut doc = self.doc.borrow_mut();
-            let session = doc.session_mut();
-            session.step_suggest_all();
-            session.step_checks();
-            // Writing the case glTF takes this frame's share of time on this thread.
-            let start = now_ms();
-            while session.case_export_progress().is_some() && now_ms() - start < EXPORT_FRAME_MS {
-                session.step_case_export();
-            }
-        }
+        self.step_case_work();
         let arrived = opening == Opening::Done;
         if arrived {
             // A new case shows widgets egui has not seen; it styles them from their last pass,
@@ -473,24 +453,7 @@ impl eframe::App for Shell {
         if (opening != Opening::Done || self.gpu.is_none()) && !uploading {
             self.sync_view(&ctx);
         }
-        {
-            let mut doc = self.doc.borrow_mut();
-            doc.answer_waiting();
-            if let Some(embedding) = &mut self.embedding {
-                embedding.after_frame(&mut doc);
-            }
-            doc.lesson_events.clear();
-            self.case_text.update(&doc);
-            self.case_text.update_lesson(&doc);
-            self.repainting = doc.working();
-            if self.repainting && doc.working_elsewhere() {
-                // The replies wake the page; this only moves the progress on. Frames drawn
-                // for nothing would take a core from the workers.
-                ctx.request_repaint_after(crate::app::Pacing::of(&ctx).work_repaint);
-            } else if self.repainting {
-                ctx.request_repaint();
-            }
-        }
+        self.tell_and_pace(&ctx);
 
         egui::Panel::top("top_bar").show(ui, |ui| self.top_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
@@ -504,6 +467,58 @@ impl eframe::App for Shell {
 
         if ctx.input(|i| !i.raw.hovered_files.is_empty()) {
             drop_hint(&ctx);
+        }
+    }
+}
+
+impl Shell {
+    /// The keyboard's shortcuts, where the page takes them (the viewer only those it reads).
+    fn take_shortcuts(&mut self, ctx: &egui::Context) {
+        let keys = self.doc.borrow().shortcuts;
+        let pressed = if keys {
+            shortcuts::pressed(ctx)
+        } else {
+            Vec::new()
+        };
+        for action in pressed {
+            if !self.reads() || shortcuts::reads(action) {
+                self.apply(action);
+            }
+        }
+    }
+
+    /// The case's background work steps on: Suggest all's answers, the checks', and this
+    /// frame's share of writing the case glTF.
+    fn step_case_work(&mut self) {
+        let mut doc = self.doc.borrow_mut();
+        let session = doc.session_mut();
+        session.step_suggest_all();
+        session.step_checks();
+        // Writing the case glTF takes this frame's share of time on this thread.
+        let start = now_ms();
+        while session.case_export_progress().is_some() && now_ms() - start < EXPORT_FRAME_MS {
+            session.step_case_export();
+        }
+    }
+
+    /// After the frame's work: the calls and the embedding answered, the screen reader's text
+    /// updated, and the next frame asked for while work goes on (paced while workers work).
+    fn tell_and_pace(&mut self, ctx: &egui::Context) {
+        let mut doc = self.doc.borrow_mut();
+        doc.answer_waiting();
+        if let Some(embedding) = &mut self.embedding {
+            embedding.after_frame(&mut doc);
+        }
+        doc.lesson_events.clear();
+        self.case_text.update(&doc);
+        self.case_text.update_lesson(&doc);
+        self.repainting = doc.working();
+        if self.repainting && doc.working_elsewhere() {
+            // The replies wake the page; this only moves the progress on. Frames drawn
+            // for nothing would take a core from the workers.
+            ctx.request_repaint_after(crate::app::Pacing::of(ctx).work_repaint);
+        } else if self.repainting {
+            ctx.request_repaint();
         }
     }
 }

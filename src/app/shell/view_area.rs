@@ -11,20 +11,25 @@ use crate::app::pointing::Pointing;
 use crate::app::{legend, orientation_marker, status, view_tools, viewer};
 
 impl Shell {
-    /// The 3D view with its legend, its tools and the messages over it; the structure under
-    /// the pointer is named (and, in the viewer, selected by a click).
-    pub(super) fn view(&mut self, ui: &mut egui::Ui) {
-        // The legend takes a strip at the right; the view has the rest.
+    /// The colour legend, in a strip at the right of the space left; returns the rest, the
+    /// view's.
+    fn legend(&self, ui: &mut egui::Ui) -> egui::Rect {
         let whole = ui.available_rect_before_wrap();
         let strip = self.shown.legend.as_ref().map(|l| {
             let width = legend::width(ui, l).min(whole.width() * 0.4);
             let strip = whole.with_min_x(whole.max.x - width);
             (strip, l)
         });
-        let view_rect = strip.map_or(whole, |(s, _)| whole.with_max_x(s.min.x));
         if let Some((strip, l)) = strip {
             legend::paint(ui, strip, l, viewer::BACKGROUND);
         }
+        strip.map_or(whole, |(s, _)| whole.with_max_x(s.min.x))
+    }
+
+    /// The 3D view with its legend, its tools and the messages over it; the structure under
+    /// the pointer is named (and, in the viewer, selected by a click).
+    pub(super) fn view(&mut self, ui: &mut egui::Ui) {
+        let view_rect = self.legend(ui);
         let reads = self.reads();
         let rect = match &mut self.view {
             Some((viewer, _)) => {
