@@ -21,9 +21,11 @@ const CONTENT_TYPES = {
 
 /**
  * Serves `root` until `close()`. Every request is recorded in `served` (method and path), so a
- * test can see what the page asked for from this side too.
+ * test can see what the page asked for from this side too. `types` names other content types
+ * by extension (`{".wasm": "application/octet-stream"}`, as many servers send it).
  */
-export async function serveDirectory(root, port = 0) {
+export async function serveDirectory(root, port = 0, { types = {} } = {}) {
+    const contentTypes = { ...CONTENT_TYPES, ...types };
     const rootDir = normalize(root + sep);
     const served = [];
     const files = new Map();
@@ -42,7 +44,7 @@ export async function serveDirectory(root, port = 0) {
             }
             const body = kept ?? (await readFile(file));
             response.writeHead(200, {
-                "Content-Type": CONTENT_TYPES[extname(file)] ?? "application/octet-stream",
+                "Content-Type": contentTypes[extname(file)] ?? "application/octet-stream",
                 "Content-Length": body.length,
                 "Cache-Control": "no-store",
             });
