@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::names::{self, Names};
 use super::Case;
-use crate::view::{Clip, Planes};
+use super::{Clip, Planes};
 
 /// Longest step title, label text or structure name the lesson accepts (characters).
 const MAX_SHORT_TEXT: usize = 200;

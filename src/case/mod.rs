@@ -8,6 +8,7 @@
 //! quiz in `lesson`, and what a student did with them as xAPI statements in `xapi`.
 
 mod checks;
+mod clip;
 mod folder;
 mod from_files;
 mod image;
@@ -22,6 +23,7 @@ mod voxel_grid;
 pub mod xapi;
 
 pub use checks::{check, check_marks, checks_json, checks_text};
+pub use clip::{Clip, ClipAxis, Planes};
 pub use folder::{
     folder_order, read_in_folder, EntryKind, FolderListing, FOLDER_DEPTH, FOLDER_ENTRIES,
 };

@@ -21,8 +21,9 @@ pub mod thumbnail;
 mod tour;
 mod uniforms;
 
+pub use crate::case::{Clip, ClipAxis, Planes};
 pub use camera::{OrbitCamera, DEFAULT_FOV, ORBIT_RADIANS_PER_POINT, PITCH_LIMIT};
-pub use clip::{Clip, ClipAxis, Planes, StandardView, ViewRequest};
+pub use clip::{StandardView, ViewRequest};
 pub use labels::{label_spots, LabelSpot};
 pub use link::{CameraPose, ViewLink, LINK_KEYS};
 pub use morph::toward_original;
