@@ -19,7 +19,7 @@ const OUT = outputDir(MODE);
 const tmp = mkdtempSync(join(tmpdir(), "meshsmooth-subfolder-"));
 after(() => rmSync(tmp, { recursive: true, force: true }));
 
-testIn(EVERY_RUN, "S1 served from a subfolder, its wasm as octet-stream, the app starts, opens its sample and asks nothing outside its folder", { timeout: 180_000 }, async () => {
+testIn(EVERY_RUN, "H1 served from a subfolder, its wasm as octet-stream, the app starts, opens its sample and asks nothing outside its folder", { timeout: 180_000 }, async () => {
     mkdirSync(join(tmp, "course"));
     symlinkSync(resolve(DIST), join(tmp, "course", "viewer"));
     const server = await serveDirectory(tmp, 0, { types: { ".wasm": "application/octet-stream" } });
@@ -30,7 +30,7 @@ testIn(EVERY_RUN, "S1 served from a subfolder, its wasm as octet-stream, the app
             await app.api();
             const state = await app.stateWhen((s) => s.structures?.structures.length === 4, "the sample case");
             assert.equal(state.model, "abdomen_phantom.glb: liver");
-            await app.screenshot("S1-subfolder");
+            await app.screenshot("H1-subfolder");
             const folder = `${server.url}course/viewer/`;
             const outside = app.requests.filter((url) => !/^(data|blob):/.test(url) && !url.startsWith(folder));
             assert.deepEqual(outside, [], "requests outside the page's folder");
