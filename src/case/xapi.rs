@@ -14,15 +14,20 @@ const FAILED: &str = "http://adlnet.gov/expapi/verbs/failed";
 /// The activity type of a question (SCORM's interaction, as xAPI adopted it).
 const INTERACTION: &str = "http://adlnet.gov/expapi/activities/cmi.interaction";
 
-/// The activity id of part `fragment` of the case: an IRI under the case's title, since a
-/// case carries no address of its own (the platform may replace it with its own).
-fn activity_id(case: &Case, fragment: &str) -> String {
+/// The case's activity id: an IRI made from its title, since a case carries no address of its
+/// own (the platform may replace it with its own). A package's cmi5 AU has this id.
+pub fn case_activity(case: &Case) -> String {
     let title = if case.title.is_empty() {
         "case"
     } else {
         &case.title
     };
-    format!("urn:meshsmooth:case:{}#{fragment}", slug(title))
+    format!("urn:meshsmooth:case:{}", slug(title))
+}
+
+/// The activity id of part `fragment` of the case, under [`case_activity`].
+fn activity_id(case: &Case, fragment: &str) -> String {
+    format!("{}#{fragment}", case_activity(case))
 }
 
 /// `text` with every character but ASCII letters and digits as `-`, for an IRI.

@@ -1,5 +1,6 @@
 //! `meshsmooth case build INPUTS... -o case.glb`: the fixed pipeline for a whole segmentation
-//! (every structure suggested and smoothed, one case glTF), and `meshsmooth case info`.
+//! (every structure suggested and smoothed, one case glTF), `meshsmooth case info`, and the
+//! build `case package` runs first (see `package`).
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -8,6 +9,7 @@ use std::time::Instant;
 use super::inputs::Inputs;
 use super::params::filter as parse_filter;
 use super::progress::ProgressLine;
+use crate::case::relations::{PairRelation, RelationChanges};
 use crate::case::{
     self, Case, SuggestAllOptions, SuggestAllProgress, SuggestAllSearch, WindowPreset,
     DEFAULT_MAX_VOLUME_CHANGE,
@@ -22,6 +24,9 @@ pub(super) enum CaseCommand {
     /// Suggest and smooth every structure, then write one case glTF (.glb, or .gltf with the
     /// buffer embedded).
     Build(Box<BuildArgs>),
+    /// Write a package a learning management system imports (SCORM 1.2, SCORM 2004 or cmi5):
+    /// the case, the student viewer and the page that reports to the LMS.
+    Package(Box<super::package::PackageArgs>),
     /// Print a case glTF's structures, parameters and measures.
     Info {
         file: PathBuf,
@@ -39,6 +44,13 @@ pub(super) struct BuildArgs {
     /// The case glTF to write: .glb, or .gltf (one file, buffer embedded).
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    options: BuildOptions,
+}
+
+/// How `case build` (and `case package`, which builds first) makes the case.
+#[derive(clap::Args)]
+pub(super) struct BuildOptions {
     /// Target smoothness: the weight of smoothness against accuracy in the score, [0, 1].
     #[arg(long, default_value_t = 0.5)]
     tau: f64,
@@ -127,42 +139,109 @@ pub(super) struct BuildArgs {
     #[arg(long, value_name = "TRIANGLES")]
     triangle_budget: Option<usize>,
     #[arg(long)]
-    json: bool,
+    pub(super) json: bool,
 }
 
 pub(super) fn run(command: &CaseCommand) -> Result<(), String> {
     match command {
         CaseCommand::Build(args) => build(args),
+        CaseCommand::Package(args) => super::package::run(args),
         CaseCommand::Info { file, json } => info(file, *json),
     }
 }
 
 fn build(args: &BuildArgs) -> Result<(), String> {
-    super::check_tau(args.tau)?;
-    if args.simplify.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
-        return Err("--simplify takes a distance in voxel diagonals above 0".into());
-    }
-    if args.triangle_budget == Some(0) {
-        return Err("--triangle-budget takes a count of triangles above 0".into());
-    }
     let container = container(&args.output)?;
     super::check_destination(&args.output)?;
+    let built = build_case(&args.inputs, &args.options, container)?;
+    super::write_file(&args.output, &built.bytes)?;
+    let case = &built.case;
+    if args.options.json {
+        let mut out = case_json(case);
+        out["checks"] = case::checks_json(case, &built.after, &built.changes);
+        out["evaluations"] = serde_json::json!(built.evaluations);
+        out["open_seconds"] = serde_json::json!(built.seconds.open);
+        out["suggest_seconds"] = serde_json::json!(built.seconds.suggest);
+        out["checks_seconds"] = serde_json::json!(built.seconds.checks);
+        out["export_seconds"] = serde_json::json!(built.seconds.export);
+        out["seconds"] = serde_json::json!(built.seconds.all);
+        out["bytes"] = serde_json::json!(built.bytes.len());
+        outln!("{}", super::to_json(&out)?);
+    } else {
+        out!("{}", table(case));
+        out!("{}", image_line(case));
+        out!("{}", lesson_line(case));
+        out!(
+            "{}",
+            case::checks_text(case, &built.before, &built.after, &built.changes)
+        );
+        outln!(
+            "{} structures, {} parameter sets, suggested and smoothed in {:.2} s; \
+             {} written ({} bytes)",
+            case.structures.len(),
+            built.evaluations,
+            built.seconds.suggest,
+            args.output.display(),
+            built.bytes.len()
+        );
+    }
+    Ok(())
+}
+
+/// A case built from files: the structures opened, authored, suggested, smoothed and checked,
+/// and its glTF.
+pub(super) struct Built {
+    pub case: Case,
+    pub bytes: Vec<u8>,
+    pub evaluations: usize,
+    before: Vec<PairRelation>,
+    after: Vec<PairRelation>,
+    changes: RelationChanges,
+    seconds: Seconds,
+}
+
+/// Where a build's time went.
+struct Seconds {
+    open: f64,
+    suggest: f64,
+    checks: f64,
+    export: f64,
+    all: f64,
+}
+
+/// Opens `inputs` as a case, adds what the options author, suggests and smooths every
+/// structure, checks them, and writes the case glTF in `container`.
+pub(super) fn build_case(
+    inputs: &[PathBuf],
+    options: &BuildOptions,
+    container: Container,
+) -> Result<Built, String> {
+    super::check_tau(options.tau)?;
+    if options
+        .simplify
+        .is_some_and(|v| !(v.is_finite() && v > 0.0))
+    {
+        return Err("--simplify takes a distance in voxel diagonals above 0".into());
+    }
+    if options.triangle_budget == Some(0) {
+        return Err("--triangle-budget takes a count of triangles above 0".into());
+    }
     let started = Instant::now();
-    let mut case = open(args)?;
-    author(&mut case, args)?;
+    let mut case = open(inputs, options)?;
+    author(&mut case, options)?;
     let opened = started.elapsed().as_secs_f64();
     let checks_started = Instant::now();
     let before = case::check(&case, false);
     let mut checks_seconds = checks_started.elapsed().as_secs_f64();
 
-    let options = SuggestAllOptions {
-        tau: args.tau,
-        filter: args.filter,
-        search: args.search,
-        max_volume_change: args.max_volume_change.0.map(|p| p / 100.0),
+    let suggest_options = SuggestAllOptions {
+        tau: options.tau,
+        filter: options.filter,
+        search: options.search,
+        max_volume_change: options.max_volume_change.0.map(|p| p / 100.0),
     };
     let suggest_started = Instant::now();
-    let suggestions = suggest_all_shown(&mut case, &options)?;
+    let suggestions = suggest_all_shown(&mut case, &suggest_options)?;
     let suggest_seconds = suggest_started.elapsed().as_secs_f64();
     let checks_started = Instant::now();
     let after = case::check(&case, true);
@@ -170,44 +249,28 @@ fn build(args: &BuildArgs) -> Result<(), String> {
     let changes = case::relations::changes(&before, &after);
 
     let export_started = Instant::now();
-    let bytes = export::write_case(&case, &gltf_options(args, container))
-        .map_err(|e| format!("{}: {e}", args.output.display()))?;
-    let export_seconds = export_started.elapsed().as_secs_f64();
-    super::write_file(&args.output, &bytes)?;
-
-    let evaluations: usize = suggestions.iter().flatten().map(|s| s.evaluations).sum();
-    let checks = case::checks_json(&case, &after, &changes);
-    if args.json {
-        let mut out = case_json(&case);
-        out["checks"] = checks;
-        out["evaluations"] = serde_json::json!(evaluations);
-        out["open_seconds"] = serde_json::json!(opened);
-        out["suggest_seconds"] = serde_json::json!(suggest_seconds);
-        out["checks_seconds"] = serde_json::json!(checks_seconds);
-        out["export_seconds"] = serde_json::json!(export_seconds);
-        out["seconds"] = serde_json::json!(started.elapsed().as_secs_f64());
-        out["bytes"] = serde_json::json!(bytes.len());
-        outln!("{}", super::to_json(&out)?);
-    } else {
-        out!("{}", table(&case));
-        out!("{}", image_line(&case));
-        out!("{}", lesson_line(&case));
-        out!("{}", case::checks_text(&case, &before, &after, &changes));
-        outln!(
-            "{} structures, {evaluations} parameter sets, suggested and smoothed in {:.2} s; \
-             {} written ({} bytes)",
-            case.structures.len(),
-            suggest_seconds,
-            args.output.display(),
-            bytes.len()
-        );
-    }
-    Ok(())
+    let bytes =
+        export::write_case(&case, &gltf_options(options, container)).map_err(|e| e.to_string())?;
+    Ok(Built {
+        evaluations: suggestions.iter().flatten().map(|s| s.evaluations).sum(),
+        case,
+        bytes,
+        before,
+        after,
+        changes,
+        seconds: Seconds {
+            open: opened,
+            suggest: suggest_seconds,
+            checks: checks_seconds,
+            export: export_started.elapsed().as_secs_f64(),
+            all: started.elapsed().as_secs_f64(),
+        },
+    })
 }
 
 /// Adds the image at `path`: one file, or a folder of a DICOM series' slices (in subfolders,
 /// as a DICOM export keeps them).
-fn add_image(case: &mut Case, path: &Path, args: &BuildArgs) -> Result<(), String> {
+fn add_image(case: &mut Case, path: &Path, args: &BuildOptions) -> Result<(), String> {
     let name = path.display().to_string();
     let added = if path.is_dir() {
         let files = super::inputs::read_folder(path)?;
@@ -233,7 +296,7 @@ fn path_text(path: &Path) -> String {
 
 /// What the author adds to the structures opened: the image, title, description, lesson,
 /// names in other languages, and no bound where asked.
-fn author(case: &mut Case, args: &BuildArgs) -> Result<(), String> {
+fn author(case: &mut Case, args: &BuildOptions) -> Result<(), String> {
     let read = |path: &Path| {
         let name = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
@@ -292,7 +355,7 @@ fn suggest_all_shown(
 }
 
 /// How `case build` writes the glTF.
-fn gltf_options(args: &BuildArgs, container: Container) -> CaseGltfOptions {
+fn gltf_options(args: &BuildOptions, container: Container) -> CaseGltfOptions {
     CaseGltfOptions {
         frame: if args.millimetres {
             SceneFrame::Millimetres
@@ -361,8 +424,8 @@ fn container(output: &Path) -> Result<Container, String> {
     }
 }
 
-fn open(args: &BuildArgs) -> Result<Case, String> {
-    let inputs = Inputs::read(&args.inputs, args.colors.as_deref())?;
+pub(super) fn open(inputs: &[PathBuf], args: &BuildOptions) -> Result<Case, String> {
+    let inputs = Inputs::read(inputs, args.colors.as_deref())?;
     let options = OpenOptions {
         extract: ExtractOptions {
             labels: args.labels.clone(),

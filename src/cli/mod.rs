@@ -14,6 +14,7 @@ mod info;
 mod inputs;
 mod measure;
 mod output;
+mod package;
 mod params;
 mod progress;
 mod smooth;

@@ -1,11 +1,13 @@
 //! Writers: an indexed mesh out as bytes (binary PLY, binary STL, OBJ, GLB), vertex order kept,
-//! and a case (several named, coloured structures) as one glTF scene.
+//! a case (several named, coloured structures) as one glTF scene, and a case with the student
+//! viewer as a package a learning management system imports (`lms`).
 //! Nothing from an input file's header is ever written (STL headers often carry patient names).
 
 mod case_gltf;
 mod case_lesson;
 mod compressed;
 mod glb;
+pub mod lms;
 mod meshopt;
 mod obj;
 mod ply;
