@@ -69,6 +69,9 @@ stage fuzz env FUZZ_SECONDS="${FUZZ_SECONDS:-10}" bash tests/fuzz/run.sh
 stage test-wasm32-browser env CHROMEDRIVER="${CHROMEDRIVER:-/usr/bin/chromedriver}" \
     cargo test --target wasm32-unknown-unknown --lib --test wasm_io --test wasm_gpu
 stage web-build trunk build --release
+# The LMS packages: the launch page's runtime against scorm-again, and the phantom's SCORM 1.2,
+# SCORM 2004 and cmi5 packages against their manifests' schemas (tests/lms/run.sh).
+stage lms bash tests/lms/run.sh
 # End-to-end tests of the built app (dist/) in headless Chromium, with WebGPU and without, against
 # the CLI's numbers; screenshots in target/e2e/. (The browser benchmarks are a command of their
 # own: bash tests/e2e/run.sh --bench.)
