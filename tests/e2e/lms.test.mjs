@@ -1,0 +1,308 @@
+// End-to-end tests of the LMS packages (`meshsmooth case package`): a test LMS page built on
+// scorm-again (its Scorm12API or Scorm2004API as window.API / window.API_1484_11) frames the
+// unzipped package from its own origin; the student takes the tour and the quiz by clicks and
+// taps; the data model the LMS keeps is read back, and a relaunch with it resumes.
+//
+//   E2E_MODE=cpu node --test tests/e2e/lms.test.mjs   (tests/e2e/run.sh runs it in the cpu run)
+import { after } from "node:test";
+import assert from "node:assert/strict";
+import { execFileSync } from "node:child_process";
+import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+
+import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
+import * as cli from "./lib/cli.mjs";
+import { DIST, ROOT, meshPath, outputDir } from "./lib/paths.mjs";
+import { serveDirectory } from "./lib/server.mjs";
+import { CPU_RUN, testIn } from "./lib/suite.mjs";
+
+const MODE = modeFromEnv();
+const OUT = outputDir(MODE);
+const TIMEOUT = 240_000;
+const tmp = mkdtempSync(join(tmpdir(), "meshsmooth-lms-"));
+after(() => rmSync(tmp, { recursive: true, force: true }));
+
+const lessonFile = join(ROOT, "tests/data/phantom_lesson.json");
+const lesson = JSON.parse(readFileSync(lessonFile, "utf8"));
+const SCORM_AGAIN = join(ROOT, "web/node_modules/scorm-again/dist");
+
+/** Each format's folder (the test LMS page beside the unzipped package), built once per run. */
+const built = {};
+
+/** The SCORM package of the phantom with its lesson, unzipped into `<tmp>/<format>/package/`. */
+async function builtPackage(format) {
+    const root = join(tmp, format);
+    mkdirSync(root, { recursive: true });
+    const zip = join(OUT, `phantom-${format}.zip`);
+    const map = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
+    await cli.cliJson("case", "package", map, "--search", "local", "--lesson", lessonFile, "--title", "Abdominal phantom", "--format", format, "--viewer", DIST, "-o", zip, "--json");
+    execFileSync("python3", ["-m", "zipfile", "-e", zip, join(root, "package")]);
+    const script = format === "scorm12" ? "scorm12.min.js" : "scorm2004.min.js";
+    copyFileSync(join(SCORM_AGAIN, script), join(root, script));
+    writeFileSync(join(root, "lms.html"), lmsPage(format, script));
+    return root;
+}
+
+/**
+ * The test LMS: `launch(kept)` makes a fresh API (loaded with what the LMS kept of the last
+ * attempt) and frames the package; `leave()` takes the frame away, as a platform does when the
+ * student goes elsewhere; `kept()` is the data model as the LMS holds it.
+ */
+function lmsPage(format, script) {
+    const [global, make, commit] = format === "scorm12" ? ["API", "Scorm12API", "LMSCommit"] : ["API_1484_11", "Scorm2004API", "Commit"];
+    return `<!DOCTYPE html><html><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1"><title>Test LMS</title>
+<link rel="icon" href="data:,"><script src="${script}"></script>
+<style>html, body { margin: 0; height: 100%; } iframe { border: 0; width: 100%; height: 100%; display: block; }</style>
+</head><body><script>
+window.commits = 0;
+window.launch = (kept) => {
+    const api = new ${make}({ lmsCommitUrl: false, autocommit: false, logLevel: 4 });
+    if (kept) api.loadFromJSON(kept);
+    api.on("${commit}", () => { window.commits += 1; });
+    window.${global} = api;
+    const frame = document.createElement("iframe");
+    frame.src = "package/index.html";
+    document.body.append(frame);
+};
+window.leave = () => document.querySelector("iframe")?.remove();
+window.kept = () => window.${global}.renderCMIToJSONObject().cmi;
+</script></body></html>`;
+}
+
+/** The viewer's frame inside the launch page's, with its API and its place on the LMS page. */
+async function viewerOf(page) {
+    const deadline = Date.now() + 60_000;
+    for (;;) {
+        const frame = page.frames().find((f) => f.url().includes("/package/viewer/index.html"));
+        if (frame && (await frame.evaluate(() => Boolean(window.meshsmooth)).catch(() => false))) {
+            const box = await (await frame.frameElement()).boundingBox();
+            return { frame, box };
+        }
+        if (Date.now() > deadline) throw new Error("the packaged viewer did not start");
+        await new Promise((resolve) => setTimeout(resolve, 200));
+    }
+}
+
+/** Polls the viewer's `state()` until `test` holds. */
+async function stateWhen(viewer, test, what) {
+    const deadline = Date.now() + 30_000;
+    for (;;) {
+        const state = await viewer.frame.evaluate(() => window.meshsmooth.state());
+        if (test(state)) return state;
+        if (Date.now() > deadline) throw new Error(`timed out waiting for ${what}`);
+        await new Promise((resolve) => setTimeout(resolve, 100));
+    }
+}
+
+/** A click (or a tap) at a point of the viewer's page, on the LMS page. */
+async function touch(page, viewer, x, y, tap) {
+    const [px, py] = [viewer.box.x + x, viewer.box.y + y];
+    if (tap) await page.touchscreen.tap(px, py);
+    else await page.mouse.click(px, py);
+}
+
+async function press(page, viewer, key, tap = false) {
+    const s = await stateWhen(viewer, (s) => s.layout.lesson?.[key], `the ${key} button`);
+    const r = s.layout.lesson[key];
+    await touch(page, viewer, r.x + r.width / 2, r.y + r.height / 2, tap);
+}
+
+const phantomShown = (viewer) => stateWhen(viewer, (s) => s.structures?.structures.length === 4 && s.loading === null, "the phantom's four structures");
+
+/**
+ * A point of the view on `name` as the view stands: the pointer is moved over the view from its
+ * centre outwards until the viewer says that structure lies under it.
+ */
+async function pointOn(page, viewer, name) {
+    const s = await stateWhen(viewer, (s) => s.view, "the view");
+    const { x, y, width, height } = s.view;
+    const points = [];
+    for (let i = 1; i < 12; i++) for (let j = 1; j < 12; j++) points.push([x + (width * i) / 12, y + (height * j) / 12]);
+    const [cx, cy] = [x + width / 2, y + height / 2];
+    points.sort((a, b) => Math.hypot(a[0] - cx, a[1] - cy) - Math.hypot(b[0] - cx, b[1] - cy));
+    for (const [px, py] of points) {
+        await page.mouse.move(viewer.box.x + px, viewer.box.y + py);
+        // Two frames for the view to pick what lies under the pointer.
+        await new Promise((resolve) => setTimeout(resolve, 150));
+        const pointed = await viewer.frame.evaluate(() => window.meshsmooth.state().view.pointed);
+        if (pointed === name) return { x: px, y: py };
+    }
+    throw new Error(`no point of the view shows the ${name}`);
+}
+
+/**
+ * Takes the quiz by clicks (or taps): "Find it" by clicking the liver (right once), "Name it" by
+ * picking the right name `namedRight` times, a wrong one after. Returns the answers as the
+ * viewer saw them.
+ */
+async function takeQuiz(page, viewer, namedRight, tap = false) {
+    await press(page, viewer, "quiz", tap);
+    let s = await stateWhen(viewer, (s) => s.quiz?.running && s.quiz.question === 0, "the quiz started");
+    const liver = await pointOn(page, viewer, "liver");
+    const answers = [];
+    for (let q = 0; q < s.quiz.questions; q++) {
+        s = await stateWhen(viewer, (s) => s.quiz.question === q && !s.layout.lesson["next-question"], `question ${q + 1}`);
+        const { mode, asked, choices } = s.quiz;
+        if (mode === "find-it") {
+            await touch(page, viewer, liver.x, liver.y, tap);
+        } else {
+            const named = answers.filter((a) => a.mode === "name-it" && a.right).length;
+            const pick = named < namedRight ? choices.indexOf(asked) : choices.findIndex((c) => c !== asked);
+            await press(page, viewer, `choice-${pick}`, tap);
+        }
+        s = await stateWhen(viewer, (s) => s.quiz.answer !== null, `question ${q + 1} answered`);
+        answers.push({ mode, asked, ...s.quiz.answer });
+        await press(page, viewer, "next-question", tap);
+    }
+    await stateWhen(viewer, (s) => s.quiz.finished, "the quiz finished");
+    return answers;
+}
+
+/** What the LMS keeps for the next launch, as an LMS relaunches a suspended attempt. */
+function relaunchData(format, cmi) {
+    const kept = structuredClone(cmi);
+    const core = format === "scorm12" ? kept.core : kept;
+    core.entry = core.exit === "suspend" ? "resume" : "";
+    delete core.exit;
+    delete core.session_time;
+    return kept;
+}
+
+const interactionsOf = (cmi) => Object.values(cmi.interactions ?? {}).filter((i) => i && typeof i === "object" && i.id);
+
+/**
+ * One student's attempt in `format`: two tour steps, leave, relaunch (back at the second step),
+ * the last step, the quiz (right and wrong in each mode), leave; returns what the LMS kept and
+ * the answers given.
+ */
+async function attempt(format, { device = null, namedRight = 1 } = {}) {
+    built[format] ??= builtPackage(format);
+    const server = await serveDirectory(await built[format]);
+    const browser = await launchBrowser(MODE);
+    const requests = [];
+    try {
+        const context = await browser.newContext(device ?? { viewport: { width: 1280, height: 800 } });
+        const page = await context.newPage();
+        page.on("request", (r) => requests.push(r.url()));
+        const errors = [];
+        page.on("pageerror", (e) => errors.push(String(e)));
+        const tap = Boolean(device?.hasTouch);
+        await page.goto(`${server.url}lms.html`);
+        await page.evaluate(() => window.launch(null));
+        let viewer = await viewerOf(page);
+        await phantomShown(viewer);
+        await press(page, viewer, "start", tap);
+        await stateWhen(viewer, (s) => s.tour?.step === 0, "step 1");
+        await press(page, viewer, "next", tap);
+        await stateWhen(viewer, (s) => s.tour?.step === 1, "step 2");
+        await page.screenshot({ path: join(OUT, `lms-${format}${tap ? "-phone" : ""}-tour.png`) });
+        await page.evaluate(() => window.leave());
+        const left = await page.evaluate(() => window.kept());
+
+        await page.evaluate((kept) => window.launch(kept), relaunchData(format, left));
+        viewer = await viewerOf(page);
+        await phantomShown(viewer);
+        await stateWhen(viewer, (s) => s.tour?.step === 1, "the relaunch resumed at step 2");
+        await press(page, viewer, "next", tap);
+        await stateWhen(viewer, (s) => s.tour?.step === 2, "step 3, the last");
+        await press(page, viewer, "leave", tap);
+        await stateWhen(viewer, (s) => s.tour.step === null && !s.layout.lesson?.leave, "the tour left, drawn");
+        const answers = await takeQuiz(page, viewer, namedRight, tap);
+        await page.screenshot({ path: join(OUT, `lms-${format}${tap ? "-phone" : ""}-score.png`) });
+        await page.evaluate(() => window.leave());
+        const kept = await page.evaluate(() => window.kept());
+        const commits = await page.evaluate(() => window.commits);
+        const outside = requests.filter((url) => !/^(data|blob):/.test(url) && !url.startsWith(server.url));
+        assert.deepEqual(outside, [], "requests outside the LMS's origin");
+        assert.deepEqual(errors, [], "uncaught errors");
+        await context.close();
+        return { left, kept, answers, commits };
+    } finally {
+        await browser.close();
+        await server.close();
+    }
+}
+
+/** The checks both versions share: one interaction per answer, with its result and response. */
+function checkInteractions(format, kept, answers) {
+    const interactions = interactionsOf(kept);
+    assert.equal(interactions.length, answers.length, "one interaction per answer");
+    const [right, wrong] = format === "scorm12" ? ["correct", "wrong"] : ["correct", "incorrect"];
+    for (const [i, a] of answers.entries()) {
+        const it = interactions[i];
+        assert.equal(it.result, a.right ? right : wrong, `${JSON.stringify(it)} for ${JSON.stringify(a)}`);
+        assert.match(it.id, new RegExp(a.mode), it.id);
+        const response = format === "scorm12" ? it.student_response : it.learner_response;
+        assert.ok(response, `a response in ${JSON.stringify(it)}`);
+    }
+    for (const mode of ["find-it", "name-it"]) {
+        const of = answers.filter((a) => a.mode === mode);
+        assert.ok(of.some((a) => a.right) && of.some((a) => !a.right), `${mode}: a right and a wrong answer`);
+    }
+}
+
+testIn(CPU_RUN, "P1 SCORM 1.2: the tour and quiz by clicks reach the LMS: location, suspend data, interactions, score, failed; a relaunch resumes", { timeout: TIMEOUT }, async () => {
+    const { left, kept, answers, commits } = await attempt("scorm12");
+    assert.equal(left.core.lesson_location, "2", "the step left, counted from 1");
+    assert.equal(left.core.exit, "suspend");
+    assert.ok(left.suspend_data.length > 0 && left.suspend_data.length <= 4096, left.suspend_data);
+    assert.equal(left.core.lesson_status, "incomplete");
+    checkInteractions("scorm12", kept, answers);
+    const right = answers.filter((a) => a.right).length;
+    assert.equal(right, 2, "the liver found once, one name right");
+    assert.equal(Number(kept.core.score.raw), (100 * right) / answers.length);
+    assert.equal(kept.core.score.min, "0");
+    assert.equal(kept.core.score.max, "100");
+    assert.equal(kept.core.lesson_status, "failed", `${right} of ${answers.length} is under the pass mark of ${lesson.quiz.pass_mark}`);
+    assert.ok(commits >= 3, `committed along the way (${commits})`);
+});
+
+testIn(CPU_RUN, "P2 SCORM 2004: progress, interactions, the scaled score passed at the pass mark, completed; a relaunch resumes", { timeout: TIMEOUT }, async () => {
+    const { left, kept, answers } = await attempt("scorm2004", { namedRight: 3 });
+    assert.equal(left.location, "2");
+    assert.equal(left.exit, "suspend");
+    assert.ok(Number(left.progress_measure) > 0 && Number(left.progress_measure) < 1, `progress ${left.progress_measure}`);
+    assert.equal(left.completion_status, "incomplete");
+    checkInteractions("scorm2004", kept, answers);
+    const right = answers.filter((a) => a.right).length;
+    assert.equal(right, 4, "the liver found once, three names right");
+    assert.equal(Number(kept.score.scaled), right / answers.length);
+    assert.equal(Number(kept.score.raw), (100 * right) / answers.length);
+    assert.equal(kept.success_status, "passed", `${right} of ${answers.length} reaches the pass mark of ${lesson.quiz.pass_mark}`);
+    assert.equal(kept.completion_status, "completed");
+});
+
+testIn(CPU_RUN, "P3 SCORM 1.2 on a phone held upright: the same attempt by taps", { timeout: TIMEOUT }, async () => {
+    const phone = { viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true, deviceScaleFactor: 1 };
+    const { left, kept, answers } = await attempt("scorm12", { device: phone });
+    assert.equal(left.core.lesson_location, "2");
+    checkInteractions("scorm12", kept, answers);
+    assert.equal(kept.core.lesson_status, "failed");
+});
+
+testIn(CPU_RUN, "P4 a package opened on its own plays the lesson and says once that nothing is recorded", { timeout: TIMEOUT }, async () => {
+    built.scorm12 ??= builtPackage("scorm12");
+    const server = await serveDirectory(await built.scorm12);
+    const browser = await launchBrowser(MODE);
+    try {
+        const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+        const errors = [];
+        page.on("pageerror", (e) => errors.push(String(e)));
+        await page.goto(`${server.url}package/index.html`);
+        const viewer = await viewerOf(page);
+        await phantomShown(viewer);
+        const notice = page.locator("#notice");
+        await notice.waitFor({ state: "visible" });
+        assert.match(await notice.innerText(), /outside a learning platform: your progress and answers are not recorded/i);
+        await press(page, viewer, "start");
+        await stateWhen(viewer, (s) => s.tour?.step === 0, "the tour plays without an LMS");
+        await page.screenshot({ path: join(OUT, "lms-outside.png") });
+        await page.locator("#notice-close").click();
+        await notice.waitFor({ state: "hidden" });
+        assert.deepEqual(errors, [], "uncaught errors");
+    } finally {
+        await browser.close();
+        await server.close();
+    }
+});
