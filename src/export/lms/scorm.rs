@@ -13,11 +13,31 @@ fn identifier(about: &About) -> String {
     format!("meshsmooth-{tail}")
 }
 
-fn file_list(files: &[&str]) -> String {
-    files
-        .iter()
+/// The manifest's end, the same in both versions but for the SCO attribute's spelling
+/// (`scormtype` in 1.2, `scormType` in 2004): one organization of one item (`item_more` after
+/// its title: the mastery or the sequencing), played by the launch page, which lists `files`.
+fn organization(about: &About, item_more: &str, scorm_type: &str, files: &[&str]) -> String {
+    let id = identifier(about);
+    let title = xml_text(&about.title);
+    let files: String = (files.iter())
         .map(|f| format!("      <file href=\"{}\"/>\n", xml_text(f)))
-        .collect()
+        .collect();
+    format!(
+        r#"  <organizations default="{id}-organization">
+    <organization identifier="{id}-organization">
+      <title>{title}</title>
+      <item identifier="{id}-item" identifierref="{id}-sco" isvisible="true">
+        <title>{title}</title>
+{item_more}      </item>
+    </organization>
+  </organizations>
+  <resources>
+    <resource identifier="{id}-sco" type="webcontent" adlcp:{scorm_type}="sco" href="index.html">
+{files}    </resource>
+  </resources>
+</manifest>
+"#
+    )
 }
 
 /// SCORM 1.2: the pass mark as `adlcp:masteryscore` (0 to 100), the description in the
@@ -52,22 +72,9 @@ pub(super) fn manifest_12(about: &About, files: &[&str]) -> String {
       </imsmd:general>
     </imsmd:lom>
   </metadata>
-  <organizations default="{id}-organization">
-    <organization identifier="{id}-organization">
-      <title>{title}</title>
-      <item identifier="{id}-item" identifierref="{id}-sco" isvisible="true">
-        <title>{title}</title>
-{mastery}      </item>
-    </organization>
-  </organizations>
-  <resources>
-    <resource identifier="{id}-sco" type="webcontent" adlcp:scormtype="sco" href="index.html">
-{files}    </resource>
-  </resources>
-</manifest>
-"#,
+{organization}"#,
         id = identifier(about),
-        files = file_list(files),
+        organization = organization(about, &mastery, "scormtype", files),
     )
 }
 
@@ -114,21 +121,8 @@ pub(super) fn manifest_2004(about: &About, files: &[&str]) -> String {
       </lom:general>
     </lom:lom>
   </metadata>
-  <organizations default="{id}-organization">
-    <organization identifier="{id}-organization">
-      <title>{title}</title>
-      <item identifier="{id}-item" identifierref="{id}-sco" isvisible="true">
-        <title>{title}</title>
-{sequencing}      </item>
-    </organization>
-  </organizations>
-  <resources>
-    <resource identifier="{id}-sco" type="webcontent" adlcp:scormType="sco" href="index.html">
-{files}    </resource>
-  </resources>
-</manifest>
-"#,
+{organization}"#,
         id = identifier(about),
-        files = file_list(files),
+        organization = organization(about, &sequencing, "scormType", files),
     )
 }
