@@ -1,7 +1,7 @@
 //! The authoring page's Lesson panel: the tour's steps recorded from the view as it stands,
 //! their titles and captions edited, reordered, deleted and shown again; labels placed by
 //! clicking a structure in the view, their texts and notes edited; the quiz's modes, structures
-//! and pass mark. Titles, captions, texts and notes are edited in the own (English) words or in
+//! and pass mark; and "Export for LMS" (see `lms_export`). Titles, captions, texts and notes are edited in the own (English) words or in
 //! another language the author picks. Every edit goes through `CaseDocument::set_lesson`, which
 //! checks it against the case.
 
@@ -11,6 +11,7 @@ use glam::Vec3;
 use super::document::Document;
 use crate::case::names::{self, Names};
 use crate::case::{Label, Lesson, Quiz, QuizMode};
+use crate::export::lms::LmsFormat;
 use crate::view::recorded_step;
 
 impl Document {
@@ -90,6 +91,8 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     ui.separator();
     let names = doc.case().structure_names();
     quiz(ui, &mut lesson, &names, &mut drawn, &mut asked);
+    ui.separator();
+    let lms = export_for_lms(ui, &mut drawn);
     (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
     if asked.edited {
         if let Err(e) = doc.case_mut().set_lesson(lesson) {
@@ -106,6 +109,32 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     if let Some(i) = asked.show_step {
         let _ = doc.ask_step(i);
     }
+    if let Some(format) = lms {
+        super::lms_export::save(doc.session(), format);
+    }
+}
+
+/// "Export for LMS": a button a format; the one clicked, if any.
+fn export_for_lms(ui: &mut egui::Ui, drawn: &mut Vec<(String, egui::Rect)>) -> Option<LmsFormat> {
+    let mut asked = None;
+    ui.label("Export for LMS (a package to upload as a course activity):");
+    ui.horizontal_wrapped(|ui| {
+        for (format, label) in [
+            (LmsFormat::Scorm12, "SCORM 1.2"),
+            (LmsFormat::Scorm2004, "SCORM 2004"),
+            (LmsFormat::Cmi5, "cmi5"),
+        ] {
+            let button = ui.button(label).on_hover_text(
+                "The case, its lesson and the student viewer as one zip; the LMS records the \
+                 tour, each quiz answer and the score",
+            );
+            drawn.push((format!("lms-{}", format.name()), button.rect));
+            if button.clicked() {
+                asked = Some(format);
+            }
+        }
+    });
+    asked
 }
 
 /// The language the words below are edited in, typed or picked among those the lesson has:

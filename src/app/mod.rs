@@ -14,7 +14,8 @@
 //!   engine's dedicated workers), `gpu_engine` (the WebGPU engine's driver), `pacing` (how
 //!   often the page redraws for work it does not see);
 //! - the authoring page's panels: `controls`, `guide`, `structure_list` with
-//!   `case_export_view`, `lesson_panel`, `report_view`, `legend`, `status`, `shortcuts`,
+//!   `case_export_view`, `lesson_panel` with `lms_export` (the package for an LMS),
+//!   `report_view`, `legend`, `status`, `shortcuts`,
 //!   `bottom_panel` with `graphs` and `gallery` / `gallery_view`;
 //! - the viewer's panel (`?mode=viewer`): `case_reader`, and `case_text` for screen readers;
 //!   the lesson as the student plays it: `tour`, `quiz`, and `labels` over the view;
@@ -45,6 +46,7 @@ mod labels;
 mod layout;
 mod legend;
 mod lesson_panel;
+mod lms_export;
 mod orientation_marker;
 mod pacing;
 mod page;

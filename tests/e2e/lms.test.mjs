@@ -15,10 +15,12 @@ import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
 import { DIST, ROOT, meshPath, outputDir } from "./lib/paths.mjs";
 import { serveDirectory } from "./lib/server.mjs";
-import { CPU_RUN, testIn } from "./lib/suite.mjs";
+import { frames } from "./lib/input.mjs";
+import { CPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
 const MODE = modeFromEnv();
 const OUT = outputDir(MODE);
+const { withApp } = appSuite({ beforeAll: () => cli.requireCli() });
 const TIMEOUT = 240_000;
 const tmp = mkdtempSync(join(tmpdir(), "meshsmooth-lms-"));
 after(() => rmSync(tmp, { recursive: true, force: true }));
@@ -305,4 +307,48 @@ testIn(CPU_RUN, "P4 a package opened on its own plays the lesson and says once t
         await browser.close();
         await server.close();
     }
+});
+
+testIn(CPU_RUN, "P5 the Lesson panel's Export for LMS saves the package the CLI writes for the same case", { timeout: TIMEOUT }, async () => {
+    const caseFile = join(OUT, "lms-lesson-case.glb");
+    const map = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
+    await cli.cliJson("case", "build", map, "--search", "local", "--lesson", lessonFile, "--title", "Abdominal phantom", "-o", caseFile, "--json");
+    const routes = { "cases/lesson.glb": readFileSync(caseFile) };
+    await withApp(async (app) => {
+        await app.stateWhen((s) => s.loading === null && s.structures?.structures.length === 4 && s.layout.lesson?.["lesson-tab"], "the case open");
+        const centreOf = (r) => [r.x + r.width / 2, r.y + r.height / 2];
+        const click = async (key) => {
+            let s = await app.stateWhen((s) => s.layout.lesson?.[key], `the Lesson panel's ${key}`);
+            // A button out of the panel's sight is scrolled into it, as the author would.
+            for (let tries = 0; tries < 20 && s.layout.lesson["in-sight"]; tries++) {
+                const [r, v] = [s.layout.lesson[key], s.layout.lesson["in-sight"]];
+                const below = r.y + r.height > v.y + v.height;
+                if (!below && r.y >= v.y) break;
+                await app.page.mouse.move(...centreOf(v));
+                await app.page.mouse.wheel(0, below ? 100 : -100);
+                await frames(app);
+                s = await app.state();
+            }
+            await app.page.mouse.click(...centreOf(s.layout.lesson[key]));
+            await frames(app);
+        };
+        await click("lesson-tab");
+        const saved = app.page.waitForEvent("download", { timeout: 60_000 });
+        await click("lms-scorm2004");
+        const download = await saved;
+        assert.equal(download.suggestedFilename(), "Abdominal_phantom_scorm2004.zip");
+        const zip = join(OUT, "lms-page-scorm2004.zip");
+        await download.saveAs(zip);
+        const fromPage = readFileSync(zip);
+        const called = Buffer.from(await app.page.evaluate(async () => Array.from(await window.meshsmooth.exportLms("scorm2004"))));
+        assert.ok(called.equals(fromPage), "exportLms() gives the button's package");
+
+        // The CLI, given the page's case glTF and the page's build as the viewer.
+        const unzipped = join(tmp, "page-package");
+        execFileSync("python3", ["-m", "zipfile", "-e", zip, unzipped]);
+        const fromCli = join(OUT, "lms-cli-scorm2004.zip");
+        await cli.cliJson("case", "package", join(unzipped, "case.glb"), "--format", "scorm2004", "--viewer", DIST, "-o", fromCli, "--json");
+        assert.ok(readFileSync(fromCli).equals(fromPage), "the page's package is the CLI's, byte for byte");
+        assert.match(readFileSync(join(unzipped, "imsmanifest.xml"), "utf8"), /<imsss:minNormalizedMeasure>0\.5<\/imsss:minNormalizedMeasure>/);
+    }, { query: "?case=cases/lesson.glb", routes });
 });

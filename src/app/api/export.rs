@@ -1,5 +1,6 @@
-//! The API's exports: `exportMesh` (the model alone), `exportCase` (the case glTF at once) and
-//! `writeCase` (the case glTF a structure per frame, as the page's button writes it).
+//! The API's exports: `exportMesh` (the model alone), `exportCase` (the case glTF at once),
+//! `writeCase` (the case glTF a structure per frame, as the page's button writes it) and
+//! `exportLms` (the package for an LMS, as the Lesson panel's buttons save it).
 
 use eframe::egui;
 use js_sys::{Promise, Uint8Array};
@@ -9,6 +10,8 @@ use wasm_bindgen::JsValue;
 
 use super::{from_js, settled, to_js, when_current, when_ready, Api};
 use crate::app::document::SharedDocument;
+use crate::app::lms_export;
+use crate::export::lms::LmsFormat;
 use crate::export::{CaseGltfOptions, Container, ExportFormat, Simplification};
 
 /// `exportMesh`, `exportCase` and `writeCase`.
@@ -89,6 +92,28 @@ pub(super) fn define_export(
                         .to_string()),
                 },
             )
+        }),
+    )?;
+
+    let (d, c) = (doc.clone(), ctx.clone());
+    api.define(
+        "exportLms",
+        Closure::<dyn FnMut(JsValue) -> Promise>::new(move |format: JsValue| {
+            let name = format.as_string().unwrap_or_default();
+            let Some(format) = LmsFormat::from_name(&name) else {
+                return settled(Err(format!(
+                    "unknown package format '{name}': use scorm12, scorm2004 or cmi5"
+                )));
+            };
+            when_current(&d, &c, move |session| {
+                let (case, glb) = lms_export::case_and_glb(session)?;
+                let zip = async move {
+                    let zip = lms_export::package(format, case, glb).await;
+                    zip.map(|z| Uint8Array::from(z.as_slice()).into())
+                        .map_err(|e| super::error(&e))
+                };
+                Ok(wasm_bindgen_futures::future_to_promise(zip).into())
+            })
         }),
     )
 }

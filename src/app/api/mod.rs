@@ -58,6 +58,10 @@
 //! - `writeCase({simplify, triangle_budget}): Promise<{bytes, triangles}>`: writes the
 //!   compressed case glTF a structure per frame, as the page's "Write case" does (its progress
 //!   in `state().case_export`), and resolves with its size and triangles
+//! - `exportLms(format): Promise<Uint8Array>`: the package for an LMS (`scorm12`, `scorm2004`
+//!   or `cmi5`) the Lesson panel's "Export for LMS" saves: the case glTF (`writeCase`'s when
+//!   current, else `exportCase`'s), its lesson and this page's build as the viewer, what
+//!   `meshsmooth case package` writes for that glTF with the page's build as `--viewer`
 //! - `suggest({tau, search}): Promise<object>`: sets tau and searches (`grid`, the default, or
 //!   `local`) for the active filter; resolves with the CLI's `suggest --json` keys (the
 //!   suggestion is shown, not applied)
