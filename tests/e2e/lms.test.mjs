@@ -89,7 +89,8 @@ const interactionsOf = (cmi) => Object.values(cmi.interactions ?? {}).filter((i)
  */
 async function attempt(format, { device = null, namedRight = 1 } = {}) {
     built[format] ??= builtPackage(format);
-    const server = await serveDirectory(await built[format]);
+    // As many LMSs serve a package's files: the wasm as a plain download.
+    const server = await serveDirectory(await built[format], 0, { types: { ".wasm": "application/octet-stream" } });
     const browser = await launchBrowser(MODE);
     const requests = [];
     try {
