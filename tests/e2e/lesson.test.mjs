@@ -10,7 +10,7 @@ import { join } from "node:path";
 import * as cli from "./lib/cli.mjs";
 import { E2E_OUT, ROOT, meshPath } from "./lib/paths.mjs";
 import { EVERY_RUN, appSuite, testIn } from "./lib/suite.mjs";
-import { drag, frames } from "./lib/input.mjs";
+import { drag, frames, pressLessonControl } from "./lib/input.mjs";
 import { changedPixels, drawn } from "./lib/view.mjs";
 
 const { MODE, withApp } = appSuite({ beforeAll: () => cli.requireCli() });
@@ -314,22 +314,7 @@ testIn(EVERY_RUN, "L5 the author builds the lesson in the page's Lesson panel: t
     await withApp(async (app) => {
         await app.loadMesh(readFileSync(PHANTOM_NRRD), "case_phantom_shared.seg.nrrd", "loadCase");
         let s = await app.stateWhen((s) => s.loading === null && s.view.camera && s.layout.lesson?.["lesson-tab"], "the case open");
-        const centreOf = (r) => [r.x + r.width / 2, r.y + r.height / 2];
-        const press = async (key) => {
-            let state = await app.stateWhen((s) => s.layout.lesson?.[key], `the Lesson panel's ${key}`);
-            // A control out of the panel's sight is scrolled into it, as the author would.
-            for (let tries = 0; tries < 20 && state.layout.lesson["in-sight"]; tries++) {
-                const [r, v] = [state.layout.lesson[key], state.layout.lesson["in-sight"]];
-                const below = r.y + r.height > v.y + v.height;
-                if (!below && r.y >= v.y) break;
-                await app.page.mouse.move(...centreOf(v));
-                await app.page.mouse.wheel(0, below ? 100 : -100);
-                await frames(app);
-                state = await app.state();
-            }
-            await app.page.mouse.click(...centreOf(state.layout.lesson[key]));
-            await frames(app);
-        };
+        const press = (key) => pressLessonControl(app, key);
         await press("lesson-tab");
         const typeInto = async (key, text) => {
             await press(key);

@@ -15,7 +15,7 @@ import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
 import { DIST, ROOT, meshPath, outputDir } from "./lib/paths.mjs";
 import { serveDirectory } from "./lib/server.mjs";
-import { frames } from "./lib/input.mjs";
+import { pressLessonControl } from "./lib/input.mjs";
 import { LESSON_FILE, phantomPackage, phantomShown, press, stateWhen, takeQuiz, viewerOf } from "./lib/packaged.mjs";
 import { CPU_RUN, appSuite, testIn } from "./lib/suite.mjs";
 
@@ -226,22 +226,7 @@ testIn(CPU_RUN, "P5 the Lesson panel's Export for LMS saves the package the CLI 
     const routes = { "cases/lesson.glb": readFileSync(caseFile) };
     await withApp(async (app) => {
         await app.stateWhen((s) => s.loading === null && s.structures?.structures.length === 4 && s.layout.lesson?.["lesson-tab"], "the case open");
-        const centreOf = (r) => [r.x + r.width / 2, r.y + r.height / 2];
-        const click = async (key) => {
-            let s = await app.stateWhen((s) => s.layout.lesson?.[key], `the Lesson panel's ${key}`);
-            // A button out of the panel's sight is scrolled into it, as the author would.
-            for (let tries = 0; tries < 20 && s.layout.lesson["in-sight"]; tries++) {
-                const [r, v] = [s.layout.lesson[key], s.layout.lesson["in-sight"]];
-                const below = r.y + r.height > v.y + v.height;
-                if (!below && r.y >= v.y) break;
-                await app.page.mouse.move(...centreOf(v));
-                await app.page.mouse.wheel(0, below ? 100 : -100);
-                await frames(app);
-                s = await app.state();
-            }
-            await app.page.mouse.click(...centreOf(s.layout.lesson[key]));
-            await frames(app);
-        };
+        const click = (key) => pressLessonControl(app, key);
         await click("lesson-tab");
         const saved = app.page.waitForEvent("download", { timeout: 60_000 });
         await click("lms-scorm2004");

@@ -46,3 +46,24 @@ export async function settled(app) {
     return { metrics, state };
 }
 
+
+/**
+ * Clicks the control `key` of the page's lessons (`state().layout.lesson`): the Lesson panel's,
+ * the tour's, the quiz's. One out of the panel's sight is scrolled into it first, as the author
+ * would.
+ */
+export async function pressLessonControl(app, key) {
+    const centreOf = (r) => [r.x + r.width / 2, r.y + r.height / 2];
+    let state = await app.stateWhen((s) => s.layout.lesson?.[key], `the lesson's ${key}`);
+    for (let tries = 0; tries < 20 && state.layout.lesson["in-sight"]; tries++) {
+        const [r, v] = [state.layout.lesson[key], state.layout.lesson["in-sight"]];
+        const below = r.y + r.height > v.y + v.height;
+        if (!below && r.y >= v.y) break;
+        await app.page.mouse.move(...centreOf(v));
+        await app.page.mouse.wheel(0, below ? 100 : -100);
+        await frames(app);
+        state = await app.state();
+    }
+    await app.page.mouse.click(...centreOf(state.layout.lesson[key]));
+    await frames(app);
+}
