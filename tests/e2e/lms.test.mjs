@@ -207,6 +207,13 @@ testIn(CPU_RUN, "P4 a package opened on its own plays the lesson and says once t
         const notice = page.locator("#notice");
         await notice.waitFor({ state: "visible" });
         assert.match(await notice.innerText(), /outside a learning platform: your progress and answers are not recorded/i);
+        // The labels and a cut, as the viewer shows them anywhere.
+        let s = await stateWhen(viewer, (s) => s.view.labels.length === 2, "the case's two labels");
+        assert.deepEqual(s.view.labels.map((l) => l.text).sort(), ["Liver", "Tumour"]);
+        await viewer.frame.evaluate(() => window.meshsmooth.setView({ clip: { axis: "axial", at: 0.5, flip: false } }));
+        s = await stateWhen(viewer, (s) => s.view.clip?.axis === "axial", "the cut");
+        await page.screenshot({ path: join(OUT, "lms-outside-cut.png") });
+        await viewer.frame.evaluate(() => window.meshsmooth.setView({ clip: null }));
         await press(page, viewer, "start");
         await stateWhen(viewer, (s) => s.tour?.step === 0, "the tour plays without an LMS");
         await page.screenshot({ path: join(OUT, "lms-outside.png") });
