@@ -26,5 +26,5 @@ pub mod worker;
 #[cfg(all(not(target_arch = "wasm32"), feature = "cli"))]
 pub mod cli;
 
-#[cfg(all(target_arch = "wasm32", feature = "cli"))]
+#[cfg(all(target_arch = "wasm32", feature = "web-app"))]
 pub mod app;
