@@ -29,10 +29,13 @@ const RALPH = join(ROOT, "tests/lms/ralph.sh");
 const store = { dir: join(tmp, "ralph"), port: 18_000 + Math.floor(Math.random() * 2000) };
 const ralph = (...args) => execFileSync("bash", [RALPH, ...args], { encoding: "utf8", stdio: ["ignore", "pipe", "inherit"] });
 after(() => {
-    try {
-        ralph("stop", store.dir);
-    } catch {
-        // Not running.
+    // Stopped here whatever the test's outcome; it starts only in the run that takes the test.
+    if (store.started) {
+        try {
+            ralph("stop", store.dir);
+        } catch {
+            // Stopped already.
+        }
     }
     rmSync(tmp, { recursive: true, force: true });
 });
@@ -114,6 +117,7 @@ async function statementsOf(registration) {
 
 testIn(CPU_RUN, "P6 cmi5: the statements reach a real record store in cmi5's order with the launch's actor and registration; none lost while it was down", { timeout: TIMEOUT }, async () => {
     await phantomPackage("cmi5", join(OUT, "phantom-cmi5.zip"), join(tmp, "package"));
+    store.started = true;
     ralph("start", store.dir, String(store.port));
     const lms = await testLms(join(tmp, "package"));
     const browser = await launchBrowser(MODE);
