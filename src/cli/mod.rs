@@ -8,6 +8,7 @@ mod backend;
 mod bench;
 mod bench_load;
 mod case;
+mod case_info;
 mod convert;
 mod extract;
 mod info;
