@@ -113,7 +113,11 @@ pub fn package_files(package: &LmsPackage) -> Result<Vec<(String, Vec<u8>)>, Pac
         .iter()
         .map(|(name, text)| (name.to_string(), text.as_bytes().to_vec()))
         .collect();
-    content.push(("launch.json".into(), launch_json(package).into_bytes()));
+    let about = About::of(package.case);
+    content.push((
+        "launch.json".into(),
+        launch_json(package, &about).into_bytes(),
+    ));
     content.push((case_name.to_string(), case_bytes.to_vec()));
     for (path, bytes) in package.viewer {
         content.push((format!("{VIEWER_FOLDER}/{path}"), bytes.clone()));
@@ -122,7 +126,6 @@ pub fn package_files(package: &LmsPackage) -> Result<Vec<(String, Vec<u8>)>, Pac
         return Err(PackageError::BadPath(bad.clone()));
     }
     let listed: Vec<&str> = content.iter().map(|(p, _)| p.as_str()).collect();
-    let about = About::of(package.case);
     let manifest = match package.format {
         LmsFormat::Scorm12 => ("imsmanifest.xml", scorm::manifest_12(&about, &listed)),
         LmsFormat::Scorm2004 => ("imsmanifest.xml", scorm::manifest_2004(&about, &listed)),
@@ -178,7 +181,7 @@ impl About {
 
 /// The lesson facts the launch page reads first: which standard to speak, how many tour
 /// steps there are (the last one seen completes the lesson) and the quiz's pass mark.
-fn launch_json(package: &LmsPackage) -> String {
+fn launch_json(package: &LmsPackage, about: &About) -> String {
     let lesson = &package.case.lesson;
     let quiz = lesson
         .quiz
@@ -186,7 +189,7 @@ fn launch_json(package: &LmsPackage) -> String {
         .map(|q| serde_json::json!({ "pass_mark": decimal(q.pass_mark) }));
     let launch = serde_json::json!({
         "format": package.format.name(),
-        "title": About::of(package.case).title,
+        "title": about.title,
         "steps": lesson.steps.len(),
         "quiz": quiz,
         "viewer": format!("{VIEWER_FOLDER}/index.html"),
