@@ -5,6 +5,11 @@
 //! command-line tool (native) and the web app (wasm32) sit on top and own no algorithm. [`view`] is the 3D view's
 //! camera and shading record, kept apart from the app so it is tested natively.
 
+/// Whether this build is the author's (the `authoring` feature) or the student's viewer alone.
+/// Tested where the two part, as a constant: the branch a build cannot take is compiled but
+/// left out of its binary, with all it alone calls (readers, smoothing, search, writers).
+pub const AUTHORING: bool = cfg!(feature = "authoring");
+
 pub mod case;
 pub mod evaluate;
 pub mod export;

@@ -204,4 +204,28 @@ fn a_missing_viewer_or_a_wrong_name_is_said_before_any_work() {
     ]);
     let said = String::from_utf8_lossy(&out.stderr);
     assert!(said.contains("a package is written as .zip"), "{said}");
+
+    // The app's build, the student's viewer in its viewer/ folder: that folder is named.
+    let app = tmp("app_build");
+    std::fs::create_dir_all(app.join("viewer")).unwrap();
+    for page in [
+        app.join("index.html"),
+        app.join("viewer").join("index.html"),
+    ] {
+        std::fs::write(page, "<!DOCTYPE html><title>meshsmooth</title>").unwrap();
+    }
+    let out = meshsmooth(&[
+        "case",
+        "package",
+        text(&map),
+        "--format",
+        "cmi5",
+        "--viewer",
+        text(&app),
+        "-o",
+        text(&zip),
+    ]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(said.contains("its viewer/ folder"), "{said}");
+    assert!(!zip.exists());
 }

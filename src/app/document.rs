@@ -419,7 +419,7 @@ impl Document {
     /// With the CPU engine it waits until the current parameters' result is there: what the
     /// user is looking at comes first. True when a job finished.
     pub fn compute_guidance(&mut self, offload: Option<&mut dyn Offload>) -> bool {
-        if self.backend == Backend::Cpu && self.busy() {
+        if !crate::AUTHORING || (self.backend == Backend::Cpu && self.busy()) {
             return false;
         }
         self.session.step_guidance_on(&now_ms, offload)

@@ -110,7 +110,7 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
         let _ = doc.ask_step(i);
     }
     if let Some(format) = lms {
-        super::lms_export::save(doc.session(), format);
+        super::lms_export::save(doc.session(), format, ui.ctx());
     }
 }
 
@@ -134,6 +134,15 @@ fn export_for_lms(ui: &mut egui::Ui, drawn: &mut Vec<(String, egui::Rect)>) -> O
             }
         }
     });
+    match super::lms_export::outcome() {
+        Some(Ok(said)) => {
+            ui.small(said);
+        }
+        Some(Err(why)) => {
+            ui.colored_label(ui.visuals().error_fg_color, format!("Not exported: {why}"));
+        }
+        None => {}
+    }
     asked
 }
 

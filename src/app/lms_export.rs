@@ -1,7 +1,8 @@
-//! "Export for LMS": the case and this page's own build as a package a learning management
+//! "Export for LMS": the case and the student's viewer as a package a learning management
 //! system imports, by the writer `meshsmooth case package` uses ([`crate::export::lms`]). The
-//! page's files are fetched from its own folder: what its server serves is what `trunk build`
-//! wrote, so the package equals the CLI's given that build as `--viewer` and the same case glTF.
+//! viewer's files are fetched from the `viewer/` folder beside this page: what its server serves
+//! is what `trunk build` wrote, so the package equals the CLI's given that folder as `--viewer`
+//! and the same case glTF.
 
 use std::collections::BTreeMap;
 
@@ -24,9 +25,9 @@ pub fn case_and_glb(session: &Session) -> Result<(Case, Vec<u8>), String> {
     Ok((case, bytes))
 }
 
-/// The package of `case` (its glTF `glb`) in `format`, with this page's build as its viewer.
+/// The package of `case` (its glTF `glb`) in `format`, with the student's viewer.
 pub async fn package(format: LmsFormat, case: Case, glb: Vec<u8>) -> Result<Vec<u8>, String> {
-    let viewer = own_build().await?;
+    let viewer = viewer_build().await?;
     lms::write_package(&LmsPackage {
         format,
         case: &case,
@@ -36,26 +37,46 @@ pub async fn package(format: LmsFormat, case: Case, glb: Vec<u8>) -> Result<Vec<
     .map_err(|e| e.to_string())
 }
 
-/// Packages the session's case in `format` and saves the zip, off the frame: the page's own
-/// files are fetched first. A failure is logged; the case is untouched either way.
-pub fn save(session: &Session, format: LmsFormat) {
+/// Packages the session's case in `format` and saves the zip, off the frame: the viewer's
+/// files are fetched first. The outcome is kept for the panel ([`outcome`]) and logged; the
+/// case is untouched either way.
+pub fn save(session: &Session, format: LmsFormat, ctx: &eframe::egui::Context) {
     let (case, glb) = match case_and_glb(session) {
         Ok(c) => c,
-        Err(e) => {
-            log::warn!("Export for LMS: {e}");
-            return;
-        }
+        Err(e) => return tell(Err(e), ctx),
     };
     let name = format!("{}_{}.zip", file_stem(&case), format.name());
+    set_outcome(Ok(format!("Packing {name}…")));
+    let ctx = ctx.clone();
     wasm_bindgen_futures::spawn_local(async move {
         let saved = match package(format, case, glb).await {
             Ok(zip) => super::download::save(&name, &zip, "application/zip"),
             Err(e) => Err(e),
         };
-        if let Err(e) = saved {
-            log::warn!("Export for LMS: {e}");
-        }
+        tell(saved.map(|()| format!("Saved {name}")), &ctx);
     });
+}
+
+thread_local! {
+    /// What the last Export for LMS came to: under way or saved (`Ok`), or why not.
+    static OUTCOME: std::cell::RefCell<Option<Result<String, String>>> = Default::default();
+}
+
+fn set_outcome(outcome: Result<String, String>) {
+    OUTCOME.with(|o| *o.borrow_mut() = Some(outcome));
+}
+
+fn tell(outcome: Result<String, String>, ctx: &eframe::egui::Context) {
+    if let Err(e) = &outcome {
+        log::warn!("Export for LMS: {e}");
+    }
+    set_outcome(outcome);
+    super::wake(ctx);
+}
+
+/// What the last Export for LMS came to, for the Lesson panel to say.
+pub fn outcome() -> Option<Result<String, String>> {
+    OUTCOME.with(|o| o.borrow().clone())
 }
 
 /// The case's title as a file name: letters, digits, `-` and `_`.
@@ -76,9 +97,10 @@ fn file_stem(case: &Case) -> String {
     }
 }
 
-/// This page's build, by file name: the page, its wasm-bindgen glue and module (the hashed
-/// names the page links), and the engine workers' script.
-async fn own_build() -> Result<BTreeMap<String, Vec<u8>>, String> {
+/// The student's viewer, by file name: its page, the wasm-bindgen glue and module the page
+/// links (hashed names), and the engine workers' script, fetched from the `viewer/` folder
+/// beside this page, where the web build puts it (`web/build_viewer.sh`).
+async fn viewer_build() -> Result<BTreeMap<String, Vec<u8>>, String> {
     let document = web_sys::window()
         .and_then(|w| w.document())
         .ok_or("no document")?;
@@ -87,30 +109,43 @@ async fn own_build() -> Result<BTreeMap<String, Vec<u8>>, String> {
         .ok()
         .flatten()
         .ok_or("no base address")?;
+    let folder = web_sys::Url::new_with_base(VIEWER_FOLDER, &base)
+        .map_err(|_| format!("{VIEWER_FOLDER}: not an address"))?
+        .href();
+    let mut files = BTreeMap::new();
+    let page = fetch_file(&folder, "index.html").await?;
+    let text = String::from_utf8_lossy(&page).into_owned();
+    files.insert("index.html".to_string(), page);
+    let parsed = web_sys::DomParser::new()
+        .and_then(|p| p.parse_from_string(&text, web_sys::SupportedType::TextHtml))
+        .map_err(|e| super::page::js_error_text(&e))?;
     let linked = |selector: &str| {
-        document
-            .query_selector(selector)
-            .ok()
-            .flatten()
+        (parsed.query_selector(selector).ok().flatten())
             .and_then(|e| e.get_attribute("href"))
-            .ok_or_else(|| format!("the page links no {selector}"))
+            .ok_or_else(|| format!("the viewer's page links no {selector}"))
     };
     let glue = linked("link[rel=modulepreload][href$='.js']")?;
     let wasm = linked("link[rel=preload][href$='.wasm']")?;
-    let mut files = BTreeMap::new();
-    for href in ["index.html", "worker.js", glue.as_str(), wasm.as_str()] {
-        let url = web_sys::Url::new_with_base(href, &base)
+    for href in ["worker.js", glue.as_str(), wasm.as_str()] {
+        let url = web_sys::Url::new_with_base(href, &folder)
             .map_err(|_| format!("{href}: not an address"))?;
-        let name = url
-            .pathname()
-            .rsplit('/')
-            .next()
+        let name = (url.pathname().rsplit('/').next())
             .unwrap_or_default()
             .to_string();
-        let bytes = super::read_bytes::fetch(&url.href(), Box::new(|_, _| {}))
-            .await
-            .map_err(|e| format!("the page's {name}: {e}"))?;
+        let bytes = fetch_file(&folder, &name).await?;
         files.insert(name, bytes);
     }
     Ok(files)
+}
+
+/// Where the web build puts the student's viewer, beside the app's page.
+const VIEWER_FOLDER: &str = "viewer/";
+
+/// The file `name` of the viewer's build in `folder` (an absolute address).
+async fn fetch_file(folder: &str, name: &str) -> Result<Vec<u8>, String> {
+    let url =
+        web_sys::Url::new_with_base(name, folder).map_err(|_| format!("{name}: not an address"))?;
+    super::read_bytes::fetch(&url.href(), Box::new(|_, _| {}))
+        .await
+        .map_err(|e| format!("the viewer's {name} ({VIEWER_FOLDER} beside this page): {e}"))
 }

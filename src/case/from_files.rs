@@ -24,7 +24,11 @@ pub enum CaseOpenError {
     Tables { first: String, second: String },
     #[error("no file given")]
     NoFiles,
+    #[error("{0}: {VIEWER_READS}")]
+    NotACase(String),
 }
+
+const VIEWER_READS: &str = "the viewer opens case glTF files (.glb, .gltf) only";
 
 impl CaseOpenError {
     /// What is wrong, without the file's name: for a caller that names the one file itself.
@@ -35,6 +39,7 @@ impl CaseOpenError {
             | CaseOpenError::Load { error, .. } => error.to_string(),
             CaseOpenError::Segmentation(OpenError::Extract { error, .. }) => error.to_string(),
             CaseOpenError::Record { error, .. } => error.to_string(),
+            CaseOpenError::NotACase(_) => VIEWER_READS.to_string(),
             other => other.to_string(),
         }
     }
@@ -74,6 +79,9 @@ pub fn open_staged(
     }
     let (maps, others): (Vec<NamedBytes>, Vec<NamedBytes>) =
         files.iter().partition(|f| io::is_label_map(f.name));
+    if !crate::AUTHORING {
+        return open_case_gltfs(files, on_stage);
+    }
     let mut case = Case::default();
     if !maps.is_empty() {
         let structures = segmentation::open_staged(&maps, table, options, on_stage)?;
@@ -96,16 +104,7 @@ pub fn open_staged(
             error,
         };
         match Format::from_name(f.name) {
-            Some(Format::Glb | Format::Gltf) => {
-                let scene = io::load_gltf_scene(f.bytes, f.name).map_err(load)?;
-                let opened = from_gltf_scene(scene, file_name(f.name)).map_err(|error| {
-                    CaseOpenError::Record {
-                        name: f.name.to_string(),
-                        error,
-                    }
-                })?;
-                case.add(opened);
-            }
+            Some(Format::Glb | Format::Gltf) => case.add(read_case_gltf(&f)?),
             // Surfaces, and whatever else: io::load says what it cannot read.
             _ => {
                 let mesh = io::load(f.bytes, f.name).map_err(load)?;
@@ -116,6 +115,34 @@ pub fn open_staged(
         }
     }
     Ok(case)
+}
+
+/// The student's viewer's reading: case glTF files only (its build has no other reader).
+fn open_case_gltfs(
+    files: &[NamedBytes],
+    on_stage: &mut dyn FnMut(&'static str),
+) -> Result<Case, CaseOpenError> {
+    let mut case = Case::default();
+    for f in files {
+        on_stage(READING_FILE);
+        match Format::from_name(f.name) {
+            Some(Format::Glb | Format::Gltf) => case.add(read_case_gltf(f)?),
+            _ => return Err(CaseOpenError::NotACase(f.name.to_string())),
+        }
+    }
+    Ok(case)
+}
+
+/// A glTF file read as a case (any glTF: one written here keeps its record).
+fn read_case_gltf(f: &NamedBytes) -> Result<Case, CaseOpenError> {
+    let scene = io::load_gltf_scene(f.bytes, f.name).map_err(|error| CaseOpenError::Load {
+        name: f.name.to_string(),
+        error,
+    })?;
+    from_gltf_scene(scene, file_name(f.name)).map_err(|error| CaseOpenError::Record {
+        name: f.name.to_string(),
+        error,
+    })
 }
 
 /// The file the case's first structure comes from: label maps open before the other files.

@@ -26,8 +26,8 @@ pub(super) struct PackageArgs {
     /// scorm12 (SCORM 1.2), scorm2004 (SCORM 2004 4th edition) or cmi5.
     #[arg(long, value_parser = parse_format)]
     format: LmsFormat,
-    /// The student viewer's build folder (what `trunk build` wrote).
-    #[arg(long, default_value = "dist")]
+    /// The student viewer's build folder (what `trunk build` wrote beside the app).
+    #[arg(long, default_value = "dist/viewer")]
     viewer: PathBuf,
     #[command(flatten)]
     build: BuildOptions,
@@ -108,6 +108,12 @@ fn read_viewer(folder: &Path) -> Result<BTreeMap<String, Vec<u8>>, String> {
         return Err(format!(
             "{shown}: no viewer build here (no index.html): build it with `trunk build` (see \
              the README) or name its folder with --viewer"
+        ));
+    }
+    if folder.join("viewer").join("index.html").is_file() {
+        return Err(format!(
+            "{shown}: the web app's build; the student's viewer is its viewer/ folder: name \
+             that with --viewer"
         ));
     }
     let mut files = BTreeMap::new();

@@ -231,6 +231,18 @@ impl Worker {
                 }
                 None
             }
+            // The student's viewer smooths the structure shown (its measures and how far it
+            // moved), but searches and checks nothing: its build has neither.
+            Request::Terms { job, .. }
+            | Request::SuggestStructure { job, .. }
+            | Request::CheckCase { job, .. }
+                if !crate::AUTHORING =>
+            {
+                Some(Reply::Failed {
+                    job,
+                    why: "the viewer searches and checks nothing".into(),
+                })
+            }
             Request::Smooth { job, params, tau } => Some(self.smooth(job, &params, tau, clock)),
             Request::Terms { job, params, at } => Some(self.terms(job, &params, &at, clock)),
             Request::SuggestStructure {
@@ -286,6 +298,9 @@ impl Worker {
             Input::Addition(bytes) => (model::open_case(name, &bytes, &mut on_stage))
                 .map(|case| (None, case))
                 .map_err(|e| e.reason()),
+            Input::Image { .. } if !crate::AUTHORING => {
+                Err(format!("{name}: the viewer opens no image"))
+            }
             Input::Image {
                 files,
                 preset,

@@ -13,7 +13,7 @@ import { gzipSync } from "node:zlib";
 
 import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
-import { DIST, E2E_OUT } from "./lib/paths.mjs";
+import { DIST, E2E_OUT, VIEWER_DIST } from "./lib/paths.mjs";
 import { phantomPackage, stateWhen, viewerOf } from "./lib/packaged.mjs";
 import { serveDirectory } from "./lib/server.mjs";
 import { CPU_RUN, testIn } from "./lib/suite.mjs";
@@ -56,7 +56,7 @@ testIn(CPU_RUN, "LB1 what a student downloads: the package's viewer wasm against
     assert.ok(dir, "E2E_WHOLE_BODY names no folder: run tests/e2e/run.sh --bench, which makes the whole-body map");
     const zip = join(tmp, "whole-body-scorm12.zip");
     const started = performance.now();
-    const out = await cli.cliJson("case", "package", join(dir, "whole_body.nii.gz"), "--colors", join(dir, "whole_body_labels.txt"), "--simplify", "0.1", "--format", "scorm12", "--viewer", DIST, "-o", zip, "--json");
+    const out = await cli.cliJson("case", "package", join(dir, "whole_body.nii.gz"), "--colors", join(dir, "whole_body_labels.txt"), "--simplify", "0.1", "--format", "scorm12", "--viewer", VIEWER_DIST, "-o", zip, "--json");
     emit({
         bench: "lms-package", case: "whole_body.nii.gz (114 structures), simplified at 0.1 voxel diagonals",
         structures: out.structures, case_bytes: out.case_bytes, package_bytes: out.bytes,

@@ -13,7 +13,7 @@ import { join } from "node:path";
 
 import { launchBrowser, modeFromEnv } from "./lib/browser.mjs";
 import * as cli from "./lib/cli.mjs";
-import { DIST, ROOT, meshPath, outputDir } from "./lib/paths.mjs";
+import { ROOT, VIEWER_DIST, meshPath, outputDir } from "./lib/paths.mjs";
 import { serveDirectory } from "./lib/server.mjs";
 import { pressLessonControl } from "./lib/input.mjs";
 import { LESSON_FILE, phantomPackage, phantomShown, press, stateWhen, takeQuiz, viewerOf } from "./lib/packaged.mjs";
@@ -219,6 +219,25 @@ testIn(CPU_RUN, "P4 a package opened on its own plays the lesson and says once t
         await page.screenshot({ path: join(OUT, "lms-outside.png") });
         await page.locator("#notice-close").click();
         await notice.waitFor({ state: "hidden" });
+        // The structure shown is smoothed and measured in the viewer as in the app.
+        s = await stateWhen(viewer, (s) => !s.busy, "the shown structure's smoothing");
+        assert.equal(s.error, null, "the viewer shows no error");
+        // The student's build: the viewer's calls only, and a case glTF the one file it reads.
+        const calls = await viewer.frame.evaluate(() => Object.keys(window.meshsmooth));
+        for (const author of ["loadMesh", "addImage", "suggestAll", "setParams", "exportCase", "exportLms"]) {
+            assert.ok(!calls.includes(author), `the packaged viewer has no ${author}: ${calls.join(", ")}`);
+        }
+        const refused = await viewer.frame.evaluate(async () => {
+            try {
+                await window.meshsmooth.loadCase(new Uint8Array([1, 2, 3]), "abdomen.nii.gz");
+                return "opened";
+            } catch (e) {
+                return String(e?.message ?? e);
+            }
+        });
+        assert.match(refused, /abdomen\.nii\.gz\b.*the viewer opens case glTF files \(\.glb, \.gltf\) only/);
+        // The case it had stays open.
+        await phantomShown(viewer);
         assert.deepEqual(errors, [], "uncaught errors");
     } finally {
         await browser.close();
@@ -249,7 +268,7 @@ testIn(CPU_RUN, "P5 the Lesson panel's Export for LMS saves the package the CLI 
         const unzipped = join(tmp, "page-package");
         execFileSync("python3", ["-m", "zipfile", "-e", zip, unzipped]);
         const fromCli = join(OUT, "lms-cli-scorm2004.zip");
-        await cli.cliJson("case", "package", join(unzipped, "case.glb"), "--format", "scorm2004", "--viewer", DIST, "-o", fromCli, "--json");
+        await cli.cliJson("case", "package", join(unzipped, "case.glb"), "--format", "scorm2004", "--viewer", VIEWER_DIST, "-o", fromCli, "--json");
         assert.ok(readFileSync(fromCli).equals(fromPage), "the page's package is the CLI's, byte for byte");
         assert.match(readFileSync(join(unzipped, "imsmanifest.xml"), "utf8"), /<imsss:minNormalizedMeasure>0\.5<\/imsss:minNormalizedMeasure>/);
     }, { query: "?case=cases/lesson.glb", routes });

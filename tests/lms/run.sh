@@ -4,13 +4,13 @@
 # case with its lesson packaged by the CLI in each format, its manifest validated against the
 # published schemas (validate.sh). The browser's part is tests/e2e/lms.test.mjs.
 #
-#   bash tests/lms/run.sh          (after `trunk build --release` made dist/, the viewer packed)
+#   bash tests/lms/run.sh          (after `trunk build --release` made dist/; dist/viewer/ is packed)
 set -euo pipefail
 
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
-dist="${E2E_DIST:-dist}"
-if [ ! -f "$dist/index.html" ]; then
-    echo "tests/lms/run.sh: $dist/index.html is missing: build the page first (trunk build --release)" >&2
+viewer="${E2E_DIST:-dist}/viewer"
+if [ ! -f "$viewer/index.html" ]; then
+    echo "tests/lms/run.sh: $viewer/index.html is missing: build the page first (trunk build --release)" >&2
     exit 1
 fi
 
@@ -28,6 +28,6 @@ for format in scorm12 scorm2004 cmi5; do
     "$cli" case package "$data/case_phantom_shared.nii.gz" \
         --colors "$data/case_phantom_shared_labels.txt" \
         --lesson tests/data/phantom_lesson.json --title "Abdominal phantom" --search local \
-        --format "$format" --viewer "$dist" -o "$out/phantom-$format.zip"
+        --format "$format" --viewer "$viewer" -o "$out/phantom-$format.zip"
     bash tests/lms/validate.sh "$out/phantom-$format.zip"
 done

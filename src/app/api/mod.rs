@@ -60,8 +60,9 @@
 //!   in `state().case_export`), and resolves with its size and triangles
 //! - `exportLms(format): Promise<Uint8Array>`: the package for an LMS (`scorm12`, `scorm2004`
 //!   or `cmi5`) the Lesson panel's "Export for LMS" saves: the case glTF (`writeCase`'s when
-//!   current, else `exportCase`'s), its lesson and this page's build as the viewer, what
-//!   `meshsmooth case package` writes for that glTF with the page's build as `--viewer`
+//!   current, else `exportCase`'s), its lesson and the student's viewer (the `viewer/` folder
+//!   beside this page), what `meshsmooth case package` writes for that glTF with that folder as
+//!   `--viewer`
 //! - `suggest({tau, search}): Promise<object>`: sets tau and searches (`grid`, the default, or
 //!   `local`) for the active filter; resolves with the CLI's `suggest --json` keys (the
 //!   suggestion is shown, not applied)
@@ -311,24 +312,21 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
         reading: doc.borrow().reading,
     };
 
-    for call in [FileCall::Mesh, FileCall::Case, FileCall::Add] {
-        api.define(call.name(), file_call(doc, ctx, call))?;
+    // The student's viewer has only the reading calls in its build (crate::AUTHORING).
+    if crate::AUTHORING {
+        define_authors_files(&api, doc, ctx)?;
+    } else {
+        api.define(FileCall::Case.name(), file_call(doc, ctx, FileCall::Case))?;
     }
-    api.define("addImage", files::image_call(doc, ctx))?;
-    let (d, c) = (doc.clone(), ctx.clone());
-    let remove_image = Closure::<dyn FnMut()>::new(move || {
-        d.borrow_mut().session_mut().remove_image();
-        crate::app::wake(&c);
-    });
-    api.define("removeImage", remove_image)?;
-
     api.define("setView", view::set_view(doc, ctx))?;
     view::define_screenshot(&api, doc, ctx)?;
     view::define_tour(&api, doc, ctx)?;
     case::define(&api, doc, ctx)?;
-    guidance::define(&api, doc, ctx)?;
-    define_smoothing(&api, doc, ctx)?;
-    export::define_export(&api, doc, ctx)?;
+    if crate::AUTHORING {
+        guidance::define(&api, doc, ctx)?;
+        define_smoothing(&api, doc, ctx)?;
+        export::define_export(&api, doc, ctx)?;
+    }
     define_page(&api, doc)?;
 
     js_sys::Reflect::set(&window, &"meshsmooth".into(), &api.object)
@@ -338,6 +336,24 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
         .dispatch_event(&event)
         .map_err(|e| super::page::js_error_text(&e))?;
     Ok(api.object)
+}
+
+/// `loadMesh`, `loadCase`, `addFile`, `addImage` and `removeImage`: the author's files.
+fn define_authors_files(
+    api: &Api,
+    doc: &SharedDocument,
+    ctx: &egui::Context,
+) -> Result<(), String> {
+    for call in [FileCall::Mesh, FileCall::Case, FileCall::Add] {
+        api.define(call.name(), file_call(doc, ctx, call))?;
+    }
+    api.define("addImage", files::image_call(doc, ctx))?;
+    let (d, c) = (doc.clone(), ctx.clone());
+    let remove_image = Closure::<dyn FnMut()>::new(move || {
+        d.borrow_mut().session_mut().remove_image();
+        crate::app::wake(&c);
+    });
+    api.define("removeImage", remove_image)
 }
 
 /// `setFilter`, `setParams`, `metrics` and `clearWeights`: the current structure's smoothing.

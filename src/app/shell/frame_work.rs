@@ -31,6 +31,9 @@ impl Shell {
     /// The case's background work steps on: Suggest all's answers, the checks', and this
     /// frame's share of writing the case glTF.
     pub(super) fn step_case_work(&mut self) {
+        if !crate::AUTHORING {
+            return;
+        }
         let mut doc = self.doc.borrow_mut();
         let session = doc.session_mut();
         session.step_suggest_all();

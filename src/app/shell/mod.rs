@@ -133,7 +133,7 @@ fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
 
 impl Shell {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Self {
-        let reading = query::viewer_mode();
+        let reading = !crate::AUTHORING || query::viewer_mode();
         let software = cc
             .wgpu_render_state
             .as_ref()
@@ -228,7 +228,7 @@ impl Shell {
     /// Returns whether it uploaded a new model to the GPU (the frame is full then).
     fn compute(&mut self) -> bool {
         let mut doc = self.doc.borrow_mut();
-        if let Some(gpu) = &mut self.gpu {
+        if let Some(gpu) = self.gpu.as_mut().filter(|_| crate::AUTHORING) {
             match gpu.step(&mut doc) {
                 Ok(sent) => return sent == Sent::Model,
                 Err(why) => {
@@ -304,7 +304,8 @@ impl Shell {
                 };
             }
             Action::Filter(k) => self.doc.borrow_mut().case_mut().set_filter(Filter::ALL[k]),
-            Action::ExportGlb => self.export(ExportFormat::Glb),
+            Action::ExportGlb if crate::AUTHORING => self.export(ExportFormat::Glb),
+            Action::ExportGlb => {}
             Action::ToggleHelp => self.help_open = !self.help_open,
             Action::ApplySuggestion => {
                 let mut doc = self.doc.borrow_mut();
@@ -312,11 +313,12 @@ impl Shell {
                     let _ = doc.case_mut().set_params(s.suggestion.params);
                 }
             }
-            Action::ToggleGraphs => {
+            Action::ToggleGraphs if crate::AUTHORING => {
                 let open = !self.bottom.open;
                 self.bottom
                     .set_open(open, self.doc.borrow_mut().session_mut());
             }
+            Action::ToggleGraphs => {}
             Action::ToggleBrush => self.brush.active = !self.brush.active,
             Action::CancelBackground => {
                 let mut doc = self.doc.borrow_mut();
@@ -441,10 +443,12 @@ impl eframe::App for Shell {
             ctx.request_discard("a new case's widgets, seen for the first time");
         }
         let uploading = !arrived && self.compute();
-        if !arrived && !uploading {
+        if crate::AUTHORING && !arrived && !uploading {
             self.step_guidance();
         }
-        self.bottom.update(&ctx, &mut self.doc.borrow_mut());
+        if crate::AUTHORING {
+            self.bottom.update(&ctx, &mut self.doc.borrow_mut());
+        }
         // The view takes up a new model once the GPU engine has (a frame later); the CPU
         // engine's take-up is a message to a worker, so the view need not wait a frame.
         if (opening != Opening::Done || self.gpu.is_none()) && !uploading {

@@ -23,7 +23,7 @@ pub(super) struct Preview {
 impl Shell {
     /// Whether the viewer's frame is shown: the viewer's page, or the author's preview.
     pub(super) fn reads(&self) -> bool {
-        self.reading || self.preview.on
+        !crate::AUTHORING || self.reading || self.preview.on
     }
 
     /// Follows the document's preview switch (flipped by the Lesson panel or the way back).

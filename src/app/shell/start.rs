@@ -18,13 +18,19 @@ pub(super) fn open_start_model(
     files: &FileInput,
     ctx: &egui::Context,
 ) -> bool {
+    // The student's viewer bundles no sample: a package names its case.
+    let open_sample = || {
+        if crate::AUTHORING {
+            let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
+        }
+    };
     match query::model_url() {
         None => {
-            let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
+            open_sample();
             false
         }
         Some(Err(e)) => {
-            let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
+            open_sample();
             doc.borrow_mut().session_mut().fail("?model", &e);
             false
         }
@@ -74,7 +80,7 @@ pub(super) fn gpu_engine(
     let rs = cc.wgpu_render_state.as_ref()?;
     let info = rs.adapter.get_info();
     log::info!("adapter: {} ({:?})", info.name, info.backend);
-    (info.backend == wgpu::Backend::BrowserWebGpu && !reading)
+    (crate::AUTHORING && info.backend == wgpu::Backend::BrowserWebGpu && !reading)
         .then(|| GpuEngine::new(&rs.device, &rs.queue, software))
 }
 
@@ -111,6 +117,9 @@ pub(super) fn start_workers(doc: &SharedDocument, reading: bool, ctx: &egui::Con
 /// a `software` GPU each frame costs a whole canvas of CPU time, and comes a few times a second:
 /// widgets change at once rather than animate over frames, and progress moves less often.
 pub(super) fn set_style(ctx: &egui::Context, software: bool) {
+    if !crate::AUTHORING {
+        ctx.set_fonts(viewer_fonts());
+    }
     crate::app::Pacing::for_gpu(software).keep(ctx);
     ctx.set_theme(egui::Theme::Dark);
     ctx.all_styles_mut(|s| {
@@ -120,4 +129,28 @@ pub(super) fn set_style(ctx: &egui::Context, software: bool) {
             s.animation_time = 0.0;
         }
     });
+}
+
+/// The student's viewer's fonts: egui's proportional font and its icons, for monospace text
+/// too (the author's build has egui's default fonts, which add a monospace font).
+fn viewer_fonts() -> egui::FontDefinitions {
+    use egui::{FontData, FontFamily, FontTweak};
+    use std::sync::Arc;
+    let mut fonts = egui::FontDefinitions::empty();
+    let text = FontData::from_static(epaint_default_fonts::UBUNTU_LIGHT);
+    // As egui's defaults size its icons.
+    let icons = FontData::from_static(epaint_default_fonts::EGUI_ICONS).tweak(FontTweak {
+        scale: 0.90,
+        ..Default::default()
+    });
+    fonts
+        .font_data
+        .insert("Ubuntu-Light".into(), Arc::new(text));
+    fonts.font_data.insert("egui-icons".into(), Arc::new(icons));
+    for family in [FontFamily::Proportional, FontFamily::Monospace] {
+        fonts
+            .families
+            .insert(family, vec!["Ubuntu-Light".into(), "egui-icons".into()]);
+    }
+    fonts
 }

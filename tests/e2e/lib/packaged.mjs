@@ -4,14 +4,14 @@ import { execFileSync } from "node:child_process";
 import { join } from "node:path";
 
 import * as cli from "./cli.mjs";
-import { DIST, ROOT, meshPath } from "./paths.mjs";
+import { ROOT, VIEWER_DIST, meshPath } from "./paths.mjs";
 
 export const LESSON_FILE = join(ROOT, "tests/data/phantom_lesson.json");
 
 /** `meshsmooth case package` of the phantom with its lesson in `format` into `zip`, unzipped into `folder`. */
 export async function phantomPackage(format, zip, folder) {
     const map = meshPath("labelmaps/case_phantom_shared.seg.nrrd");
-    await cli.cliJson("case", "package", map, "--search", "local", "--lesson", LESSON_FILE, "--title", "Abdominal phantom", "--format", format, "--viewer", DIST, "-o", zip, "--json");
+    await cli.cliJson("case", "package", map, "--search", "local", "--lesson", LESSON_FILE, "--title", "Abdominal phantom", "--format", format, "--viewer", VIEWER_DIST, "-o", zip, "--json");
     execFileSync("python3", ["-m", "zipfile", "-e", zip, folder]);
 }
 

@@ -6,6 +6,8 @@ import { isAbsolute, join, resolve } from "node:path";
 export const ROOT = resolve(import.meta.dirname, "../../..");
 export const DATA = resolve(process.env.E2E_DATA ?? join(ROOT, "../shared/data"));
 export const DIST = resolve(process.env.E2E_DIST ?? join(ROOT, "dist"));
+/** The student's viewer, built beside the app (web/build_viewer.sh): what a package carries. */
+export const VIEWER_DIST = join(DIST, "viewer");
 
 /** The native CLI that `cargo build --release` made (honours CARGO_TARGET_DIR). */
 export function cliPath() {
