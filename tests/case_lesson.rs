@@ -17,6 +17,8 @@ mod glb;
 
 #[path = "common/cli.rs"]
 mod common_cli;
+mod common_session;
+use common_session::smooth_cpu;
 
 fn step(title: &str, camera: Camera) -> Step {
     Step {
@@ -493,7 +495,7 @@ fn the_session_keeps_the_lesson_through_a_rename_and_its_export() {
         .expect("quiz")
         .structures
         .contains(&"Tumour".to_string()));
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     let glb = session
         .case()
         .export_case(&CaseGltfOptions::default())

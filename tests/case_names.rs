@@ -13,6 +13,8 @@ mod glb;
 
 #[path = "common/cli.rs"]
 mod common_cli;
+mod common_session;
+use common_session::smooth_cpu;
 
 fn names(pairs: &[(&str, &str)]) -> Names {
     (pairs.iter())
@@ -122,7 +124,7 @@ fn the_session_sets_names_that_travel_and_a_lying_record_is_refused() {
         session.case().case_version() > version,
         "the page redraws its names"
     );
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     for compressed in [true, false] {
         let options = CaseGltfOptions {
             compressed,

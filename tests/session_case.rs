@@ -13,6 +13,8 @@ mod vertex_match;
 use meshsmooth::export::CaseGltfOptions;
 use meshsmooth::session::{Session, StructureChange};
 use vertex_match::match_vertices;
+mod common_session;
+use common_session::smooth_cpu;
 
 /// The page's case glTF: compressed, with the local error.
 fn page_export() -> CaseGltfOptions {
@@ -187,7 +189,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         ..Params::defaults(Filter::Taubin)
     };
     session.case_mut().set_params(liver_params).unwrap();
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     let liver = session.case().result().expect("smoothed").clone();
     session.select_structure(1).unwrap();
     let others = session.case().other_structures();
@@ -200,7 +202,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .case_mut()
         .set_params(Params::defaults(Filter::Laplace))
         .unwrap();
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     let case = session.case();
     assert_eq!(case.current_structure(), Some(1));
     assert_eq!(case.case_structures()[2].name, "tumour");
@@ -226,7 +228,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     );
     assert_eq!(session.case().result().unwrap().positions, liver.positions);
     assert_eq!(session.case().result().unwrap().metrics, liver.metrics);
-    assert!(session.smooth_cpu().is_none(), "nothing to smooth");
+    assert!(smooth_cpu(&mut session).is_none(), "nothing to smooth");
     assert_eq!(
         session.case().case_structures()[2].name,
         "tumour",
@@ -340,7 +342,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
         ..Default::default()
     };
     session.case_mut().set_structure(0, glassy).unwrap();
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     let liver_params = *session.case().params();
     session.select_structure(3).unwrap();
     let kidney_params = Params {
@@ -348,7 +350,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
         ..Params::defaults(Filter::Taubin)
     };
     session.case_mut().set_params(kidney_params).unwrap();
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     let first = session.case().export_case(&page_export()).unwrap();
 
     let mut again = Session::default();
@@ -372,7 +374,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
         ("Abdomen", "Liver, tumour, vessels")
     );
     assert_eq!(again.case().case_structures()[3].params, kidney_params);
-    again.smooth_cpu();
+    smooth_cpu(&mut again);
     let second = again.case().export_case(&page_export()).unwrap();
 
     let read_case = |bytes: &[u8]| {
@@ -431,7 +433,7 @@ fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     let case = session.case().export_case(&page_export()).unwrap();
 
     let mut again = Session::default();
@@ -458,7 +460,7 @@ fn a_case_glb_structure_keeps_its_surface_when_the_engine_measures_it() {
         session.case().kept_surface().is_none(),
         "a label map holds no surfaces"
     );
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     let case = session.case().export_case(&page_export()).unwrap();
     let stated = quantization_error(&case);
 
@@ -476,7 +478,7 @@ fn a_case_glb_structure_keeps_its_surface_when_the_engine_measures_it() {
         farthest(&kept, segmentation, &same) > 0.1,
         "smoothed, not the segmentation"
     );
-    again.smooth_cpu();
+    smooth_cpu(&mut again);
     // The engine's recomputation lies within the quantization of the file's surface; the
     // structure keeps the file's, with the engine's per-vertex measures.
     let result = again.case().result().unwrap();
@@ -567,7 +569,7 @@ fn a_viewer_shows_a_structure_without_a_smoothing_record_as_the_file_holds_it() 
     open_in_session(&mut viewer, "case.glb", unsmoothed.clone());
     assert!(viewer.case().shown_as_read(0));
     assert!(!viewer.case().needs_smoothing(), "nothing to compute");
-    assert!(viewer.smooth_cpu().is_none());
+    assert!(smooth_cpu(&mut viewer).is_none());
     assert!(viewer.case().result().is_none());
     let held = &viewer.case().case_structures()[0];
     assert!(held.smoothed.is_none());
@@ -582,7 +584,7 @@ fn a_viewer_shows_a_structure_without_a_smoothing_record_as_the_file_holds_it() 
     );
 
     // A structure the file holds a smoothing of is measured in the viewer too.
-    author.smooth_cpu();
+    smooth_cpu(&mut author);
     let smoothed = author.case().export_case(&page_export()).expect("writes");
     let mut viewer = Session::default();
     viewer.case_mut().show_as_read(true);

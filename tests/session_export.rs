@@ -11,12 +11,14 @@ use label_maps::{open_in_session, read};
 use meshsmooth::export::{CaseGltfOptions, Simplification};
 use meshsmooth::session::{Session, StructureChange};
 use vertex_match::match_vertices;
+mod common_session;
+use common_session::smooth_cpu;
 
 fn phantom_session() -> Session {
     let mut session = Session::default();
     let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", bytes);
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     session
 }
 
@@ -31,9 +33,9 @@ fn simplified() -> CaseGltfOptions {
 /// Steps the case glTF being written to its end; the progress seen at each step.
 fn write_all(session: &mut Session) -> Vec<(usize, usize, usize)> {
     let mut seen = Vec::new();
-    while let Some(p) = session.case_export_progress() {
+    while let Some(p) = session.case_export().progress() {
         seen.push((p.structures_done, p.bytes, p.triangles));
-        assert!(session.step_case_export());
+        assert!(session.case_export_mut().step());
         assert!(seen.len() < 100, "it ends");
     }
     seen
@@ -43,13 +45,13 @@ fn write_all(session: &mut Session) -> Vec<(usize, usize, usize)> {
 fn the_page_writes_the_case_a_structure_per_step_as_the_cli_writes_it() {
     let mut session = phantom_session();
     let options = simplified();
-    session.start_case_export(options).unwrap();
+    session.case_export_mut().start(options).unwrap();
     let seen = write_all(&mut session);
     // One structure per step, the size and triangles growing, then the file put together.
     let done: Vec<usize> = seen.iter().map(|s| s.0).collect();
     assert_eq!(done, [0, 1, 2, 3, 4]);
     assert!(seen.windows(2).all(|w| w[1].1 > w[0].1 && w[1].2 > w[0].2));
-    let written = session.written_case().expect("written");
+    let written = session.case_export().written().expect("written");
     assert_eq!(written.options, options);
     let at_once = session.case().export_case(&options).unwrap();
     assert!(written.bytes == at_once, "the same file as written at once");
@@ -62,7 +64,7 @@ fn the_page_writes_the_case_a_structure_per_step_as_the_cli_writes_it() {
         "simplified: {} of {before} triangles",
         written.triangles
     );
-    assert!(session.case_export_error().is_none());
+    assert!(session.case_export().error().is_none());
 
     // A change to the case makes the file stale.
     let change = StructureChange {
@@ -70,7 +72,10 @@ fn the_page_writes_the_case_a_structure_per_step_as_the_cli_writes_it() {
         ..Default::default()
     };
     session.case_mut().set_structure(1, change).unwrap();
-    assert!(session.written_case().is_none(), "stale after a change");
+    assert!(
+        session.case_export().written().is_none(),
+        "stale after a change"
+    );
 }
 
 #[test]
@@ -80,28 +85,28 @@ fn a_case_changed_while_it_is_written_is_written_again_and_cancelling_stops() {
         local_error: true,
         ..CaseGltfOptions::default()
     };
-    session.start_case_export(options).unwrap();
-    session.step_case_export();
-    session.step_case_export();
-    assert_eq!(session.case_export_progress().unwrap().structures_done, 2);
+    session.case_export_mut().start(options).unwrap();
+    session.case_export_mut().step();
+    session.case_export_mut().step();
+    assert_eq!(session.case_export().progress().unwrap().structures_done, 2);
     let change = StructureChange {
         name: Some("hepar".into()),
         ..Default::default()
     };
     session.case_mut().set_structure(0, change).unwrap();
     write_all(&mut session);
-    let written = session.written_case().expect("written");
+    let written = session.case_export().written().expect("written");
     assert!(written.bytes == session.case().export_case(&options).unwrap());
 
-    session.start_case_export(options).unwrap();
-    session.step_case_export();
-    session.cancel_case_export();
-    assert!(session.case_export_progress().is_none());
+    session.case_export_mut().start(options).unwrap();
+    session.case_export_mut().step();
+    session.case_export_mut().cancel();
+    assert!(session.case_export().progress().is_none());
     assert!(
-        session.written_case().is_none(),
+        session.case_export().written().is_none(),
         "the new file was not finished"
     );
-    assert!(!session.step_case_export(), "nothing left to write");
+    assert!(!session.case_export_mut().step(), "nothing left to write");
 }
 
 #[test]
@@ -117,7 +122,7 @@ fn a_reopened_case_shows_and_writes_the_surfaces_its_file_holds() {
     }];
     let read_back = meshsmooth::case::open(&files, None, &Default::default()).unwrap();
     // The engine measures the model's surface anew; what is shown stays the file's.
-    again.smooth_cpu();
+    smooth_cpu(&mut again);
     let model = again.case().result().expect("measured");
     assert!(model.vertex_measures().is_some());
     assert!(model.positions == read_back.structures[0].positions());

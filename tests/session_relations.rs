@@ -7,6 +7,8 @@ mod label_maps;
 
 use label_maps::{open_in_session, read};
 use meshsmooth::session::{Session, StructureChange};
+mod common_session;
+use common_session::smooth_cpu;
 
 /// The page's checks between structures report what the CLI's `case build` reports for the
 /// case as it stands: the tumour lies inside the liver, until the liver is shrunk around it.
@@ -16,7 +18,7 @@ fn the_session_checks_its_structures_as_they_stand() {
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     session.start_checks().unwrap();
     assert!(
         session.step_checks(),
@@ -51,7 +53,7 @@ fn the_session_checks_its_structures_as_they_stand() {
     };
     session.case_mut().set_params(shrink).unwrap();
     assert!(!session.background().checks_current());
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     session.start_checks().unwrap();
     session.step_checks();
     let report = session.background().checks_report().unwrap();
@@ -100,13 +102,13 @@ fn the_session_checks_its_structures_as_they_stand() {
         .case_mut()
         .set_params(Params::defaults(Filter::Hc))
         .unwrap();
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     assert!(!session.background().checks_current());
     assert_eq!(session.background().marks_key(), None);
     assert!(session.background().marked_surfaces().is_empty());
     // Back to the checked parameters, the same surface again: the marks are current again.
     session.case_mut().set_params(shrink).unwrap();
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     assert_eq!(session.background().marks_key(), Some(key));
 }
 

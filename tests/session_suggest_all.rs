@@ -6,6 +6,8 @@ mod label_maps;
 
 use label_maps::read;
 use meshsmooth::session::StructureOutcome;
+mod common_session;
+use common_session::smooth_cpu;
 
 /// "Suggest all" in the page's session: each structure gets what the CLI's pipeline suggests for
 /// it (its own filter and bound), the model's structure as its new parameters, the others kept
@@ -63,7 +65,7 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
         first.params,
         "the model takes its suggestion"
     );
-    session.smooth_cpu();
+    smooth_cpu(&mut session);
     assert_eq!(
         session.case().result().unwrap().positions,
         liver.smoothed.as_ref().unwrap().positions

@@ -59,7 +59,7 @@ impl ExportChoice {
             ui.label("voxel diagonals");
         });
         ui.horizontal(|ui| {
-            if let Some(p) = session.case_export_progress() {
+            if let Some(p) = session.case_export().progress() {
                 let bar = egui::ProgressBar::new(p.structures_done as f32 / p.structures.max(1) as f32)
                     .desired_width(160.0)
                     .text(format!(
@@ -81,7 +81,7 @@ impl ExportChoice {
             {
                 actions.push(StructureAction::ExportCase(self.options()));
             }
-            if let Some(w) = session.written_case() {
+            if let Some(w) = session.case_export().written() {
                 let how = match w.options.simplify {
                     Some(Simplification::VoxelDiagonals(d)) => format!("simplified within {d} voxel diagonals: "),
                     Some(Simplification::TriangleBudget(n)) => format!("simplified to about {n} triangles: "),
@@ -93,7 +93,7 @@ impl ExportChoice {
                 }
             }
         });
-        if let Some(e) = session.case_export_error() {
+        if let Some(e) = session.case_export().error() {
             ui.colored_label(ui.visuals().warn_fg_color, format!("Not written: {e}"));
         }
     }

@@ -76,11 +76,11 @@ fn write_list(id: &str, lines: &[String]) {
 /// the answer's outcome.
 fn lesson_lines(doc: &Document) -> Vec<String> {
     let mut lines = Vec::new();
-    let steps = &doc.case().lesson().steps;
-    let lesson = doc.case().lesson();
+    let steps = &doc.session().case().lesson().steps;
+    let lesson = doc.session().case().lesson();
     let shown = doc
         .tour
-        .and_then(|i| Some((i, lesson.step_text(i, doc.reader_languages())?)));
+        .and_then(|i| Some((i, lesson.step_text(i, doc.words().languages)?)));
     if let Some((i, (title, caption))) = shown {
         let mut line = format!("Tour step {} of {}: {title}.", i + 1, steps.len());
         if !caption.is_empty() {
@@ -104,7 +104,7 @@ fn lesson_lines(doc: &Document) -> Vec<String> {
     if !words.heading.is_empty() {
         lines.push(format!("{}. {}", words.heading, words.question));
         let choices = (doc.quiz.as_ref().and_then(|r| r.current()))
-            .map(|(_, q)| q.choices.iter().map(|&c| doc.shown_name(c)))
+            .map(|(_, q)| q.choices.iter().map(|&c| doc.words().name(c)))
             .map(|c| c.collect::<Vec<_>>().join(", "))
             .filter(|c| !c.is_empty());
         if let Some(choices) = choices {
@@ -133,7 +133,7 @@ fn label(doc: &Document) -> String {
         structures.len()
     );
     if let Some(i) = session.case().current_structure() {
-        text.push_str(&format!("; selected: {}", doc.shown_name(i)));
+        text.push_str(&format!("; selected: {}", doc.words().name(i)));
     }
     text
 }
@@ -141,10 +141,10 @@ fn label(doc: &Document) -> String {
 /// One line per structure: its name, group, whether it is shown and how opaque, whether it is
 /// selected, and its description.
 fn lines(doc: &Document) -> Vec<String> {
-    let current = doc.case().current_structure();
-    (doc.case().case_structures().iter().enumerate())
+    let current = doc.session().case().current_structure();
+    (doc.session().case().case_structures().iter().enumerate())
         .map(|(i, s)| {
-            let mut line = doc.shown_name(i).to_string();
+            let mut line = doc.words().name(i).to_string();
             if let Some(group) = &s.group {
                 line.push_str(&format!(" ({group})"));
             }

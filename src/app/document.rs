@@ -11,6 +11,7 @@ use crate::worker::NamedFile;
 
 use super::backend::{Backend, EngineTimings};
 use super::layout::{DrawnLabel, PanelLayout, ViewReport};
+use super::words::Words;
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -111,57 +112,21 @@ pub struct Document {
 pub type SharedDocument = Rc<RefCell<Document>>;
 
 impl Document {
-    /// The open case, its current structure and its model.
-    pub fn case(&self) -> &crate::session::CaseDocument {
-        self.session.case()
-    }
-
-    pub fn case_mut(&mut self) -> &mut crate::session::CaseDocument {
-        self.session.case_mut()
-    }
-
-    /// Structure `index`'s name as the page shows it: in the reader's language where it has a
-    /// name in one and the page is read (the viewer, the author's preview), else its own.
-    pub fn shown_name(&self, index: usize) -> &str {
-        let Some(s) = self.case().case_structures().get(index) else {
-            return "";
-        };
-        let languages = self.reader_languages();
-        crate::case::names::pick(&s.name, &s.names, languages)
-    }
-
-    /// The reader's languages where the page is read (the viewer, the author's preview); none
-    /// while the author edits, who sees the case's own names.
-    pub fn reader_languages(&self) -> &[String] {
-        match self.reading || self.previewing {
-            true => &self.languages,
+    /// The case's names, labels and notes in the words the page shows them in.
+    pub fn words(&self) -> Words<'_> {
+        // The reader's languages where the page is read (the viewer, the author's preview);
+        // none while the author edits, who sees the case's own names.
+        let languages = match self.reading || self.previewing {
+            true => &self.languages[..],
             false => &[],
+        };
+        Words {
+            structures: self.session.case().case_structures(),
+            languages,
         }
     }
 
-    /// A lesson label's text as the page shows it: one naming its structure in the reader's
-    /// language where the page is read ([`crate::case::names::label_text`]).
-    pub fn label_text<'a>(&'a self, label: &'a crate::case::Label) -> &'a str {
-        let structures = self.case().case_structures();
-        let Some(s) = structures.iter().find(|s| s.name == label.structure) else {
-            return &label.text;
-        };
-        let languages = self.reader_languages();
-        let text = (label.text.as_str(), &label.texts);
-        crate::case::names::label_text(text, (&s.name, &s.names), languages)
-    }
-
-    /// A lesson label's note in the reader's language, else the author's words.
-    pub fn label_note<'a>(&'a self, label: &'a crate::case::Label) -> &'a str {
-        crate::case::names::pick(&label.note, &label.notes, self.reader_languages())
-    }
-
-    /// What guidance, Suggest all and the checks found.
-    pub fn background(&self) -> crate::session::Background<'_> {
-        self.session.background()
-    }
-
-    /// Openings, the CPU engine and the background work, for the panels that start or stop it.
+    /// The case (`session().case()`), its openings, the CPU engine and the background work.
     pub fn session(&self) -> &Session {
         &self.session
     }
@@ -175,7 +140,7 @@ impl Document {
         (&mut self.session, &mut self.panel)
     }
 
-    pub fn new(backend: Backend) -> Self {
+    pub fn with_backend(backend: Backend) -> Self {
         Self {
             session: Session::default(),
             backend,
@@ -205,9 +170,9 @@ impl Document {
         }
     }
 
-    /// Opens a file's bytes at once (the bundled sample at start); on failure the current
-    /// model stays and the error is kept.
-    pub fn open(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
+    /// Opens a file's bytes at once, on the page's thread (the bundled sample at start); on
+    /// failure the current model stays and the error is kept.
+    pub fn open_now(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
         match self.session.open(name, bytes) {
             Ok(_) => {
                 self.opened();
@@ -220,16 +185,11 @@ impl Document {
         }
     }
 
-    /// Starts opening a file's bytes in a worker ([`Self::step_loading`] takes it); the current
-    /// model stays until it is open. `waiter`, when given, hears how it ended. A file still
-    /// opening is dropped for this one, and its waiters hear so.
-    pub fn begin_open(&mut self, name: &str, bytes: Vec<u8>, waiter: Option<LoadWaiter>) {
-        let name = name.to_string();
-        self.begin_open_files(vec![NamedFile { name, bytes }], waiter);
-    }
-
-    /// [`Self::begin_open`] of files chosen or dropped together, opened as one case.
-    pub fn begin_open_files(&mut self, files: Vec<NamedFile>, waiter: Option<LoadWaiter>) {
+    /// Asks a worker to open files chosen or dropped together as one case
+    /// ([`Self::step_loading`] takes it); the current model stays until it is open. `waiter`,
+    /// when given, hears how it ended. Files still opening are dropped for these, and their
+    /// waiters hear so.
+    pub fn ask_open(&mut self, files: Vec<NamedFile>, waiter: Option<LoadWaiter>) {
         let name = files.first().map_or_else(String::new, |f| f.name.clone());
         if let Some(replaced) = self.session.begin_open_files(files) {
             let why = format!("{replaced} was not opened: {name} was opened before it finished");
@@ -241,8 +201,9 @@ impl Document {
     }
 
     /// Makes structure `index` of the open case the model, on this thread (its settings and
-    /// result are in the case; see [`Session::select_structure`]).
-    pub fn select_structure(&mut self, index: usize) -> Result<(), String> {
+    /// result are in the case; see [`Session::select_structure`]); another model ends the
+    /// page's tour and quiz.
+    pub fn select(&mut self, index: usize) -> Result<(), String> {
         let before = self.session.case().model_id();
         self.session.select_structure(index)?;
         if self.session.case().model_id() != before {
@@ -251,17 +212,17 @@ impl Document {
         Ok(())
     }
 
-    /// Starts adding a file's structures to the open case (after the file opening now, if
-    /// one is). `waiter`, when given, hears once everything asked to open is open.
-    pub fn begin_add(&mut self, name: &str, bytes: Vec<u8>, waiter: Option<LoadWaiter>) {
+    /// Asks a worker to add a file's structures to the open case (after the file opening now,
+    /// if one is). `waiter`, when given, hears once everything asked to open is open.
+    pub fn ask_add(&mut self, name: &str, bytes: Vec<u8>, waiter: Option<LoadWaiter>) {
         self.session.begin_add(name, bytes);
         self.waiting_for_load.extend(waiter);
     }
 
-    /// Starts reading the image under the open case's surfaces in a worker: one file, or the
+    /// Asks a worker to read the image under the open case's surfaces: one file, or the
     /// slices of a DICOM series. `waiter`, when given, hears once it is read (or at once, when
     /// it cannot be asked).
-    pub fn begin_image(
+    pub fn ask_image(
         &mut self,
         files: Vec<crate::worker::NamedFile>,
         preset: crate::case::WindowPreset,
@@ -369,7 +330,7 @@ impl Document {
     pub fn working_elsewhere(&self) -> bool {
         self.backend == Backend::Cpu
             && !self.guidance_on_gpu
-            && self.session.case_export_progress().is_none()
+            && self.session.case_export().progress().is_none()
             && self.session.cpu_engine().threaded()
     }
 
@@ -381,7 +342,7 @@ impl Document {
             || self.session.loading().is_some()
             || self.session.background().suggesting_all()
             || self.session.background().checking()
-            || self.session.case_export_progress().is_some()
+            || self.session.case_export().progress().is_some()
     }
 
     /// The CPU engine's share of this frame: asks its workers for the current parameters'

@@ -208,7 +208,7 @@ impl GpuEngine {
     /// way; a new model is uploaded first, in a frame of its own. `Some` is what the frame
     /// sent when it goes no further.
     fn start_run(&mut self, doc: &Document) -> Result<Option<Sent>, String> {
-        let generation = doc.case().model_id();
+        let generation = doc.session().case().model_id();
         if self
             .running
             .as_ref()
@@ -217,10 +217,10 @@ impl GpuEngine {
             self.running = None;
         }
         if self.running.is_none() {
-            if !doc.case().needs_smoothing() {
+            if !doc.session().case().needs_smoothing() {
                 return Ok(Some(Sent::Nothing));
             }
-            let Some(model) = doc.case().model() else {
+            let Some(model) = doc.session().case().model() else {
                 return Ok(Some(Sent::Nothing));
             };
             if self.mesh.as_ref().map(|m| m.0) != Some(generation) {
@@ -237,9 +237,9 @@ impl GpuEngine {
             }
             self.running = Some(Running {
                 generation,
-                revision: doc.case().revision(),
+                revision: doc.session().case().revision(),
                 started_ms: now_ms(),
-                pieces: RunPieces::new(doc.case().params()),
+                pieces: RunPieces::new(doc.session().case().params()),
             });
         }
         Ok(None)
@@ -286,9 +286,9 @@ impl GpuEngine {
             return Ok(Sent::Nothing);
         };
         let e = |e: crate::gpu::GpuError| e.to_string();
-        let weights_version = doc.case().weights_version();
+        let weights_version = doc.session().case().weights_version();
         if self.weights_uploaded != Some(weights_version) {
-            mesh.set_weights(&self.queue, doc.case().weights())
+            mesh.set_weights(&self.queue, doc.session().case().weights())
                 .map_err(e)?;
             self.weights_uploaded = Some(weights_version);
         }
@@ -310,7 +310,7 @@ impl GpuEngine {
             .map_err(e)?;
         self.frame_work.sent(advance.spent, advance.full);
         self.device_work.sent = true;
-        let stale = run.revision != doc.case().revision();
+        let stale = run.revision != doc.session().case().revision();
         if run.pieces.smoothed() && stale {
             // The parameters moved on: show where these took the mesh, skip its measures.
             self.submitted = Some(run.revision);
@@ -340,7 +340,7 @@ impl GpuEngine {
         let Some(run) = self.in_flight.as_mut() else {
             return Ok(());
         };
-        if run.generation != doc.case().model_id() {
+        if run.generation != doc.session().case().model_id() {
             // A run for a model that is no longer open: its measures belong to another
             // original. Dropping it drops its pending mappings.
             self.in_flight = None;
@@ -352,11 +352,14 @@ impl GpuEngine {
                 Some(r) => run.result = Some(r.map_err(|e| e.to_string())?.positions),
             }
         }
-        let Some(model) = doc.case().model() else {
+        let Some(model) = doc.session().case().model() else {
             self.in_flight = None;
             return Ok(());
         };
-        let measured = match run.measures.try_take(&model.original, doc.case().tau()) {
+        let measured = match run
+            .measures
+            .try_take(&model.original, doc.session().case().tau())
+        {
             None => return Ok(()),
             Some(m) => m.map_err(|e| e.to_string())?,
         };

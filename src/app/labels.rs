@@ -42,7 +42,7 @@ impl LabelPainter {
         viewer: &Viewer,
         doc: &Document,
     ) -> Vec<DrawnLabel> {
-        let labels = &doc.case().lesson().labels;
+        let labels = &doc.session().case().lesson().labels;
         if labels.is_empty() {
             return Vec::new();
         }
@@ -50,7 +50,10 @@ impl LabelPainter {
             camera: *viewer.camera(),
             plane: viewer.clip_plane(),
             size: [rect.width(), rect.height()],
-            case: (doc.case().case_version(), doc.case().revision()),
+            case: (
+                doc.session().case().case_version(),
+                doc.session().case().revision(),
+            ),
         };
         if self.asked.is_some_and(|a| a.case != asked.case) {
             // Another lesson may number its labels otherwise.
@@ -66,17 +69,17 @@ impl LabelPainter {
 
 /// Where the case's labels go in the view, and which are faded.
 fn spots(rect: egui::Rect, viewer: &Viewer, doc: &Document) -> Vec<LabelSpot> {
-    let labels = &doc.case().lesson().labels;
-    let visible: HashSet<&str> = (doc.case().case_structures().iter())
+    let labels = &doc.session().case().lesson().labels;
+    let visible: HashSet<&str> = (doc.session().case().case_structures().iter())
         .filter(|s| s.visible)
         .map(|s| s.name.as_str())
         .collect();
     let shown = |name: &str| visible.contains(name);
     let size = Vec2::new(rect.width(), rect.height());
     let plane = viewer.clip_plane();
-    let structures = doc.case().case_structures();
+    let structures = doc.session().case().case_structures();
     let nearest = |ray: &Ray, structure: &str| {
-        let (i, hit) = doc.case().opaque_at(ray, plane)?;
+        let (i, hit) = doc.session().case().opaque_at(ray, plane)?;
         Some((hit.distance, structures[i].name == structure))
     };
     label_spots(labels, shown, (viewer.camera(), nearest), size, plane)
@@ -90,7 +93,7 @@ fn draw(
     doc: &Document,
     open: &mut Option<usize>,
 ) -> Vec<DrawnLabel> {
-    let labels = &doc.case().lesson().labels;
+    let labels = &doc.session().case().lesson().labels;
     let painter = ui.painter_at(rect);
     let font = egui::FontId::proportional(14.0);
     let mut drawn = Vec::with_capacity(spots.len());
@@ -108,8 +111,8 @@ fn draw(
         let (point, text) = (at(spot.point), at(spot.text));
         painter.line_segment([point, text], egui::Stroke::new(1.5, ink));
         painter.circle_filled(point, 3.0, ink);
-        let said = doc.label_text(label).to_string();
-        let note = doc.label_note(label).trim().to_string();
+        let said = doc.words().label_text(label).to_string();
+        let note = doc.words().label_note(label).trim().to_string();
         let galley = painter.layout_no_wrap(said.clone(), font.clone(), ink);
         // Room on the plate for the note's mark.
         let mark = if note.is_empty() { 0.0 } else { MARK + 4.0 };

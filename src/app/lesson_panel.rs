@@ -17,26 +17,26 @@ use crate::view::recorded_step;
 impl Document {
     /// Adds the view as it stands as the tour's last step; returns the number of steps.
     pub fn record_step(&mut self, title: &str, caption: &str) -> Result<usize, String> {
-        let names = self.case().structure_names();
+        let names = self.session().case().structure_names();
         let step = recorded_step(&self.view_link(), &names, title, caption)?;
-        let mut lesson = self.case().lesson().clone();
+        let mut lesson = self.session().case().lesson().clone();
         lesson.steps.push(step);
         let steps = lesson.steps.len();
-        self.case_mut().set_lesson(lesson)?;
+        self.session_mut().case_mut().set_lesson(lesson)?;
         Ok(steps)
     }
 
     /// Adds a label on structure `index` at `point` (where the author clicked it), its text
     /// the structure's name until edited.
     pub fn place_label(&mut self, index: usize, point: Vec3) -> Result<(), String> {
-        let name = (self.case().case_structures().get(index))
+        let name = (self.session().case().case_structures().get(index))
             .map(|s| s.name.clone())
             .ok_or(format!("the case has no structure {index}"))?;
-        let mut lesson = self.case().lesson().clone();
+        let mut lesson = self.session().case().lesson().clone();
         lesson
             .labels
             .push(Label::new(&name, point.to_array(), &name));
-        self.case_mut().set_lesson(lesson)
+        self.session_mut().case_mut().set_lesson(lesson)
     }
 
     /// Back from the preview to authoring: a quiz taken there ends (it asked nothing of the case).
@@ -58,7 +58,7 @@ struct Asked {
 /// The Lesson panel.
 pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     // The panel edits a copy: every edit must pass the case's checks before it lands.
-    let mut lesson = doc.case().lesson().clone();
+    let mut lesson = doc.session().case().lesson().clone();
     // What of the panel is in sight: its controls below scroll into view.
     let mut drawn: Vec<(String, egui::Rect)> = vec![("in-sight".into(), ui.clip_rect())];
     let mut asked = Asked::default();
@@ -89,19 +89,19 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     }
     labels(ui, &mut lesson, editing, &mut drawn, &mut asked);
     ui.separator();
-    let names = doc.case().structure_names();
+    let names = doc.session().case().structure_names();
     quiz(ui, &mut lesson, &names, &mut drawn, &mut asked);
     ui.separator();
     let lms = export_for_lms(ui, &mut drawn);
     (doc.panel.lesson).extend(drawn.into_iter().map(|(k, r)| (k, r.into())));
     if asked.edited {
-        if let Err(e) = doc.case_mut().set_lesson(lesson) {
+        if let Err(e) = doc.session_mut().case_mut().set_lesson(lesson) {
             // An emptied title or text: the edit waits for a non-empty one.
             log::info!("lesson edit refused: {e}");
         }
     }
     if asked.record {
-        let n = doc.case().lesson().steps.len() + 1;
+        let n = doc.session().case().lesson().steps.len() + 1;
         if let Err(e) = doc.record_step(&format!("Step {n}"), "") {
             log::warn!("{e}");
         }

@@ -15,7 +15,7 @@ use crate::session::Session;
 /// written now as `exportCase` writes it by default.
 pub fn case_and_glb(session: &Session) -> Result<(Case, Vec<u8>), String> {
     let case = session.case().to_case().ok_or("no case is open")?;
-    let bytes = match session.written_case() {
+    let bytes = match session.case_export().written() {
         Some(written) => written.bytes.clone(),
         None => session.case().export_case(&CaseGltfOptions {
             local_error: true,

@@ -10,7 +10,7 @@
 //!   and folders, chunked reads), `download` (bytes out), `api` (`window.meshsmooth` and the
 //!   embedding's messages), `layout` (where the page drew what, for `state()`);
 //! - the document and its engines: `document` (the session shared by the UI and the API, the
-//!   calls waiting on it), `backend` (which engine smooths, and its timing), `workers` (the CPU
+//!   calls waiting on it), `words` (the case in the reader's language), `backend` (which engine smooths, and its timing), `workers` (the CPU
 //!   engine's dedicated workers), `gpu_engine` (the WebGPU engine's driver), `pacing` (how
 //!   often the page redraws for work it does not see);
 //! - the authoring page's panels: `controls`, `guide`, `structure_list` with
@@ -63,11 +63,13 @@ mod structure_list;
 mod tour;
 mod view_tools;
 pub mod viewer;
+mod words;
 mod workers;
 
 pub use backend::Backend;
 pub use document::Document;
 use pacing::{Pacing, PROGRESS_REPAINT};
+pub use words::Words;
 
 /// Asks for one frame, as soon as the browser draws the next, for a change made between frames
 /// (a worker's reply, a call of `window.meshsmooth`, a file read, a picture taken). egui

@@ -69,7 +69,7 @@ impl Pointing {
             self.asked = Some(asked);
         }
         let index = self.named.as_ref()?.0;
-        let name = doc.shown_name(index).to_string();
+        let name = doc.words().name(index).to_string();
         if quiet {
             return response.clicked().then_some(index);
         }

@@ -21,10 +21,10 @@ pub struct QuizWords {
 impl Document {
     /// Starts the case's quiz (again), leaving the tour; the structures it asks are shown.
     pub fn start_quiz(&mut self) -> Result<(), String> {
-        let quiz = (self.case().lesson().quiz.clone()).ok_or("the case has no quiz")?;
-        let structures = self.case().case_structures();
+        let quiz = (self.session().case().lesson().quiz.clone()).ok_or("the case has no quiz")?;
+        let structures = self.session().case().case_structures();
         let shown: Vec<bool> = structures.iter().map(|s| s.visible).collect();
-        let names = self.case().structure_names();
+        let names = self.session().case().structure_names();
         // The clock seeds the order, so that a second try asks in another.
         let now = now_ms();
         let run = QuizRun::new(&quiz, &names, &shown, now.to_bits(), now)?;
@@ -36,7 +36,7 @@ impl Document {
                 visible: Some(true),
                 ..Default::default()
             };
-            self.case_mut().set_structure(i, visible)?;
+            self.session_mut().case_mut().set_structure(i, visible)?;
         }
         self.leave_tour();
         self.quiz = Some(run);
@@ -50,12 +50,12 @@ impl Document {
         let answer = running.answer(given, now_ms())?;
         let run = self.quiz.as_ref().ok_or("no quiz is running")?;
         let (_, question) = run.current().ok_or("the quiz is over")?;
-        let names = self.case().structure_names();
+        let names = self.session().case().structure_names();
         let name = |i: usize| names.get(i).copied().unwrap_or_default();
         let choices: Vec<&str> = question.choices.iter().map(|&i| name(i)).collect();
         let asked = (name(question.structure), question.mode);
         let statement = xapi::quiz_answered(
-            self.case().as_case(),
+            self.session().case().as_case(),
             asked,
             &choices,
             name(given),
@@ -82,7 +82,12 @@ impl Document {
         }
         let run = self.quiz.as_ref().ok_or("no quiz is running")?;
         let (right, questions) = (run.score().0, run.questions().len());
-        let statement = xapi::quiz_finished(self.case().as_case(), run.quiz(), right, questions);
+        let statement = xapi::quiz_finished(
+            self.session().case().as_case(),
+            run.quiz(),
+            right,
+            questions,
+        );
         let event = json!({
             "right": right,
             "questions": questions,
@@ -125,7 +130,8 @@ impl Document {
         let Some(run) = &self.quiz else {
             return QuizWords::default();
         };
-        let name = |i: usize| self.shown_name(i);
+        let words = self.words();
+        let name = |i: usize| words.name(i);
         let total = run.questions().len();
         let Some((i, question)) = run.current() else {
             let percent = (100.0 * run.scaled()).round();
@@ -164,13 +170,13 @@ impl Document {
 
     /// The quiz for `state()`: null without one in the case; `running` false until started.
     pub fn quiz_json(&self) -> Value {
-        let Some(quiz) = &self.case().lesson().quiz else {
+        let Some(quiz) = &self.session().case().lesson().quiz else {
             return Value::Null;
         };
         let Some(run) = &self.quiz else {
             return json!({ "running": false, "modes": quiz.modes, "pass_mark": quiz.pass_mark });
         };
-        let names = self.case().structure_names();
+        let names = self.session().case().structure_names();
         let name = |i: usize| names.get(i).copied().unwrap_or_default();
         let current = run.current();
         let (right, answered) = run.score();

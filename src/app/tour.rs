@@ -8,7 +8,7 @@ use super::document::Document;
 impl Document {
     /// Shows tour step `index` from the next frame on (the camera flies there).
     pub fn ask_step(&mut self, index: usize) -> Result<(), String> {
-        let steps = self.case().lesson().steps.len();
+        let steps = self.session().case().lesson().steps.len();
         if index >= steps {
             return Err(match steps {
                 0 => "the case has no tour".to_string(),
@@ -29,12 +29,12 @@ impl Document {
     /// `{step, steps, title, caption, left}` (`step` null outside the tour, `left` the step
     /// the student left it at), or null without a tour.
     pub fn tour_json(&self) -> Value {
-        let steps = &self.case().lesson().steps;
+        let steps = &self.session().case().lesson().steps;
         if steps.is_empty() {
             return Value::Null;
         }
-        let lesson = self.case().lesson();
-        let shown = (self.tour).and_then(|i| lesson.step_text(i, self.reader_languages()));
+        let lesson = self.session().case().lesson();
+        let shown = (self.tour).and_then(|i| lesson.step_text(i, self.words().languages));
         json!({
             "step": self.tour,
             "steps": steps.len(),
@@ -47,7 +47,11 @@ impl Document {
     /// The platform's `step` event: the step shown and its xAPI statement.
     pub fn step_event(&self, index: usize) -> Value {
         let mut detail = self.tour_json();
-        detail["statement"] = self.case().step_statement(index).unwrap_or_default();
+        detail["statement"] = self
+            .session()
+            .case()
+            .step_statement(index)
+            .unwrap_or_default();
         detail
     }
 }

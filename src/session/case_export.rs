@@ -67,15 +67,45 @@ fn as_written(s: &CaseStructure) -> Cow<'_, CaseStructure> {
 }
 
 impl Session {
+    /// The case glTF being written or written, read.
+    pub fn case_export(&self) -> CaseExportOf<'_> {
+        CaseExportOf {
+            export: &self.case_export,
+            doc: &self.doc,
+        }
+    }
+
+    /// The case glTF being written or written, to start, step or stop.
+    pub fn case_export_mut(&mut self) -> CaseExportMut<'_> {
+        CaseExportMut {
+            export: &mut self.case_export,
+            doc: &self.doc,
+        }
+    }
+}
+
+/// Writing the open case's glTF, as it is read: [`Session::case_export`].
+pub struct CaseExportOf<'a> {
+    export: &'a CaseExport,
+    doc: &'a CaseDocument,
+}
+
+/// Writing the open case's glTF, as it is done: [`Session::case_export_mut`].
+pub struct CaseExportMut<'a> {
+    export: &'a mut CaseExport,
+    doc: &'a CaseDocument,
+}
+
+impl CaseExportMut<'_> {
     /// Starts writing the case glTF with `options` (replacing one under way or written).
-    pub fn start_case_export(&mut self, options: CaseGltfOptions) -> Result<(), String> {
+    pub fn start(&mut self, options: CaseGltfOptions) -> Result<(), String> {
         self.doc.current_structure().ok_or("nothing is open")?;
         let writer = CaseWriter::new(&self.doc.case, &options).map_err(|e| e.to_string())?;
-        self.case_export = CaseExport {
+        *self.export = CaseExport {
             writing: Some(Writing {
                 writer,
                 options,
-                state: case_state(&self.doc),
+                state: case_state(self.doc),
             }),
             written: None,
             error: None,
@@ -84,21 +114,21 @@ impl Session {
     }
 
     /// Stops writing the case glTF.
-    pub fn cancel_case_export(&mut self) {
-        self.case_export.writing = None;
+    pub fn cancel(&mut self) {
+        self.export.writing = None;
     }
 
     /// Writes the next structure; returns whether anything was done. A case changed while
     /// it is written is written again from the start.
-    pub fn step_case_export(&mut self) -> bool {
-        let Some(writing) = &mut self.case_export.writing else {
+    pub fn step(&mut self) -> bool {
+        let Some(writing) = &mut self.export.writing else {
             return false;
         };
-        let state = case_state(&self.doc);
+        let state = case_state(self.doc);
         if state != writing.state {
             let options = writing.options;
-            if let Err(e) = self.start_case_export(options) {
-                self.case_export.error = Some(e);
+            if let Err(e) = self.start(options) {
+                self.export.error = Some(e);
             }
             return true;
         }
@@ -106,7 +136,7 @@ impl Session {
         let outcome = match self.doc.case.structures.get(next) {
             Some(s) => writing.writer.add(&as_written(s)).map(|()| None),
             None => {
-                let Some(w) = self.case_export.writing.take() else {
+                let Some(w) = self.export.writing.take() else {
                     return false;
                 };
                 let triangles = w.writer.triangles();
@@ -121,19 +151,21 @@ impl Session {
             }
         };
         match outcome {
-            Ok(Some(written)) => self.case_export.written = Some(written),
+            Ok(Some(written)) => self.export.written = Some(written),
             Ok(None) => {}
             Err(e) => {
-                self.case_export.writing = None;
-                self.case_export.error = Some(e.to_string());
+                self.export.writing = None;
+                self.export.error = Some(e.to_string());
             }
         }
         true
     }
+}
 
+impl<'a> CaseExportOf<'a> {
     /// How far the case glTF being written has come.
-    pub fn case_export_progress(&self) -> Option<ExportProgress> {
-        let w = &self.case_export.writing.as_ref()?.writer;
+    pub fn progress(&self) -> Option<ExportProgress> {
+        let w = &self.export.writing.as_ref()?.writer;
         Some(ExportProgress {
             structures_done: w.structures(),
             structures: self.doc.case.structures.len(),
@@ -143,12 +175,12 @@ impl Session {
     }
 
     /// The case glTF written last, while the case is as it was written.
-    pub fn written_case(&self) -> Option<&WrittenCase> {
-        (self.case_export.written.as_ref()).filter(|w| w.state == case_state(&self.doc))
+    pub fn written(&self) -> Option<&'a WrittenCase> {
+        (self.export.written.as_ref()).filter(|w| w.state == case_state(self.doc))
     }
 
     /// Why the case glTF could not be written, the last time.
-    pub fn case_export_error(&self) -> Option<&str> {
-        self.case_export.error.as_deref()
+    pub fn error(&self) -> Option<&'a str> {
+        self.export.error.as_deref()
     }
 }

@@ -8,14 +8,6 @@ use crate::metrics::{Metrics, VertexMeasures};
 use crate::worker::{metrics_of, Pool, Reply};
 
 impl Session {
-    /// A session whose CPU engine is `cpu` (the page's workers; by default one on this thread).
-    pub fn with_cpu_engine(cpu: Pool) -> Self {
-        Self {
-            cpu,
-            ..Self::default()
-        }
-    }
-
     /// Makes `cpu` the CPU engine (the page's workers); a run under way is asked again.
     pub fn set_cpu_engine(&mut self, cpu: Pool) {
         self.cpu = cpu;
@@ -31,19 +23,6 @@ impl Session {
     /// already asked for: the view's result, the searches' parameter sets to come).
     pub fn pump_cpu_engine(&mut self) {
         self.cpu.pump();
-    }
-
-    /// Smooths and measures the current revision on the CPU engine until its result is there
-    /// (at once with workers on this thread); the time each half took comes back.
-    pub fn smooth_cpu(&mut self) -> Option<Timings> {
-        loop {
-            if let Some(timings) = self.compute_cpu() {
-                return Some(timings);
-            }
-            if !self.smoothing_on_cpu() {
-                return None;
-            }
-        }
     }
 
     /// The CPU engine's share of a frame: asks the workers for the current revision's result

@@ -29,7 +29,7 @@ mod suggest_all;
 mod weights;
 
 pub use crate::model::{Model, OpenFailure};
-pub use case_export::{ExportProgress, WrittenCase};
+pub use case_export::{CaseExportMut, CaseExportOf, ExportProgress, WrittenCase};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use document::CaseDocument;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
@@ -164,5 +164,7 @@ impl Session {
     }
 }
 
+#[cfg(test)]
+pub(crate) mod testing;
 #[cfg(test)]
 mod tests;

@@ -1,3 +1,4 @@
+use super::testing::smooth_cpu;
 use super::*;
 use crate::case::Smoothed;
 use crate::export::ExportFormat;
@@ -47,7 +48,7 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
         .set_params_json(&serde_json::json!({"lambda": 0.6, "mu": -0.65, "iterations": 12}))
         .unwrap();
     assert!(s.case().needs_smoothing());
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     let r = s
         .case()
         .result()
@@ -71,7 +72,7 @@ fn cpu_result_equals_smoothing_then_measuring_directly() {
 #[test]
 fn every_change_makes_the_result_stale_and_late_results_are_refused() {
     let mut s = sample_session();
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     assert!(!s.case().needs_smoothing());
     let old = s.case().revision();
     let r = s.case().result().unwrap().clone();
@@ -137,7 +138,7 @@ fn exports_carry_the_smoothing_and_read_back() {
     s.case_mut()
         .set_params_json(&serde_json::json!({"iterations": 5}))
         .unwrap();
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     let r = s.case().result().unwrap().clone();
     for format in [
         ExportFormat::Ply,
@@ -166,13 +167,13 @@ fn exports_carry_the_smoothing_and_read_back() {
 #[test]
 fn an_export_never_states_parameters_its_surface_was_not_made_with() {
     let mut s = sample_session();
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     s.case_mut()
         .set_params_json(&serde_json::json!({"iterations": 7}))
         .unwrap();
     let stale = s.case().export(ExportFormat::Glb, None);
     assert!(stale.unwrap_err().contains("still being computed"));
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     let glb = s.case().export(ExportFormat::Glb, None).unwrap();
     assert!(String::from_utf8_lossy(&glb).contains("\"iterations\":7"));
 }
@@ -183,7 +184,7 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     s.case_mut()
         .set_params_json(&serde_json::json!({"iterations": 0}))
         .unwrap();
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     let (colors, legend) = s.case().colors(ColorField::LocalError).unwrap();
     assert_eq!(
         colors.len(),
@@ -198,7 +199,7 @@ fn colours_follow_the_field_and_the_legend_reads_in_voxel_diagonals() {
     s.case_mut()
         .set_params_json(&serde_json::json!({"iterations": 10}))
         .unwrap();
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     let (colors, legend) = s.case().colors(ColorField::LocalError).unwrap();
     assert!(colors.iter().any(|c| *c != legend.bar[0]));
     assert_eq!(legend.min, 0.0);
@@ -225,7 +226,7 @@ fn every_filter_gives_what_the_cli_computes() {
     for filter in ["laplace", "taubin", "hc", "sinc"] {
         let mut s = sample_session();
         s.case_mut().set_filter_name(filter).unwrap();
-        let timings = s.smooth_cpu().expect("smoothed");
+        let timings = smooth_cpu(&mut s).expect("smoothed");
         assert!(timings.smooth_ms >= 0.0 && timings.measure_ms >= 0.0);
         let original = &s.case().model().unwrap().original;
         let (positions, reference) =
@@ -257,7 +258,7 @@ fn a_change_while_a_run_is_out_takes_only_the_newer_result() {
 #[test]
 fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
     let mut s = sample_session();
-    s.smooth_cpu();
+    smooth_cpu(&mut s);
     let r = s.case().result().unwrap().clone();
     let old = s.case().revision();
     s.case_mut()
@@ -287,7 +288,11 @@ fn measured_results_from_elsewhere_are_taken_only_for_the_current_revision() {
 fn deferred_session() -> (Session, std::rc::Rc<std::cell::Cell<bool>>) {
     let (carrier, deliver) = crate::worker::deferred::Deferred::new(1);
     (
-        Session::with_cpu_engine(Pool::new(Box::new(carrier))),
+        {
+            let mut s = Session::default();
+            s.set_cpu_engine(Pool::new(Box::new(carrier)));
+            s
+        },
         deliver,
     )
 }
@@ -337,7 +342,7 @@ fn opening_in_a_worker_equals_opening_at_once_and_keeps_the_model_until_done() {
     assert_eq!(model.original.volume(), at_once.original.volume());
     assert_eq!(s.poll_opening(), None, "nothing left to open");
     // The workers hold the new model: the view's result comes from them.
-    assert!(s.smooth_cpu().is_some() && s.case().result().is_some());
+    assert!(smooth_cpu(&mut s).is_some() && s.case().result().is_some());
 }
 
 #[test]

@@ -113,6 +113,7 @@ impl CaseDocument {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::session::testing::smooth_cpu;
     use crate::session::ColorField;
     use crate::session::Session;
     use crate::smooth::Filter;
@@ -127,7 +128,7 @@ mod tests {
     }
 
     fn smoothed(s: &mut Session) -> Vec<[f32; 3]> {
-        s.smooth_cpu();
+        smooth_cpu(s);
         s.case().result().expect("a result").positions.clone()
     }
 
@@ -164,7 +165,7 @@ mod tests {
                 0.0
             ));
             assert_eq!(s.case().weights().unwrap(), w.as_slice());
-            s.smooth_cpu();
+            smooth_cpu(&mut s);
             assert_eq!(
                 s.case().result().unwrap().positions,
                 weighted,
@@ -205,7 +206,7 @@ mod tests {
         assert_eq!(s.case().weights_version(), generation + 1);
         let w = s.case().weights().unwrap();
         assert_eq!((w[3], w[4], w[5], w[6]), (0.0, 0.5, 1.0, 1.0));
-        s.smooth_cpu();
+        smooth_cpu(&mut s);
         let revision = s.case().revision();
         assert!(
             !s.case_mut().paint_weights(&footprint, 0.0),

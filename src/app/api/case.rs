@@ -16,7 +16,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
         "structures",
         Closure::<dyn FnMut() -> JsValue>::new(move || {
             let doc = d.borrow();
-            match super::json::structures(doc.case()) {
+            match super::json::structures(doc.session().case()) {
                 Some(s) => to_js(&s),
                 None => JsValue::NULL,
             }
@@ -72,8 +72,8 @@ fn select_structure(
             ));
         };
         let mut doc = d.borrow_mut();
-        let selected = doc.select_structure(index as usize).and_then(|()| {
-            super::json::info(doc.case())
+        let selected = doc.select(index as usize).and_then(|()| {
+            super::json::info(doc.session().case())
                 .map(|v| to_js(&v))
                 .ok_or_else(|| "nothing is open".to_string())
         });

@@ -57,7 +57,8 @@ pub(super) fn define_export(
                     Err(e) => return settled(Err(e)),
                 };
                 when_current(&d, &c, move |session| {
-                    let written = (session.written_case()).filter(|w| w.options == options);
+                    let written =
+                        (session.case_export().written()).filter(|w| w.options == options);
                     let bytes = match written {
                         Some(w) => w.bytes.clone(),
                         None => session.case().export_case(&options)?,
@@ -73,7 +74,7 @@ pub(super) fn define_export(
         "writeCase",
         Closure::<dyn FnMut(JsValue) -> Promise>::new(move |asked: JsValue| {
             let started = case_options(&asked, "writeCase")
-                .and_then(|o| d.borrow_mut().session_mut().start_case_export(o));
+                .and_then(|o| d.borrow_mut().session_mut().case_export_mut().start(o));
             if let Err(e) = started {
                 return settled(Err(e));
             }
@@ -81,13 +82,14 @@ pub(super) fn define_export(
             when_ready(
                 &d,
                 &c,
-                |s| s.case_export_progress().is_none(),
-                |session| match session.written_case() {
+                |s| s.case_export().progress().is_none(),
+                |session| match session.case_export().written() {
                     Some(w) => Ok(to_js(
                         &json!({ "bytes": w.bytes.len(), "triangles": w.triangles }),
                     )),
                     None => Err(session
-                        .case_export_error()
+                        .case_export()
+                        .error()
                         .unwrap_or("the case changed while it was written")
                         .to_string()),
                 },

@@ -74,15 +74,21 @@ pub(super) fn file_call(
             let Some(bytes) = bytes.take() else { return };
             let structures = |s: &crate::session::Session| super::json::structures(s.case());
             let mut doc = d.borrow_mut();
+            let file = |bytes| {
+                vec![NamedFile {
+                    name: name.clone(),
+                    bytes,
+                }]
+            };
             match call {
-                FileCall::Mesh => doc.begin_open(&name, bytes, Some(info_waiter(resolve, reject))),
+                FileCall::Mesh => doc.ask_open(file(bytes), Some(info_waiter(resolve, reject))),
                 FileCall::Case => {
                     let waiter = load_waiter(resolve, reject, structures);
-                    doc.begin_open(&name, bytes, Some(waiter))
+                    doc.ask_open(file(bytes), Some(waiter))
                 }
                 FileCall::Add => {
                     let waiter = load_waiter(resolve, reject, structures);
-                    doc.begin_add(&name, bytes, Some(waiter))
+                    doc.ask_add(&name, bytes, Some(waiter))
                 }
             }
             crate::app::wake(&c);
@@ -120,7 +126,7 @@ pub(super) fn image_call(
             let Some(files) = files.take() else { return };
             let structures = |s: &crate::session::Session| super::json::structures(s.case());
             let waiter = load_waiter(resolve, reject, structures);
-            d.borrow_mut().begin_image(files, preset, Some(waiter));
+            d.borrow_mut().ask_image(files, preset, Some(waiter));
             crate::app::wake(&c);
         })
     })

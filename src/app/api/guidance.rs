@@ -48,7 +48,7 @@ fn suggest(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut(JsVal
 fn sweep(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> Promise> {
     let (d, c) = (doc.clone(), ctx.clone());
     Closure::new(move || {
-        if d.borrow().case().model().is_none() {
+        if d.borrow().session().case().model().is_none() {
             return settled(Err("no mesh is open: call loadMesh first".into()));
         }
         d.borrow_mut().session_mut().set_graphs_wanted(true);
@@ -114,7 +114,7 @@ fn gallery(doc: &SharedDocument, ctx: &egui::Context) -> Closure<dyn FnMut() -> 
     Closure::new(move || {
         {
             let mut doc = d.borrow_mut();
-            if doc.case().model().is_none() {
+            if doc.session().case().model().is_none() {
                 return settled(Err("no mesh is open: call loadMesh first".into()));
             }
             doc.session_mut().start_gallery();

@@ -144,12 +144,12 @@ pub(crate) fn session_state(session: &Session, busy: bool) -> Value {
 /// and current (`written`: its bytes and triangles), and why the last one failed; null before
 /// any.
 fn case_export(session: &Session) -> Value {
-    let writing = session.case_export_progress().map(|p| {
+    let writing = session.case_export().progress().map(|p| {
         json!({"done": p.structures_done, "total": p.structures, "bytes": p.bytes, "triangles": p.triangles})
     });
-    let written =
-        (session.written_case()).map(|w| json!({"bytes": w.bytes.len(), "triangles": w.triangles}));
-    let error = session.case_export_error();
+    let written = (session.case_export().written())
+        .map(|w| json!({"bytes": w.bytes.len(), "triangles": w.triangles}));
+    let error = session.case_export().error();
     if writing.is_none() && written.is_none() && error.is_none() {
         return Value::Null;
     }
@@ -300,7 +300,7 @@ mod tests {
             list["structures"][0]["metrics"].is_null(),
             "not smoothed yet"
         );
-        session.smooth_cpu();
+        crate::session::testing::smooth_cpu(&mut session);
         let list = structures(session.case()).unwrap();
         assert_eq!(
             list["structures"][0]["metrics"],

@@ -102,7 +102,7 @@ impl Embedding {
     }
 
     fn post_structures(&self, event: &str, doc: &Document) {
-        let detail = super::json::structures(doc.case()).unwrap_or_default();
+        let detail = super::json::structures(doc.session().case()).unwrap_or_default();
         self.post_event(event, &detail);
     }
 
@@ -138,7 +138,7 @@ fn parent_origin(value: &str) -> Result<String, String> {
 type CaseKey = (u64, Option<usize>, u64);
 
 fn case_key(doc: &Document) -> CaseKey {
-    let s = doc.case();
+    let s = doc.session().case();
     (s.case_version(), s.current_structure(), s.revision())
 }
 

@@ -177,7 +177,7 @@ fn when_current(
     ctx: &egui::Context,
     answer: impl Fn(&crate::session::Session) -> Result<JsValue, String> + 'static,
 ) -> Promise {
-    if doc.borrow().case().model().is_none() {
+    if doc.borrow().session().case().model().is_none() {
         return Promise::reject(&error("no mesh is open: call loadMesh first"));
     }
     let doc = doc.clone();
@@ -389,7 +389,7 @@ fn define_smoothing(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Res
     api.define(
         "clearWeights",
         Closure::<dyn FnMut()>::new(move || {
-            d.borrow_mut().case_mut().clear_weights();
+            d.borrow_mut().session_mut().case_mut().clear_weights();
             crate::app::wake(&c);
         }),
     )

@@ -134,7 +134,7 @@ fn define_lesson(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result
     api.define(
         "lesson",
         Closure::<dyn FnMut() -> JsValue>::new(move || {
-            to_js(&serde_json::json!(d.borrow().case().lesson()))
+            to_js(&serde_json::json!(d.borrow().session().case().lesson()))
         }),
     )?;
     let (d, c) = (doc.clone(), ctx.clone());
@@ -144,7 +144,7 @@ fn define_lesson(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Result
             let lesson = from_js(&value)
                 .and_then(|v| serde_json::from_value(v).map_err(|e| format!("not a lesson: {e}")))
                 .map_err(|e| error(&format!("setLesson: {e}")))?;
-            let set = d.borrow_mut().case_mut().set_lesson(lesson);
+            let set = d.borrow_mut().session_mut().case_mut().set_lesson(lesson);
             crate::app::wake(&c);
             set.map_err(|e| error(&format!("setLesson: {e}")))
         }),

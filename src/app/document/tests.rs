@@ -12,26 +12,29 @@ const TUBE: &[u8] = include_bytes!("../../../tests/data/bent_tube_staircase.ply"
 
 #[wasm_bindgen_test]
 fn a_bad_file_keeps_the_previous_model_and_reports_why() {
-    let mut doc = Document::new(Backend::Cpu);
-    doc.open(TUBE_NAME, TUBE).unwrap();
+    let mut doc = Document::with_backend(Backend::Cpu);
+    doc.open_now(TUBE_NAME, TUBE).unwrap();
     let generation = doc.session.case().model_id();
-    let error = doc.open("notes.txt", b"not a mesh").unwrap_err();
+    let error = doc.open_now("notes.txt", b"not a mesh").unwrap_err();
     assert!(error.starts_with("Cannot open notes.txt: "), "{error}");
     assert!(error.contains(".stl .obj .ply"), "{error}");
     assert_eq!(doc.session.case().model_id(), generation);
     let state = doc.state_json();
     assert_eq!(state["model"], TUBE_NAME);
     assert_eq!(state["error"], error.as_str());
-    assert!(doc.open("empty.stl", b"").unwrap_err().contains("empty"));
+    assert!(doc
+        .open_now("empty.stl", b"")
+        .unwrap_err()
+        .contains("empty"));
 }
 
 #[wasm_bindgen_test]
 fn a_workers_reply_asks_for_a_frame_only_when_what_is_shown_changed() {
-    let mut doc = Document::new(Backend::Cpu);
+    let mut doc = Document::with_backend(Backend::Cpu);
     let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
     let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
     doc.session.set_cpu_engine(pool);
-    doc.open(TUBE_NAME, TUBE).unwrap();
+    doc.open_now(TUBE_NAME, TUBE).unwrap();
     assert!(
         !doc.step_cpu_engine(),
         "the smoothing is asked, not answered"
@@ -54,11 +57,11 @@ fn a_workers_reply_asks_for_a_frame_only_when_what_is_shown_changed() {
 #[wasm_bindgen_test]
 fn the_end_of_suggest_all_asks_for_a_frame_at_once() {
     // Replies come between frames; the bar moves with paced frames, its end must not wait.
-    let mut doc = Document::new(Backend::Cpu);
+    let mut doc = Document::with_backend(Backend::Cpu);
     let (carrier, deliver) = crate::worker::deferred::Deferred::new(1);
     doc.session
         .set_cpu_engine(crate::worker::Pool::new(Box::new(carrier)));
-    doc.open(TUBE_NAME, TUBE).unwrap();
+    doc.open_now(TUBE_NAME, TUBE).unwrap();
     let search = crate::case::SuggestAllSearch::Local;
     doc.session
         .start_suggest_all(0.5, search, None, 0.0)
@@ -73,8 +76,8 @@ fn the_end_of_suggest_all_asks_for_a_frame_at_once() {
 
 #[wasm_bindgen_test]
 fn waiting_calls_are_answered_once_the_result_is_computed() {
-    let mut doc = Document::new(Backend::Cpu);
-    doc.open(TUBE_NAME, TUBE).unwrap();
+    let mut doc = Document::with_backend(Backend::Cpu);
+    doc.open_now(TUBE_NAME, TUBE).unwrap();
     let answered = Rc::new(Cell::new(0));
     let seen = answered.clone();
     doc.when_current(Box::new(move |s| {

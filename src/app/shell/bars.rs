@@ -70,7 +70,7 @@ impl Shell {
             // privacy note alone.
             let narrow = ui.ctx().content_rect().width() < super::reading::NARROW;
             let named = doc.quiz.is_none() && !(narrow && self.reads());
-            if let Some(model) = doc.case().model().filter(|_| named) {
+            if let Some(model) = doc.session().case().model().filter(|_| named) {
                 ui.label(format!(
                     "{}: {} vertices, {} faces",
                     model.name, model.report.vertices, model.report.faces

@@ -40,8 +40,8 @@ impl Shell {
         session.step_checks();
         // Writing the case glTF takes this frame's share of time on this thread.
         let start = now_ms();
-        while session.case_export_progress().is_some() && now_ms() - start < EXPORT_FRAME_MS {
-            session.step_case_export();
+        while session.case_export().progress().is_some() && now_ms() - start < EXPORT_FRAME_MS {
+            session.case_export_mut().step();
         }
     }
 

@@ -119,13 +119,13 @@ fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
         match group.purpose {
             FilesFor::OpenCase => {
                 for f in files {
-                    doc.begin_add(&f.name, f.bytes, None);
+                    doc.ask_add(&f.name, f.bytes, None);
                 }
             }
             // One image: a file, or the slices of a DICOM series chosen together.
-            FilesFor::Image(preset) if !files.is_empty() => doc.begin_image(files, preset, None),
+            FilesFor::Image(preset) if !files.is_empty() => doc.ask_image(files, preset, None),
             FilesFor::Image(_) => {}
-            FilesFor::NewCase if !files.is_empty() => doc.begin_open_files(files, None),
+            FilesFor::NewCase if !files.is_empty() => doc.ask_open(files, None),
             FilesFor::NewCase => {}
         }
     }
@@ -144,7 +144,7 @@ impl Shell {
         } else {
             Backend::Cpu
         };
-        let doc = Rc::new(RefCell::new(Document::new(backend)));
+        let doc = Rc::new(RefCell::new(Document::with_backend(backend)));
         start_workers(&doc, reading, &cc.egui_ctx);
         let view = cc.wgpu_render_state.as_ref().map(|rs| {
             let mut viewer = Viewer::new(rs);
@@ -303,14 +303,19 @@ impl Shell {
                         .copied(),
                 };
             }
-            Action::Filter(k) => self.doc.borrow_mut().case_mut().set_filter(Filter::ALL[k]),
+            Action::Filter(k) => self
+                .doc
+                .borrow_mut()
+                .session_mut()
+                .case_mut()
+                .set_filter(Filter::ALL[k]),
             Action::ExportGlb if crate::AUTHORING => self.export(ExportFormat::Glb),
             Action::ExportGlb => {}
             Action::ToggleHelp => self.help_open = !self.help_open,
             Action::ApplySuggestion => {
                 let mut doc = self.doc.borrow_mut();
-                if let Some(s) = doc.background().suggestion() {
-                    let _ = doc.case_mut().set_params(s.suggestion.params);
+                if let Some(s) = doc.session().background().suggestion() {
+                    let _ = doc.session_mut().case_mut().set_params(s.suggestion.params);
                 }
             }
             Action::ToggleGraphs if crate::AUTHORING => {
@@ -349,16 +354,19 @@ impl Shell {
                     doc.session_mut().remove_image();
                     Ok(())
                 }
-                StructureAction::Select(i) => doc.select_structure(i),
-                StructureAction::Change(i, change) => doc.case_mut().set_structure(i, change),
-                StructureAction::Solo(i) => doc.case_mut().solo_structure(i),
+                StructureAction::Select(i) => doc.select(i),
+                StructureAction::Change(i, change) => {
+                    doc.session_mut().case_mut().set_structure(i, change)
+                }
+                StructureAction::Solo(i) => doc.session_mut().case_mut().solo_structure(i),
                 StructureAction::CaseText(title, description) => {
-                    doc.case_mut()
+                    doc.session_mut()
+                        .case_mut()
                         .set_case_text(Some(&title), Some(&description));
                     Ok(())
                 }
                 StructureAction::SuggestAll => {
-                    let tau = doc.case().tau();
+                    let tau = doc.session().case().tau();
                     let search = crate::case::SuggestAllSearch::default();
                     let now = crate::app::document::now_ms();
                     doc.session_mut().start_suggest_all(tau, search, None, now)
@@ -369,17 +377,17 @@ impl Shell {
                     Ok(())
                 }
                 StructureAction::ExportCase(options) => {
-                    doc.session_mut().start_case_export(options)
+                    doc.session_mut().case_export_mut().start(options)
                 }
                 StructureAction::CancelExport => {
-                    doc.session_mut().cancel_case_export();
+                    doc.session_mut().case_export_mut().cancel();
                     Ok(())
                 }
                 StructureAction::SaveCase => {
-                    let file = doc.case().case_file();
+                    let file = doc.session().case().case_file();
                     let stem = file.split('.').next().filter(|s| !s.is_empty());
                     let name = format!("{}_case.glb", stem.unwrap_or("case"));
-                    match doc.session().written_case() {
+                    match doc.session().case_export().written() {
                         Some(w) => download::save(&name, &w.bytes, "model/gltf-binary"),
                         None => Err("the case changed since it was written: write it again".into()),
                     }
@@ -390,19 +398,19 @@ impl Shell {
             }
         }
         ui.heading("Smoothing");
-        self.controls.filter(ui, doc.case_mut());
-        self.drag_params.panel(ui, doc.case().filter());
+        self.controls.filter(ui, doc.session_mut().case_mut());
+        self.drag_params.panel(ui, doc.session().case().filter());
         ui.separator();
-        self.brush.panel(ui, doc.case_mut());
+        self.brush.panel(ui, doc.session_mut().case_mut());
         ui.separator();
         ui.heading("Suggest");
         self.guide.show(ui, doc.session_mut());
         ui.separator();
         ui.heading("Measures");
-        controls::measures(ui, doc.case(), timings);
+        controls::measures(ui, doc.session().case(), timings);
         ui.separator();
         ui.heading("Colours");
-        controls::coloring(ui, &mut self.coloring, doc.case_mut());
+        controls::coloring(ui, &mut self.coloring, doc.session_mut().case_mut());
         drop(guard);
         if let Some(purpose) = picker {
             self.open_picker(purpose);
@@ -476,7 +484,7 @@ impl Shell {
     /// The background's guidance steps on, its runs on the GPU engine when it takes them.
     fn step_guidance(&mut self) {
         let mut doc = self.doc.borrow_mut();
-        let vertices = (doc.case().model()).map_or(0, |m| m.mesh().vertex_count());
+        let vertices = (doc.session().case().model()).map_or(0, |m| m.mesh().vertex_count());
         let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
         doc.guidance_on_gpu = offload.is_some();
         doc.compute_guidance(offload);
@@ -526,7 +534,7 @@ impl Shell {
                         .push(("lesson-tab".into(), tab.rect.into()));
                 });
                 ui.separator();
-                egui::ScrollArea::vertical().show(ui, |ui| match doc.case().model() {
+                egui::ScrollArea::vertical().show(ui, |ui| match doc.session().case().model() {
                     Some(_) if self.lesson_tab => crate::app::lesson_panel::show(ui, &mut doc),
                     Some(model) => report_view::show(ui, model),
                     None => {}

@@ -15,7 +15,7 @@ impl Shell {
     /// The quiz's start button, where the case has a quiz and none runs.
     pub(super) fn quiz_start(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
-        if doc.case().lesson().quiz.is_none() || doc.quiz.is_some() {
+        if doc.session().case().lesson().quiz.is_none() || doc.quiz.is_some() {
             return;
         }
         let start = ui.button("Take the quiz");
@@ -47,7 +47,7 @@ impl Shell {
         let choices = run.current().map_or(&[][..], |(_, q)| &q.choices[..]);
         const KEYS: [&str; 4] = ["choice-0", "choice-1", "choice-2", "choice-3"];
         for (k, &c) in choices.iter().enumerate() {
-            let label = doc.shown_name(c);
+            let label = doc.words().name(c);
             let button = ui.add_enabled(run.answered().is_none(), egui::Button::new(label));
             drawn.push((KEYS[k.min(3)], button.rect));
             if button.clicked() {

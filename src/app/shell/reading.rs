@@ -112,7 +112,7 @@ impl Shell {
                 let doc = &mut *guard;
                 let was = self.coloring == Some(ColorField::LocalError);
                 let mut error_colours = was;
-                let languages = doc.reader_languages().to_vec();
+                let languages = doc.words().languages.to_vec();
                 let (session, panel) = doc.session_and_panel();
                 let filter = &mut self.reading_filter;
                 let reader = (&*session, &languages[..]);
@@ -122,11 +122,11 @@ impl Shell {
                 }
                 for action in actions {
                     let done = match action {
-                        StructureAction::Select(i) => doc.select_structure(i),
+                        StructureAction::Select(i) => doc.select(i),
                         StructureAction::Change(i, change) => {
-                            doc.case_mut().set_structure(i, change)
+                            doc.session_mut().case_mut().set_structure(i, change)
                         }
-                        StructureAction::Solo(i) => doc.case_mut().solo_structure(i),
+                        StructureAction::Solo(i) => doc.session_mut().case_mut().solo_structure(i),
                         _ => Ok(()),
                     };
                     if let Err(e) = done {

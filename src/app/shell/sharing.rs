@@ -18,7 +18,13 @@ impl Shell {
             egui::Rect::from_min_size(egui::pos2(r.left, r.top), egui::vec2(r.width, r.height));
         if let Some(png) = self.picture.take(view, ctx.pixels_per_point()) {
             if std::mem::take(&mut self.picture.download) {
-                let stem = doc.case().case_file().split('.').next().unwrap_or("");
+                let stem = doc
+                    .session()
+                    .case()
+                    .case_file()
+                    .split('.')
+                    .next()
+                    .unwrap_or("");
                 let name = format!("{}_view.png", if stem.is_empty() { "case" } else { stem });
                 if let Err(e) = (png.as_ref())
                     .map_err(String::clone)
@@ -92,7 +98,7 @@ impl Shell {
 /// Shows the structures, selection, clip or planes and slide `link` asks for (not its
 /// camera); what could not be shown, in words.
 pub(super) fn show_view(doc: &mut Document, link: &ViewLink) -> Vec<String> {
-    let count = doc.case().case_structures().len();
+    let count = doc.session().case().case_structures().len();
     let mut problems = Vec::new();
     for &i in link
         .hidden
@@ -109,7 +115,7 @@ pub(super) fn show_view(doc: &mut Document, link: &ViewLink) -> Vec<String> {
             opacity: (link.opacity.iter().find(|(j, _)| *j == i)).map(|(_, a)| *a),
             ..Default::default()
         };
-        if let Err(e) = doc.case_mut().set_structure(i, change) {
+        if let Err(e) = doc.session_mut().case_mut().set_structure(i, change) {
             problems.push(e);
         }
     }
@@ -121,7 +127,7 @@ pub(super) fn show_view(doc: &mut Document, link: &ViewLink) -> Vec<String> {
     }
     doc.view_asks.toward_segmentation = link.toward_segmentation;
     if let Some(i) = link.selected {
-        if let Err(e) = doc.select_structure(i) {
+        if let Err(e) = doc.select(i) {
             problems.push(e);
         }
     }

@@ -21,7 +21,7 @@ pub(super) fn open_start_model(
     // The student's viewer bundles no sample: a package names its case.
     let open_sample = || {
         if crate::AUTHORING {
-            let _ = doc.borrow_mut().open(SAMPLE_NAME, SAMPLE_BYTES);
+            let _ = doc.borrow_mut().open_now(SAMPLE_NAME, SAMPLE_BYTES);
         }
     };
     match query::model_url() {

@@ -15,10 +15,10 @@ impl Shell {
         let Some(index) = doc.view_asks.step.take() else {
             return;
         };
-        let Some(step) = doc.case().lesson().steps.get(index).cloned() else {
+        let Some(step) = doc.session().case().lesson().steps.get(index).cloned() else {
             return;
         };
-        let link = step_view(&step, &doc.case().structure_names());
+        let link = step_view(&step, &doc.session().case().structure_names());
         let problems = show_view(&mut doc, &link);
         if !problems.is_empty() {
             log::warn!("tour step {}: {}", index + 1, problems.join("; "));
@@ -52,13 +52,13 @@ impl Shell {
     /// them.
     pub(super) fn tour_panel(&mut self, ui: &mut egui::Ui) {
         let mut doc = self.doc.borrow_mut();
-        if !doc.case().lesson().labels.is_empty() {
+        if !doc.session().case().lesson().labels.is_empty() {
             let mut shown = !doc.view_asks.hide_labels;
             let toggle = ui.checkbox(&mut shown, "Labels");
             doc.panel.lesson.push(("labels".into(), toggle.rect.into()));
             doc.view_asks.hide_labels = !shown;
         }
-        let steps = &doc.case().lesson().steps;
+        let steps = &doc.session().case().lesson().steps;
         if steps.is_empty() {
             return;
         }
@@ -78,8 +78,8 @@ impl Shell {
             ui.separator();
             return;
         };
-        let languages = doc.reader_languages();
-        let lesson = doc.case().lesson();
+        let languages = doc.words().languages;
+        let lesson = doc.session().case().lesson();
         let (title, caption) = (lesson.step_text(index.min(count - 1), languages))
             .map(|(t, c)| (t.to_string(), c.to_string()))
             .unwrap_or_default();

@@ -65,7 +65,7 @@ impl Shell {
                 };
                 // A picture shows the view alone (and which way the patient lies).
                 if !self.picture.pending {
-                    let has_image = doc.case().case_image().is_some();
+                    let has_image = doc.session().case().case_image().is_some();
                     let asks = &mut doc.view_asks;
                     doc.panel.planes = view_tools::show(ui, response.rect, asks, has_image);
                 }
@@ -76,11 +76,12 @@ impl Shell {
                     Some(Positions::Cpu(r) | Positions::Gpu(r)) => Some(r),
                     _ => None,
                 };
-                let surface = (doc.case().model_id(), shown);
+                let surface = (doc.session().case().model_id(), shown);
                 let camera = viewer.camera();
                 self.brush
-                    .interact(ui, &response, camera, doc.case_mut(), surface);
-                self.drag_params.interact(ui, &response, doc.case_mut());
+                    .interact(ui, &response, camera, doc.session_mut().case_mut(), surface);
+                self.drag_params
+                    .interact(ui, &response, doc.session_mut().case_mut());
                 doc.view = ViewReport {
                     rect: response.rect.into(),
                     pose: Some(viewer.pose()),
@@ -136,9 +137,9 @@ fn point(
         }
         return;
     }
-    let current = doc.case().current_structure();
+    let current = doc.session().case().current_structure();
     if let (true, Some(i)) = (reading, clicked.filter(|&i| Some(i) != current)) {
-        if let Err(e) = doc.select_structure(i) {
+        if let Err(e) = doc.select(i) {
             log::warn!("{e}");
         }
     }
