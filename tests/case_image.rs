@@ -226,7 +226,7 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
         label_maps::read("labelmaps/case_phantom_shared.seg.nrrd"),
     );
     session.poll_opening().expect("done").expect("opens");
-    assert!(session.case().case_image().is_none());
+    assert!(session.case().as_case().image.as_ref().is_none());
     let nrrd = phantom_ct_nrrd();
     (begin_one(
         &mut session,
@@ -236,7 +236,13 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
     ))
     .expect("asked");
     session.poll_opening().expect("done").expect("read");
-    let image = session.case().case_image().expect("added").clone();
+    let image = session
+        .case()
+        .as_case()
+        .image
+        .as_ref()
+        .expect("added")
+        .clone();
     let mut case = label_maps::phantom_case();
     add_one(
         &mut case,
@@ -258,9 +264,13 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
             && error.contains("1.000 mm"),
         "{error}"
     );
-    assert_eq!(session.case().case_image(), Some(&image), "kept");
+    assert_eq!(
+        session.case().as_case().image.as_ref(),
+        Some(&image),
+        "kept"
+    );
     session.remove_image();
-    assert!(session.case().case_image().is_none());
+    assert!(session.case().as_case().image.as_ref().is_none());
 }
 
 #[test]

@@ -486,7 +486,13 @@ fn the_page_session_adds_a_series_under_the_phantom() {
     };
     (session.begin_image(named("phantom_ct"), WindowPreset::CtSoftTissue)).expect("asked");
     session.poll_opening().expect("done").expect("read");
-    let image = session.case().case_image().expect("added").clone();
+    let image = session
+        .case()
+        .as_case()
+        .image
+        .as_ref()
+        .expect("added")
+        .clone();
     assert_eq!(image.source, "DICOM series (24 slices)");
     assert_eq!(image.dims, [160, 140, 24]);
 
@@ -513,7 +519,11 @@ fn the_page_session_adds_a_series_under_the_phantom() {
             && error.contains("gantry tilt"),
         "{error}"
     );
-    assert_eq!(session.case().case_image(), Some(&image), "kept");
+    assert_eq!(
+        session.case().as_case().image.as_ref(),
+        Some(&image),
+        "kept"
+    );
 }
 
 /// The oblique series in Deflated Explicit VR Little Endian reads as the uncompressed one; a

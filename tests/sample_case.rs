@@ -99,7 +99,7 @@ fn the_sample_opens_as_a_case_with_its_lesson() {
     session.open("abdomen_phantom.glb", &bytes).expect("opens");
     let case = session.case();
     assert_eq!(
-        case.structure_names(),
+        case.as_case().names(),
         ["liver", "portal_vein", "tumor", "right_kidney"]
     );
     let lesson: Lesson = serde_json::from_slice(

@@ -84,7 +84,7 @@ fn the_session_checks_its_structures_as_they_stand() {
     let key = session.background().marks_key().expect("marks to show");
     let patches = session.background().marked_surfaces();
     assert_eq!(patches.len(), 3);
-    let liver = &session.case().case_structures()[0];
+    let liver = &session.case().as_case().structures.as_slice()[0];
     assert!(patches[0].triangle_count() < liver.original.triangle_count() / 2);
     // Hiding or recolouring a structure leaves the surfaces as checked; a hidden one's marks
     // are not drawn.
@@ -120,7 +120,9 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
-    let tumour = &session.case().case_structures()[2].original.positions;
+    let tumour = &session.case().as_case().structures.as_slice()[2]
+        .original
+        .positions;
     let centre = tumour
         .iter()
         .fold(glam::Vec3::ZERO, |sum, &p| sum + glam::Vec3::from(p))
@@ -131,35 +133,40 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
         direction: glam::Vec3::X,
     };
     let none = [0.0; 4];
-    let (first, hit) = session
-        .case()
-        .structure_at(&ray, none)
-        .expect("the case in the way");
+    let (first, hit) =
+        meshsmooth::view::structure_at(&session.case().as_case().structures, &ray, none)
+            .expect("the case in the way");
     assert_eq!(first, 0, "the liver first");
     let clear = StructureChange {
         opacity: Some(0.0),
         ..Default::default()
     };
     session.case_mut().set_structure(0, clear).unwrap();
-    let (seen, deeper) = session.case().structure_at(&ray, none).unwrap();
+    let (seen, deeper) =
+        meshsmooth::view::structure_at(&session.case().as_case().structures, &ray, none).unwrap();
     assert_eq!(seen, 2, "through the transparent liver, the tumour");
     assert!(deeper.distance > hit.distance);
     session.case_mut().solo_structure(2).unwrap();
-    let (alone, near) = session.case().structure_at(&ray, none).unwrap();
+    let (alone, near) =
+        meshsmooth::view::structure_at(&session.case().as_case().structures, &ray, none).unwrap();
     assert_eq!(alone, 2);
     // A plane through the tumour's centre cutting away its near half (x below the centre):
     // the pointer meets its far half.
     let cut_near = [-1.0, 0.0, 0.0, -centre.x];
-    let (_, far) = session.case().structure_at(&ray, cut_near).unwrap();
+    let (_, far) =
+        meshsmooth::view::structure_at(&session.case().as_case().structures, &ray, cut_near)
+            .unwrap();
     assert!(
         far.point.x > centre.x && far.distance > near.distance,
         "{far:?}"
     );
     // Cutting everything away leaves nothing to name.
-    assert!(session
-        .case()
-        .structure_at(&ray, [0.0, 0.0, 0.0, -1.0])
-        .is_none());
+    assert!(meshsmooth::view::structure_at(
+        &session.case().as_case().structures,
+        &ray,
+        [0.0, 0.0, 0.0, -1.0]
+    )
+    .is_none());
     session.case_mut().solo_structure(2).unwrap();
     let hide = StructureChange {
         visible: Some(false),
@@ -167,7 +174,8 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
     };
     session.case_mut().set_structure(2, hide).unwrap();
     assert_ne!(
-        session.case().structure_at(&ray, none).map(|(i, _)| i),
+        meshsmooth::view::structure_at(&session.case().as_case().structures, &ray, none)
+            .map(|(i, _)| i),
         Some(2),
         "hidden"
     );

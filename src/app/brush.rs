@@ -6,7 +6,7 @@
 //! what they do the engines'. A fast stroke is filled in with dabs spaced half a brush radius apart on screen.
 
 use super::document::now_ms;
-use crate::session::CaseDocument;
+use crate::session::{CaseDocument, Dab};
 use crate::view::{brush_footprint, pick_triangle, Hit, OrbitCamera};
 use eframe::egui;
 use glam::Vec2;
@@ -120,7 +120,7 @@ impl Brush {
                     .suffix(" mm"),
             );
         });
-        if let Some(w) = case.weights_summary() {
+        if let Some(w) = crate::session::WeightsSummary::of(case.weights()) {
             ui.small(format!(
                 "{} vertices painted, {} locked (lowest weight {:.2})",
                 w.painted, w.locked, w.min
@@ -198,9 +198,9 @@ impl Brush {
         }
         for footprint in footprints {
             match self.mode {
-                BrushMode::Lock => case.paint_weights(&footprint, 0.0),
-                BrushMode::Weaken => case.paint_weights(&footprint, 1.0 - self.strength),
-                BrushMode::Erase => case.erase_weights(&footprint),
+                BrushMode::Lock => case.dab_weights(&footprint, Dab::Paint(0.0)),
+                BrushMode::Weaken => case.dab_weights(&footprint, Dab::Paint(1.0 - self.strength)),
+                BrushMode::Erase => case.dab_weights(&footprint, Dab::Erase),
             };
         }
         self.draw_circle(ui, camera, rect, size);

@@ -106,7 +106,7 @@ impl ExportChoice {
         session: &Session,
         actions: &mut Vec<StructureAction>,
     ) {
-        ui.horizontal_wrapped(|ui| match session.case().case_image() {
+        ui.horizontal_wrapped(|ui| match session.case().as_case().image.as_ref() {
             Some(image) => {
                 let [i, j, k] = image.dims;
                 let size = megabytes(image.voxels.len());

@@ -30,15 +30,15 @@ pub fn show(
     let Some(current) = session.case().current_structure() else {
         return actions;
     };
-    let list = session.case().case_structures();
-    let title = session.case().case_title();
+    let list = session.case().as_case().structures.as_slice();
+    let title = session.case().as_case().title.as_str();
     ui.heading(if title.is_empty() {
         session.case().case_file()
     } else {
         title
     });
-    if !session.case().case_description().is_empty() {
-        ui.label(session.case().case_description());
+    if !session.case().as_case().description.is_empty() {
+        ui.label(session.case().as_case().description.as_str());
     }
     ui.separator();
     ui.horizontal(|ui| {

@@ -27,7 +27,10 @@ impl CaseText {
             session.case().case_version(),
             session.case().current_structure(),
         );
-        let (file, title) = (session.case().case_file(), session.case().case_title());
+        let (file, title) = (
+            session.case().case_file(),
+            session.case().as_case().title.as_str(),
+        );
         if let Some((v, c, p, f, t)) = &self.written {
             let now = (version, current, doc.previewing, file, title);
             if (*v, *c, *p, f.as_str(), t.as_str()) == now {
@@ -120,9 +123,9 @@ fn lesson_lines(doc: &Document) -> Vec<String> {
 /// The canvas's label: what the view shows.
 fn label(doc: &Document) -> String {
     let session = doc.session();
-    let structures = session.case().case_structures();
+    let structures = session.case().as_case().structures.as_slice();
     let shown = structures.iter().filter(|s| s.visible).count();
-    let title = session.case().case_title();
+    let title = session.case().as_case().title.as_str();
     let what = if title.is_empty() {
         session.case().case_file()
     } else {
@@ -142,23 +145,29 @@ fn label(doc: &Document) -> String {
 /// selected, and its description.
 fn lines(doc: &Document) -> Vec<String> {
     let current = doc.session().case().current_structure();
-    (doc.session().case().case_structures().iter().enumerate())
-        .map(|(i, s)| {
-            let mut line = doc.words().name(i).to_string();
-            if let Some(group) = &s.group {
-                line.push_str(&format!(" ({group})"));
-            }
-            line.push_str(if s.visible { ", shown" } else { ", hidden" });
-            if s.visible && s.color[3] < 1.0 {
-                line.push_str(&format!(", {:.0}% opaque", s.color[3] * 100.0));
-            }
-            if Some(i) == current {
-                line.push_str(", selected");
-            }
-            if !s.description.is_empty() {
-                line.push_str(&format!(": {}", s.description));
-            }
-            line
-        })
-        .collect()
+    (doc.session()
+        .case()
+        .as_case()
+        .structures
+        .as_slice()
+        .iter()
+        .enumerate())
+    .map(|(i, s)| {
+        let mut line = doc.words().name(i).to_string();
+        if let Some(group) = &s.group {
+            line.push_str(&format!(" ({group})"));
+        }
+        line.push_str(if s.visible { ", shown" } else { ", hidden" });
+        if s.visible && s.color[3] < 1.0 {
+            line.push_str(&format!(", {:.0}% opaque", s.color[3] * 100.0));
+        }
+        if Some(i) == current {
+            line.push_str(", selected");
+        }
+        if !s.description.is_empty() {
+            line.push_str(&format!(": {}", s.description));
+        }
+        line
+    })
+    .collect()
 }

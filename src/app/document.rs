@@ -121,7 +121,7 @@ impl Document {
             false => &[],
         };
         Words {
-            structures: self.session.case().case_structures(),
+            structures: self.session.case().as_case().structures.as_slice(),
             languages,
         }
     }
@@ -439,7 +439,14 @@ impl Document {
     /// The view as it stands: camera, hidden and see-through structures, the selected one,
     /// the clipping plane or the image's planes and the slide towards the segmentation.
     pub fn view_link(&self) -> ViewLink {
-        let listed = self.session.case().case_structures().iter().enumerate();
+        let listed = self
+            .session
+            .case()
+            .as_case()
+            .structures
+            .as_slice()
+            .iter()
+            .enumerate();
         ViewLink {
             camera: self.view.pose,
             hidden: (listed.clone().filter(|(_, s)| !s.visible))

@@ -70,16 +70,17 @@ impl LabelPainter {
 /// Where the case's labels go in the view, and which are faded.
 fn spots(rect: egui::Rect, viewer: &Viewer, doc: &Document) -> Vec<LabelSpot> {
     let labels = &doc.session().case().lesson().labels;
-    let visible: HashSet<&str> = (doc.session().case().case_structures().iter())
+    let visible: HashSet<&str> = (doc.session().case().as_case().structures.as_slice().iter())
         .filter(|s| s.visible)
         .map(|s| s.name.as_str())
         .collect();
     let shown = |name: &str| visible.contains(name);
     let size = Vec2::new(rect.width(), rect.height());
     let plane = viewer.clip_plane();
-    let structures = doc.session().case().case_structures();
+    let structures = doc.session().case().as_case().structures.as_slice();
     let nearest = |ray: &Ray, structure: &str| {
-        let (i, hit) = doc.session().case().opaque_at(ray, plane)?;
+        let (i, hit) =
+            crate::view::opaque_at(&doc.session().case().as_case().structures, ray, plane)?;
         Some((hit.distance, structures[i].name == structure))
     };
     label_spots(labels, shown, (viewer.camera(), nearest), size, plane)

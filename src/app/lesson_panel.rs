@@ -17,7 +17,7 @@ use crate::view::recorded_step;
 impl Document {
     /// Adds the view as it stands as the tour's last step; returns the number of steps.
     pub fn record_step(&mut self, title: &str, caption: &str) -> Result<usize, String> {
-        let names = self.session().case().structure_names();
+        let names = self.session().case().as_case().names();
         let step = recorded_step(&self.view_link(), &names, title, caption)?;
         let mut lesson = self.session().case().lesson().clone();
         lesson.steps.push(step);
@@ -29,9 +29,15 @@ impl Document {
     /// Adds a label on structure `index` at `point` (where the author clicked it), its text
     /// the structure's name until edited.
     pub fn place_label(&mut self, index: usize, point: Vec3) -> Result<(), String> {
-        let name = (self.session().case().case_structures().get(index))
-            .map(|s| s.name.clone())
-            .ok_or(format!("the case has no structure {index}"))?;
+        let name = (self
+            .session()
+            .case()
+            .as_case()
+            .structures
+            .as_slice()
+            .get(index))
+        .map(|s| s.name.clone())
+        .ok_or(format!("the case has no structure {index}"))?;
         let mut lesson = self.session().case().lesson().clone();
         lesson
             .labels
@@ -89,7 +95,7 @@ pub fn show(ui: &mut egui::Ui, doc: &mut Document) {
     }
     labels(ui, &mut lesson, editing, &mut drawn, &mut asked);
     ui.separator();
-    let names = doc.session().case().structure_names();
+    let names = doc.session().case().as_case().names();
     quiz(ui, &mut lesson, &names, &mut drawn, &mut asked);
     ui.separator();
     let lms = export_for_lms(ui, &mut drawn);

@@ -54,17 +54,29 @@ impl Pointing {
             case: (
                 session.case().case_version(),
                 session.case().revision(),
-                session.case().case_structures().len(),
+                session.case().as_case().structures.as_slice().len(),
             ),
         };
         if self.asked != Some(asked) {
             let rect = response.rect;
             let at = Vec2::new(pointer.x - rect.left(), pointer.y - rect.top());
             let ray = camera.ray_through(at, Vec2::new(rect.width(), rect.height()));
-            let hit = ray.and_then(|ray| session.case().structure_at(&ray, plane));
+            let hit = ray.and_then(|ray| {
+                crate::view::structure_at(&session.case().as_case().structures, &ray, plane)
+            });
             self.point = hit.map(|(_, h)| h.point);
             self.named = hit.and_then(|(i, _)| {
-                Some((i, session.case().case_structures().get(i)?.name.clone()))
+                Some((
+                    i,
+                    session
+                        .case()
+                        .as_case()
+                        .structures
+                        .as_slice()
+                        .get(i)?
+                        .name
+                        .clone(),
+                ))
             });
             self.asked = Some(asked);
         }

@@ -22,9 +22,9 @@ impl Document {
     /// Starts the case's quiz (again), leaving the tour; the structures it asks are shown.
     pub fn start_quiz(&mut self) -> Result<(), String> {
         let quiz = (self.session().case().lesson().quiz.clone()).ok_or("the case has no quiz")?;
-        let structures = self.session().case().case_structures();
+        let structures = self.session().case().as_case().structures.as_slice();
         let shown: Vec<bool> = structures.iter().map(|s| s.visible).collect();
-        let names = self.session().case().structure_names();
+        let names = self.session().case().as_case().names();
         // The clock seeds the order, so that a second try asks in another.
         let now = now_ms();
         let run = QuizRun::new(&quiz, &names, &shown, now.to_bits(), now)?;
@@ -50,7 +50,7 @@ impl Document {
         let answer = running.answer(given, now_ms())?;
         let run = self.quiz.as_ref().ok_or("no quiz is running")?;
         let (_, question) = run.current().ok_or("the quiz is over")?;
-        let names = self.session().case().structure_names();
+        let names = self.session().case().as_case().names();
         let name = |i: usize| names.get(i).copied().unwrap_or_default();
         let choices: Vec<&str> = question.choices.iter().map(|&i| name(i)).collect();
         let asked = (name(question.structure), question.mode);
@@ -176,7 +176,7 @@ impl Document {
         let Some(run) = &self.quiz else {
             return json!({ "running": false, "modes": quiz.modes, "pass_mark": quiz.pass_mark });
         };
-        let names = self.session().case().structure_names();
+        let names = self.session().case().as_case().names();
         let name = |i: usize| names.get(i).copied().unwrap_or_default();
         let current = run.current();
         let (right, answered) = run.score();

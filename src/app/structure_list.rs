@@ -80,7 +80,7 @@ impl StructureList {
         let Some(current) = session.case().current_structure() else {
             return actions;
         };
-        let list = session.case().case_structures();
+        let list = session.case().as_case().structures.as_slice();
         ui.horizontal(|ui| {
             ui.heading("Structures");
             let tip = "Open more files (meshes, a label map, a case glTF) into this case";
@@ -186,8 +186,8 @@ impl StructureList {
         actions: &mut Vec<StructureAction>,
     ) {
         let stored = (
-            session.case().case_title().to_string(),
-            session.case().case_description().to_string(),
+            session.case().as_case().title.to_string(),
+            session.case().as_case().description.to_string(),
         );
         if self.case_text.1 != stored {
             self.case_text = (stored.clone(), stored);
@@ -292,7 +292,7 @@ pub fn measures(s: &CaseStructure, session: &Session, i: usize) -> [String; 2] {
             "shown as the file holds it".into(),
         ];
     }
-    let params = session.case().structure_params(i).unwrap_or(s.params);
+    let params = s.params;
     let how = format!("{}: {}", params.filter.name(), params.describe());
     let what = match session.case().structure_metrics(i) {
         Some(m) => measured(m, s.voxel_diagonal()),

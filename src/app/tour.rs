@@ -47,10 +47,9 @@ impl Document {
     /// The platform's `step` event: the step shown and its xAPI statement.
     pub fn step_event(&self, index: usize) -> Value {
         let mut detail = self.tour_json();
-        detail["statement"] = self
-            .session()
-            .case()
-            .step_statement(index)
+        let case = self.session().case().as_case();
+        detail["statement"] = (case.lesson.steps.get(index))
+            .map(|step| crate::case::xapi::step_shown(case, index, step))
             .unwrap_or_default();
         detail
     }

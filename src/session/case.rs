@@ -2,21 +2,13 @@
 //! structure as the author arranged and smoothed it (a mesh alone is a case of one).
 
 use super::CaseDocument;
-use std::sync::Arc;
 
-use crate::case::{xapi, Case, CaseImage, Lesson};
+use crate::case::{Case, Lesson};
 use crate::export::{self, CaseGltfOptions};
 
 impl CaseDocument {
-    pub fn case_title(&self) -> &str {
-        &self.case.title
-    }
-
-    pub fn case_description(&self) -> &str {
-        &self.case.description
-    }
-
-    /// The case itself, read-only (its edits go through this document).
+    /// The case itself, read-only: its title, description, image and structures (its edits
+    /// go through this document).
     pub fn as_case(&self) -> &Case {
         &self.case
     }
@@ -33,17 +25,6 @@ impl CaseDocument {
         self.case.lesson = lesson;
         self.case_version += 1;
         Ok(())
-    }
-
-    /// What the platform records when tour step `index` is shown (an xAPI statement).
-    pub fn step_statement(&self, index: usize) -> Option<serde_json::Value> {
-        let step = self.case.lesson.steps.get(index)?;
-        Some(xapi::step_shown(&self.case, index, step))
-    }
-
-    /// The image under the surfaces, where the case carries one.
-    pub fn case_image(&self) -> Option<&Arc<CaseImage>> {
-        self.case.image.as_ref()
     }
 
     /// Sets the case's title and description (`None` keeps one as it is).

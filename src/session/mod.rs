@@ -3,7 +3,7 @@
 //! which of its structures is the model (`structures`, `case`, `models`), the files being
 //! opened by the workers (`opening`), the CPU engine's runs (`cpu`), the background work that
 //! guides the author (`guidance`: graphs, suggestion, gallery; `suggest_all`; `checks`), and
-//! the colours and pointing the view asks for (`colors`, `pointing`).
+//! the colours the view asks for (`colors`).
 //!
 //! Each structure's filter, parameters, tau, weights and result live in the case, and only
 //! there: the getters and setters here read and write the structure that is the model.
@@ -23,7 +23,6 @@ mod document;
 mod guidance;
 mod models;
 mod opening;
-mod pointing;
 mod structures;
 mod suggest_all;
 mod weights;
@@ -36,7 +35,7 @@ pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use opening::LoadProgress;
 pub use structures::{OtherStructure, StructureChange};
 pub use suggest_all::{structure_work, StructureOutcome, SuggestAllReport};
-pub use weights::WeightsSummary;
+pub use weights::{Dab, WeightsSummary};
 
 use crate::worker::{Pool, SmoothJob};
 

@@ -38,17 +38,6 @@ pub struct OtherStructure<'a> {
 }
 
 impl CaseDocument {
-    /// The open case's structures (empty with nothing open); the model's entry holds what it
-    /// had when it became the model.
-    pub fn case_structures(&self) -> &[CaseStructure] {
-        &self.case.structures
-    }
-
-    /// The structures' names, in the case's order (as a lesson names them).
-    pub fn structure_names(&self) -> Vec<&str> {
-        self.case.names()
-    }
-
     /// Which structure the model is, while one is open.
     pub fn current_structure(&self) -> Option<usize> {
         self.model().map(|_| self.current)
@@ -260,10 +249,5 @@ impl CaseDocument {
             let s = self.case.structures.get(index)?;
             s.smoothed_now().map(|k| &k.metrics)
         }
-    }
-
-    /// Structure `index`'s filter and parameters.
-    pub fn structure_params(&self, index: usize) -> Option<Params> {
-        self.case.structures.get(index).map(|s| s.params)
     }
 }

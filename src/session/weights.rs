@@ -19,15 +19,26 @@ pub struct WeightsSummary {
     pub mean: f64,
 }
 
-/// The summary of `weights`, or `None` when nothing is painted.
-fn summarize(weights: Option<&[f32]>) -> Option<WeightsSummary> {
-    let w = weights?;
-    Some(WeightsSummary {
-        painted: w.iter().filter(|&&x| x < 1.0).count(),
-        locked: w.iter().filter(|&&x| x <= 0.0).count(),
-        min: w.iter().copied().fold(1.0, f32::min),
-        mean: w.iter().map(|&x| x as f64).sum::<f64>() / w.len().max(1) as f64,
-    })
+/// What a brush dab does to the weights under it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Dab {
+    /// Lowers them: at most `1 - (1 - target) * f`, so `target` 0 locks the centre.
+    Paint(f32),
+    /// Raises them back towards 1 (free): at least `f`.
+    Erase,
+}
+
+impl WeightsSummary {
+    /// The summary of `weights` ([`CaseDocument::weights`]), or `None` when nothing is painted.
+    pub fn of(weights: Option<&[f32]>) -> Option<Self> {
+        let w = weights?;
+        Some(Self {
+            painted: w.iter().filter(|&&x| x < 1.0).count(),
+            locked: w.iter().filter(|&&x| x <= 0.0).count(),
+            min: w.iter().copied().fold(1.0, f32::min),
+            mean: w.iter().map(|&x| x as f64).sum::<f64>() / w.len().max(1) as f64,
+        })
+    }
 }
 
 impl CaseDocument {
@@ -36,28 +47,22 @@ impl CaseDocument {
         self.structure()?.weights.as_deref()
     }
 
-    /// How many vertices are painted and locked, and the lowest weight; `None` when nothing is.
-    pub fn weights_summary(&self) -> Option<WeightsSummary> {
-        summarize(self.weights())
-    }
-
     /// Changes whenever the weights change (paint, erase, clear, a new model).
     pub fn weights_version(&self) -> u64 {
         self.weights_version
     }
 
-    /// Lowers the weights under a brush dab: vertex `i` with falloff `f` in [0, 1] (1 at the
-    /// brush's centre) gets at most `1 - (1 - target) * f`, so `target` 0 locks the centre.
-    /// Returns whether anything changed (only then do the results recompute).
-    pub fn paint_weights(&mut self, footprint: &[(u32, f32)], target: f32) -> bool {
-        let target = target.clamp(0.0, 1.0);
-        self.edit_weights(footprint, |w, f| w.min(1.0 - (1.0 - target) * f))
-    }
-
-    /// Raises the weights under a brush dab back towards 1 (free): vertex `i` with falloff `f`
-    /// gets at least `f`. Returns whether anything changed.
-    pub fn erase_weights(&mut self, footprint: &[(u32, f32)]) -> bool {
-        self.edit_weights(footprint, |w, f| w.max(f))
+    /// Changes the weights under a brush dab: vertex `i` with falloff `f` in [0, 1] (1 at the
+    /// brush's centre) as `dab` says. Returns whether anything changed (only then do the
+    /// results recompute).
+    pub fn dab_weights(&mut self, footprint: &[(u32, f32)], dab: Dab) -> bool {
+        match dab {
+            Dab::Paint(target) => {
+                let target = target.clamp(0.0, 1.0);
+                self.edit_weights(footprint, |w, f| w.min(1.0 - (1.0 - target) * f))
+            }
+            Dab::Erase => self.edit_weights(footprint, |w, f| w.max(f)),
+        }
     }
 
     /// Every vertex free again. Returns whether anything was painted.
@@ -140,9 +145,11 @@ mod tests {
     #[test]
     fn locked_vertices_do_not_move_with_any_filter() {
         let mut s = sample_session();
-        assert!(s.case_mut().paint_weights(&dab(50), 0.0));
+        assert!(s.case_mut().dab_weights(&dab(50), Dab::Paint(0.0)));
         // A half weight on the next ones: they move, but less than unweighted.
-        assert!(s.case_mut().paint_weights(&[(60, 1.0), (61, 1.0)], 0.5));
+        assert!(s
+            .case_mut()
+            .dab_weights(&[(60, 1.0), (61, 1.0)], Dab::Paint(0.5)));
         let original = s.case().model().unwrap().mesh().positions.clone();
         for filter in Filter::ALL {
             s.case_mut().set_filter(filter);
@@ -157,12 +164,12 @@ mod tests {
             // In frame-sized chunks too (the browser's CPU engine).
             let w = s.case().weights().unwrap().to_vec();
             s.case_mut().clear_weights();
-            assert!(s.case_mut().paint_weights(
+            assert!(s.case_mut().dab_weights(
                 &w.iter()
                     .enumerate()
                     .map(|(i, &w)| (i as u32, 1.0 - w))
                     .collect::<Vec<_>>(),
-                0.0
+                Dab::Paint(0.0)
             ));
             assert_eq!(s.case().weights().unwrap(), w.as_slice());
             smooth_cpu(&mut s);
@@ -181,7 +188,7 @@ mod tests {
         let free = smoothed(&mut s);
         let free_metrics = s.case().result().unwrap().metrics.clone();
         let revision = s.case().revision();
-        assert!(s.case_mut().paint_weights(&dab(400), 0.2));
+        assert!(s.case_mut().dab_weights(&dab(400), Dab::Paint(0.2)));
         assert!(s.case().revision() > revision, "painting recomputes");
         let painted = smoothed(&mut s);
         assert_ne!(painted, free);
@@ -191,8 +198,8 @@ mod tests {
         assert_eq!(smoothed(&mut s), free);
         assert_eq!(s.case().result().unwrap().metrics, free_metrics);
         // Erasing everything painted is the same as clearing.
-        assert!(s.case_mut().paint_weights(&dab(400), 0.0));
-        assert!(s.case_mut().erase_weights(&dab(400)));
+        assert!(s.case_mut().dab_weights(&dab(400), Dab::Paint(0.0)));
+        assert!(s.case_mut().dab_weights(&dab(400), Dab::Erase));
         assert_eq!(s.case().weights(), None);
         assert_eq!(smoothed(&mut s), free);
     }
@@ -202,36 +209,37 @@ mod tests {
         let mut s = sample_session();
         let footprint = [(3, 1.0), (4, 0.5), (5, 0.0), (6, f32::NAN), (99_999, 1.0)];
         let generation = s.case().weights_version();
-        assert!(s.case_mut().paint_weights(&footprint, 0.0));
+        assert!(s.case_mut().dab_weights(&footprint, Dab::Paint(0.0)));
         assert_eq!(s.case().weights_version(), generation + 1);
         let w = s.case().weights().unwrap();
         assert_eq!((w[3], w[4], w[5], w[6]), (0.0, 0.5, 1.0, 1.0));
         smooth_cpu(&mut s);
         let revision = s.case().revision();
         assert!(
-            !s.case_mut().paint_weights(&footprint, 0.0),
+            !s.case_mut().dab_weights(&footprint, Dab::Paint(0.0)),
             "the same dab again"
         );
         // A weaker brush does not unlock what is locked.
-        assert!(!s.case_mut().paint_weights(&footprint, 0.7));
+        assert!(!s.case_mut().dab_weights(&footprint, Dab::Paint(0.7)));
         assert_eq!(s.case().revision(), revision);
         assert!(s.case().result().is_some(), "nothing to recompute");
         // Erasing at half strength raises to at least the falloff.
-        assert!(s.case_mut().erase_weights(&[(3, 0.25)]));
+        assert!(s.case_mut().dab_weights(&[(3, 0.25)], Dab::Erase));
         assert_eq!(s.case().weights().unwrap()[3], 0.25);
 
-        let summary = summarize(s.case().weights()).unwrap();
+        let summary = WeightsSummary::of(s.case().weights()).unwrap();
         assert_eq!((summary.painted, summary.locked), (2, 0));
         assert_eq!(summary.min, 0.25);
-        assert_eq!(s.case().weights_summary(), Some(summary));
 
         // A new model starts free.
         s.open("again.ply", SAMPLE).unwrap();
         assert_eq!(s.case().weights(), None);
-        assert_eq!(s.case().weights_summary(), None);
+        assert_eq!(WeightsSummary::of(s.case().weights()), None);
         assert!(s.case().weights_version() > generation + 1);
         // Nothing open, nothing to paint.
-        assert!(!Session::default().case_mut().paint_weights(&footprint, 0.0));
+        assert!(!Session::default()
+            .case_mut()
+            .dab_weights(&footprint, Dab::Paint(0.0)));
     }
 
     #[test]
@@ -245,7 +253,7 @@ mod tests {
         assert!(free.iter().all(|c| *c == free[0]));
         assert_eq!((legend.min, legend.max), (0.0, 1.0));
         assert_eq!(legend.ticks[0].label, "0");
-        s.case_mut().paint_weights(&dab(1), 0.0);
+        s.case_mut().dab_weights(&dab(1), Dab::Paint(0.0));
         let (painted, _) = s.case().colors(ColorField::Weights).unwrap();
         assert_ne!(painted[0], painted[1]);
         assert_eq!(painted[1], free[1]);

@@ -15,6 +15,7 @@ mod morph;
 mod orientation;
 mod param_drag;
 mod pick;
+mod pointing;
 mod quiz;
 mod slice;
 pub mod thumbnail;
@@ -34,6 +35,7 @@ pub use param_drag::{
 pub use pick::{
     brush_falloff, brush_footprint, moller_trumbore, pick_triangle, pick_triangle_where, Hit, Ray,
 };
+pub use pointing::{opaque_at, structure_at};
 pub use quiz::{Answer, Question, QuizRun, CHOICES};
 pub use slice::{SlicePlacement, SliceTexture, SliceUniforms};
 pub use tour::{recorded_step, step_view, Flight, FLIGHT_SECONDS};

@@ -20,7 +20,7 @@ pub(crate) fn metrics(case: &CaseDocument) -> Option<Value> {
 /// measures.
 pub(crate) fn structures(case: &CaseDocument) -> Option<Value> {
     let current = case.current_structure()?;
-    let list: Vec<_> = (case.case_structures().iter().enumerate())
+    let list: Vec<_> = (case.as_case().structures.as_slice().iter().enumerate())
         .map(|(i, s)| {
             json!({
                 "label": s.label,
@@ -46,10 +46,10 @@ pub(crate) fn structures(case: &CaseDocument) -> Option<Value> {
     Some(json!({
         "file": case.case_file(),
         "current": current,
-        "title": case.case_title(),
-        "description": case.case_description(),
+        "title": case.as_case().title.as_str(),
+        "description": case.as_case().description.as_str(),
         "structures": list,
-        "image": case.case_image().map(|i| json!({
+        "image": case.as_case().image.as_ref().map(|i| json!({
             "source": i.source,
             "dims": i.dims,
             "preset": i.preset,
@@ -125,7 +125,7 @@ pub(crate) fn session_state(session: &Session, busy: bool) -> Value {
         "tau": case.tau(),
         "busy": busy,
         "cpu_engine": cpu_engine(session.cpu_engine()),
-        "weights": case.weights_summary(),
+        "weights": crate::session::WeightsSummary::of(case.weights()),
         "structures": structures(case),
         "loading": session.loading().map(|l| json!({
             "name": l.name, "stage": l.stage, "stages": l.total, "doing": l.doing,

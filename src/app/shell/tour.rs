@@ -18,7 +18,7 @@ impl Shell {
         let Some(step) = doc.session().case().lesson().steps.get(index).cloned() else {
             return;
         };
-        let link = step_view(&step, &doc.session().case().structure_names());
+        let link = step_view(&step, &doc.session().case().as_case().names());
         let problems = show_view(&mut doc, &link);
         if !problems.is_empty() {
             log::warn!("tour step {}: {}", index + 1, problems.join("; "));

@@ -65,7 +65,7 @@ impl Shell {
                 };
                 // A picture shows the view alone (and which way the patient lies).
                 if !self.picture.pending {
-                    let has_image = doc.session().case().case_image().is_some();
+                    let has_image = doc.session().case().as_case().image.as_ref().is_some();
                     let asks = &mut doc.view_asks;
                     doc.panel.planes = view_tools::show(ui, response.rect, asks, has_image);
                 }

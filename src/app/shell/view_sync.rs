@@ -160,7 +160,7 @@ fn sync_model(
     let kept_view = viewer.view_state();
     viewer.set_mesh(rs, &mesh.positions, &normals, &mesh.triangles, &model.edges);
     // A segmentation is framed whole once; another of its structures keeps the view.
-    let structures = session.case().case_structures();
+    let structures = session.case().as_case().structures.as_slice();
     let case =
         (structures.len() > 1).then(|| (session.case().case_file().to_string(), structures.len()));
     match (&case, case == *framed_case) {
@@ -276,7 +276,7 @@ fn upload_looks(
     (toward, highlight): (f32, Option<usize>),
 ) {
     let others = session.case().other_structures();
-    let list = session.case().case_structures();
+    let list = session.case().as_case().structures.as_slice();
     let moved: Vec<Option<Vec<[f32; 3]>>> = (others.iter())
         .map(|o| {
             let original = &list[o.index].original.positions;
@@ -295,7 +295,7 @@ fn upload_looks(
         })
         .collect();
     viewer.set_context(rs, &surfaces);
-    viewer.set_image(rs, session.case().case_image());
+    viewer.set_image(rs, session.case().as_case().image.as_ref());
     set_model_look(viewer, session, highlight);
 }
 

@@ -296,7 +296,9 @@ fn searches_reuse_the_terms_measured_before_until_the_weights_change() {
         alone.requests.len()
     );
     // Other weights: measured afresh.
-    assert!(s.case_mut().paint_weights(&[(0, 1.0), (1, 1.0)], 0.0));
+    assert!(s
+        .case_mut()
+        .dab_weights(&[(0, 1.0), (1, 1.0)], crate::session::Dab::Paint(0.0)));
     s.start_gallery();
     settle_on(&mut s, Some(&mut offload));
     assert!(offload.requests.len() > suggestion + gallery);
