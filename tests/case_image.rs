@@ -236,13 +236,7 @@ fn the_page_session_adds_the_image_keeps_it_on_a_refusal_and_removes_it() {
     ))
     .expect("asked");
     session.poll_opening().expect("done").expect("read");
-    let image = session
-        .case()
-        .as_case()
-        .image
-        .as_ref()
-        .expect("added")
-        .clone();
+    let image = session.case().as_case().image.clone().expect("added");
     let mut case = label_maps::phantom_case();
     add_one(
         &mut case,

@@ -116,18 +116,13 @@ fn the_session_sets_names_that_travel_and_a_lying_record_is_refused() {
     let error = set(&mut session, names(&[("deutsch", "Leber")])).expect_err("a bad tag");
     assert!(error.contains("'deutsch' is not a language tag"), "{error}");
     assert!(
-        session.case().as_case().structures.as_slice()[0]
-            .names
-            .is_empty(),
+        session.case().as_case().structures[0].names.is_empty(),
         "kept"
     );
     let version = session.case().case_version();
     set(&mut session, names(&[("DE", " Leber "), ("fr", "Foie")])).expect("set");
     let kept = names(&[("de", "Leber"), ("fr", "Foie")]);
-    assert_eq!(
-        session.case().as_case().structures.as_slice()[0].names,
-        kept
-    );
+    assert_eq!(session.case().as_case().structures[0].names, kept);
     assert!(
         session.case().case_version() > version,
         "the page redraws its names"

@@ -159,51 +159,35 @@ fn a_case_gltf_is_packaged_as_it_is() {
 fn a_missing_viewer_or_a_wrong_name_is_said_before_any_work() {
     let zip = tmp("never.zip");
     let map = data("labelmaps/case_phantom_shared.nii.gz");
-    let missing = tmp("no_viewer_here");
-    let out = meshsmooth(&[
-        "case",
-        "package",
-        text(&map),
-        "--format",
-        "scorm12",
-        "--viewer",
-        text(&missing),
-        "-o",
-        text(&zip),
-    ]);
-    assert!(!out.status.success());
-    let said = String::from_utf8_lossy(&out.stderr);
-    assert!(said.contains("no viewer build here"), "{said}");
+    // What `case package` of the phantom says on its standard error.
+    let said = |format: &str, viewer: &Path, out: &Path| {
+        let run = meshsmooth(&[
+            "case",
+            "package",
+            text(&map),
+            "--format",
+            format,
+            "--viewer",
+            text(viewer),
+            "-o",
+            text(out),
+        ]);
+        assert!(!run.status.success());
+        String::from_utf8_lossy(&run.stderr).into_owned()
+    };
+    let missing = said("scorm12", &tmp("no_viewer_here"), &zip);
+    assert!(missing.contains("no viewer build here"), "{missing}");
     assert!(!zip.exists());
 
     let viewer = viewer_folder();
-    let out = meshsmooth(&[
-        "case",
-        "package",
-        text(&map),
-        "--format",
-        "scorm",
-        "--viewer",
-        text(&viewer),
-        "-o",
-        text(&zip),
-    ]);
-    let said = String::from_utf8_lossy(&out.stderr);
-    assert!(said.contains("scorm12, scorm2004, cmi5"), "{said}");
+    let wrong = said("scorm", &viewer, &zip);
+    assert!(wrong.contains("scorm12, scorm2004, cmi5"), "{wrong}");
 
-    let out = meshsmooth(&[
-        "case",
-        "package",
-        text(&map),
-        "--format",
-        "cmi5",
-        "--viewer",
-        text(&viewer),
-        "-o",
-        text(&tmp("course.glb")),
-    ]);
-    let said = String::from_utf8_lossy(&out.stderr);
-    assert!(said.contains("a package is written as .zip"), "{said}");
+    let not_zip = said("cmi5", &viewer, &tmp("course.glb"));
+    assert!(
+        not_zip.contains("a package is written as .zip"),
+        "{not_zip}"
+    );
 
     // The app's build, the student's viewer in its viewer/ folder: that folder is named.
     let app = tmp("app_build");
@@ -214,18 +198,7 @@ fn a_missing_viewer_or_a_wrong_name_is_said_before_any_work() {
     ] {
         std::fs::write(page, "<!DOCTYPE html><title>meshsmooth</title>").unwrap();
     }
-    let out = meshsmooth(&[
-        "case",
-        "package",
-        text(&map),
-        "--format",
-        "cmi5",
-        "--viewer",
-        text(&app),
-        "-o",
-        text(&zip),
-    ]);
-    let said = String::from_utf8_lossy(&out.stderr);
-    assert!(said.contains("its viewer/ folder"), "{said}");
+    let app_build = said("cmi5", &app, &zip);
+    assert!(app_build.contains("its viewer/ folder"), "{app_build}");
     assert!(!zip.exists());
 }

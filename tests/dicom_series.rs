@@ -486,13 +486,7 @@ fn the_page_session_adds_a_series_under_the_phantom() {
     };
     (session.begin_image(named("phantom_ct"), WindowPreset::CtSoftTissue)).expect("asked");
     session.poll_opening().expect("done").expect("read");
-    let image = session
-        .case()
-        .as_case()
-        .image
-        .as_ref()
-        .expect("added")
-        .clone();
+    let image = session.case().as_case().image.clone().expect("added");
     assert_eq!(image.source, "DICOM series (24 slices)");
     assert_eq!(image.dims, [160, 140, 24]);
 

@@ -61,7 +61,7 @@ fn files_opened_together_make_the_case_the_cli_makes() {
     )
     .expect("the CLI's way");
     same(&session, &cli);
-    let names: Vec<&str> = (session.case().as_case().structures.as_slice().iter())
+    let names: Vec<&str> = (session.case().as_case().structures.iter())
         .map(|s| s.name.as_str())
         .collect();
     assert!(!names.iter().any(|n| n.starts_with("label ")), "{names:?}");
@@ -96,7 +96,7 @@ fn files_opened_together_make_the_case_the_cli_makes() {
         &session,
         &case::open(&named, None, &Default::default()).unwrap(),
     );
-    let names: Vec<&str> = (session.case().as_case().structures.as_slice().iter())
+    let names: Vec<&str> = (session.case().as_case().structures.iter())
         .map(|s| s.name.as_str())
         .collect();
     assert_eq!(

@@ -99,12 +99,11 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         read("labelmaps/case_phantom_shared.seg.nrrd"),
     );
     session.poll_opening().expect("done").expect("opens");
-    assert_eq!(session.case().as_case().structures.as_slice().len(), 4);
+    assert_eq!(session.case().as_case().structures.len(), 4);
     assert!(session
         .case()
         .as_case()
         .structures
-        .as_slice()
         .iter()
         .all(|l| l.visible && l.color[3] == 1.0));
     // Three others around the liver, as extracted.
@@ -121,7 +120,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     let version = session.case().case_version();
     session.case_mut().set_structure(2, change).unwrap();
     assert!(session.case().case_version() > version);
-    let tumour = &session.case().as_case().structures.as_slice()[2];
+    let tumour = &session.case().as_case().structures[2];
     assert_eq!(
         (tumour.name.as_str(), tumour.color),
         ("tumour", [0.0, 1.0, 0.0, 0.4])
@@ -148,7 +147,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .set_structure(9, StructureChange::default())
         .is_err());
     assert_eq!(
-        session.case().as_case().structures.as_slice()[2].name,
+        session.case().as_case().structures[2].name,
         "tumour",
         "a refusal changes nothing"
     );
@@ -162,16 +161,11 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .set_structure(1, group(Some(" Vessels ")))
         .unwrap();
     assert_eq!(
-        session.case().as_case().structures.as_slice()[1]
-            .group
-            .as_deref(),
+        session.case().as_case().structures[1].group.as_deref(),
         Some("Vessels")
     );
     session.case_mut().set_structure(1, group(None)).unwrap();
-    assert_eq!(
-        session.case().as_case().structures.as_slice()[1].group,
-        None
-    );
+    assert_eq!(session.case().as_case().structures[1].group, None);
     session
         .case_mut()
         .set_structure(1, group(Some("Vessels")))
@@ -183,7 +177,6 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .case()
         .as_case()
         .structures
-        .as_slice()
         .iter()
         .map(|l| l.visible)
         .collect();
@@ -194,7 +187,6 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         .case()
         .as_case()
         .structures
-        .as_slice()
         .iter()
         .all(|l| l.visible));
 
@@ -220,8 +212,8 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     smooth_cpu(&mut session);
     let case = session.case();
     assert_eq!(case.current_structure(), Some(1));
-    assert_eq!(case.as_case().structures.as_slice()[2].name, "tumour");
-    assert_eq!(case.as_case().structures.as_slice()[2].color[3], 0.4);
+    assert_eq!(case.as_case().structures[2].name, "tumour");
+    assert_eq!(case.as_case().structures[2].color[3], 0.4);
     assert_eq!(case.structure_metrics(0), Some(&liver.metrics));
     assert!(case.structure_metrics(3).is_none(), "never smoothed");
     assert!(case.structure_metrics(1).is_some());
@@ -236,10 +228,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     );
     assert!(session.case().model_id() > model_before);
     assert_eq!(*session.case().params(), liver_params);
-    assert_eq!(
-        session.case().as_case().structures.as_slice()[0].params,
-        liver_params
-    );
+    assert_eq!(session.case().as_case().structures[0].params, liver_params);
     assert!(
         !session.case().needs_smoothing(),
         "its result is there at once"
@@ -248,7 +237,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     assert_eq!(session.case().result().unwrap().metrics, liver.metrics);
     assert!(smooth_cpu(&mut session).is_none(), "nothing to smooth");
     assert_eq!(
-        session.case().as_case().structures.as_slice()[2].name,
+        session.case().as_case().structures[2].name,
         "tumour",
         "looks stay across switches"
     );
@@ -291,9 +280,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     // codecs' order; the staircase says which is which.
     let stated = quantization_error(&glb);
     let matched = match_vertices(
-        &session.case().as_case().structures.as_slice()[0]
-            .original
-            .positions,
+        &session.case().as_case().structures[0].original.positions,
         &back.structures[0].original.positions,
         f64::from(stated) * 1.001,
     );
@@ -309,10 +296,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
         read("labelmaps/case_phantom_shared.seg.nrrd"),
     );
     session.poll_opening().expect("done").expect("opens");
-    assert_eq!(
-        session.case().as_case().structures.as_slice()[2].name,
-        "tumor"
-    );
+    assert_eq!(session.case().as_case().structures[2].name, "tumor");
 }
 
 /// The largest difference of two position lists, in mm.
@@ -399,10 +383,7 @@ fn a_case_glb_reopens_in_the_session_and_exports_the_same_case() {
         ),
         ("Abdomen", "Liver, tumour, vessels")
     );
-    assert_eq!(
-        again.case().as_case().structures.as_slice()[3].params,
-        kidney_params
-    );
+    assert_eq!(again.case().as_case().structures[3].params, kidney_params);
     smooth_cpu(&mut again);
     let second = again.case().export_case(&page_export()).unwrap();
 
@@ -467,9 +448,7 @@ fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
 
     let mut again = Session::default();
     open_in_session(&mut again, "case.glb", case);
-    let kept = again.case().as_case().structures.as_slice()[0]
-        .smoothed
-        .clone();
+    let kept = again.case().as_case().structures[0].smoothed.clone();
     assert!(kept.is_some(), "the case glTF holds the liver smoothed");
     assert!(
         again.case().last_result().is_none(),
@@ -477,10 +456,7 @@ fn a_structure_left_before_its_result_keeps_its_smoothed_surface() {
     );
     again.select_structure(2).unwrap();
     assert_eq!(again.case().current_structure(), Some(2));
-    assert_eq!(
-        again.case().as_case().structures.as_slice()[0].smoothed,
-        kept
-    );
+    assert_eq!(again.case().as_case().structures[0].smoothed, kept);
 }
 
 /// A case glTF's structure shows the surface the case holds for its parameters, before and
@@ -562,7 +538,7 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
         read("synthetic/sphere_r20_mask.nii.gz"),
     );
     session.poll_opening().expect("done").expect("added");
-    let mask = &session.case().as_case().structures.as_slice()[5];
+    let mask = &session.case().as_case().structures[5];
     assert!(mask.voxel_size.is_some() && mask.label.is_some());
     assert_eq!(mask.params.max_displacement, mask.default_bound());
     let bound = mask.default_bound();
@@ -576,9 +552,9 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     session.begin_add("synthetic_sphere_r20.stl", sphere.clone());
     session.poll_opening().expect("done").expect("opens");
     assert!(session.loading().is_some(), "the addition follows");
-    assert_eq!(session.case().as_case().structures.as_slice().len(), 4);
+    assert_eq!(session.case().as_case().structures.len(), 4);
     session.poll_opening().expect("done").expect("added");
-    assert_eq!(session.case().as_case().structures.as_slice().len(), 5);
+    assert_eq!(session.case().as_case().structures.len(), 5);
     assert!(session.loading().is_none());
 
     // A file that fails to open takes the files meant for its case with it.
@@ -590,7 +566,7 @@ fn files_added_join_the_open_case_and_wait_for_the_one_opening() {
     assert!(e.starts_with("Cannot open half.nii.gz: "), "{e}");
     assert!(session.loading().is_none(), "nothing left to add");
     assert_eq!(
-        session.case().as_case().structures.as_slice().len(),
+        session.case().as_case().structures.len(),
         5,
         "the case stays"
     );
@@ -609,7 +585,7 @@ fn a_viewer_shows_a_structure_without_a_smoothing_record_as_the_file_holds_it() 
     assert!(!viewer.case().needs_smoothing(), "nothing to compute");
     assert!(smooth_cpu(&mut viewer).is_none());
     assert!(viewer.case().result().is_none());
-    let held = &viewer.case().as_case().structures.as_slice()[0];
+    let held = &viewer.case().as_case().structures[0];
     assert!(held.smoothed.is_none());
     assert_eq!(viewer.case().model().expect("open").mesh(), &held.original);
 

@@ -55,7 +55,7 @@ fn the_page_writes_the_case_a_structure_per_step_as_the_cli_writes_it() {
     assert_eq!(written.options, options);
     let at_once = session.case().export_case(&options).unwrap();
     assert!(written.bytes == at_once, "the same file as written at once");
-    let before: usize = (session.case().as_case().structures.as_slice().iter())
+    let before: usize = (session.case().as_case().structures.iter())
         .map(|s| s.original.triangle_count())
         .sum();
     assert_eq!(written.triangles, seen[4].2);

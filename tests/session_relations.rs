@@ -84,7 +84,7 @@ fn the_session_checks_its_structures_as_they_stand() {
     let key = session.background().marks_key().expect("marks to show");
     let patches = session.background().marked_surfaces();
     assert_eq!(patches.len(), 3);
-    let liver = &session.case().as_case().structures.as_slice()[0];
+    let liver = &session.case().as_case().structures[0];
     assert!(patches[0].triangle_count() < liver.original.triangle_count() / 2);
     // Hiding or recolouring a structure leaves the surfaces as checked; a hidden one's marks
     // are not drawn.
@@ -120,9 +120,7 @@ fn the_structure_under_the_pointer_is_the_nearest_drawn() {
     let mut session = Session::default();
     let phantom = read("labelmaps/case_phantom_shared.seg.nrrd");
     open_in_session(&mut session, "case_phantom_shared.seg.nrrd", phantom);
-    let tumour = &session.case().as_case().structures.as_slice()[2]
-        .original
-        .positions;
+    let tumour = &session.case().as_case().structures[2].original.positions;
     let centre = tumour
         .iter()
         .fold(glam::Vec3::ZERO, |sum, &p| sum + glam::Vec3::from(p))

@@ -71,7 +71,7 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
         liver.smoothed.as_ref().unwrap().positions
     );
     for i in 1..4 {
-        let kept = &session.case().as_case().structures.as_slice()[i];
+        let kept = &session.case().as_case().structures[i];
         let want = &expected.structures[i];
         assert_eq!(kept.params, want.params, "structure {i}");
         let smoothed = kept.smoothed.as_ref().unwrap();
@@ -116,7 +116,7 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
         session.begin_add(copy, bytes.clone());
         session.poll_opening().expect("done").expect("adds");
     }
-    let count = session.case().as_case().structures.as_slice().len();
+    let count = session.case().as_case().structures.len();
     assert!(count > 2 * LEARNING_BATCH, "{count} structures");
     let mut expected = Case {
         structures: session.case().as_case().structures.as_slice().to_vec(),
@@ -196,7 +196,7 @@ fn suggest_all_on_some_structures_leaves_the_others_as_they_were() {
     let mut session = Session::default();
     session.begin_open("case_phantom_shared.seg.nrrd", bytes);
     session.poll_opening().expect("done").expect("opens");
-    let before: Vec<_> = (session.case().as_case().structures.as_slice().iter())
+    let before: Vec<_> = (session.case().as_case().structures.iter())
         .map(|s| s.params)
         .collect();
     let refused = session.start_suggest_all(0.5, SuggestAllSearch::Local, Some(&[1, 4]), 0.0);
@@ -211,7 +211,7 @@ fn suggest_all_on_some_structures_leaves_the_others_as_they_were() {
     assert_eq!((outcome.done, outcome.total), (2, 2));
     let got: Vec<bool> = outcome.structures.iter().map(Option::is_some).collect();
     assert_eq!(got, [false, true, false, true]);
-    let after: Vec<_> = (session.case().as_case().structures.as_slice().iter())
+    let after: Vec<_> = (session.case().as_case().structures.iter())
         .map(|s| s.params)
         .collect();
     assert_eq!((after[0], after[2]), (before[0], before[2]));

@@ -145,29 +145,23 @@ fn label(doc: &Document) -> String {
 /// selected, and its description.
 fn lines(doc: &Document) -> Vec<String> {
     let current = doc.session().case().current_structure();
-    (doc.session()
-        .case()
-        .as_case()
-        .structures
-        .as_slice()
-        .iter()
-        .enumerate())
-    .map(|(i, s)| {
-        let mut line = doc.words().name(i).to_string();
-        if let Some(group) = &s.group {
-            line.push_str(&format!(" ({group})"));
-        }
-        line.push_str(if s.visible { ", shown" } else { ", hidden" });
-        if s.visible && s.color[3] < 1.0 {
-            line.push_str(&format!(", {:.0}% opaque", s.color[3] * 100.0));
-        }
-        if Some(i) == current {
-            line.push_str(", selected");
-        }
-        if !s.description.is_empty() {
-            line.push_str(&format!(": {}", s.description));
-        }
-        line
-    })
-    .collect()
+    (doc.session().case().as_case().structures.iter().enumerate())
+        .map(|(i, s)| {
+            let mut line = doc.words().name(i).to_string();
+            if let Some(group) = &s.group {
+                line.push_str(&format!(" ({group})"));
+            }
+            line.push_str(if s.visible { ", shown" } else { ", hidden" });
+            if s.visible && s.color[3] < 1.0 {
+                line.push_str(&format!(", {:.0}% opaque", s.color[3] * 100.0));
+            }
+            if Some(i) == current {
+                line.push_str(", selected");
+            }
+            if !s.description.is_empty() {
+                line.push_str(&format!(": {}", s.description));
+            }
+            line
+        })
+        .collect()
 }

@@ -67,8 +67,6 @@ pub struct Document {
     pub view_asks: ViewAsks,
     /// The name of the structure under the pointer in the view.
     pub pointed: Option<String>,
-    /// The page is the viewer (`?mode=viewer`): it reads cases and edits none.
-    pub reading: bool,
     /// The reader's languages, most wanted first: the viewer (and the author's preview) names
     /// structures in the first one they have a name in.
     pub languages: Vec<String>,
@@ -116,7 +114,7 @@ impl Document {
     pub fn words(&self) -> Words<'_> {
         // The reader's languages where the page is read (the viewer, the author's preview);
         // none while the author edits, who sees the case's own names.
-        let languages = match self.reading || self.previewing {
+        let languages = match super::query::is_viewer() || self.previewing {
             true => &self.languages[..],
             false => &[],
         };
@@ -148,7 +146,6 @@ impl Document {
             view: ViewReport::default(),
             view_asks: ViewAsks::default(),
             pointed: None,
-            reading: false,
             languages: Vec::new(),
             shortcuts: true,
             finished_opening: None,
@@ -390,7 +387,7 @@ impl Document {
     pub fn state_json(&self) -> serde_json::Value {
         let mut state = super::api::json::session_state(&self.session, self.busy());
         state["backend"] = serde_json::json!(self.backend.name());
-        state["mode"] = serde_json::json!(if self.reading { "viewer" } else { "author" });
+        state["mode"] = serde_json::json!(super::query::mode_name());
         state["preview"] = serde_json::json!(self.previewing);
         state["shortcuts"] = serde_json::json!(self.shortcuts);
         // The page's own memory beside its workers' (each instance's peak: it only grows).
@@ -429,8 +426,6 @@ impl Document {
         state["layout"] = self.panel.to_json();
         state["tour"] = self.tour_json();
         state["quiz"] = self.quiz_json();
-        // WebAssembly memory only grows: its size is the page's peak.
-        state["memory_bytes"] = serde_json::json!(core::arch::wasm32::memory_size::<0>() * 65536);
         state
     }
 }
@@ -439,14 +434,7 @@ impl Document {
     /// The view as it stands: camera, hidden and see-through structures, the selected one,
     /// the clipping plane or the image's planes and the slide towards the segmentation.
     pub fn view_link(&self) -> ViewLink {
-        let listed = self
-            .session
-            .case()
-            .as_case()
-            .structures
-            .as_slice()
-            .iter()
-            .enumerate();
+        let listed = self.session.case().as_case().structures.iter().enumerate();
         ViewLink {
             camera: self.view.pose,
             hidden: (listed.clone().filter(|(_, s)| !s.visible))

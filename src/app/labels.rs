@@ -70,7 +70,7 @@ impl LabelPainter {
 /// Where the case's labels go in the view, and which are faded.
 fn spots(rect: egui::Rect, viewer: &Viewer, doc: &Document) -> Vec<LabelSpot> {
     let labels = &doc.session().case().lesson().labels;
-    let visible: HashSet<&str> = (doc.session().case().as_case().structures.as_slice().iter())
+    let visible: HashSet<&str> = (doc.session().case().as_case().structures.iter())
         .filter(|s| s.visible)
         .map(|s| s.name.as_str())
         .collect();

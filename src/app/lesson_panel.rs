@@ -29,15 +29,9 @@ impl Document {
     /// Adds a label on structure `index` at `point` (where the author clicked it), its text
     /// the structure's name until edited.
     pub fn place_label(&mut self, index: usize, point: Vec3) -> Result<(), String> {
-        let name = (self
-            .session()
-            .case()
-            .as_case()
-            .structures
-            .as_slice()
-            .get(index))
-        .map(|s| s.name.clone())
-        .ok_or(format!("the case has no structure {index}"))?;
+        let name = (self.session().case().as_case().structures.get(index))
+            .map(|s| s.name.clone())
+            .ok_or(format!("the case has no structure {index}"))?;
         let mut lesson = self.session().case().lesson().clone();
         lesson
             .labels

@@ -10,8 +10,8 @@
 //!   and folders, chunked reads), `download` (bytes out), `api` (`window.meshsmooth` and the
 //!   embedding's messages), `layout` (where the page drew what, for `state()`);
 //! - the document and its engines: `document` (the session shared by the UI and the API, the
-//!   calls waiting on it), `words` (the case in the reader's language), `backend` (which engine smooths, and its timing), `workers` (the CPU
-//!   engine's dedicated workers), `gpu_engine` (the WebGPU engine's driver), `pacing` (how
+//!   calls waiting on it), `words` (the case in the reader's language), `backend` (which
+//!   engine smooths, and its timing), `workers` (the CPU engine's dedicated workers), `gpu_engine` (the WebGPU engine's driver), `pacing` (how
 //!   often the page redraws for work it does not see);
 //! - the authoring page's panels: `controls`, `guide`, `structure_list` with
 //!   `case_export_view`, `lesson_panel` with `lms_export` (the package for an LMS),
@@ -23,6 +23,23 @@
 //!   `pointing` (the name under the pointer), `view_tools` (standard views, clip),
 //!   `orientation_marker`, `picture` (the view as PNG);
 //! - `shell` (the `eframe::App` that lays these out each frame) and `viewer` (the 3D view).
+//!
+//! A click, followed. **A dropped file**: [`file_input::FileInput`] reads the dropped bytes
+//! (`collect_dropped`, chunked by `read_bytes`) and hands them over as an `Arrived` group;
+//! the [`shell::Shell`] gives the group to [`Document::ask_open`], which keeps the caller's
+//! waiter (an API call's promise) and asks the [`crate::session::Session`] to
+//! `begin_open_files`; the session's [`crate::worker::Pool`] posts a `Request::Load` through
+//! [`workers::WebWorkers`] to a worker, where [`crate::worker::Worker`] opens the files
+//! (`model::open_files`, the CLI's reading) and replies `Loaded`. Each frame the shell calls
+//! [`Document::step_loading`], which takes the reply (`Session::poll_opening`) into the
+//! session's [`crate::session::CaseDocument`] and answers the waiters; the shell's
+//! `sync_view` then uploads the new case to the [`viewer::Viewer`], which draws it.
+//! **A parameter drag**: [`drag_params::DragParams`] turns the pointer's drag over the view
+//! into new parameters and sets them on the `CaseDocument` (`set_params`, a new revision);
+//! the shell's `compute` hands the revision to the engine that smooths: the
+//! [`gpu_engine::GpuEngine`], or [`Document::compute_on_cpu`], whose session asks the pool
+//! for a `Request::Smooth` (`Session::compute_cpu`) and takes its `Smoothed` reply into the
+//! case; `sync_view` uploads the new positions and colours to the `Viewer`.
 
 mod api;
 mod backend;

@@ -54,7 +54,7 @@ impl Pointing {
             case: (
                 session.case().case_version(),
                 session.case().revision(),
-                session.case().as_case().structures.as_slice().len(),
+                session.case().as_case().structures.len(),
             ),
         };
         if self.asked != Some(asked) {
@@ -66,17 +66,7 @@ impl Pointing {
             });
             self.point = hit.map(|(_, h)| h.point);
             self.named = hit.and_then(|(i, _)| {
-                Some((
-                    i,
-                    session
-                        .case()
-                        .as_case()
-                        .structures
-                        .as_slice()
-                        .get(i)?
-                        .name
-                        .clone(),
-                ))
+                Some((i, session.case().as_case().structures.get(i)?.name.clone()))
             });
             self.asked = Some(asked);
         }

@@ -20,9 +20,20 @@ pub fn param(name: &str) -> Option<String> {
         .get(name)
 }
 
-/// Whether the page is the case viewer (`?mode=viewer`) rather than the authoring page.
-pub fn viewer_mode() -> bool {
-    param("mode").as_deref() == Some("viewer")
+/// Whether the page is the student's viewer: the viewer's build, or `?mode=viewer` (read once:
+/// it holds for the page's life). The viewer's build answers at compile time, so what only the
+/// author's page reaches is left out of it.
+pub fn is_viewer() -> bool {
+    thread_local!(static ASKED: bool = param("mode").as_deref() == Some("viewer"));
+    !crate::AUTHORING || ASKED.with(|asked| *asked)
+}
+
+/// The page's mode as `state()` and the embedding's `ready` event name it.
+pub fn mode_name() -> &'static str {
+    match is_viewer() {
+        true => "viewer",
+        false => "author",
+    }
 }
 
 /// The reader's languages, most wanted first: `?lang=de` (or `de,fr`) where the embedding

@@ -207,7 +207,7 @@ testIn(WEBGPU_RUN, "S4 a CT-sized label map (512 x 512 x 400) opens natively and
             const text = atob(base64);
             const data = new Uint8Array(text.length);
             for (let i = 0; i < text.length; i++) data[i] = text.charCodeAt(i);
-            const before = window.meshsmooth.state().memory_bytes;
+            const before = window.meshsmooth.state().memory.page;
             const start = performance.now();
             await window.meshsmooth.loadMesh(data, "ct_sized.nii.gz");
             const seconds = (performance.now() - start) / 1000;
@@ -227,7 +227,7 @@ testIn(WEBGPU_RUN, "S4 a CT-sized label map (512 x 512 x 400) opens natively and
             page_open_seconds: run.seconds,
             page_stage_ms: stageMs,
             page_memory_mb_before: Math.round(run.before / 1e6),
-            page_memory_mb_peak: Math.round(run.state.memory_bytes / 1e6),
+            page_memory_mb_peak: Math.round(run.state.memory.page / 1e6),
         };
         console.log(JSON.stringify(line));
         appendFileSync(join(E2E_OUT, "bench.json"), JSON.stringify(line) + "\n");

@@ -25,7 +25,7 @@ pub(super) fn define(api: &Api, doc: &SharedDocument, ctx: &egui::Context) -> Re
 
     api.define("selectStructure", select_structure(doc, ctx))?;
 
-    let reading = api.reading;
+    let reading = crate::app::query::is_viewer();
     api.define(
         "setStructure",
         setter(doc, ctx, move |session, values| {

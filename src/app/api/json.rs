@@ -20,7 +20,7 @@ pub(crate) fn metrics(case: &CaseDocument) -> Option<Value> {
 /// measures.
 pub(crate) fn structures(case: &CaseDocument) -> Option<Value> {
     let current = case.current_structure()?;
-    let list: Vec<_> = (case.as_case().structures.as_slice().iter().enumerate())
+    let list: Vec<_> = (case.as_case().structures.iter().enumerate())
         .map(|(i, s)| {
             json!({
                 "label": s.label,

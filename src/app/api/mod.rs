@@ -283,7 +283,6 @@ const READING_CALLS: [&str; 15] = [
 /// `window.meshsmooth` as it is built: in the viewer, only [`READING_CALLS`] are defined.
 struct Api {
     object: js_sys::Object,
-    reading: bool,
 }
 
 impl Api {
@@ -293,7 +292,7 @@ impl Api {
         name: &str,
         f: Closure<F>,
     ) -> Result<(), String> {
-        if self.reading && !READING_CALLS.contains(&name) {
+        if crate::app::query::is_viewer() && !READING_CALLS.contains(&name) {
             return Ok(());
         }
         js_sys::Reflect::set(&self.object, &name.into(), f.as_ref().unchecked_ref())
@@ -309,7 +308,6 @@ pub fn install(doc: &SharedDocument, ctx: &egui::Context) -> Result<js_sys::Obje
     let window = web_sys::window().ok_or("no window")?;
     let api = Api {
         object: js_sys::Object::new(),
-        reading: doc.borrow().reading,
     };
 
     // The student's viewer has only the reading calls in its build (crate::AUTHORING).

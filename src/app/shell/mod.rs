@@ -72,10 +72,8 @@ pub struct Shell {
     /// The segmentation the view framed whole (its file and structure count).
     framed_case: Option<(String, usize)>,
     structures: StructureList,
-    /// The page is the viewer (`?mode=viewer`): the case's structures and the view, no editing.
-    reading: bool,
-    /// The authoring page shows the viewer's frame for now (`Document::previewing`).
-    preview: reading::Preview,
+    /// The colouring of the viewer's frame, the student's (the author's is `coloring`).
+    reader_coloring: Option<ColorField>,
     /// The viewer's filter of its structure list.
     reading_filter: String,
     /// The structure under the pointer.
@@ -133,7 +131,7 @@ fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
 
 impl Shell {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Self {
-        let reading = !crate::AUTHORING || query::viewer_mode();
+        let reading = query::is_viewer();
         let software = cc
             .wgpu_render_state
             .as_ref()
@@ -163,7 +161,6 @@ impl Shell {
         {
             // The viewer shows no guidance: nothing runs for it in the background.
             let mut doc = doc.borrow_mut();
-            doc.reading = reading;
             doc.languages = query::languages();
             doc.session_mut().set_graphs_wanted(!reading);
             doc.session_mut().set_suggest_on_open(!reading);
@@ -183,8 +180,9 @@ impl Shell {
             bottom: BottomPanel::new(),
             brush: Brush::default(),
             drag_params: DragParams::default(),
+            coloring: Some(ColorField::LocalError),
             // A student sees the structures' own colours until asking how far they moved.
-            coloring: (!reading).then_some(ColorField::LocalError),
+            reader_coloring: None,
             bake_colors: false,
             show_original: false,
             help_open: false,
@@ -196,8 +194,6 @@ impl Shell {
             shown: Shown::default(),
             framed_case: None,
             structures: StructureList::default(),
-            reading,
-            preview: Default::default(),
             reading_filter: String::new(),
             pointing: Pointing::default(),
             labels: LabelPainter::default(),
@@ -427,7 +423,6 @@ impl eframe::App for Shell {
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
-        self.sync_preview();
         self.receive_files(&ctx);
         self.take_shortcuts(&ctx);
         // The frame a new model arrives in takes it up; uploading it to the GPU takes the next.

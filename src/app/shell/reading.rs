@@ -4,50 +4,34 @@
 use eframe::egui;
 
 use super::Shell;
-use crate::app::case_reader;
 use crate::app::structure_list::StructureAction;
+use crate::app::{case_reader, query};
 use crate::session::ColorField;
 
 /// Below this page width (points) the case's panel goes under the view: a phone held upright.
 pub(super) const NARROW: f32 = 700.0;
 
-/// The author's preview of the viewer.
-#[derive(Default)]
-pub(super) struct Preview {
-    on: bool,
-    /// The author's colouring of the view, put back after the preview (a student's viewer
-    /// opens without one).
-    author_coloring: Option<ColorField>,
-}
-
 impl Shell {
     /// Whether the viewer's frame is shown: the viewer's page, or the author's preview.
     pub(super) fn reads(&self) -> bool {
-        !crate::AUTHORING || self.reading || self.preview.on
+        query::is_viewer() || self.doc.borrow().previewing
     }
 
-    /// Follows the document's preview switch (flipped by the Lesson panel or the way back).
-    pub(super) fn sync_preview(&mut self) {
-        let on = self.doc.borrow().previewing;
-        if on != self.preview.on {
-            self.preview.on = on;
-            match on {
-                true => {
-                    self.preview.author_coloring = self.coloring.take();
-                    // The student's clicks in the view select; they paint no weights.
-                    self.brush.active = false;
-                }
-                false => self.coloring = self.preview.author_coloring.take(),
-            }
+    /// The colouring the view shows: the reader's in the viewer's frame (none until the
+    /// student asks how far the surfaces moved), else the author's.
+    pub(super) fn shown_coloring(&self) -> Option<ColorField> {
+        match self.reads() {
+            true => self.reader_coloring,
+            false => self.coloring,
         }
     }
 
     /// The author's way back from the preview.
     fn preview_back(&mut self, ui: &mut egui::Ui) {
-        if !self.preview.on {
+        let mut doc = self.doc.borrow_mut();
+        if !doc.previewing {
             return;
         }
-        let mut doc = self.doc.borrow_mut();
         let back = ui.button("◀ Back to authoring");
         doc.panel
             .lesson
@@ -110,7 +94,7 @@ impl Shell {
                 self.quiz_start(ui);
                 let mut guard = self.doc.borrow_mut();
                 let doc = &mut *guard;
-                let was = self.coloring == Some(ColorField::LocalError);
+                let was = self.reader_coloring == Some(ColorField::LocalError);
                 let mut error_colours = was;
                 let languages = doc.words().languages.to_vec();
                 let (session, panel) = doc.session_and_panel();
@@ -118,7 +102,7 @@ impl Shell {
                 let reader = (&*session, &languages[..]);
                 let actions = case_reader::show(ui, reader, panel, (filter, &mut error_colours));
                 if error_colours != was {
-                    self.coloring = error_colours.then_some(ColorField::LocalError);
+                    self.reader_coloring = error_colours.then_some(ColorField::LocalError);
                 }
                 for action in actions {
                     let done = match action {

@@ -98,7 +98,7 @@ impl Shell {
 /// Shows the structures, selection, clip or planes and slide `link` asks for (not its
 /// camera); what could not be shown, in words.
 pub(super) fn show_view(doc: &mut Document, link: &ViewLink) -> Vec<String> {
-    let count = doc.session().case().as_case().structures.as_slice().len();
+    let count = doc.session().case().as_case().structures.len();
     let mut problems = Vec::new();
     for &i in link
         .hidden

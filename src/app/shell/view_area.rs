@@ -31,6 +31,10 @@ impl Shell {
     pub(super) fn view(&mut self, ui: &mut egui::Ui) {
         let view_rect = self.legend(ui);
         let reads = self.reads();
+        // The student's clicks in the view select; they paint no weights.
+        if reads {
+            self.brush.active = false;
+        }
         let rect = match &mut self.view {
             Some((viewer, _)) => {
                 viewer.painting = self.brush.active;

@@ -53,6 +53,7 @@ impl Shell {
     /// and the checks' marks.
     pub(super) fn sync_view(&mut self, ctx: &eframe::egui::Context) {
         let looks_every_ms = crate::app::Pacing::of(ctx).looks_every_ms;
+        let coloring = self.shown_coloring();
         let Some((viewer, rs)) = &mut self.view else {
             return;
         };
@@ -86,7 +87,7 @@ impl Shell {
         let colors = if self.brush.active {
             Some((ColorField::Weights, session.case().weights_version()))
         } else {
-            (self.coloring.filter(|_| !self.show_original))
+            (coloring.filter(|_| !self.show_original))
                 .zip(session.case().last_result().map(|r| r.revision))
         };
         if shown.colors != colors {
