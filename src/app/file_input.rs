@@ -29,8 +29,8 @@ pub enum FilesFor {
     /// Opened together as a new case.
     #[default]
     NewCase,
-    /// Their structures join the open case (the Add button).
-    OpenCase,
+    /// Their structures are added to the open case (the Add button).
+    Add,
     /// The image under the open case's surfaces, windowed by the preset.
     Image(crate::case::WindowPreset),
 }

@@ -18,7 +18,7 @@ pub enum StructureAction {
     /// The case's title and description as edited.
     CaseText(String, String),
     /// Choose files whose structures join the case.
-    AddFiles,
+    Add,
     /// Choose the image under the case's surfaces, windowed by the preset.
     AddImage(crate::case::WindowPreset),
     /// Take the image from under the surfaces.
@@ -85,7 +85,7 @@ impl StructureList {
             ui.heading("Structures");
             let tip = "Open more files (meshes, a label map, a case glTF) into this case";
             if ui.button("Add files…").on_hover_text(tip).clicked() {
-                actions.push(StructureAction::AddFiles);
+                actions.push(StructureAction::Add);
             }
         });
         filter_field(ui, &mut self.filter, list.len(), layout);

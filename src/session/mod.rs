@@ -1,8 +1,9 @@
 //! The document the app and its embedding API edit, free of any UI, so the browser app, its
 //! JavaScript API and the native tests drive the same state the same way: the open case and
-//! which of its structures is the model (`structures`, `case`, `models`), the files being
-//! opened by the workers (`opening`), the CPU engine's runs (`cpu`), the background work that
-//! guides the author (`guidance`: graphs, suggestion, gallery; `suggest_all`; `checks`), and
+//! which of its structures is the model (`case_document`, `structures`, `case`, `models`),
+//! the files being opened by the workers (`opening`), the CPU engine's runs (`cpu`), the
+//! background work that guides the author (`guidance`: graphs, suggestion, gallery;
+//! `suggest_all`; `checks`), the case glTF written a structure at a time (`case_export`), and
 //! the colours the view asks for (`colors`).
 //!
 //! Each structure's filter, parameters, tau, weights and result live in the case, and only
@@ -15,11 +16,11 @@
 //! revision is refused and the measures shown always match the parameters shown.
 
 mod case;
+mod case_document;
 mod case_export;
 mod checks;
 mod colors;
 mod cpu;
-mod document;
 mod guidance;
 mod models;
 mod opening;
@@ -28,9 +29,9 @@ mod suggest_all;
 mod weights;
 
 pub use crate::model::{Model, OpenFailure};
+pub use case_document::CaseDocument;
 pub use case_export::{CaseExportMut, CaseExportOf, ExportProgress, WrittenCase};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
-pub use document::CaseDocument;
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
 pub use opening::LoadProgress;
 pub use structures::{OtherStructure, StructureChange};

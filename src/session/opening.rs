@@ -27,7 +27,7 @@ enum Purpose {
     /// A file becomes the open case, its first structure the model.
     File,
     /// A file's structures join the open case.
-    Addition,
+    Add,
     /// A file is the image under the open case's surfaces.
     Image,
 }
@@ -37,7 +37,7 @@ impl Purpose {
     fn shown(self, name: &str) -> String {
         match self {
             Purpose::Image => format!("the image {name}"),
-            Purpose::File | Purpose::Addition => name.to_string(),
+            Purpose::File | Purpose::Add => name.to_string(),
         }
     }
 }
@@ -112,8 +112,8 @@ impl Session {
             self.begin(
                 first_file.clone(),
                 first_file,
-                Input::Addition(bytes),
-                Purpose::Addition,
+                Input::Add(bytes),
+                Purpose::Add,
             );
         }
     }
@@ -220,7 +220,7 @@ impl Session {
         self.open_stages = stages;
         match (purpose, model, case) {
             (Purpose::File, Some(model), case) => self.take_file(name, first_file, *case, *model),
-            (Purpose::Addition, _, case) => {
+            (Purpose::Add, _, case) => {
                 self.error = None;
                 self.doc.add(*case);
             }

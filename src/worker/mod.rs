@@ -37,7 +37,7 @@ pub enum Input {
     /// table: [`model::open_files`]), its first structure as the model.
     Files(Vec<NamedFile>),
     /// A file's bytes read as a case only, to add its structures to the open one.
-    Addition(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
+    Add(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
     /// The image the segmentation was drawn on, read as a case holding only it
     /// ([`crate::case::CaseImage::read`]: one file, or the slices of a DICOM series): windowed
     /// by the preset so named, checked against the open case's grids.
@@ -102,7 +102,7 @@ pub enum Reply {
     },
     Loaded {
         job: u64,
-        /// The model (none for an [`Input::Addition`]).
+        /// The model (none for an [`Input::Add`]).
         model: Option<Box<Model>>,
         /// The case the files make.
         case: Box<Case>,
@@ -295,7 +295,7 @@ impl Worker {
                     .map(|o| (Some(o.model), o.case))
                     .map_err(|e| e.reason())
             }
-            Input::Addition(bytes) => (model::open_case(name, &bytes, &mut on_stage))
+            Input::Add(bytes) => (model::open_case(name, &bytes, &mut on_stage))
                 .map(|case| (None, case))
                 .map_err(|e| e.reason()),
             Input::Image { .. } if !crate::AUTHORING => {

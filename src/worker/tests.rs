@@ -431,7 +431,7 @@ fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
 #[test]
 fn a_file_to_add_comes_back_as_its_case_alone_after_its_reading_stage() {
     let mut pool = Pool::in_thread(1);
-    let job = pool.load("tube.ply", Input::Addition(SAMPLE.to_vec()));
+    let job = pool.load("tube.ply", Input::Add(SAMPLE.to_vec()));
     let Some(Reply::Loaded {
         model,
         case,

@@ -115,7 +115,7 @@ fn open_arrived(arrived: Vec<Arrived>, doc: &mut Document) {
             }
         }
         match group.purpose {
-            FilesFor::OpenCase => {
+            FilesFor::Add => {
                 for f in files {
                     doc.ask_add(&f.name, f.bytes, None);
                 }
@@ -338,8 +338,8 @@ impl Shell {
         let (session, panel) = doc.session_and_panel();
         for action in self.structures.show(ui, session, panel) {
             let done = match action {
-                StructureAction::AddFiles => {
-                    picker = Some(FilesFor::OpenCase);
+                StructureAction::Add => {
+                    picker = Some(FilesFor::Add);
                     Ok(())
                 }
                 StructureAction::AddImage(preset) => {
