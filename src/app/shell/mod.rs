@@ -337,59 +337,7 @@ impl Shell {
         let mut picker = None;
         let (session, panel) = doc.session_and_panel();
         for action in self.structures.show(ui, session, panel) {
-            let done = match action {
-                StructureAction::Add => {
-                    picker = Some(FilesFor::Add);
-                    Ok(())
-                }
-                StructureAction::AddImage(preset) => {
-                    picker = Some(FilesFor::Image(preset));
-                    Ok(())
-                }
-                StructureAction::RemoveImage => {
-                    doc.session_mut().remove_image();
-                    Ok(())
-                }
-                StructureAction::Select(i) => doc.select(i),
-                StructureAction::Change(i, change) => {
-                    doc.session_mut().case_mut().set_structure(i, change)
-                }
-                StructureAction::Solo(i) => doc.session_mut().case_mut().solo_structure(i),
-                StructureAction::CaseText(title, description) => {
-                    doc.session_mut()
-                        .case_mut()
-                        .set_case_text(Some(&title), Some(&description));
-                    Ok(())
-                }
-                StructureAction::SuggestAll => {
-                    let tau = doc.session().case().tau();
-                    let search = crate::case::SuggestAllSearch::default();
-                    let now = crate::app::document::now_ms();
-                    doc.session_mut().start_suggest_all(tau, search, None, now)
-                }
-                StructureAction::Check => doc.session_mut().start_checks(),
-                StructureAction::CancelSuggestAll => {
-                    doc.session_mut().cancel_suggest_all();
-                    Ok(())
-                }
-                StructureAction::ExportCase(options) => {
-                    doc.session_mut().case_export_mut().start(options)
-                }
-                StructureAction::CancelExport => {
-                    doc.session_mut().case_export_mut().cancel();
-                    Ok(())
-                }
-                StructureAction::SaveCase => {
-                    let file = doc.session().case().case_file();
-                    let stem = file.split('.').next().filter(|s| !s.is_empty());
-                    let name = format!("{}_case.glb", stem.unwrap_or("case"));
-                    match doc.session().case_export().written() {
-                        Some(w) => download::save(&name, &w.bytes, "model/gltf-binary"),
-                        None => Err("the case changed since it was written: write it again".into()),
-                    }
-                }
-            };
-            if let Err(e) = done {
+            if let Err(e) = structure_action(doc, action, &mut picker) {
                 log::warn!("{e}");
             }
         }
@@ -410,6 +358,62 @@ impl Shell {
         drop(guard);
         if let Some(purpose) = picker {
             self.open_picker(purpose);
+        }
+    }
+}
+
+/// Does what the Structures list asked; a file dialog it asks for is left in `picker`.
+fn structure_action(
+    doc: &mut Document,
+    action: StructureAction,
+    picker: &mut Option<FilesFor>,
+) -> Result<(), String> {
+    match action {
+        StructureAction::Add => {
+            *picker = Some(FilesFor::Add);
+            Ok(())
+        }
+        StructureAction::AddImage(preset) => {
+            *picker = Some(FilesFor::Image(preset));
+            Ok(())
+        }
+        StructureAction::RemoveImage => {
+            doc.session_mut().remove_image();
+            Ok(())
+        }
+        StructureAction::Select(i) => doc.select(i),
+        StructureAction::Change(i, change) => doc.session_mut().case_mut().set_structure(i, change),
+        StructureAction::Solo(i) => doc.session_mut().case_mut().solo_structure(i),
+        StructureAction::CaseText(title, description) => {
+            doc.session_mut()
+                .case_mut()
+                .set_case_text(Some(&title), Some(&description));
+            Ok(())
+        }
+        StructureAction::SuggestAll => {
+            let tau = doc.session().case().tau();
+            let search = crate::case::SuggestAllSearch::default();
+            let now = crate::app::document::now_ms();
+            doc.session_mut().start_suggest_all(tau, search, None, now)
+        }
+        StructureAction::Check => doc.session_mut().start_checks(),
+        StructureAction::CancelSuggestAll => {
+            doc.session_mut().cancel_suggest_all();
+            Ok(())
+        }
+        StructureAction::ExportCase(options) => doc.session_mut().case_export_mut().start(options),
+        StructureAction::CancelExport => {
+            doc.session_mut().case_export_mut().cancel();
+            Ok(())
+        }
+        StructureAction::SaveCase => {
+            let file = doc.session().case().case_file();
+            let stem = file.split('.').next().filter(|s| !s.is_empty());
+            let name = format!("{}_case.glb", stem.unwrap_or("case"));
+            match doc.session().case_export().written() {
+                Some(w) => download::save(&name, &w.bytes, "model/gltf-binary"),
+                None => Err("the case changed since it was written: write it again".into()),
+            }
         }
     }
 }

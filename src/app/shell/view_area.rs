@@ -32,9 +32,7 @@ impl Shell {
         let view_rect = self.legend(ui);
         let reads = self.reads();
         // The student's clicks in the view select; they paint no weights.
-        if reads {
-            self.brush.active = false;
-        }
+        self.brush.active &= !reads;
         let rect = match &mut self.view {
             Some((viewer, _)) => {
                 viewer.painting = self.brush.active;
@@ -69,7 +67,7 @@ impl Shell {
                 };
                 // A picture shows the view alone (and which way the patient lies).
                 if !self.picture.pending {
-                    let has_image = doc.session().case().as_case().image.as_ref().is_some();
+                    let has_image = doc.session().case().as_case().image.is_some();
                     let asks = &mut doc.view_asks;
                     doc.panel.planes = view_tools::show(ui, response.rect, asks, has_image);
                 }
@@ -101,10 +99,13 @@ impl Shell {
                 view_rect
             }
         };
-        if self.picture.pending {
-            return;
+        if !self.picture.pending {
+            self.messages(ui, rect);
         }
-        // Messages over the view's top-left corner.
+    }
+
+    /// Messages over the view's top-left corner.
+    fn messages(&self, ui: &mut egui::Ui, rect: egui::Rect) {
         let doc = self.doc.borrow();
         let reading = self.files.reading();
         let error = self.export_error.as_deref();
