@@ -59,7 +59,11 @@ pub struct ViewAsks {
 pub struct Document {
     /// The case and the engines; the shell reads the case through [`Self::case`].
     session: Session,
-    pub backend: Backend,
+    /// Which engine smooths: its one home (the shell's GPU engine runs only while it is the
+    /// WebGPU engine).
+    backend: Backend,
+    /// Why the GPU engine was given up for the CPU engine.
+    gpu_fallback: Option<String>,
     /// Timings of the last result.
     pub timings: Option<EngineTimings>,
     /// What the 3D view reports to `state()`.
@@ -142,6 +146,7 @@ impl Document {
         Self {
             session: Session::default(),
             backend,
+            gpu_fallback: None,
             timings: None,
             view: ViewReport::default(),
             view_asks: ViewAsks::default(),
@@ -282,6 +287,23 @@ impl Document {
         self.tour = None;
         self.tour_left = None;
         self.quiz = None;
+    }
+
+    /// Which engine smooths.
+    pub fn backend(&self) -> Backend {
+        self.backend
+    }
+
+    /// Why the GPU engine was given up, once it was.
+    pub fn gpu_fallback(&self) -> Option<&str> {
+        self.gpu_fallback.as_deref()
+    }
+
+    /// Gives up the GPU engine for the CPU engine, for the rest of the page's life.
+    pub fn fall_back_to_cpu(&mut self, why: String) {
+        log::error!("GPU engine failed, using the CPU engine: {why}");
+        self.backend = Backend::Cpu;
+        self.gpu_fallback = Some(why);
     }
 
     /// Whether work for the current parameters is still to do.

@@ -398,7 +398,7 @@ fn define_page(api: &Api, doc: &SharedDocument) -> Result<(), String> {
     let d = doc.clone();
     api.define(
         "backend",
-        Closure::<dyn FnMut() -> JsValue>::new(move || d.borrow().backend.name().into()),
+        Closure::<dyn FnMut() -> JsValue>::new(move || d.borrow().backend().name().into()),
     )?;
 
     let d = doc.clone();

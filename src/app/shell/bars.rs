@@ -85,11 +85,11 @@ impl Shell {
                 ui.separator();
             }
             if !self.reads() {
-                ui.label(format!("engine: {}", doc.backend.name()));
+                ui.label(format!("engine: {}", doc.backend().name()));
                 if let Some(t) = doc.timings {
                     ui.label(t.describe());
                 }
-                if let Some(why) = &self.gpu_fallback {
+                if let Some(why) = doc.gpu_fallback() {
                     ui.colored_label(ui.visuals().warn_fg_color, "CPU fallback")
                         .on_hover_text(why);
                 }

@@ -61,10 +61,9 @@ pub struct Shell {
     lesson_tab: bool,
     /// Why the last export failed.
     export_error: Option<String>,
-    /// The WebGPU engine, where the page has WebGPU.
+    /// The WebGPU engine's resources, where the page has WebGPU; it runs while the
+    /// document's engine is it ([`engine_of`]).
     gpu: Option<GpuEngine>,
-    /// Why the GPU engine was given up for the CPU engine.
-    gpu_fallback: Option<String>,
     /// The 3D view and the GPU it draws with; `None` when eframe has no wgpu renderer.
     view: Option<(Viewer, egui_wgpu::RenderState)>,
     /// What the view shows now, so it is re-uploaded only when that changes.
@@ -189,7 +188,6 @@ impl Shell {
             lesson_tab: false,
             export_error: None,
             gpu,
-            gpu_fallback: None,
             view,
             shown: Shown::default(),
             framed_case: None,
@@ -224,14 +222,13 @@ impl Shell {
     /// Returns whether it uploaded a new model to the GPU (the frame is full then).
     fn compute(&mut self) -> bool {
         let mut doc = self.doc.borrow_mut();
-        if let Some(gpu) = self.gpu.as_mut().filter(|_| crate::AUTHORING) {
+        if let Some(gpu) = engine_of(&mut self.gpu, &doc).filter(|_| crate::AUTHORING) {
             match gpu.step(&mut doc) {
                 Ok(sent) => return sent == Sent::Model,
                 Err(why) => {
-                    log::error!("GPU engine failed, using the CPU engine: {why}");
+                    doc.fall_back_to_cpu(why);
+                    // Its buffers are not needed again.
                     self.gpu = None;
-                    self.gpu_fallback = Some(why);
-                    doc.backend = Backend::Cpu;
                 }
             }
         }
@@ -458,7 +455,8 @@ impl eframe::App for Shell {
         }
         // The view takes up a new model once the GPU engine has (a frame later); the CPU
         // engine's take-up is a message to a worker, so the view need not wait a frame.
-        if (opening != Opening::Done || self.gpu.is_none()) && !uploading {
+        let on_gpu = self.doc.borrow().backend() == Backend::WebGpu;
+        if (opening != Opening::Done || !on_gpu) && !uploading {
             self.sync_view(&ctx);
         }
         self.tell_and_pace(&ctx);
@@ -484,14 +482,14 @@ impl Shell {
     fn step_guidance(&mut self) {
         let mut doc = self.doc.borrow_mut();
         let vertices = (doc.session().case().model()).map_or(0, |m| m.mesh().vertex_count());
-        let offload = self.gpu.as_mut().and_then(|g| g.evaluator(vertices));
+        let offload = engine_of(&mut self.gpu, &doc).and_then(|g| g.evaluator(vertices));
         doc.guidance_on_gpu = offload.is_some();
         doc.compute_guidance(offload);
-        if let Some(gpu) = self.gpu.as_mut() {
+        if let Some(gpu) = engine_of(&mut self.gpu, &doc) {
             gpu.guidance_sent();
-        }
-        if let Some(why) = self.gpu.as_mut().and_then(|g| g.take_evaluator_failure()) {
-            doc.session_mut().guidance_engine_failed(&why);
+            if let Some(why) = gpu.take_evaluator_failure() {
+                doc.session_mut().guidance_engine_failed(&why);
+            }
         }
     }
 
@@ -540,6 +538,11 @@ impl Shell {
                 });
             });
     }
+}
+
+/// The GPU engine, while it is the document's engine.
+fn engine_of<'a>(gpu: &'a mut Option<GpuEngine>, doc: &Document) -> Option<&'a mut GpuEngine> {
+    gpu.as_mut().filter(|_| doc.backend() == Backend::WebGpu)
 }
 
 /// Dims the page while a file is dragged over it.

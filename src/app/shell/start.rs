@@ -57,7 +57,10 @@ pub(super) fn embed(doc: &SharedDocument, ctx: &egui::Context) -> Option<api::Em
             return None;
         }
     };
-    let (mode, backend) = (crate::app::query::mode_name(), doc.borrow().backend.name());
+    let (mode, backend) = (
+        crate::app::query::mode_name(),
+        doc.borrow().backend().name(),
+    );
     if let Err(e) = embedding.listen(&api, mode, backend) {
         log::error!("the embedding page is not answered: {e}");
         return None;

@@ -76,7 +76,7 @@ impl Shell {
             };
         }
         let toward = doc.view_asks.toward_segmentation;
-        let gpu = self.gpu.as_ref();
+        let gpu = (self.gpu.as_ref()).filter(|_| doc.backend() == crate::app::Backend::WebGpu);
         let wanted = wanted_positions(session, gpu, self.show_original, toward, shown.positions);
         if shown.positions != Some(wanted)
             && upload_positions(viewer, rs, session, gpu, wanted, shown.positions, toward)
