@@ -439,7 +439,7 @@ impl Document {
         state["view"]["labels"] = v.labels.iter().map(DrawnLabel::to_json).collect();
         state["view"]["toward_segmentation"] =
             serde_json::json!(self.view_asks.toward_segmentation);
-        state["view"]["link"] = serde_json::json!(self.view_link_url());
+        state["view"]["link"] = serde_json::json!(super::query::viewer_url(&self.view_link()));
         state["view"]["camera"] = match self.view.pose {
             Some(p) => serde_json::json!({"yaw": p.yaw, "pitch": p.pitch, "distance": p.distance,
                 "target": p.target.to_array()}),
@@ -470,18 +470,6 @@ impl Document {
             planes: self.view_asks.planes,
             toward_segmentation: self.view_asks.toward_segmentation,
         }
-    }
-
-    /// The viewer's address that opens the case as it is shown now, where the case came from
-    /// an address (`?case=`); `None` for a file dropped or handed over.
-    pub fn view_link_url(&self) -> Option<String> {
-        let (_, case) = super::query::case_param()?;
-        let location = web_sys::window()?.location();
-        let page = format!("{}{}", location.origin().ok()?, location.pathname().ok()?);
-        let case = String::from(js_sys::encode_uri_component(&case));
-        let link = self.view_link().to_query();
-        let sep = if link.is_empty() { "" } else { "&" };
-        Some(format!("{page}?mode=viewer&case={case}{sep}{link}"))
     }
 }
 

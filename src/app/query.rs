@@ -28,6 +28,18 @@ pub fn is_viewer() -> bool {
     !crate::AUTHORING || ASKED.with(|asked| *asked)
 }
 
+/// The viewer's address that opens the case as `link` shows it, where the case came from an
+/// address (`?case=`); `None` for a file dropped or handed over.
+pub fn viewer_url(link: &crate::view::ViewLink) -> Option<String> {
+    let (_, case) = case_param()?;
+    let location = web_sys::window()?.location();
+    let page = format!("{}{}", location.origin().ok()?, location.pathname().ok()?);
+    let case = String::from(js_sys::encode_uri_component(&case));
+    let link = link.to_query();
+    let sep = if link.is_empty() { "" } else { "&" };
+    Some(format!("{page}?mode=viewer&case={case}{sep}{link}"))
+}
+
 /// The page's mode as `state()` and the embedding's `ready` event name it.
 pub fn mode_name() -> &'static str {
     match is_viewer() {

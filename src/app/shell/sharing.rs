@@ -64,7 +64,10 @@ impl Shell {
         let button = button
             .on_hover_text(tip)
             .on_disabled_hover_text("Only a case opened from an address (?case=) has a link");
-        if let (true, Some(url)) = (button.clicked(), self.doc.borrow().view_link_url()) {
+        if let (true, Some(url)) = (
+            button.clicked(),
+            crate::app::query::viewer_url(&self.doc.borrow().view_link()),
+        ) {
             ui.ctx().copy_text(url);
             self.link_copied = true;
         }
