@@ -16,6 +16,11 @@ use vertex_match::match_vertices;
 mod common_session;
 use common_session::smooth_cpu;
 
+/// The open case's structures.
+fn structures(session: &Session) -> &[meshsmooth::case::CaseStructure] {
+    &session.case().as_case().structures
+}
+
 /// The page's case glTF: compressed, with the local error.
 fn page_export() -> CaseGltfOptions {
     CaseGltfOptions {
@@ -100,10 +105,7 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
     );
     session.poll_opening().expect("done").expect("opens");
     assert_eq!(session.case().as_case().structures.len(), 4);
-    assert!(session
-        .case()
-        .as_case()
-        .structures
+    assert!(structures(&session)
         .iter()
         .all(|l| l.visible && l.color[3] == 1.0));
     // Three others around the liver, as extracted.
@@ -173,22 +175,11 @@ fn a_session_keeps_each_structures_look_and_smoothing() {
 
     // Solo shows one alone; again, every one.
     session.case_mut().solo_structure(3).unwrap();
-    let visible: Vec<bool> = session
-        .case()
-        .as_case()
-        .structures
-        .iter()
-        .map(|l| l.visible)
-        .collect();
+    let visible: Vec<bool> = structures(&session).iter().map(|l| l.visible).collect();
     assert_eq!(visible, [false, false, false, true]);
     assert_eq!(session.case().other_structures().len(), 1);
     session.case_mut().solo_structure(3).unwrap();
-    assert!(session
-        .case()
-        .as_case()
-        .structures
-        .iter()
-        .all(|l| l.visible));
+    assert!(structures(&session).iter().all(|l| l.visible));
 
     // Smooth the liver, then work on the portal vein: the liver keeps its smoothing.
     let liver_params = Params {
