@@ -14,9 +14,19 @@ pub fn smooth_structure(structure: &mut CaseStructure) {
     structure.keep(smoothed);
 }
 
-pub(super) fn smooth_on(structure: &CaseStructure, original: &Original) -> Smoothed {
+fn smooth_on(structure: &CaseStructure, original: &Original) -> Smoothed {
     let weights = structure.weights.as_deref();
     let (positions, reference) = smooth_drifting(original, &structure.params, weights);
+    measured(structure, original, positions, reference)
+}
+
+/// The structure's result from its smoothed `positions` and their drifting `reference`.
+pub(super) fn measured(
+    structure: &CaseStructure,
+    original: &Original,
+    positions: Vec<[f32; 3]>,
+    reference: Vec<u32>,
+) -> Smoothed {
     let (metrics, vertex) = measure_vertices(original, &positions, &reference, structure.tau);
     Smoothed {
         curvature: Some(vertex.gaussian_curvature),

@@ -9,7 +9,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
-use super::pipeline::smooth_on;
+use super::pipeline::measured;
 use super::{Case, CaseStructure};
 use crate::mesh::Topology;
 use crate::metrics::Original;
@@ -402,9 +402,10 @@ pub fn suggest_structure(
         }
         None => search(&mut whole, starts)?,
     };
+    let (positions, reference) = whole.smooth_drifting(&suggestion.params);
     s.set_params(suggestion.params);
     s.set_tau(options.tau);
-    let smoothed = smooth_on(s, &original);
+    let smoothed = measured(s, &original, positions, reference);
     s.keep(smoothed);
     Ok(Some(suggestion))
 }

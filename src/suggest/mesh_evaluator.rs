@@ -74,6 +74,35 @@ impl<'a> MeshEvaluator<'a> {
     pub(crate) fn unchanged(&self) -> Terms {
         unchanged_terms(self.original)
     }
+
+    /// The positions after `params` and the local error's drifting references, as
+    /// [`crate::metrics::smooth_drifting`] gives them, resumed from the latest state its runs
+    /// kept of these weights: a search's suggestion is most often a count it ran to, so the
+    /// structure it is applied to is not smoothed a second time.
+    pub fn smooth_drifting(&mut self, params: &Params) -> (Vec<[f32; 3]>, Vec<u32>) {
+        let (mesh, topology) = (self.original.mesh(), self.original.topology());
+        let kept = (self.states.as_mut()).and_then(|s| s.latest(params, params.iterations));
+        let Some(kept) = kept.filter(|_| is_cumulative(params.filter)) else {
+            return crate::metrics::smooth_drifting(self.original, params, self.weights);
+        };
+        let (count, start) = (kept.count, kept.positions.clone());
+        let state = DriftState::at_home(self.original, kept.reference.clone());
+        let mut drift = DriftingReference::resume(self.original, state);
+        let more = params.iterations - count;
+        match smooth::resume(
+            mesh,
+            topology,
+            params,
+            self.weights,
+            start,
+            count,
+            more,
+            &mut drift,
+        ) {
+            Some(positions) => (positions, drift.into_reference()),
+            None => crate::metrics::smooth_drifting(self.original, params, self.weights),
+        }
+    }
 }
 
 /// Measures after the wanted iterations of a run; with a drifting reference watching every
@@ -451,6 +480,34 @@ mod tests {
         for at in [&[50][..], &[45], &[5]] {
             let (want, got) = (fresh.measure(&blown, at), kept.measure(&blown, at));
             assert_eq!(format!("{got:?}"), format!("{want:?}"), "{at:?}");
+        }
+    }
+
+    #[test]
+    fn the_smoothing_after_a_search_resumes_from_its_runs_and_equals_a_fresh_one() {
+        let original = bent_tube();
+        let n = original.mesh().vertex_count();
+        let weights: Vec<f32> = (0..n).map(|i| (i % 4) as f32 / 3.0).collect();
+        for (filter, weights) in [
+            (Filter::Hc, None),
+            (Filter::Hc, Some(&weights[..])),
+            (Filter::Taubin, None),
+            (Filter::Sinc, None),
+        ] {
+            let params = Params::defaults(filter);
+            let mut kept = MeshEvaluator::new(&original, weights)
+                .unwrap()
+                .keeping_states(1 << 30, 5);
+            kept.measure(&params, &[20, 25]).unwrap();
+            let before = kept.iterations;
+            // At a count it ran to, from a kept state below one, and past every kept state.
+            for count in [25, 22, 40, 0] {
+                let mut p = params;
+                p.iterations = count;
+                let want = crate::metrics::smooth_drifting(&original, &p, weights);
+                assert_eq!(kept.smooth_drifting(&p), want, "{filter} {count}");
+            }
+            assert_eq!(kept.iterations, before, "not counted as the search's");
         }
     }
 
