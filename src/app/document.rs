@@ -76,9 +76,6 @@ pub struct Document {
     pub languages: Vec<String>,
     /// Whether keys act (an embedding page can turn them off).
     pub shortcuts: bool,
-    /// How the latest files asked to open ended, once all of them have: for the embedding
-    /// page's `loaded` event, which takes it.
-    pub finished_opening: Option<Result<(), String>>,
     /// Where the graphs and gallery cards are, for `state()`.
     pub panel: PanelLayout,
     /// The tour step shown, while the student follows the case's tour.
@@ -106,8 +103,6 @@ pub struct Document {
     waiting_for_load: Vec<LoadWaiter>,
     /// Calls waiting for a picture of the view.
     pub waiting_for_picture: Vec<PictureWaiter>,
-    /// The first failure among the files opened since the waiters last heard.
-    load_failure: Option<String>,
 }
 
 /// The handle the shell and the API hold.
@@ -153,7 +148,6 @@ impl Document {
             pointed: None,
             languages: Vec::new(),
             shortcuts: true,
-            finished_opening: None,
             panel: PanelLayout::default(),
             tour: None,
             tour_left: None,
@@ -168,7 +162,6 @@ impl Document {
             guidance_on_gpu: false,
             waiting_for_load: Vec::new(),
             waiting_for_picture: Vec::new(),
-            load_failure: None,
         }
     }
 
@@ -259,14 +252,10 @@ impl Document {
             Ok(()) => {}
             Err(message) => log::warn!("{message}"),
         }
-        if let Err(message) = outcome {
-            self.load_failure.get_or_insert(message);
-        }
-        if self.session.loading().is_none() {
-            let outcome = self.load_failure.take();
-            self.finished_opening = Some(outcome.clone().map_or(Ok(()), Err));
+        if let (None, Some(outcome)) = (self.session.loading(), self.session.openings().last()) {
+            let outcome = outcome.clone();
             for w in std::mem::take(&mut self.waiting_for_load) {
-                w(outcome.clone().map_or(Ok(&self.session), Err));
+                w(outcome.clone().map(|()| &self.session));
             }
         }
         Opening::Done

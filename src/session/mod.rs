@@ -33,7 +33,7 @@ pub use case_document::CaseDocument;
 pub use case_export::{CaseExportMut, CaseExportOf, ExportProgress, WrittenCase};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
-pub use opening::LoadProgress;
+pub use opening::{LoadProgress, Openings};
 pub use structures::{OtherStructure, StructureChange};
 pub use suggest_all::{structure_work, StructureOutcome, SuggestAllReport};
 pub use weights::{Dab, WeightsSummary};
@@ -74,6 +74,8 @@ pub struct Session {
     guidance: guidance::Guidance,
     /// A file the CPU engine's workers are opening.
     opening: Option<opening::WorkerOpening>,
+    /// How the files asked to open ended.
+    openings: opening::Openings,
     /// How long each stage of the latest opening took (ms), in order.
     open_stages: Vec<(String, f64)>,
     /// Files to add to the case once the one opening now is open.
@@ -95,6 +97,7 @@ impl Default for Session {
             error: None,
             guidance: guidance::Guidance::default(),
             opening: None,
+            openings: Default::default(),
             open_stages: Vec::new(),
             additions: Default::default(),
             suggest_all: Default::default(),

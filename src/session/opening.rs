@@ -21,6 +21,38 @@ pub struct LoadProgress {
     pub fraction: f32,
 }
 
+/// How the files asked to open ended: the first failure among those asked since nothing was
+/// opening, and, once none is left, that batch's outcome, numbered so that each listener (the
+/// API's waiters, the embedding page) hears each ending once.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Openings {
+    failure_so_far: Option<String>,
+    ended: u64,
+    last: Option<Result<(), String>>,
+}
+
+impl Openings {
+    /// How many batches of files have ended, the latest included.
+    pub fn ended(&self) -> u64 {
+        self.ended
+    }
+
+    /// How the latest batch ended: open, or the first failure among its files.
+    pub fn last(&self) -> Option<&Result<(), String>> {
+        self.last.as_ref()
+    }
+
+    fn record(&mut self, outcome: &Result<(), String>, batch_over: bool) {
+        if let Err(why) = outcome {
+            self.failure_so_far.get_or_insert_with(|| why.clone());
+        }
+        if batch_over {
+            self.ended += 1;
+            self.last = Some(self.failure_so_far.take().map_or(Ok(()), Err));
+        }
+    }
+}
+
 /// What an opening makes of what comes back.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Purpose {
@@ -105,7 +137,13 @@ impl Session {
     pub fn begin_add(&mut self, name: &str, bytes: Vec<u8>) {
         if self.opening.is_some() || !self.additions.is_empty() {
             self.additions.push_back((name.to_string(), bytes));
-        } else if self.doc.model().is_none() {
+        } else {
+            self.start_add(name, bytes);
+        }
+    }
+
+    fn start_add(&mut self, name: &str, bytes: Vec<u8>) {
+        if self.doc.model().is_none() {
             self.begin_open(name, bytes);
         } else {
             let first_file = name.to_string();
@@ -154,8 +192,9 @@ impl Session {
     /// Starts the next file waiting to be added, once nothing is being opened.
     fn next_addition(&mut self) {
         if self.opening.is_none() {
+            // Started at once: those still waiting wait for this one.
             if let Some((name, bytes)) = self.additions.pop_front() {
-                self.begin_add(&name, bytes);
+                self.start_add(&name, bytes);
             }
         }
     }
@@ -197,6 +236,8 @@ impl Session {
             self.additions.clear();
         }
         self.next_addition();
+        let batch_over = self.opening.is_none();
+        self.openings.record(&outcome, batch_over);
         Some(outcome)
     }
 
@@ -262,6 +303,11 @@ impl Session {
     }
 
     /// How far the file being opened got, while one is.
+    /// How the files asked to open ended ([`Openings`]).
+    pub fn openings(&self) -> &Openings {
+        &self.openings
+    }
+
     pub fn loading(&self) -> Option<LoadProgress> {
         let opening = self.opening.as_ref()?;
         let (stage, total, doing) = match self.cpu.load_stage(opening.job) {

@@ -369,3 +369,30 @@ fn a_bad_file_opened_in_a_worker_keeps_the_model_and_a_later_file_replaces_an_ea
     assert_eq!(s.case().model().unwrap().name, "second.ply");
     assert_eq!(s.error(), None);
 }
+
+#[test]
+fn files_asked_together_end_once_with_the_first_failure_among_them() {
+    let mut s = sample_session();
+    assert_eq!((s.openings().ended(), s.openings().last()), (0, None));
+    s.begin_open("one.ply", SAMPLE.to_vec());
+    s.begin_add("broken.ply", b"ply\n".to_vec());
+    s.begin_add("two.ply", SAMPLE.to_vec());
+    assert_eq!(s.poll_opening(), Some(Ok(())));
+    assert_eq!(s.openings().ended(), 0, "two files still to add");
+    let e = s.poll_opening().unwrap().unwrap_err();
+    assert!(e.starts_with("Cannot open broken.ply: "), "{e}");
+    assert_eq!(s.poll_opening(), Some(Ok(())));
+    assert_eq!(s.openings().ended(), 1);
+    assert_eq!(s.openings().last(), Some(&Err(e)), "the first failure");
+    assert_eq!(
+        s.case().as_case().structures.len(),
+        2,
+        "one.ply and two.ply"
+    );
+    s.begin_open("three.ply", SAMPLE.to_vec());
+    assert_eq!(s.poll_opening(), Some(Ok(())));
+    assert_eq!(
+        (s.openings().ended(), s.openings().last()),
+        (2, Some(&Ok(())))
+    );
+}

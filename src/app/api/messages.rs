@@ -34,6 +34,8 @@ pub struct Embedding {
     heard: Option<CaseKey>,
     /// The tour step the parent last heard was shown.
     heard_step: Option<usize>,
+    /// How many openings had ended when the parent last heard of one ([`crate::session::Openings::ended`]).
+    heard_openings: u64,
 }
 
 impl Embedding {
@@ -45,6 +47,7 @@ impl Embedding {
             parent,
             heard: None,
             heard_step: None,
+            heard_openings: 0,
         }))
     }
 
@@ -82,8 +85,10 @@ impl Embedding {
                 self.post_event("step", &doc.step_event(step));
             }
         }
-        if let Some(outcome) = doc.finished_opening.take() {
-            match outcome {
+        let openings = doc.session().openings();
+        if openings.ended() != self.heard_openings {
+            self.heard_openings = openings.ended();
+            match openings.last().cloned().unwrap_or(Ok(())) {
                 Ok(()) => {
                     self.heard = Some(case_key(doc));
                     self.post_structures("loaded", doc);
