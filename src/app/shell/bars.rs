@@ -9,7 +9,7 @@ use crate::export::ExportFormat;
 
 impl Shell {
     pub(super) fn top_bar(&mut self, ui: &mut egui::Ui) {
-        if self.reads() {
+        if super::reading::reads(&self.doc.borrow()) {
             self.reading_top_bar(ui);
             return;
         }
@@ -69,14 +69,15 @@ impl Shell {
             // A quiz names no structure but in its questions; a phone has room for the
             // privacy note alone.
             let narrow = ui.ctx().content_rect().width() < super::reading::NARROW;
-            let named = doc.quiz.is_none() && !(narrow && self.reads());
+            let reads = super::reading::reads(&doc);
+            let named = doc.quiz.is_none() && !(narrow && reads);
             if let Some(model) = doc.session().case().model().filter(|_| named) {
                 ui.label(format!(
                     "{}: {} vertices, {} faces",
                     model.name, model.report.vertices, model.report.faces
                 ));
                 // The mesh report, the engine and its timings are the author's business.
-                if !model.warnings.is_empty() && !self.reads() {
+                if !model.warnings.is_empty() && !reads {
                     ui.colored_label(
                         ui.visuals().warn_fg_color,
                         format!("{} warning(s): see the report", model.warnings.len()),
@@ -84,7 +85,7 @@ impl Shell {
                 }
                 ui.separator();
             }
-            if !self.reads() {
+            if !reads {
                 ui.label(format!("engine: {}", doc.backend().name()));
                 if let Some(t) = doc.timings {
                     ui.label(t.describe());

@@ -15,14 +15,17 @@ const EXPORT_FRAME_MS: f64 = 80.0;
 impl Shell {
     /// The keyboard's shortcuts, where the page takes them (the viewer only those it reads).
     pub(super) fn take_shortcuts(&mut self, ctx: &egui::Context) {
-        let keys = self.doc.borrow().shortcuts;
+        let (keys, reads) = {
+            let doc = self.doc.borrow();
+            (doc.shortcuts, super::reading::reads(&doc))
+        };
         let pressed = if keys {
             shortcuts::pressed(ctx)
         } else {
             Vec::new()
         };
         for action in pressed {
-            if !self.reads() || shortcuts::reads(action) {
+            if !reads || shortcuts::reads(action) {
                 self.apply(action);
             }
         }

@@ -463,7 +463,7 @@ impl eframe::App for Shell {
 
         egui::Panel::top("top_bar").show(ui, |ui| self.top_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        if self.reads() {
+        if reading::reads(&self.doc.borrow()) {
             self.reading_panel(ui);
         } else {
             self.authoring_panels(ui);

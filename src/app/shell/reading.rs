@@ -4,6 +4,7 @@
 use eframe::egui;
 
 use super::Shell;
+use crate::app::document::Document;
 use crate::app::structure_list::StructureAction;
 use crate::app::{case_reader, query};
 use crate::session::ColorField;
@@ -11,16 +12,17 @@ use crate::session::ColorField;
 /// Below this page width (points) the case's panel goes under the view: a phone held upright.
 pub(super) const NARROW: f32 = 700.0;
 
-impl Shell {
-    /// Whether the viewer's frame is shown: the viewer's page, or the author's preview.
-    pub(super) fn reads(&self) -> bool {
-        query::is_viewer() || self.doc.borrow().previewing
-    }
+/// Whether the viewer's frame is shown: the viewer's page, or the author's preview. Takes the
+/// document its caller has borrowed, so no borrow is hidden here.
+pub(super) fn reads(doc: &Document) -> bool {
+    query::is_viewer() || doc.previewing
+}
 
+impl Shell {
     /// The colouring the view shows: the reader's in the viewer's frame (none until the
     /// student asks how far the surfaces moved), else the author's.
-    pub(super) fn shown_coloring(&self) -> Option<ColorField> {
-        match self.reads() {
+    pub(super) fn shown_coloring(&self, doc: &Document) -> Option<ColorField> {
+        match reads(doc) {
             true => self.reader_coloring,
             false => self.coloring,
         }

@@ -30,7 +30,7 @@ impl Shell {
     /// the pointer is named (and, in the viewer, selected by a click).
     pub(super) fn view(&mut self, ui: &mut egui::Ui) {
         let view_rect = self.legend(ui);
-        let reads = self.reads();
+        let reads = super::reading::reads(&self.doc.borrow());
         // The student's clicks in the view select; they paint no weights.
         self.brush.active &= !reads;
         let rect = match &mut self.view {

@@ -53,11 +53,11 @@ impl Shell {
     /// and the checks' marks.
     pub(super) fn sync_view(&mut self, ctx: &eframe::egui::Context) {
         let looks_every_ms = crate::app::Pacing::of(ctx).looks_every_ms;
-        let coloring = self.shown_coloring();
+        let doc = self.doc.borrow();
+        let coloring = self.shown_coloring(&doc);
         let Some((viewer, rs)) = &mut self.view else {
             return;
         };
-        let doc = self.doc.borrow();
         let session = doc.session();
         if session.case().model().is_none() {
             return;
