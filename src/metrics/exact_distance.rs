@@ -27,27 +27,23 @@ pub(crate) struct Node {
 /// The median-split tree over `triangles` (indices into `positions`, which must be in range):
 /// its nodes, root first, and the mesh's triangle indices in leaf order.
 fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec<u32>) {
-    // Each triangle's centroid and box, read from the mesh once: the build then walks these
-    // in order at every level instead of gathering corners from all over the positions.
+    // Each triangle's centroid, read from the mesh once: the build then walks these small
+    // items in order at every level; a node's box comes from its children's once they are
+    // built, so only the leaves read corners again.
     let mut items: Vec<Item> = triangles
         .iter()
         .enumerate()
         .map(|(t, tri)| {
-            let corners = tri.map(|v| positions[v as usize]);
-            let mut item = Item {
-                id: t as u32,
-                centroid: [0.0; 3],
-                min: corners[0],
-                max: corners[0],
-            };
-            for c in &corners {
-                for (k, &x) in c.iter().enumerate() {
-                    item.centroid[k] += x / 3.0;
-                    item.min[k] = item.min[k].min(x);
-                    item.max[k] = item.max[k].max(x);
+            let mut centroid = [0.0f32; 3];
+            for &v in tri {
+                for (k, &x) in positions[v as usize].iter().enumerate() {
+                    centroid[k] += x / 3.0;
                 }
             }
-            item
+            Item {
+                id: t as u32,
+                centroid,
+            }
         })
         .collect();
     let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
@@ -58,7 +54,8 @@ fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec
             first: 0,
             count: 0,
         });
-        build(&mut nodes, 0, &mut items, 0);
+        let mesh = (positions, triangles);
+        build(&mut nodes, 0, &mut items, 0, mesh);
     }
     (nodes, items.iter().map(|item| item.id).collect())
 }
@@ -67,8 +64,6 @@ fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec
 struct Item {
     id: u32,
     centroid: [f32; 3],
-    min: [f32; 3],
-    max: [f32; 3],
 }
 
 /// The closest point of a mesh to a query point.
@@ -214,18 +209,25 @@ impl TriangleBvh {
 
 /// Fills `nodes[index]` for `items` (whose leaf order starts at `offset`) and recurses.
 /// Depth is bounded by log2 of the triangle count because every split halves the set.
-fn build(nodes: &mut Vec<Node>, index: usize, items: &mut [Item], offset: usize) {
-    let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    let (mut cmin, mut cmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for item in items.iter() {
-        for k in 0..3 {
-            min[k] = min[k].min(item.min[k]);
-            max[k] = max[k].max(item.max[k]);
-            cmin[k] = cmin[k].min(item.centroid[k]);
-            cmax[k] = cmax[k].max(item.centroid[k]);
-        }
-    }
+fn build(
+    nodes: &mut Vec<Node>,
+    index: usize,
+    items: &mut [Item],
+    offset: usize,
+    mesh: (&[[f32; 3]], &[[u32; 3]]),
+) {
     if items.len() <= LEAF_SIZE {
+        let (positions, triangles) = mesh;
+        let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for item in items.iter() {
+            for &v in &triangles[item.id as usize] {
+                let p = positions[v as usize];
+                for k in 0..3 {
+                    min[k] = min[k].min(p[k]);
+                    max[k] = max[k].max(p[k]);
+                }
+            }
+        }
         nodes[index] = Node {
             min,
             max,
@@ -233,6 +235,13 @@ fn build(nodes: &mut Vec<Node>, index: usize, items: &mut [Item], offset: usize)
             count: items.len() as u32,
         };
         return;
+    }
+    let (mut cmin, mut cmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for item in items.iter() {
+        for k in 0..3 {
+            cmin[k] = cmin[k].min(item.centroid[k]);
+            cmax[k] = cmax[k].max(item.centroid[k]);
+        }
     }
     let axis = (0..3)
         .max_by(|&a, &b| (cmax[a] - cmin[a]).total_cmp(&(cmax[b] - cmin[b])))
@@ -248,15 +257,16 @@ fn build(nodes: &mut Vec<Node>, index: usize, items: &mut [Item], offset: usize)
     };
     nodes.push(placeholder);
     nodes.push(placeholder);
+    let (lo, hi) = items.split_at_mut(mid);
+    build(nodes, left, lo, offset, mesh);
+    build(nodes, left + 1, hi, offset + mid, mesh);
+    let (a, b) = (nodes[left], nodes[left + 1]);
     nodes[index] = Node {
-        min,
-        max,
+        min: std::array::from_fn(|k| a.min[k].min(b.min[k])),
+        max: std::array::from_fn(|k| a.max[k].max(b.max[k])),
         first: left as u32,
         count: 0,
     };
-    let (lo, hi) = items.split_at_mut(mid);
-    build(nodes, left, lo, offset);
-    build(nodes, left + 1, hi, offset + mid);
 }
 
 #[inline]
