@@ -5,7 +5,7 @@ Printed, not asserted. Needs only Python 3 and the release build (`cargo build -
     python3 tests/bench/suggest_all.py [--repeats 2] [--maps jhu,phantom] [--searches grid,local]
         [--threads 1,2]
 
-The tool is target/release/meshsmooth under the repository root (override with MESHSMOOTH_BIN); the data
+The tool is release/meshsmooth under CARGO_TARGET_DIR or the repository's target/ (override with MESHSMOOTH_BIN); the data
 is ../shared/data beside the repository (override with MESHSMOOTH_DATA).
 
 For each label map, search and thread count (RAYON_NUM_THREADS), best of --repeats: the JSON's
@@ -22,7 +22,8 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BIN = os.environ.get("MESHSMOOTH_BIN", os.path.join(ROOT, "target", "release", "meshsmooth"))
+TARGET = os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target"))
+BIN = os.environ.get("MESHSMOOTH_BIN", os.path.join(TARGET, "release", "meshsmooth"))
 DATA = os.environ.get("MESHSMOOTH_DATA", os.path.join(ROOT, "..", "shared", "data"))
 
 MAPS = {

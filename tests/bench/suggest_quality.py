@@ -45,13 +45,18 @@ def main():
     maps = {k: tuple(os.path.join(DATA, r) for r in MAPS[k]) for k in a.maps.split(",") if k}
     if a.map_file:
         maps["file"] = (a.map_file, a.colors)
-    searches = a.searches.split(",")
+    quality_table(maps, a.searches.split(","), a.tau, a.per_structure)
+
+
+def quality_table(maps, searches, tau, per_structure=False):
+    """Prints, for each label map of `maps` (key: (map, colour table)), each search's time, sets
+    and scores against the first search's."""
     print(f"{'map':<8} {'search':<8} {'structures':>10} {'vertices':>9} {'suggest s':>9} {'sets':>7} "
           f"{'worst %':>8} {'mean %':>7} {'within 1%':>9}")
     with tempfile.TemporaryDirectory() as work:
         out = os.path.join(work, "case.glb")
         for key, (label_map, table) in maps.items():
-            runs = {s: build(label_map, table, s, a.tau, out) for s in searches}
+            runs = {s: build(label_map, table, s, tau, out) for s in searches}
             reference = {s["name"]: s["score"] for s in runs[searches[0]]["structures"]}
             for search in searches:
                 r = runs[search]
@@ -65,7 +70,7 @@ def main():
                 vertices = sum(s["vertices"] for s in r["structures"])
                 print(f"{key:<8} {search:<8} {len(excess):>10} {vertices:>9} {r['suggest_seconds']:>9.2f} "
                       f"{r['evaluations']:>7} {worst:>8.3f} {mean:>7.3f} {within:>5}/{len(excess):<3}")
-                if a.per_structure and search != searches[0]:
+                if per_structure and search != searches[0]:
                     for e, s in sorted(excess, key=lambda x: -x[0]):
                         print(f"    {s['name']:<40} {s['vertices']:>8} S {s['score']:.5f} "
                               f"vs {reference[s['name']]:.5f} ({e:+.3f}%) {s['params']}")
