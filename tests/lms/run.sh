@@ -31,3 +31,27 @@ for format in scorm12 scorm2004 cmi5; do
         --format "$format" --viewer "$viewer" -o "$out/phantom-$format.zip"
     bash tests/lms/validate.sh "$out/phantom-$format.zip"
 done
+
+# The student's viewer leaves the author's work out: none of the writers and readers only the
+# author runs (SCORM's and cmi5's manifests, DICOM SEG's and FreeSurfer's tables, Suggest all)
+# may reach its wasm, and it stays well under the app's (it was 31 % smaller gzipped when the
+# split was made). Something author-only that reaches the viewer fails here by name.
+app_wasm=("${E2E_DIST:-dist}"/meshsmooth-*_bg.wasm)
+viewer_wasm=("$viewer"/meshsmooth-*_bg.wasm)
+for author_only in imsmanifest adlcp:masteryscore Left-Cerebral-White-Matter ReferencedSegmentNumber "Suggest all"; do
+    if ! grep -q -a -F "$author_only" "${app_wasm[0]}"; then
+        echo "tests/lms/run.sh: the app's wasm lacks '$author_only': the check's strings are stale" >&2
+        exit 1
+    fi
+    if grep -q -a -F "$author_only" "${viewer_wasm[0]}"; then
+        echo "tests/lms/run.sh: the viewer's wasm holds the author's '$author_only'" >&2
+        exit 1
+    fi
+done
+app_gz=$(gzip -9 -c "${app_wasm[0]}" | wc -c)
+viewer_gz=$(gzip -9 -c "${viewer_wasm[0]}" | wc -c)
+echo "viewer wasm: $viewer_gz bytes gzipped, the app's $app_gz"
+if (( viewer_gz * 100 > app_gz * 80 )); then
+    echo "tests/lms/run.sh: the viewer's wasm ($viewer_gz bytes gzipped) is over 80 % of the app's ($app_gz)" >&2
+    exit 1
+fi
