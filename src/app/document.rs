@@ -334,9 +334,13 @@ impl Document {
     }
 
     /// Whether all the work under way runs in the CPU engine's workers, whose replies wake
-    /// the page: then frames are needed only when one lands, not continuously.
+    /// the page: then frames are needed only when one lands, not continuously. The GPU
+    /// engine works in frames, but only while it has the current result or the background's
+    /// runs to do: "Suggest all" and the checks run in the workers with either engine.
     pub fn working_elsewhere(&self) -> bool {
-        self.backend == Backend::Cpu
+        let gpu_at_work = self.backend == Backend::WebGpu
+            && (self.busy() || self.session.background().guidance_busy());
+        !gpu_at_work
             && !self.guidance_on_gpu
             && self.session.case_export().progress().is_none()
             && self.session.cpu_engine().threaded()

@@ -75,6 +75,42 @@ fn the_end_of_suggest_all_asks_for_a_frame_at_once() {
 }
 
 #[wasm_bindgen_test]
+fn suggest_all_in_the_workers_needs_no_frames_with_either_engine() {
+    let mut doc = Document::with_backend(Backend::Cpu);
+    let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
+    let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
+    doc.session.set_cpu_engine(pool);
+    doc.open_now(TUBE_NAME, TUBE).unwrap();
+    doc.step_cpu_engine();
+    deliver.set(true);
+    doc.step_cpu_engine();
+    assert!(!doc.busy(), "the current result is there");
+    deliver.set(false);
+    let search = crate::case::SuggestAllSearch::Local;
+    doc.session
+        .start_suggest_all(0.5, search, None, 0.0)
+        .unwrap();
+    assert!(doc.session.background().suggesting_all());
+    for backend in [Backend::Cpu, Backend::WebGpu] {
+        doc.backend = backend;
+        assert!(doc.working(), "{backend:?}");
+        assert!(
+            doc.working_elsewhere(),
+            "{backend:?}: the workers' replies wake the page"
+        );
+    }
+    // The GPU engine computes the current result in frames; the CPU engine's workers do not.
+    let mut params = *doc.session.case().params();
+    params.iterations += 5;
+    doc.session.case_mut().set_params(params).unwrap();
+    assert!(doc.busy());
+    doc.backend = Backend::WebGpu;
+    assert!(!doc.working_elsewhere(), "the GPU engine needs frames");
+    doc.backend = Backend::Cpu;
+    assert!(doc.working_elsewhere());
+}
+
+#[wasm_bindgen_test]
 fn waiting_calls_are_answered_once_the_result_is_computed() {
     let mut doc = Document::with_backend(Backend::Cpu);
     doc.open_now(TUBE_NAME, TUBE).unwrap();
