@@ -24,9 +24,11 @@ label map is made afresh in a temporary folder (or --keep DIR, kept there): 512 
    shared JHU atlas and abdominal phantom (tests/bench/suggest_quality.py's table).
 3. The page's Suggest all on the same map in headless Chromium, in each of --page-modes (cpu: the
    CPU engine with WebGL2; webgpu: WebGPU on SwiftShader), with one and with two engine workers,
-   against the same tool's `case build` on as many threads (one, two) run right after it
-   (benchmark B9 of tests/e2e/speed.bench.mjs): seconds, the ratio to the CLI's Suggest all, the
-   page's and the workers' memory, and how many structures got the CLI's parameters.
+   against the same tool's `case build` on every core run right after it (benchmark B9 of
+   tests/e2e/speed.bench.mjs): seconds, the ratio to the CLI's Suggest all, the page's and the
+   workers' memory, and how many structures got the CLI's parameters. A pool of N workers puts
+   N + 1 threads on Suggest all: the view worker takes structures too while the view does not
+   need it. The CLI's Suggest all on one thread is printed beside, for the per-thread speed.
 """
 
 import argparse
@@ -104,9 +106,12 @@ def page_table(folder, modes):
     print(f"{'page':<7} {'workers':>7} {'page s':>7} {'CLI s':>6} {'ratio':>6} {'page MB':>8} "
           f"{'workers MB':>11} {'CLI params':>10}")
     for l in lines:
-        for k, (workers, seconds, memory, cli) in enumerate([
-                (1, l["page_one_worker_s"], l["memory_one_worker"], l["cli_suggest_one_thread_s"]),
-                (2, l["page_two_workers_s"], l["memory_two_workers"], l["cli_suggest_two_threads_s"])]):
+        cli = l["cli_suggest_all_cores_s"]
+        print(f"(the CLI's Suggest all: {cli:.2f} s on {l['cores']} threads, "
+              f"{l['cli_suggest_one_thread_s']:.2f} s on one)")
+        for k, (workers, seconds, memory) in enumerate([
+                (1, l["page_one_worker_s"], l["memory_one_worker"]),
+                (2, l["page_two_workers_s"], l["memory_two_workers"])]):
             print(f"{l.get('mode', '?'):<7} {workers:>7} {seconds:>7.2f} {cli:>6.2f} {seconds / cli:>6.2f} "
                   f"{memory['page_mb']:>8.0f} {'+'.join(f'{w:.0f}' for w in memory['workers_mb']):>11} "
                   f"{l['same_params_as_cli'][k]:>6}/{l['structures']}")
