@@ -302,12 +302,12 @@ impl Session {
             .is_some_and(|o| !self.cpu.has_loaded(o.job))
     }
 
-    /// How far the file being opened got, while one is.
     /// How the files asked to open ended ([`Openings`]).
     pub fn openings(&self) -> &Openings {
         &self.openings
     }
 
+    /// How far the file being opened got, while one is.
     pub fn loading(&self) -> Option<LoadProgress> {
         let opening = self.opening.as_ref()?;
         let (stage, total, doing) = match self.cpu.load_stage(opening.job) {
