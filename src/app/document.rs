@@ -195,14 +195,16 @@ impl Document {
         self.waiting_for_load.extend(waiter);
     }
 
-    /// Makes structure `index` of the open case the model, on this thread (its settings and
-    /// result are in the case; see [`Session::select_structure`]); another model ends the
-    /// page's tour and quiz.
+    /// Makes structure `index` of the open case the model, at once or once a worker built a
+    /// large one's model (its settings and result are in the case; see
+    /// [`Session::select_structure`]); another model ends the page's tour and quiz.
     pub fn select(&mut self, index: usize) -> Result<(), String> {
         let before = self.session.case().model_id();
         self.session.select_structure(index)?;
         if self.session.case().model_id() != before {
             self.opened();
+        } else if self.session.selecting() == Some(index) {
+            self.leave_lesson();
         }
         Ok(())
     }
@@ -243,12 +245,16 @@ impl Document {
             return Opening::Idle;
         }
         let model_before = self.session.case().model_id();
+        let selected = self.session.selecting();
         let Some(outcome) = self.session.poll_opening() else {
             return Opening::Working;
         };
+        let new_model = self.session.case().model_id() != model_before;
         match &outcome {
+            // The lesson was left when the structure was selected.
+            Ok(()) if new_model && selected.is_some() => self.took_model(),
             // A file added to the case leaves the model as it was.
-            Ok(()) if self.session.case().model_id() != model_before => self.opened(),
+            Ok(()) if new_model => self.opened(),
             Ok(()) => {}
             Err(message) => log::warn!("{message}"),
         }
@@ -263,6 +269,12 @@ impl Document {
 
     /// What a newly opened model needs.
     fn opened(&mut self) {
+        self.took_model();
+        self.leave_lesson();
+    }
+
+    /// Another model: the timings were another's.
+    fn took_model(&mut self) {
         if let Some(model) = self.session.case().model() {
             log::info!(
                 "opened {}: {} vertices, {} faces",
@@ -272,7 +284,10 @@ impl Document {
             );
         }
         self.timings = None;
-        // Another case: another lesson.
+    }
+
+    /// Another case or another structure: the tour and the quiz end.
+    fn leave_lesson(&mut self) {
         self.tour = None;
         self.tour_left = None;
         self.quiz = None;

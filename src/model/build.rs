@@ -119,13 +119,13 @@ pub fn open_case(
     .map_err(|error| OpenFailure { error, files: 1 })
 }
 
-/// Builds the model of a structure of the open case (its `mesh`), named `name`, on the
-/// calling thread.
-pub fn open_structure(name: &str, mesh: Mesh) -> Model {
+/// Builds the model of a structure of the open case (its `mesh`), named `name`;
+/// `on_stage` hears each stage as it begins.
+pub fn open_structure(name: &str, mesh: Mesh, on_stage: &mut dyn FnMut(Stage)) -> Model {
     let mut stages = Stages {
         names: MESH_STAGES.to_vec(),
         next: 0,
-        on_stage: &mut |_| {},
+        on_stage,
     };
     build(name.to_string(), mesh, &mut stages)
 }

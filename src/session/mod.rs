@@ -33,7 +33,7 @@ pub use case_document::CaseDocument;
 pub use case_export::{CaseExportMut, CaseExportOf, ExportProgress, WrittenCase};
 pub use colors::{shared_error_colors, ColorField, Legend, LegendTick};
 pub use guidance::{Activity, GalleryPick, Suggested, GALLERY_TAUS};
-pub use opening::{LoadProgress, Openings};
+pub use opening::{LoadProgress, Openings, BUILT_ELSEWHERE_ABOVE};
 pub use structures::{OtherStructure, StructureChange};
 pub use suggest_all::{structure_work, StructureOutcome, SuggestAllReport};
 pub use weights::{Dab, WeightsSummary};
@@ -146,8 +146,22 @@ impl Session {
     }
 
     /// Makes structure `index` of the open case the model (see [`CaseDocument`]: a pointer
-    /// moves, nothing is reopened). Errors when nothing is open or it has no such structure.
+    /// moves, nothing is reopened). The first time, its model is built: a large structure's
+    /// by a worker, as a file opens ([`Self::loading`] tells how far, [`Self::selecting`]
+    /// which), the model before staying until it is there; else at once. Errors when nothing
+    /// is open or it has no such structure.
     pub fn select_structure(&mut self, index: usize) -> Result<(), String> {
+        if self.selecting() == Some(index) {
+            return Ok(());
+        }
+        if let Some((name, mesh)) = self.doc.model_to_build(index)? {
+            if self.builds_elsewhere(mesh) {
+                let mesh = mesh.clone();
+                self.begin_select(index, name, mesh);
+                return Ok(());
+            }
+        }
+        self.drop_selecting();
         if self.doc.select(index)? {
             self.became_model();
         }

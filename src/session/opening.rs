@@ -5,6 +5,7 @@
 
 use super::{Model, Session};
 use crate::case::{self, Case};
+use crate::mesh::Mesh;
 use crate::model::Opened;
 use crate::segmentation::NamedBytes;
 use crate::worker::{Input, LoadJob, NamedFile, Reply};
@@ -62,6 +63,8 @@ enum Purpose {
     Add,
     /// A file is the image under the open case's surfaces.
     Image,
+    /// A structure of the open case, selected, becomes the model.
+    Select { structure: usize },
 }
 
 impl Purpose {
@@ -69,10 +72,14 @@ impl Purpose {
     fn shown(self, name: &str) -> String {
         match self {
             Purpose::Image => format!("the image {name}"),
-            Purpose::File | Purpose::Add => name.to_string(),
+            Purpose::File | Purpose::Add | Purpose::Select { .. } => name.to_string(),
         }
     }
 }
+
+/// Structures of more vertices than this have their model built by a worker when selected:
+/// a smaller one's builds within a frame on the page's thread, and is the model at once.
+pub const BUILT_ELSEWHERE_ABOVE: usize = 20_000;
 
 /// An opening asked of the workers.
 pub(super) struct WorkerOpening {
@@ -171,7 +178,7 @@ impl Session {
             _ => format!("DICOM series ({} slices)", files.len()),
         };
         let name = name.as_str();
-        if self.opening.is_some() || !self.additions.is_empty() || self.doc.model().is_none() {
+        if self.file_opening() || !self.additions.is_empty() || self.doc.model().is_none() {
             let why = "open the segmentation first, and wait until it is open";
             return Err(self.fail(name, why));
         }
@@ -182,6 +189,40 @@ impl Session {
         };
         self.begin(name.to_string(), name.to_string(), input, Purpose::Image);
         Ok(())
+    }
+
+    /// Whether structure `mesh`'s model would be built by a worker: a large one, with workers
+    /// on other threads, while no file opens (which the structure's model would supersede).
+    pub(super) fn builds_elsewhere(&self, mesh: &Mesh) -> bool {
+        mesh.vertex_count() > BUILT_ELSEWHERE_ABOVE && self.cpu.threaded() && !self.file_opening()
+    }
+
+    /// Whether a file is being opened (not a structure's model built).
+    fn file_opening(&self) -> bool {
+        (self.opening.as_ref()).is_some_and(|o| !matches!(o.purpose, Purpose::Select { .. }))
+    }
+
+    /// Starts building structure `index`'s model (named `name`, of its surface `mesh`) in a
+    /// worker; [`Self::poll_opening`] makes it the model once it is there.
+    pub(super) fn begin_select(&mut self, index: usize, name: String, mesh: Mesh) {
+        let purpose = Purpose::Select { structure: index };
+        self.begin(name.clone(), name, Input::Structure(mesh), purpose);
+    }
+
+    /// The structure whose model a worker is building, to become the model once it is there.
+    pub fn selecting(&self) -> Option<usize> {
+        match self.opening.as_ref()?.purpose {
+            Purpose::Select { structure } => Some(structure),
+            _ => None,
+        }
+    }
+
+    /// Stops waiting for the structure whose model a worker is building (another became the
+    /// model); its answer is dropped.
+    pub(super) fn drop_selecting(&mut self) {
+        if self.selecting().is_some() {
+            self.opening = None;
+        }
     }
 
     /// Takes the image from under the case's surfaces.
@@ -206,7 +247,22 @@ impl Session {
         input: Input,
         purpose: Purpose,
     ) -> Option<String> {
-        let replaced = self.opening.take().map(|o| o.name);
+        let replaced = match self.opening.take() {
+            // A file becoming the case drops a structure still being built; else it is built
+            // here first, as selected (the new opening supersedes its worker's job).
+            Some(WorkerOpening {
+                purpose: Purpose::Select { structure },
+                ..
+            }) => {
+                if matches!(purpose, Purpose::Add | Purpose::Image)
+                    && self.doc.select(structure).unwrap_or(false)
+                {
+                    self.became_model();
+                }
+                None
+            }
+            other => other.map(|o| o.name),
+        };
         self.open_stages.clear();
         let job = self.cpu.load(&name, input);
         self.opening = Some(WorkerOpening {
@@ -236,8 +292,10 @@ impl Session {
             self.additions.clear();
         }
         self.next_addition();
-        let batch_over = self.opening.is_none();
-        self.openings.record(&outcome, batch_over);
+        if !matches!(purpose, Purpose::Select { .. }) {
+            let batch_over = self.opening.is_none();
+            self.openings.record(&outcome, batch_over);
+        }
         Some(outcome)
     }
 
@@ -260,14 +318,22 @@ impl Session {
         };
         self.open_stages = stages;
         match (purpose, model, case) {
-            (Purpose::File, Some(model), case) => self.take_file(name, first_file, *case, *model),
-            (Purpose::Add, _, case) => {
+            (Purpose::File, Some(model), Some(case)) => {
+                self.take_file(name, first_file, *case, *model)
+            }
+            (Purpose::Add, _, Some(case)) => {
                 self.error = None;
                 self.doc.add(*case);
             }
-            (Purpose::Image, _, case) => {
+            (Purpose::Image, _, Some(case)) => {
                 self.error = None;
                 self.doc.set_image(case.image);
+            }
+            (Purpose::Select { structure }, Some(model), None) => {
+                if !self.doc.select_built(structure, *model) {
+                    return Err(self.fail(name, "the case changed while it was built"));
+                }
+                self.became_model();
             }
             _ => return Err(self.fail(name, "a worker answered something else")),
         }

@@ -6,6 +6,7 @@ use super::{CaseDocument, Model};
 use crate::case::names::{self, Names};
 use crate::case::{Case, CaseStructure};
 use crate::io::{self, Format};
+use crate::mesh::Mesh;
 use crate::metrics::Metrics;
 use crate::model;
 use crate::segmentation::default_color;
@@ -70,8 +71,25 @@ impl CaseDocument {
 
     /// Makes structure `index` the model: its model is built here the first time (then kept),
     /// and its settings and result are where they were. Whether it changed the model; errors
-    /// when nothing is open or the case has no such structure.
+    /// as [`Self::model_to_build`].
     pub(super) fn select(&mut self, index: usize) -> Result<bool, String> {
+        if let Some((name, mesh)) = self.model_to_build(index)? {
+            let built = model::open_structure(&name, mesh.clone(), &mut |_| {});
+            return Ok(self.select_built(index, built));
+        }
+        if index == self.current {
+            return Ok(false);
+        }
+        self.models.touch(index);
+        self.current = index;
+        self.became_model();
+        Ok(true)
+    }
+
+    /// What making structure `index` the model takes: `None` when it is the model or its
+    /// model is kept, else the name and the surface to build its model from. Errors when
+    /// nothing is open or the case has no such structure.
+    pub(super) fn model_to_build(&self, index: usize) -> Result<Option<(String, &Mesh)>, String> {
         if self.model().is_none() {
             return Err("nothing is open".to_string());
         }
@@ -81,17 +99,23 @@ impl CaseDocument {
                 "structure {index} does not exist: the case has {count}"
             ));
         };
-        if index == self.current {
-            return Ok(false);
+        if index == self.current || self.models.get(index).is_some() {
+            return Ok(None);
         }
-        if !self.models.touch(index) {
-            let name = format!("{}: {}", self.case_file, structure.name);
-            let built = model::open_structure(&name, structure.original.clone());
-            self.models.keep(index, built);
+        let name = format!("{}: {}", self.case_file, structure.name);
+        Ok(Some((name, &structure.original)))
+    }
+
+    /// Makes structure `index` the model with `model`, built from its surface (by a worker);
+    /// false, keeping nothing, when the case has no such surface there now.
+    pub(super) fn select_built(&mut self, index: usize, model: Model) -> bool {
+        let fits = (self.case.structures.get(index)).is_some_and(|s| s.original == *model.mesh());
+        if fits {
+            self.models.keep(index, model);
+            self.current = index;
+            self.became_model();
         }
-        self.current = index;
-        self.became_model();
-        Ok(true)
+        fits
     }
 
     /// Changes structure `index`'s name, colour, opacity, visibility, group, description or

@@ -396,3 +396,69 @@ fn files_asked_together_end_once_with_the_first_failure_among_them() {
         (2, Some(&Ok(())))
     );
 }
+
+/// A session whose CPU engine runs "on other threads" and answers once `deliver` is set.
+fn session_in_workers() -> (Session, std::rc::Rc<std::cell::Cell<bool>>) {
+    let (carrier, deliver) = crate::worker::deferred::Deferred::new(1);
+    let mut s = Session::default();
+    s.set_cpu_engine(Pool::new(Box::new(carrier.in_workers())));
+    (s, deliver)
+}
+
+#[test]
+fn a_large_structure_selected_the_first_time_is_built_in_a_worker_while_the_model_stays() {
+    let path = "../shared/data/segmentations/seg_mni152_brainmask_2mm.ply";
+    let large = std::fs::read(format!("{}/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let here = Model::load("brain.ply", &large).unwrap().model;
+    assert!(here.mesh().vertex_count() > BUILT_ELSEWHERE_ABOVE);
+    let (mut s, deliver) = session_in_workers();
+    s.open("tube.ply", SAMPLE).unwrap();
+    deliver.set(true);
+    s.begin_add("brain.ply", large);
+    assert_eq!(s.poll_opening(), Some(Ok(())));
+    let (ended, model_id) = (s.openings().ended(), s.case().model_id());
+
+    // Asked, then taken back by the model before it: the worker's answer is dropped.
+    deliver.set(false);
+    s.select_structure(1).unwrap();
+    assert_eq!(s.selecting(), Some(1));
+    s.select_structure(0).unwrap();
+    assert_eq!((s.selecting(), s.loading()), (None, None));
+    deliver.set(true);
+    s.pump_cpu_engine();
+    assert_eq!(s.poll_opening(), None);
+    assert_eq!(s.case().model_id(), model_id, "the tube stayed the model");
+
+    deliver.set(false);
+    s.select_structure(1).unwrap();
+    s.select_structure(1).unwrap();
+    for _ in 0..2 {
+        s.pump_cpu_engine();
+        assert_eq!(s.poll_opening(), None, "the worker is busy");
+        assert_eq!(s.case().current_structure(), Some(0), "the model stays");
+        assert_eq!(s.loading().unwrap().name, "tube.ply: brain");
+    }
+    deliver.set(true);
+    s.pump_cpu_engine();
+    assert_eq!(s.poll_opening(), Some(Ok(())));
+    assert_eq!(
+        (s.selecting(), s.case().current_structure()),
+        (None, Some(1))
+    );
+    assert_eq!(s.openings().ended(), ended, "no file was opened");
+    let model = s.case().model().unwrap();
+    assert_eq!(model.name, "tube.ply: brain");
+    assert_eq!((&model.report, &model.edges), (&here.report, &here.edges));
+    assert_eq!(model.topology(), here.topology());
+    assert_eq!(model.original.curvature(), here.original.curvature());
+    assert!(smooth_cpu(&mut s).is_some() && s.case().result().is_some());
+
+    // Both models are kept: no worker builds either again.
+    for index in [0, 1] {
+        s.select_structure(index).unwrap();
+        assert_eq!(
+            (s.selecting(), s.case().current_structure()),
+            (None, Some(index))
+        );
+    }
+}

@@ -47,8 +47,8 @@ impl Deferred {
     }
 
     /// Says it runs in workers of its own, as the page's do: their replies come between
-    /// frames, and the page steps the engine then (only the page's tests ask).
-    #[cfg(target_arch = "wasm32")]
+    /// frames, and the page steps the engine then; the session builds a large structure's
+    /// model in them.
     pub(crate) fn in_workers(mut self) -> Self {
         self.threaded = true;
         self

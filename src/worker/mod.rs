@@ -38,6 +38,9 @@ pub enum Input {
     Files(Vec<NamedFile>),
     /// A file's bytes read as a case only, to add its structures to the open one.
     Add(#[serde(with = "crate::mesh::flat_bytes")] Vec<u8>),
+    /// A structure of the open case, its surface made the model ([`model::open_structure`]),
+    /// so a large one is not built on the page's thread.
+    Structure(Mesh),
     /// The image the segmentation was drawn on, read as a case holding only it
     /// ([`crate::case::CaseImage::read`]: one file, or the slices of a DICOM series): windowed
     /// by the preset so named, checked against the open case's grids.
@@ -102,10 +105,10 @@ pub enum Reply {
     },
     Loaded {
         job: u64,
-        /// The model (none for an [`Input::Add`]).
+        /// The model (none for an [`Input::Add`] or an [`Input::Image`]).
         model: Option<Box<Model>>,
-        /// The case the files make.
-        case: Box<Case>,
+        /// The case the files make (none for an [`Input::Structure`]).
+        case: Option<Box<Case>>,
         /// Each stage with the milliseconds it took, in order.
         stages: Vec<(String, f64)>,
     },
@@ -292,12 +295,15 @@ impl Worker {
                     })
                     .collect();
                 (model::open_files(&named, &mut on_stage))
-                    .map(|o| (Some(o.model), o.case))
+                    .map(|o| (Some(o.model), Some(o.case)))
                     .map_err(|e| e.reason())
             }
             Input::Add(bytes) => (model::open_case(name, &bytes, &mut on_stage))
-                .map(|case| (None, case))
+                .map(|case| (None, Some(case)))
                 .map_err(|e| e.reason()),
+            Input::Structure(mesh) => {
+                Ok((Some(model::open_structure(name, mesh, &mut on_stage)), None))
+            }
             Input::Image { .. } if !crate::AUTHORING => {
                 Err(format!("{name}: the viewer opens no image"))
             }
@@ -311,7 +317,7 @@ impl Worker {
                     total: 1,
                     doing: "reading the image",
                 });
-                read_image(name, &files, &preset, &grids).map(|case| (None, case))
+                read_image(name, &files, &preset, &grids).map(|case| (None, Some(case)))
             }
         };
         let ended = clock();
@@ -326,7 +332,7 @@ impl Worker {
                 Reply::Loaded {
                     job,
                     model: model.map(Box::new),
-                    case: Box::new(case),
+                    case: case.map(Box::new),
                     stages,
                 }
             }

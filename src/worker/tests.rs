@@ -395,7 +395,7 @@ fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
     assert_eq!(stage.doing, "measuring the original");
     let Some(Reply::Loaded {
         model: Some(model),
-        case,
+        case: Some(case),
         stages,
         ..
     }) = pool.take_loaded(job)
@@ -434,12 +434,12 @@ fn a_file_to_add_comes_back_as_its_case_alone_after_its_reading_stage() {
     let job = pool.load("tube.ply", Input::Add(SAMPLE.to_vec()));
     let Some(Reply::Loaded {
         model,
-        case,
+        case: Some(case),
         stages,
         ..
     }) = pool.take_loaded(job)
     else {
-        panic!("nothing came back");
+        panic!("no case came back");
     };
     assert!(
         model.is_none(),
@@ -448,6 +448,45 @@ fn a_file_to_add_comes_back_as_its_case_alone_after_its_reading_stage() {
     assert_eq!(*case, Model::load("tube.ply", SAMPLE).unwrap().case);
     let names: Vec<&str> = stages.iter().map(|(doing, _)| doing.as_str()).collect();
     assert_eq!(names, ["reading the file"]);
+}
+
+#[test]
+fn a_structure_built_in_a_worker_equals_one_built_here_and_tells_its_stages() {
+    let here = Model::load("tube.ply", SAMPLE).unwrap().model;
+    let (carrier, deliver) = Deferred::new(2);
+    let mut pool = Pool::new(Box::new(carrier));
+    let job = pool.load("case: tube", Input::Structure(here.mesh().clone()));
+    assert!(
+        pool.take_loaded(job).is_none(),
+        "nothing before the worker ran"
+    );
+    deliver.set(true);
+    pool.pump();
+    let Some(Reply::Loaded {
+        model: Some(model),
+        case: None,
+        stages,
+        ..
+    }) = pool.take_loaded(job)
+    else {
+        panic!("no model alone came back");
+    };
+    assert_eq!(model.name, "case: tube");
+    assert_eq!((&model.report, &model.edges), (&here.report, &here.edges));
+    assert_eq!(model.topology(), here.topology());
+    assert_eq!(
+        (model.original.curvature(), model.original.volume()),
+        (here.original.curvature(), here.original.volume())
+    );
+    let names: Vec<&str> = stages.iter().map(|(doing, _)| doing.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "building the topology",
+            "checking the mesh",
+            "measuring the original"
+        ]
+    );
 }
 
 #[test]

@@ -557,6 +557,22 @@ testIn(EVERY_RUN, "S9 files added to the case, and several dropped together, joi
         await app.metrics();
         await app.screenshot("S9-phantom-and-added-sphere");
 
+        // A large structure selected the first time: a worker builds its model, then it is the
+        // model (the call resolves with it).
+        const brain = readFileSync(meshPath("segmentations/seg_mni152_brainmask_2mm.ply"));
+        await app.loadMesh(brain, "seg_mni152_brainmask_2mm.ply", "addFile");
+        const openings = (await app.state()).cpu_engine.openings;
+        const info = await app.call("selectStructure", 5);
+        assert.equal(info.vertices, 32626);
+        const built = await app.state();
+        assert.equal(built.structures.current, 5);
+        assert.equal(built.cpu_engine.openings, openings + 1, "a worker built its model");
+        assert.equal(built.loading, null);
+        await app.metrics();
+        await app.screenshot("S9-large-structure-selected");
+        await app.call("selectStructure", 0);
+        assert.equal((await app.state()).cpu_engine.openings, openings + 1, "the liver's model was kept");
+
         // Dropped together: they open as one case, in order.
         const ellipsoid = readFileSync(meshPath("synthetic/synthetic_ellipsoid_30_20_12.ply"));
         await app.dropFiles([

@@ -71,14 +71,26 @@ fn select_structure(
                 "selectStructure(index): index must be a whole number >= 0".into(),
             ));
         };
-        let mut doc = d.borrow_mut();
-        let selected = doc.select(index as usize).and_then(|()| {
-            super::json::info(doc.session().case())
+        let index = index as usize;
+        let selected = d.borrow_mut().select(index);
+        crate::app::wake(&c);
+        let info = move |session: &Session| {
+            if session.case().current_structure() != Some(index) {
+                let why = session.error().unwrap_or("another was opened first");
+                return Err(format!("structure {index} was not selected: {why}"));
+            }
+            super::json::info(session.case())
                 .map(|v| to_js(&v))
                 .ok_or_else(|| "nothing is open".to_string())
-        });
-        crate::app::wake(&c);
-        settled(selected)
+        };
+        match selected {
+            Err(e) => settled(Err(e)),
+            // A large structure's model is built by a worker first.
+            Ok(()) if d.borrow().session().selecting() == Some(index) => {
+                super::when_ready(&d, &c, |s| s.selecting().is_none(), info)
+            }
+            Ok(()) => settled(info(d.borrow().session())),
+        }
     })
 }
 

@@ -136,3 +136,43 @@ fn waiting_calls_are_answered_once_the_result_is_computed() {
         "the tube"
     );
 }
+
+#[wasm_bindgen_test]
+fn a_structure_built_in_a_worker_becomes_the_model_and_a_tour_step_that_chose_it_goes_on() {
+    // A brain mask at 2 mm: one structure larger than a frame's build.
+    const MASK: &[u8] = include_bytes!(
+        "../../../../shared/data/segmentations/seg_mni152_brainmask_2mm_mask.nii.gz"
+    );
+    let mut doc = Document::with_backend(Backend::Cpu);
+    let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
+    let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
+    doc.session.set_cpu_engine(pool);
+    deliver.set(true);
+    doc.open_now(TUBE_NAME, TUBE).unwrap();
+    doc.ask_add("mask.nii.gz", MASK.to_vec(), None);
+    assert_eq!(doc.step_loading(), Opening::Done);
+    let structures = &doc.session.case().as_case().structures;
+    let large = structures[1].original.vertex_count();
+    assert!(large > crate::session::BUILT_ELSEWHERE_ABOVE, "{large}");
+
+    deliver.set(false);
+    doc.tour = Some(0);
+    doc.select(1).unwrap();
+    assert_eq!(doc.session.selecting(), Some(1));
+    assert_eq!(
+        doc.tour, None,
+        "selecting another structure leaves the tour"
+    );
+    // A tour step selects its structure, then shows itself.
+    doc.tour = Some(0);
+    assert_eq!(doc.step_loading(), Opening::Working);
+    assert_eq!(doc.session.case().current_structure(), Some(0));
+    deliver.set(true);
+    assert_eq!(doc.step_loading(), Opening::Done);
+    assert_eq!(doc.session.case().current_structure(), Some(1));
+    assert_eq!(
+        doc.session.case().model().unwrap().mesh().vertex_count(),
+        large
+    );
+    assert_eq!(doc.tour, Some(0), "the step's tour goes on");
+}
