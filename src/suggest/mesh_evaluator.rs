@@ -81,15 +81,13 @@ impl<'a> MeshEvaluator<'a> {
     /// structure it is applied to is not smoothed a second time.
     pub fn smooth_drifting(&mut self, params: &Params) -> (Vec<[f32; 3]>, Vec<u32>) {
         let (mesh, topology) = (self.original.mesh(), self.original.topology());
-        let kept = (self.states.as_mut()).and_then(|s| s.latest(params, params.iterations));
-        let Some(kept) = kept.filter(|_| is_cumulative(params.filter)) else {
-            return crate::metrics::smooth_drifting(self.original, params, self.weights);
+        let fresh = |e: &Self| crate::metrics::smooth_drifting(e.original, params, e.weights);
+        let Some(mut kept) = self.resume_point(params, params.iterations) else {
+            return fresh(self);
         };
-        let (count, start) = (kept.count, kept.positions.clone());
-        let state = DriftState::at_home(self.original, kept.reference.clone());
-        let mut drift = DriftingReference::resume(self.original, state);
-        let more = params.iterations - count;
-        match smooth::resume(
+        let more = params.iterations - kept.count;
+        let (start, count) = (kept.positions, kept.count);
+        let resumed = smooth::resume(
             mesh,
             topology,
             params,
@@ -97,12 +95,37 @@ impl<'a> MeshEvaluator<'a> {
             start,
             count,
             more,
-            &mut drift,
-        ) {
-            Some(positions) => (positions, drift.into_reference()),
-            None => crate::metrics::smooth_drifting(self.original, params, self.weights),
+            &mut kept.drift,
+        );
+        match resumed {
+            Some(positions) => (positions, kept.drift.into_reference()),
+            None => fresh(self),
         }
     }
+
+    /// Where a run of `params` can resume: the latest state the runs kept of its weights at
+    /// `count` iterations or before (for a cumulative filter; `None` when none was kept).
+    fn resume_point(&mut self, params: &Params, count: u32) -> Option<ResumePoint<'a>> {
+        let states = self
+            .states
+            .as_mut()
+            .filter(|_| is_cumulative(params.filter))?;
+        let kept = states.latest(params, count)?;
+        let state = DriftState::at_home(self.original, kept.reference.clone());
+        Some(ResumePoint {
+            drift: DriftingReference::resume(self.original, state),
+            count: kept.count,
+            positions: kept.positions.clone(),
+        })
+    }
+}
+
+/// A kept state of a run, ready to go on from: the drift as it was, after `count` iterations
+/// at `positions`.
+struct ResumePoint<'o> {
+    drift: DriftingReference<'o>,
+    count: u32,
+    positions: Vec<[f32; 3]>,
 }
 
 /// Measures after the wanted iterations of a run; with a drifting reference watching every
@@ -234,14 +257,15 @@ impl MeshEvaluator<'_> {
             let mut along = Along::new(self.original, drift, if cumulative { run } else { &[] });
             // A kept state of these weights before the first count: the run resumes there.
             let mut from = None;
-            if let (Some(states), true) = (self.states.as_mut(), drift && cumulative) {
-                if let Some(kept) = states.latest(&p, run[0].saturating_sub(1)) {
-                    let state = DriftState::at_home(self.original, kept.reference.clone());
-                    along.drift = Some(DriftingReference::resume(self.original, state));
+            if drift {
+                if let Some(kept) = self.resume_point(&p, run[0].saturating_sub(1)) {
+                    along.drift = Some(kept.drift);
                     along.last_check = kept.count;
-                    from = Some((kept.count, kept.positions.clone()));
+                    from = Some((kept.count, kept.positions));
                 }
-                along.keep = Some((states, p));
+                along.keep = (self.states.as_mut())
+                    .filter(|_| cumulative)
+                    .map(|s| (s, p));
             }
             let done = from.as_ref().map_or(0, |f| f.0);
             self.iterations += u64::from(p.iterations - done);
