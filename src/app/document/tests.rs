@@ -10,6 +10,17 @@ wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_browser);
 const TUBE_NAME: &str = "bent_tube_staircase.ply";
 const TUBE: &[u8] = include_bytes!("../../../tests/data/bent_tube_staircase.ply");
 
+/// A document on the CPU engine whose `workers` workers run beside the page (unless `here`)
+/// and answer once `deliver` is set.
+fn doc_on_workers(workers: usize, here: bool) -> (Document, std::rc::Rc<Cell<bool>>) {
+    let mut doc = Document::with_backend(Backend::Cpu);
+    let (carrier, deliver) = crate::worker::deferred::Deferred::new(workers);
+    let carrier = if here { carrier } else { carrier.in_workers() };
+    doc.session
+        .set_cpu_engine(crate::worker::Pool::new(Box::new(carrier)));
+    (doc, deliver)
+}
+
 #[wasm_bindgen_test]
 fn a_bad_file_keeps_the_previous_model_and_reports_why() {
     let mut doc = Document::with_backend(Backend::Cpu);
@@ -30,10 +41,7 @@ fn a_bad_file_keeps_the_previous_model_and_reports_why() {
 
 #[wasm_bindgen_test]
 fn a_workers_reply_asks_for_a_frame_only_when_what_is_shown_changed() {
-    let mut doc = Document::with_backend(Backend::Cpu);
-    let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
-    let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
-    doc.session.set_cpu_engine(pool);
+    let (mut doc, deliver) = doc_on_workers(2, false);
     doc.open_now(TUBE_NAME, TUBE).unwrap();
     assert!(
         !doc.step_cpu_engine(),
@@ -57,10 +65,7 @@ fn a_workers_reply_asks_for_a_frame_only_when_what_is_shown_changed() {
 #[wasm_bindgen_test]
 fn the_end_of_suggest_all_asks_for_a_frame_at_once() {
     // Replies come between frames; the bar moves with paced frames, its end must not wait.
-    let mut doc = Document::with_backend(Backend::Cpu);
-    let (carrier, deliver) = crate::worker::deferred::Deferred::new(1);
-    doc.session
-        .set_cpu_engine(crate::worker::Pool::new(Box::new(carrier)));
+    let (mut doc, deliver) = doc_on_workers(1, true);
     doc.open_now(TUBE_NAME, TUBE).unwrap();
     let search = crate::case::SuggestAllSearch::Local;
     doc.session
@@ -76,10 +81,7 @@ fn the_end_of_suggest_all_asks_for_a_frame_at_once() {
 
 #[wasm_bindgen_test]
 fn suggest_all_in_the_workers_needs_no_frames_with_either_engine() {
-    let mut doc = Document::with_backend(Backend::Cpu);
-    let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
-    let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
-    doc.session.set_cpu_engine(pool);
+    let (mut doc, deliver) = doc_on_workers(2, false);
     doc.open_now(TUBE_NAME, TUBE).unwrap();
     doc.step_cpu_engine();
     deliver.set(true);
@@ -143,10 +145,7 @@ fn a_structure_built_in_a_worker_becomes_the_model_and_a_tour_step_that_chose_it
     const MASK: &[u8] = include_bytes!(
         "../../../../shared/data/segmentations/seg_mni152_brainmask_2mm_mask.nii.gz"
     );
-    let mut doc = Document::with_backend(Backend::Cpu);
-    let (carrier, deliver) = crate::worker::deferred::Deferred::new(2);
-    let pool = crate::worker::Pool::new(Box::new(carrier.in_workers()));
-    doc.session.set_cpu_engine(pool);
+    let (mut doc, deliver) = doc_on_workers(2, false);
     deliver.set(true);
     doc.open_now(TUBE_NAME, TUBE).unwrap();
     doc.ask_add("mask.nii.gz", MASK.to_vec(), None);
