@@ -28,8 +28,9 @@
 //!   from no label map;
 //!   `codes`: `{category, type, modifier}` in standard codes, as the case glTF's record, or null;
 //!   `names`: its names in other languages by language tag, `{"de": "Leber"}`, maybe empty)
-//! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`;
-//!   the structure left keeps its smoothing, one coming back gets its own back
+//! - `selectStructure(index): Promise<info>`: opens that structure as the model, as `loadMesh`
+//!   (a large one's model is built by a worker first: the promise waits for it); the structure
+//!   left keeps its smoothing, one coming back gets its own back
 //! - `setStructure({index, name, color, opacity, visible, group, description, names})`: changes
 //!   how a structure (by default the model's) is shown, grouped and named (`group` null or ""
 //!   ungroups; `names` replaces its names in other languages); throws on a bad value;
