@@ -376,6 +376,18 @@ fn a_broken_worker_fails_its_job_instead_of_holding_it() {
     ));
 }
 
+/// A model built in a worker is the one built here: its mesh, report, edges, topology and
+/// the original's measures.
+fn assert_same_model(model: &Model, here: &Model) {
+    assert_eq!(model.mesh(), here.mesh());
+    assert_eq!((&model.report, &model.edges), (&here.report, &here.edges));
+    assert_eq!(model.topology(), here.topology());
+    assert_eq!(
+        (model.original.curvature(), model.original.volume()),
+        (here.original.curvature(), here.original.volume())
+    );
+}
+
 #[test]
 fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
     let (carrier, deliver) = Deferred::new(2);
@@ -405,15 +417,8 @@ fn an_opening_in_a_worker_equals_opening_here_and_tells_its_stages() {
     let here = Model::load("tube.ply", SAMPLE).unwrap();
     assert_eq!(*case, here.case, "the file's case of one");
     assert_eq!(case.structures[0].name, "tube");
-    let here = here.model;
     assert_eq!(model.name, "tube.ply");
-    assert_eq!((&model.report, &model.edges), (&here.report, &here.edges));
-    assert_eq!(model.mesh(), here.mesh());
-    assert_eq!(model.topology(), here.topology());
-    assert_eq!(
-        (model.original.curvature(), model.original.volume()),
-        (here.original.curvature(), here.original.volume())
-    );
+    assert_same_model(&model, &here.model);
     let names: Vec<&str> = stages.iter().map(|(doing, _)| doing.as_str()).collect();
     assert_eq!(
         names,
@@ -472,12 +477,7 @@ fn a_structure_built_in_a_worker_equals_one_built_here_and_tells_its_stages() {
         panic!("no model alone came back");
     };
     assert_eq!(model.name, "case: tube");
-    assert_eq!((&model.report, &model.edges), (&here.report, &here.edges));
-    assert_eq!(model.topology(), here.topology());
-    assert_eq!(
-        (model.original.curvature(), model.original.volume()),
-        (here.original.curvature(), here.original.volume())
-    );
+    assert_same_model(&model, &here);
     let names: Vec<&str> = stages.iter().map(|(doing, _)| doing.as_str()).collect();
     assert_eq!(
         names,
