@@ -113,7 +113,7 @@ async fn viewer_build() -> Result<BTreeMap<String, Vec<u8>>, String> {
         .map_err(|_| format!("{VIEWER_FOLDER}: not an address"))?
         .href();
     let mut files = BTreeMap::new();
-    let page = fetch_file(&folder, "index.html").await?;
+    let (_, page) = fetch_file(&folder, "index.html").await?;
     let text = String::from_utf8_lossy(&page).into_owned();
     files.insert("index.html".to_string(), page);
     let parsed = web_sys::DomParser::new()
@@ -127,12 +127,7 @@ async fn viewer_build() -> Result<BTreeMap<String, Vec<u8>>, String> {
     let glue = linked("link[rel=modulepreload][href$='.js']")?;
     let wasm = linked("link[rel=preload][href$='.wasm']")?;
     for href in ["worker.js", glue.as_str(), wasm.as_str()] {
-        let url = web_sys::Url::new_with_base(href, &folder)
-            .map_err(|_| format!("{href}: not an address"))?;
-        let name = (url.pathname().rsplit('/').next())
-            .unwrap_or_default()
-            .to_string();
-        let bytes = fetch_file(&folder, &name).await?;
+        let (name, bytes) = fetch_file(&folder, href).await?;
         files.insert(name, bytes);
     }
     Ok(files)
@@ -141,11 +136,16 @@ async fn viewer_build() -> Result<BTreeMap<String, Vec<u8>>, String> {
 /// Where the web build puts the student's viewer, beside the app's page.
 const VIEWER_FOLDER: &str = "viewer/";
 
-/// The file `name` of the viewer's build in `folder` (an absolute address).
-async fn fetch_file(folder: &str, name: &str) -> Result<Vec<u8>, String> {
+/// The file of the viewer's build that `href` names in `folder` (an absolute address): its
+/// name there and its bytes.
+async fn fetch_file(folder: &str, href: &str) -> Result<(String, Vec<u8>), String> {
     let url =
-        web_sys::Url::new_with_base(name, folder).map_err(|_| format!("{name}: not an address"))?;
-    super::read_bytes::fetch(&url.href(), Box::new(|_, _| {}))
+        web_sys::Url::new_with_base(href, folder).map_err(|_| format!("{href}: not an address"))?;
+    let name = (url.pathname().rsplit('/').next())
+        .unwrap_or_default()
+        .to_string();
+    let bytes = super::read_bytes::fetch(&url.href(), Box::new(|_, _| {}))
         .await
-        .map_err(|e| format!("the viewer's {name} ({VIEWER_FOLDER} beside this page): {e}"))
+        .map_err(|e| format!("the viewer's {name} ({VIEWER_FOLDER} beside this page): {e}"))?;
+    Ok((name, bytes))
 }
