@@ -351,12 +351,12 @@ impl Document {
     /// Whether all the work under way runs in the CPU engine's workers, whose replies wake
     /// the page: then frames are needed only when one lands, not continuously. The GPU
     /// engine works in frames, but only while it has the current result or the background's
-    /// runs to do: "Suggest all" and the checks run in the workers with either engine.
+    /// runs to do (where they go to it: on a software adapter they go to the workers);
+    /// "Suggest all" and the checks run in the workers with either engine.
     pub fn working_elsewhere(&self) -> bool {
-        let gpu_at_work = self.backend == Backend::WebGpu
-            && (self.busy() || self.session.background().guidance_busy());
+        let guidance_on_gpu = self.guidance_on_gpu && self.session.background().guidance_busy();
+        let gpu_at_work = self.backend == Backend::WebGpu && (self.busy() || guidance_on_gpu);
         !gpu_at_work
-            && !self.guidance_on_gpu
             && self.session.case_export().progress().is_none()
             && self.session.cpu_engine().threaded()
     }
@@ -393,10 +393,12 @@ impl Document {
         // Its surfaces show with the next paced frame; the workers need not wait for it. Its
         // end shows at once.
         let ended = self.session.step_suggest_all();
-        if self.backend != Backend::Cpu || !self.session.cpu_engine().threaded() {
+        if !self.session.cpu_engine().threaded() {
             return ended;
         }
-        let took = self.compute_on_cpu();
+        // The GPU engine computes the current result in frames; the background's runs that
+        // go to the workers move on between frames with either engine.
+        let took = self.backend == Backend::Cpu && self.compute_on_cpu();
         let finished = !self.guidance_on_gpu && self.compute_guidance(None);
         self.answer_waiting();
         took || finished || ended

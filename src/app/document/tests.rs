@@ -93,6 +93,11 @@ fn suggest_all_in_the_workers_needs_no_frames_with_either_engine() {
         .start_suggest_all(0.5, search, None, 0.0)
         .unwrap();
     assert!(doc.session.background().suggesting_all());
+    // The graphs' runs wait in the workers behind Suggest all's structures (on a software
+    // adapter the GPU engine takes none of them).
+    doc.session.set_graphs_wanted(true);
+    doc.step_cpu_engine();
+    assert!(doc.session.background().guidance_busy());
     for backend in [Backend::Cpu, Backend::WebGpu] {
         doc.backend = backend;
         assert!(doc.working(), "{backend:?}");
@@ -101,6 +106,27 @@ fn suggest_all_in_the_workers_needs_no_frames_with_either_engine() {
             "{backend:?}: the workers' replies wake the page"
         );
     }
+    doc.guidance_on_gpu = true;
+    assert!(
+        !doc.working_elsewhere(),
+        "the GPU engine's runs need frames"
+    );
+    doc.guidance_on_gpu = false;
+    // Between frames the workers' replies move the graphs on with either engine.
+    deliver.set(true);
+    for _ in 0..1000 {
+        let background = doc.session.background();
+        if !background.suggesting_all() && !background.guidance_busy() {
+            break;
+        }
+        doc.step_cpu_engine();
+    }
+    assert!(
+        doc.session.background().graphs_current(),
+        "{:?}",
+        doc.backend
+    );
+    deliver.set(false);
     // The GPU engine computes the current result in frames; the CPU engine's workers do not.
     let mut params = *doc.session.case().params();
     params.iterations += 5;
