@@ -100,7 +100,8 @@ testIn(WEBGPU_RUN, "G2 sweep() equals the CLI's sweep --json; a click in a graph
             assert.deepEqual(curve.samples.map((s) => s.value), want.curves[k].samples.map((s) => s.value));
             assertClose(curve.samples, want.curves[k].samples, `${curve.param} samples`);
         }
-        const before = await state(app);
+        // The graphs may finish between frames: the page draws them in its next.
+        const before = await app.stateWhen((s) => s.layout.graphs.length > 0, "the graphs drawn");
         const shot = await app.screenshot("guidance-graphs");
         console.log(`graphs screenshot: ${shot.path}`);
         // A click in the iterations column's error strip, at another count than the current
