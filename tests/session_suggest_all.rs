@@ -105,7 +105,9 @@ fn a_session_suggests_every_structure_as_the_case_pipeline_does() {
 /// structure's search starts at the same sets and every structure gets the CLI's suggestion.
 #[test]
 fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
-    use meshsmooth::case::{self, Case, SuggestAllOptions, SuggestAllSearch, LEARNING_BATCH};
+    use meshsmooth::case::{
+        self, Case, SuggestAllOptions, SuggestAllSearch, LEARNING_BATCH, LEARNING_LAG,
+    };
     use meshsmooth::session::{structure_work, Session};
     let bytes = read("labelmaps/case_phantom_shared.seg.nrrd");
     let mut session = Session::default();
@@ -117,7 +119,10 @@ fn a_learned_suggest_all_in_the_session_finds_what_the_pipeline_finds() {
         session.poll_opening().expect("done").expect("adds");
     }
     let count = session.case().as_case().structures.len();
-    assert!(count > 2 * LEARNING_BATCH, "{count} structures");
+    assert!(
+        count > (LEARNING_LAG + 1) * LEARNING_BATCH,
+        "{count} structures"
+    );
     let mut expected = Case {
         structures: session.case().as_case().structures.as_slice().to_vec(),
         ..Case::default()

@@ -39,6 +39,7 @@ pub use record::{from_gltf_scene, structure_record, CaseRecordError, CASE_KEY};
 pub use suggest_all::{
     starts_from, suggest_all, suggest_structure, SuggestAllOptions, SuggestAllPlan,
     SuggestAllProgress, SuggestAllSearch, SuggestJob, DEFAULT_MAX_VOLUME_CHANGE, LEARNING_BATCH,
+    LEARNING_LAG,
 };
 
 use std::sync::Arc;

@@ -7,8 +7,6 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use rayon::prelude::*;
-
 use super::pipeline::measured;
 use super::{Case, CaseStructure};
 use crate::mesh::Topology;
@@ -99,6 +97,11 @@ impl SuggestAllOptions {
 /// How many structures, smallest first, search at once when they learn from each other.
 pub const LEARNING_BATCH: usize = 4;
 
+/// How many of the batches just before its own a batch neither waits for nor learns from: while
+/// the last structures of one batch run, the next batch's already can, so no thread waits at
+/// the end of each batch (the large structures, last, take longest).
+pub const LEARNING_LAG: usize = 1;
+
 /// One structure's part, ready to run: its index in the case and where its search starts
 /// (empty: the corners).
 #[derive(Clone, Debug, PartialEq)]
@@ -108,9 +111,10 @@ pub struct SuggestJob {
 }
 
 /// The order, the batches and the learned starts of one "Suggest all", as its structures are
-/// handed out and finish. Learning, a batch is handed out only once the batches before it have
-/// finished, and its starts come from their suggestions in the plan's order: the same starts on
-/// one thread, several, or a pool of workers finishing in any order.
+/// handed out and finish. Learning, a batch is handed out only once the batches before the
+/// [`LEARNING_LAG`] just before it have finished, and its starts come from their suggestions in
+/// the plan's order: the same starts on one thread, several, or a pool of workers finishing in
+/// any order.
 #[derive(Clone, Debug)]
 pub struct SuggestAllPlan {
     options: SuggestAllOptions,
@@ -171,12 +175,13 @@ impl SuggestAllPlan {
         }
         let learning = self.options.search.learns();
         let batch_start = position - position % LEARNING_BATCH;
-        if learning && self.finished[..batch_start].iter().any(Option::is_none) {
+        let learned_to = batch_start.saturating_sub(LEARNING_BATCH * LEARNING_LAG);
+        if learning && self.finished[..learned_to].iter().any(Option::is_none) {
             return None;
         }
         let starts = match (learning, case.structures.get(structure)) {
             (true, Some(s)) => {
-                let learned: Vec<Params> = (self.finished[..batch_start].iter())
+                let learned: Vec<Params> = (self.finished[..learned_to].iter())
                     .filter_map(|f| f.flatten())
                     .collect();
                 starts_from(&learned, self.options.filter.unwrap_or(s.params.filter))
@@ -265,93 +270,132 @@ pub struct SuggestAllProgress {
 
 /// Runs the plan of every structure of `case` on rayon's threads: each structure's suggestion at
 /// `options.tau` with its own filter and bound, then smoothed with it. Structures run in
-/// parallel (most are small, and one structure's passes use few threads). `on_progress`
-/// returns `false` to cancel: structures already finished keep their new parameters, the others
-/// are left as they were. Returns each structure's suggestion, in order; a structure with
-/// nothing to smooth (no vertices) gets `None` and is left alone.
+/// parallel (most are small, and one structure's passes use few threads), each handed out as
+/// soon as the plan lets it start. `on_progress` returns `false` to cancel: structures already
+/// finished keep their new parameters, the others are left as they were. Returns each
+/// structure's suggestion, in order; a structure with nothing to smooth (no vertices) gets
+/// `None` and is left alone.
 pub fn suggest_all(
     case: &mut Case,
     options: &SuggestAllOptions,
     on_progress: &(dyn Fn(SuggestAllProgress) -> bool + Sync),
 ) -> Result<Vec<Option<Suggestion>>, SuggestError> {
     let total = case.structures.len();
-    let cancelled = AtomicBool::new(false);
-    let done = AtomicUsize::new(0);
-    let evaluations = AtomicUsize::new(0);
-    let report = Mutex::new(());
-    let tell = |finished: bool| {
-        let _one_at_a_time = report.lock();
-        if finished {
-            done.fetch_add(1, Ordering::Relaxed);
-        }
-        let p = SuggestAllProgress {
-            structures_done: done.load(Ordering::Relaxed),
-            structures: total,
-            evaluations: evaluations.load(Ordering::Relaxed),
-        };
-        if !on_progress(p) {
-            cancelled.store(true, Ordering::Relaxed);
-        }
-        !cancelled.load(Ordering::Relaxed)
+    let plan = SuggestAllPlan::new(case, None, *options);
+    let runner = Runner {
+        options,
+        on_progress,
+        total,
+        cancelled: AtomicBool::new(false),
+        done: AtomicUsize::new(0),
+        evaluations: AtomicUsize::new(0),
+        report: Mutex::new(()),
+        shared: Mutex::new(Shared {
+            case,
+            plan,
+            suggestions: vec![None; total],
+            first_error: None,
+        }),
     };
-    let mut plan = SuggestAllPlan::new(case, None, *options);
-    let mut suggestions = vec![None; total];
-    let mut first_error = None;
-    loop {
-        let jobs: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(case)).collect();
-        if jobs.is_empty() {
-            break;
-        }
-        // Copies of these structures only, each back in the case as it finishes: a case of
-        // millions of vertices is never held twice.
-        let copies: Vec<(SuggestJob, CaseStructure)> = (jobs.into_iter())
-            .map(|job| {
-                let s = case.structures[job.structure].clone();
-                (job, s)
-            })
-            .collect();
-        let outcomes: Vec<(usize, Outcome)> = (copies.into_par_iter())
-            .with_max_len(1)
-            .map(|(job, mut s)| {
-                if cancelled.load(Ordering::Relaxed) {
-                    return (job.structure, Ok(None));
-                }
-                let outcome = suggest_structure(&mut s, options, &job.starts, &mut |_| {
-                    evaluations.fetch_add(1, Ordering::Relaxed);
-                    tell(false)
-                });
-                if matches!(outcome, Ok(Some(_))) {
-                    tell(true);
-                }
-                (job.structure, outcome.map(|o| o.map(|sg| (sg, s))))
-            })
-            .collect();
-        for (i, outcome) in outcomes {
-            match outcome {
-                Ok(Some((suggestion, structure))) => {
-                    plan.finish(i, Some(suggestion.params));
-                    case.structures[i] = structure;
-                    suggestions[i] = Some(suggestion);
-                }
-                Ok(None) | Err(SuggestError::Cancelled) => plan.finish(i, None),
-                Err(e) => {
-                    plan.finish(i, None);
-                    first_error.get_or_insert(e);
-                }
-            }
-        }
-        if cancelled.load(Ordering::Relaxed) {
-            plan.cancel();
-        }
-    }
-    match first_error {
+    rayon::scope(|scope| runner.hand_out(scope));
+    let shared = runner
+        .shared
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner());
+    match shared.first_error {
         Some(e) => Err(e),
-        None => Ok(suggestions),
+        None => Ok(shared.suggestions),
     }
 }
 
-/// A structure's suggestion and the structure smoothed with it; `None` when cancelled or empty.
-type Outcome = Result<Option<(Suggestion, CaseStructure)>, SuggestError>;
+/// What the threads of [`suggest_all`] share.
+struct Runner<'a> {
+    options: &'a SuggestAllOptions,
+    on_progress: &'a (dyn Fn(SuggestAllProgress) -> bool + Sync),
+    total: usize,
+    cancelled: AtomicBool,
+    done: AtomicUsize,
+    evaluations: AtomicUsize,
+    /// Progress is told one report at a time.
+    report: Mutex<()>,
+    shared: Mutex<Shared<'a>>,
+}
+
+/// The case, the plan and what came of the structures so far.
+struct Shared<'a> {
+    case: &'a mut Case,
+    plan: SuggestAllPlan,
+    suggestions: Vec<Option<Suggestion>>,
+    first_error: Option<SuggestError>,
+}
+
+impl<'a> Runner<'a> {
+    fn shared(&self) -> std::sync::MutexGuard<'_, Shared<'a>> {
+        self.shared.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Starts every structure the plan lets start now; each, as it finishes, hands out again.
+    fn hand_out<'s>(&'s self, scope: &rayon::Scope<'s>) {
+        let mut shared = self.shared();
+        if self.cancelled.load(Ordering::Relaxed) {
+            shared.plan.cancel();
+        }
+        let Shared { case, plan, .. } = &mut *shared;
+        while let Some(job) = plan.next_job(case) {
+            scope.spawn(move |scope| {
+                self.run(job);
+                self.hand_out(scope);
+            });
+        }
+    }
+
+    /// One structure's part on a copy of it, put back in the case when it finishes: a case of
+    /// millions of vertices is never held twice.
+    fn run(&self, job: SuggestJob) {
+        let i = job.structure;
+        let mut s = self.shared().case.structures[i].clone();
+        let outcome = match self.cancelled.load(Ordering::Relaxed) {
+            true => Ok(None),
+            false => suggest_structure(&mut s, self.options, &job.starts, &mut |_| {
+                self.evaluations.fetch_add(1, Ordering::Relaxed);
+                self.tell(false)
+            }),
+        };
+        if matches!(outcome, Ok(Some(_))) {
+            self.tell(true);
+        }
+        let mut shared = self.shared();
+        match outcome {
+            Ok(Some(suggestion)) => {
+                shared.plan.finish(i, Some(suggestion.params));
+                shared.case.structures[i] = s;
+                shared.suggestions[i] = Some(suggestion);
+            }
+            Ok(None) | Err(SuggestError::Cancelled) => shared.plan.finish(i, None),
+            Err(e) => {
+                shared.plan.finish(i, None);
+                shared.first_error.get_or_insert(e);
+            }
+        }
+    }
+
+    /// Reports progress; `false` once cancelled.
+    fn tell(&self, finished: bool) -> bool {
+        let _one_at_a_time = self.report.lock();
+        if finished {
+            self.done.fetch_add(1, Ordering::Relaxed);
+        }
+        let p = SuggestAllProgress {
+            structures_done: self.done.load(Ordering::Relaxed),
+            structures: self.total,
+            evaluations: self.evaluations.load(Ordering::Relaxed),
+        };
+        if !(self.on_progress)(p) {
+            self.cancelled.store(true, Ordering::Relaxed);
+        }
+        !self.cancelled.load(Ordering::Relaxed)
+    }
+}
 
 /// One structure's part: its suggestion (with `options.filter` first, when given), applied and
 /// smoothed; `None` when it has no vertices. `starts`, when not empty, are where its local
@@ -458,33 +502,44 @@ mod tests {
 
     #[test]
     fn learning_hands_out_batch_by_batch_the_smallest_first_starting_where_they_ended() {
-        let sizes: Vec<usize> = (0..LEARNING_BATCH + 2).rev().map(|n| 10 + n).collect();
+        let ahead = (LEARNING_LAG + 1) * LEARNING_BATCH;
+        let sizes: Vec<usize> = (0..ahead + 2).rev().map(|n| 10 + n).collect();
         let case = case_of_sizes(&sizes);
         let options = SuggestAllOptions::new(0.5, SuggestAllSearch::Learned);
         let mut plan = SuggestAllPlan::new(&case, None, options);
+        // The first batch and those it does not wait for, from the corners.
         let first: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(&case)).collect();
-        assert_eq!(first.len(), LEARNING_BATCH);
+        assert_eq!(first.len(), ahead);
         let smallest_first: Vec<usize> = (0..sizes.len()).rev().collect();
         let order: Vec<usize> = first.iter().map(|j| j.structure).collect();
-        assert_eq!(order, smallest_first[..LEARNING_BATCH]);
+        assert_eq!(order, smallest_first[..ahead]);
         assert!(first.iter().all(|j| j.starts.is_empty()), "the corners");
         let found = Params {
             iterations: 17,
             ..case.structures[0].params
         };
-        // In any order; the next batch waits for the last of this one.
-        for (k, job) in first.iter().enumerate().rev() {
-            assert_eq!(plan.next_job(&case), None, "waits for the batch");
+        let other = Params {
+            iterations: 33,
+            ..found
+        };
+        // The batches after the first, finished first, teach nothing and start nothing.
+        for job in first[LEARNING_BATCH..].iter().rev() {
+            plan.finish(job.structure, Some(other));
+            assert_eq!(plan.next_job(&case), None, "waits for the first batch");
+        }
+        // The first batch, in any order; the last waits for the last of it.
+        for (k, job) in first[..LEARNING_BATCH].iter().enumerate().rev() {
+            assert_eq!(plan.next_job(&case), None, "waits for the first batch");
             plan.finish(job.structure, (k != 1).then_some(found));
         }
-        let second: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(&case)).collect();
-        assert_eq!(second.len(), 2);
-        for job in &second {
-            assert_eq!(job.starts, [found]);
+        let last: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(&case)).collect();
+        assert_eq!(last.len(), 2);
+        for job in &last {
+            assert_eq!(job.starts, [found], "learned from the first batch only");
         }
         plan.cancel();
-        assert!(!plan.is_over(), "the second batch still runs");
-        for job in &second {
+        assert!(!plan.is_over(), "the last batch still runs");
+        for job in &last {
             plan.finish(job.structure, None);
         }
         assert!(plan.is_over());
