@@ -49,6 +49,8 @@ pub(super) enum Location {
 #[derive(Clone, Debug, Default)]
 pub(super) struct RayBvh {
     tree: TriangleBvh,
+    /// Each node's box as the rays test it ([`padded`]), worked out once.
+    boxes: Vec<Padded>,
     /// Connected shell of each entry of the tree's corners.
     shells: Vec<u32>,
 }
@@ -78,7 +80,12 @@ impl RayBvh {
         let tree = TriangleBvh::new(positions, triangles);
         let shell_of = triangle_shells(positions.len(), triangles);
         let shells = tree.ids().iter().map(|&t| shell_of[t as usize]).collect();
-        Self { tree, shells }
+        let boxes = tree.nodes().iter().map(padded).collect();
+        Self {
+            tree,
+            boxes,
+            shells,
+        }
     }
 
     /// The tree, for distances to the surface.
@@ -90,7 +97,7 @@ impl RayBvh {
     /// suffice), each shell counted by its own parity. Rays leave along the axis whose side of
     /// the surface's box is nearest, so they cross little of the tree.
     pub(super) fn locate(&self, p: [f64; 3]) -> Location {
-        let Some(root) = self.tree.nodes().first() else {
+        let Some(root) = self.boxes.first() else {
             return Location::Within { shells: 0 };
         };
         let (axis, sign) = nearest_side(root, p);
@@ -128,7 +135,7 @@ impl RayBvh {
         let (nodes, corners) = (self.tree.nodes(), self.tree.corners());
         loop {
             let node = &nodes[index];
-            if ray.enters(node) {
+            if ray.enters(&self.boxes[index]) {
                 if node.count > 0 {
                     let start = node.first as usize;
                     let end = start + node.count as usize;
@@ -202,8 +209,7 @@ impl Ray {
     /// Whether the ray (from slightly behind its origin, to catch a surface through it) meets
     /// the node's box.
     #[inline]
-    fn enters(&self, node: &TreeNode) -> bool {
-        let (min, max) = padded(node);
+    fn enters(&self, &(min, max): &Padded) -> bool {
         let (mut near, mut far) = (-ON_SURFACE, f64::INFINITY);
         for k in 0..3 {
             let a = (min[k] - self.origin[k]) * self.inverse[k];
@@ -281,8 +287,7 @@ pub(super) fn direction(axis: usize, sign: f64, tilt: [f64; 2]) -> [f64; 3] {
 }
 
 /// The axis and sign of the side of `node`'s box nearest to `p`.
-fn nearest_side(node: &TreeNode, p: [f64; 3]) -> (usize, f64) {
-    let (min, max) = padded(node);
+fn nearest_side(&(min, max): &Padded, p: [f64; 3]) -> (usize, f64) {
     let mut best = (2, 1.0, f64::INFINITY);
     for (k, ((&x, &lo), &hi)) in p.iter().zip(&min).zip(&max).enumerate() {
         for (sign, gap) in [(-1.0, x - lo), (1.0, hi - x)] {
@@ -294,10 +299,12 @@ fn nearest_side(node: &TreeNode, p: [f64; 3]) -> (usize, f64) {
     (best.0, best.1)
 }
 
+/// A node's box, widened a hair ([`padded`]).
+type Padded = ([f64; 3], [f64; 3]);
+
 /// The tree's box of `node`, widened a hair so that a ray along a box face is not lost to
 /// rounding.
-#[inline]
-fn padded(node: &TreeNode) -> ([f64; 3], [f64; 3]) {
+fn padded(node: &TreeNode) -> Padded {
     let pad = |x: f64| BOX_PAD * (1.0 + x.abs());
     (
         node.min.map(|x| f64::from(x) - pad(f64::from(x))),
