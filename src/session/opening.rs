@@ -221,7 +221,9 @@ impl Session {
     /// model); its answer is dropped.
     pub(super) fn drop_selecting(&mut self) {
         if self.selecting().is_some() {
-            self.opening = None;
+            if let Some(opening) = self.opening.take() {
+                self.cpu.forget_load(opening.job);
+            }
         }
     }
 

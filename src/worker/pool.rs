@@ -291,6 +291,19 @@ impl Pool {
         LoadJob(job)
     }
 
+    /// Stops waiting for `job` (an opening no longer wanted): dropped if it still waits, its
+    /// answer dropped when it comes, or now if it came.
+    pub fn forget_load(&mut self, job: LoadJob) {
+        if self.load.as_ref().is_some_and(|(j, _)| *j == job.0) {
+            self.load = None;
+        }
+        if matches!(self.in_flight.get(&job.0), Some(Flight::Load)) {
+            self.in_flight.remove(&job.0);
+        }
+        self.loaded.remove(&job.0);
+        self.load_stages.remove(&job.0);
+    }
+
     /// The answer to `job` once it is there ([`Reply::Loaded`] or [`Reply::Failed`]).
     pub fn take_loaded(&mut self, job: LoadJob) -> Option<Reply> {
         self.pump();

@@ -490,6 +490,30 @@ fn a_structure_built_in_a_worker_equals_one_built_here_and_tells_its_stages() {
 }
 
 #[test]
+fn a_forgotten_opening_leaves_no_answer_in_the_pool() {
+    let mesh = Model::load("tube.ply", SAMPLE)
+        .unwrap()
+        .model
+        .mesh()
+        .clone();
+    let (carrier, deliver) = Deferred::new(1);
+    let mut pool = Pool::new(Box::new(carrier));
+    // Forgotten while its worker builds it: the answer is dropped as it comes.
+    let job = pool.load("case: tube", Input::Structure(mesh.clone()));
+    pool.forget_load(job);
+    deliver.set(true);
+    pool.pump();
+    assert!(!pool.has_loaded(job) && pool.load_stage(job).is_none());
+    assert!(!pool.busy());
+    // Forgotten after it came: dropped at once.
+    let job = pool.load("case: tube", Input::Structure(mesh));
+    pool.pump();
+    assert!(pool.has_loaded(job));
+    pool.forget_load(job);
+    assert!(!pool.has_loaded(job) && pool.take_loaded(job).is_none());
+}
+
+#[test]
 fn a_newer_opening_supersedes_an_older_and_a_bad_file_fails_its_job() {
     let (carrier, deliver) = Deferred::new(1);
     let mut pool = Pool::new(Box::new(carrier));
