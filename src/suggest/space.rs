@@ -243,6 +243,21 @@ impl ParamSpace {
         out
     }
 
+    /// Whether `q` makes the smoothing stronger than `c` in one parameter and weaker in another.
+    pub fn trades_strength(&self, c: GridPoint, q: GridPoint) -> bool {
+        let (mut stronger, mut weaker) = (false, false);
+        for (k, axis) in self.axes.iter().enumerate() {
+            if q.0[k] != c.0[k] {
+                if (q.0[k] > c.0[k]) == axis.larger_is_stronger {
+                    stronger = true;
+                } else {
+                    weaker = true;
+                }
+            }
+        }
+        stronger && weaker
+    }
+
     /// Whether `a` and `b` differ in their iteration count at most.
     pub fn same_weights(&self, a: GridPoint, b: GridPoint) -> bool {
         let it = self.iteration_axis();
@@ -303,6 +318,28 @@ impl ParamSpace {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_diagonal_trades_strength_when_it_smooths_more_in_one_parameter_and_less_in_another() {
+        // HC: higher alpha or beta smooths less, more iterations more.
+        let space = ParamSpace::of(Filter::Hc);
+        let c = GridPoint([4, 4, 4]);
+        for (q, trades) in [
+            ([5, 3, 4], true),
+            ([3, 5, 4], true),
+            ([4, 5, 5], true),
+            ([5, 4, 3], false),
+            ([5, 5, 4], false),
+            ([3, 3, 5], false),
+            ([5, 4, 4], false),
+        ] {
+            assert_eq!(space.trades_strength(c, GridPoint(q)), trades, "{q:?}");
+        }
+        // Taubin: higher lambda, or mu closer to -lambda, smooths more.
+        let taubin = ParamSpace::of(Filter::Taubin);
+        assert!(taubin.trades_strength(c, GridPoint([5, 3, 4])));
+        assert!(!taubin.trades_strength(c, GridPoint([5, 5, 4])));
+    }
 
     #[test]
     fn grid_sizes_follow_the_spec() {
