@@ -186,11 +186,20 @@ fn check_labels(map: &LabelMap, labels: &[i64]) -> Result<(), ExtractError> {
 }
 
 fn code_counts(codes: &[u16], n: usize) -> Vec<usize> {
-    let mut counts = vec![0usize; n];
-    for &c in codes {
-        counts[c as usize] += 1;
+    // Four counts per code, one per lane: a label map is long runs of one code, and with one
+    // count each addition would wait for the one before it.
+    let mut lanes = vec![[0usize; 4]; n];
+    let quads = codes.chunks_exact(4);
+    let rest = quads.remainder();
+    for q in quads {
+        for (lane, &c) in q.iter().enumerate() {
+            lanes[c as usize][lane] += 1;
+        }
     }
-    counts
+    for &c in rest {
+        lanes[c as usize][0] += 1;
+    }
+    lanes.iter().map(|l| l.iter().sum()).collect()
 }
 
 /// A structure's name and colour: the file's segment, else the table's entry, else the
@@ -221,4 +230,18 @@ fn naming(
         .unwrap_or_else(|| default_color(ordinal));
     let codes = (own.and_then(|s| s.codes.clone())).or(standard.map(|c| c.codes));
     (name, color, codes)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn codes_are_counted_in_any_run_and_any_length() {
+        let codes: Vec<u16> = (0..1003u32).map(|i| ((i / 7) % 5) as u16).collect();
+        let mut expected = vec![0usize; 6];
+        for &c in &codes {
+            expected[c as usize] += 1;
+        }
+        assert_eq!(super::code_counts(&codes, 6), expected);
+        assert_eq!(super::code_counts(&[], 2), [0, 0]);
+    }
 }
