@@ -6,10 +6,13 @@
 //! to the rays.
 //!
 //! Most points the checks ask about lie in the other structure's box but away from its surface
-//! (a rib beside a lung, an organ in the box of a curved vessel); the points near the surface,
-//! where two structures meet, still get rays of their own.
+//! (a rib beside a lung, an organ in the box of a curved vessel). A point near the surface,
+//! where two structures meet, casts a short ray instead: only as far as the first placed cell
+//! along it, whose location the crossings on the way change shell by shell (parity along any
+//! path through a closed surface agrees). A ray out of the surface's box meets more of its
+//! tree, and two must agree.
 
-use super::rays::{Location, RayBvh, ON_SURFACE};
+use super::rays::{direction, Cast, Location, RayBvh, ON_SURFACE, TILTS};
 
 /// The most cells one surface's grid has, a byte each: this many per triangle (a tenth of
 /// what the trees hold per triangle), within these bounds.
@@ -22,6 +25,9 @@ const EDGES_PER_CELL: f64 = 2.0;
 /// A triangle marks every cell within this of its box (mm, plus a fraction of the
 /// coordinates), more than [`ON_SURFACE`]: no point of an unmarked cell is on the surface.
 const MARK_PAD: f64 = 1e-4;
+/// A short ray looks for a placed cell every half cell along it, this many times, before the
+/// point is left to the rays out of the box.
+const STEPS: usize = 8;
 
 /// A cell a triangle touches (or one whose region the rays could not place): its points get
 /// rays.
@@ -36,6 +42,8 @@ const LOCATED: u8 = 2;
 #[derive(Debug, Default)]
 pub(super) struct Cells {
     min: [f64; 3],
+    /// The surface's box: a point farther than [`MARK_PAD`] beyond it is outside every shell.
+    max: [f64; 3],
     size: f64,
     dims: [usize; 3],
     /// Per cell, x fastest: [`TOUCHED`] or `LOCATED + shells`.
@@ -59,6 +67,7 @@ impl Cells {
         };
         let mut cells = Self {
             min,
+            max,
             size,
             dims,
             state: vec![UNKNOWN; dims[0] * dims[1] * dims[2]],
@@ -145,8 +154,57 @@ impl Cells {
             Some(s) if s >= LOCATED => Location::Within {
                 shells: usize::from(s - LOCATED),
             },
-            _ => rays.locate(p),
+            Some(_) => self.short_ray(p, rays).unwrap_or_else(|| rays.locate(p)),
+            None => rays.locate(p),
         }
+    }
+
+    /// Where `p` lies by a short ray to the first placed point along it; `None` where it
+    /// cannot tell (no placed point near, or crossings that leave open which shells of the
+    /// placed point's count they changed). One ray is enough where [`RayBvh::locate`] wants two
+    /// that agree: its end's location is the region's, which had those votes, and the rays'
+    /// test counts every crossing of a closed shell exactly once or doubts it.
+    pub(super) fn short_ray(&self, p: [f64; 3], rays: &RayBvh) -> Option<Location> {
+        let (axis, sign) = rays.nearest_side(p)?;
+        for tilt in TILTS {
+            let dir = direction(axis, sign, tilt);
+            let (length, there) = self.placed_along(p, dir)?;
+            let odd = match rays.cast_within(p, dir, length) {
+                Cast::OnSurface => return Some(Location::OnSurface),
+                Cast::Doubtful => continue,
+                Cast::Crossed(odd) => odd.len(),
+            };
+            // The shells the crossings flip are known where the placed point lies in none or
+            // all of them, or where none flips.
+            let shells = match (there, odd) {
+                (n, 0) => n,
+                (0, k) => k,
+                (n, k) if n == rays.shell_count() => n - k,
+                _ => return None,
+            };
+            return Some(Location::Within { shells });
+        }
+        None
+    }
+
+    /// The first point along the ray from `p` along `dir` (every half cell) in a placed cell or
+    /// clear of the surface's box: its distance from `p`, and inside how many shells it lies.
+    fn placed_along(&self, p: [f64; 3], dir: [f64; 3]) -> Option<(f64, usize)> {
+        let step = 0.5 * self.size;
+        (1..=STEPS).find_map(|i| {
+            let length = i as f64 * step;
+            let q: [f64; 3] = std::array::from_fn(|k| p[k] + length * dir[k]);
+            let clear = (0..3).any(|k| {
+                q[k] < self.min[k] - 2.0 * MARK_PAD || q[k] > self.max[k] + 2.0 * MARK_PAD
+            });
+            if clear {
+                return Some((length, 0));
+            }
+            match self.cell_of(q).map(|c| self.state[c]) {
+                Some(s) if s >= LOCATED => Some((length, usize::from(s - LOCATED))),
+                _ => None,
+            }
+        })
     }
 
     /// Whether the cells answer for `p` without rays.
@@ -157,8 +215,8 @@ impl Cells {
 
     /// The cell along axis `k` holding coordinate `x`, clamped to the grid.
     fn axis_cell(&self, k: usize, x: f64) -> usize {
-        let c = ((x - self.min[k]) / self.size).floor();
-        if c <= 0.0 {
+        let c = (x - self.min[k]) / self.size;
+        if c < 1.0 {
             0
         } else {
             (c as usize).min(self.dims[k] - 1)
@@ -172,7 +230,8 @@ impl Cells {
         }
         let mut at = [0usize; 3];
         for k in 0..3 {
-            let c = ((p[k] - self.min[k]) / self.size).floor();
+            // Truncation is the floor at and above 0, without a call to `floor`.
+            let c = (p[k] - self.min[k]) / self.size;
             if !(c >= 0.0 && c < self.dims[k] as f64) {
                 return None;
             }

@@ -55,6 +55,8 @@ pub(super) struct RayBvh {
     boxes: Vec<[[f32; 3]; 2]>,
     /// Connected shell of each entry of the tree's corners.
     shells: Vec<u32>,
+    /// How many shells the surface has.
+    shell_count: usize,
 }
 
 /// What one ray saw.
@@ -70,6 +72,7 @@ pub(super) enum Cast {
 /// What one triangle does to one ray.
 enum Hit {
     Miss,
+    /// Behind the origin, or past the ray's length.
     Behind,
     Ahead,
     OnSurface,
@@ -81,6 +84,7 @@ impl RayBvh {
     pub(super) fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
         let tree = TriangleBvh::new(positions, triangles);
         let shell_of = triangle_shells(positions.len(), triangles);
+        let shell_count = shell_of.iter().max().map_or(0, |&s| s as usize + 1);
         let shells = tree.ids().iter().map(|&t| shell_of[t as usize]).collect();
         let boxes = (tree.nodes().iter())
             .map(|node| {
@@ -92,6 +96,7 @@ impl RayBvh {
             tree,
             boxes,
             shells,
+            shell_count,
         }
     }
 
@@ -100,14 +105,25 @@ impl RayBvh {
         &self.tree
     }
 
+    /// How many connected shells the surface has.
+    pub(super) fn shell_count(&self) -> usize {
+        self.shell_count
+    }
+
+    /// The axis and sign of the side of the surface's box nearest to `p`, where rays from `p`
+    /// leave it soonest; `None` for a surface without triangles.
+    pub(super) fn nearest_side(&self, p: [f64; 3]) -> Option<(usize, f64)> {
+        let root = self.tree.nodes().first()?;
+        Some(nearest_side(&padded(root), p))
+    }
+
     /// Where `p` lies: inside how many shells, by the majority of three rays (two that agree
     /// suffice), each shell counted by its own parity. Rays leave along the axis whose side of
     /// the surface's box is nearest, so they cross little of the tree.
     pub(super) fn locate(&self, p: [f64; 3]) -> Location {
-        let Some(root) = self.tree.nodes().first() else {
+        let Some((axis, sign)) = self.nearest_side(p) else {
             return Location::Within { shells: 0 };
         };
-        let (axis, sign) = nearest_side(&padded(root), p);
         let mut clean: Vec<Vec<u32>> = Vec::with_capacity(3);
         for tilt in TILTS {
             match self.cast(p, direction(axis, sign, tilt)) {
@@ -134,7 +150,14 @@ impl RayBvh {
 
     /// Casts one ray from `origin` along the unit vector `dir`.
     pub(super) fn cast(&self, origin: [f64; 3], dir: [f64; 3]) -> Cast {
-        let ray = Ray::new(origin, dir);
+        self.cast_within(origin, dir, f64::INFINITY)
+    }
+
+    /// Casts one ray from `origin` along the unit vector `dir`, counting the crossings up to
+    /// `length` (mm) from the origin: the end must lie away from the surface, where no
+    /// triangle's crossing is too close to `length` to tell.
+    pub(super) fn cast_within(&self, origin: [f64; 3], dir: [f64; 3], length: f64) -> Cast {
+        let ray = Ray::new(origin, dir, length);
         let mut odd: Vec<u32> = Vec::new();
         let mut stack = [0u32; STACK_DEPTH];
         let mut top = 0usize;
@@ -181,6 +204,8 @@ impl RayBvh {
 struct Ray {
     origin: [f64; 3],
     inverse: [f64; 3],
+    /// Crossings at or beyond this distance along the ray do not count.
+    length: f64,
     /// Axes that become x', y' and z'.
     kx: usize,
     ky: usize,
@@ -192,7 +217,7 @@ struct Ray {
 }
 
 impl Ray {
-    fn new(origin: [f64; 3], dir: [f64; 3]) -> Self {
+    fn new(origin: [f64; 3], dir: [f64; 3], length: f64) -> Self {
         let kz = (0..3)
             .max_by(|&a, &b| dir[a].abs().total_cmp(&dir[b].abs()))
             .unwrap_or(2);
@@ -204,6 +229,7 @@ impl Ray {
         Self {
             origin,
             inverse: dir.map(|d| 1.0 / d),
+            length,
             kx,
             ky,
             kz,
@@ -217,7 +243,7 @@ impl Ray {
     /// the node's box.
     #[inline]
     fn enters(&self, &[min, max]: &[[f32; 3]; 2]) -> bool {
-        let (mut near, mut far) = (-ON_SURFACE, f64::INFINITY);
+        let (mut near, mut far) = (-ON_SURFACE, self.length);
         for k in 0..3 {
             let a = (f64::from(min[k]) - self.origin[k]) * self.inverse[k];
             let b = (f64::from(max[k]) - self.origin[k]) * self.inverse[k];
@@ -260,7 +286,7 @@ impl Ray {
         let t = (u * a[2] + v * b[2] + w * c[2]) / det;
         if t.abs() <= ON_SURFACE {
             Hit::OnSurface
-        } else if t < 0.0 {
+        } else if t < 0.0 || t >= self.length {
             Hit::Behind
         } else if u == 0.0 || v == 0.0 || w == 0.0 {
             Hit::Doubtful

@@ -477,3 +477,58 @@ fn cells_place_points_as_the_rays_do_in_material_cavity_and_a_notch() {
         "{placed:?}"
     );
 }
+
+#[test]
+fn a_short_ray_to_a_placed_cell_tells_what_the_rays_out_of_the_box_tell() {
+    // The block with a cavity and a notch, and points near its faces but off the voxel grid,
+    // where the cells leave them to rays: in the material, the cavity and outside.
+    let voxels = grid(30, |x, y, z| {
+        let block = [x, y, z].iter().all(|&c| (2..28).contains(&c));
+        let cavity = [x, y, z].iter().all(|&c| (9..21).contains(&c));
+        let notch = x >= 22 && y >= 22;
+        u8::from(block && !cavity && !notch)
+    });
+    let mesh = voxel_surface(&voxels, 1);
+    let rays = RayBvh::new(&mesh.positions, &mesh.triangles);
+    assert_eq!(rays.shell_count(), 2);
+    let bounds = Box3::of(&mesh.positions).unwrap();
+    let cells = super::cells::Cells::new(
+        &mesh.positions,
+        &mesh.triangles,
+        bounds.min,
+        bounds.max,
+        &rays,
+    );
+    let mut told = [0usize; 3];
+    let mut left = 0;
+    let steps = (0..=120).map(|i| f64::from(i) * 0.25 + 0.0173);
+    for x in steps.clone() {
+        for y in steps.clone() {
+            for z in steps.clone() {
+                let p = [x, y + 0.0311, z - 0.0057];
+                if cells.placed(p) {
+                    continue;
+                }
+                let by_rays = rays.locate(p);
+                match cells.short_ray(p, &rays) {
+                    Some(short) => {
+                        assert_eq!(short, by_rays, "at {p:?}");
+                        if let Location::Within { shells } = short {
+                            told[shells] += 1;
+                        }
+                    }
+                    None => left += 1,
+                }
+                assert_eq!(cells.locate(p, &rays), by_rays, "at {p:?}");
+            }
+        }
+    }
+    // Near the outer faces, the notch and the cavity's faces, the short rays told most. Rays
+    // from the cavity head out through the wall to cells within one shell of the two, where
+    // which one they crossed is not known: the rays out of the box tell those.
+    assert!(told[0] > 1000 && told[1] > 1000, "{told:?}, {left} left");
+    assert!(
+        left * 10 < told.iter().sum::<usize>(),
+        "{told:?}, {left} left"
+    );
+}
