@@ -25,9 +25,9 @@ const EDGES_PER_CELL: f64 = 2.0;
 /// A triangle marks every cell within this of its box (mm, plus a fraction of the
 /// coordinates), more than [`ON_SURFACE`]: no point of an unmarked cell is on the surface.
 const MARK_PAD: f64 = 1e-4;
-/// A short ray looks for a placed cell every half cell along it, this many times, before the
-/// point is left to the rays out of the box.
-const STEPS: usize = 8;
+/// A short ray looks for a placed cell every half cell along it, this many times, before
+/// another direction is tried: rays that stay short cross few of the tree's nodes.
+const STEPS: usize = 4;
 
 /// A cell a triangle touches (or one whose region the rays could not place): its points get
 /// rays.
@@ -159,16 +159,21 @@ impl Cells {
         }
     }
 
-    /// Where `p` lies by a short ray to the first placed point along it; `None` where it
-    /// cannot tell (no placed point near, or crossings that leave open which shells of the
-    /// placed point's count they changed). One ray is enough where [`RayBvh::locate`] wants two
+    /// Where `p` lies by a short ray to the first placed point along it, towards the nearest
+    /// side of the surface's box first, then the other five; `None` where none can tell (no
+    /// placed point near, or crossings that leave open which shells of the placed point's
+    /// count they changed). One ray is enough where [`RayBvh::locate`] wants two
     /// that agree: its end's location is the region's, which had those votes, and the rays'
     /// test counts every crossing of a closed shell exactly once or doubts it.
     pub(super) fn short_ray(&self, p: [f64; 3], rays: &RayBvh) -> Option<Location> {
-        let (axis, sign) = rays.nearest_side(p)?;
-        for tilt in TILTS {
+        let nearest = rays.nearest_side(p)?;
+        let others = (0..6).map(|s| (s / 2, if s % 2 == 0 { -1.0 } else { 1.0 }));
+        let sides = std::iter::once(nearest).chain(others.filter(|&s| s != nearest));
+        for ((axis, sign), tilt) in sides.zip(TILTS) {
             let dir = direction(axis, sign, tilt);
-            let (length, there) = self.placed_along(p, dir)?;
+            let Some((length, there)) = self.placed_along(p, dir) else {
+                continue;
+            };
             let odd = match rays.cast_within(p, dir, length) {
                 Cast::OnSurface => return Some(Location::OnSurface),
                 Cast::Doubtful => continue,
@@ -180,7 +185,7 @@ impl Cells {
                 (n, 0) => n,
                 (0, k) => k,
                 (n, k) if n == rays.shell_count() => n - k,
-                _ => return None,
+                _ => continue,
             };
             return Some(Location::Within { shells });
         }

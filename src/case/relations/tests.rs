@@ -523,12 +523,12 @@ fn a_short_ray_to_a_placed_cell_tells_what_the_rays_out_of_the_box_tell() {
             }
         }
     }
-    // Near the outer faces, the notch and the cavity's faces, the short rays told most. Rays
-    // from the cavity head out through the wall to cells within one shell of the two, where
-    // which one they crossed is not known: the rays out of the box tell those.
-    assert!(told[0] > 1000 && told[1] > 1000, "{told:?}, {left} left");
+    // Near the outer faces, the notch and the cavity's faces, the short rays told most: a ray
+    // from the cavity that ends in the wall, within one of the two shells, cannot tell which
+    // it crossed, and another direction is tried.
+    assert!(told.iter().all(|&n| n > 10_000), "{told:?}, {left} left");
     assert!(
-        left * 10 < told.iter().sum::<usize>(),
+        left * 50 < told.iter().sum::<usize>(),
         "{told:?}, {left} left"
     );
 }
