@@ -353,20 +353,24 @@ impl<'a> Runner<'a> {
     /// millions of vertices is never held twice.
     fn run(&self, job: SuggestJob) {
         let i = job.structure;
-        let mut s = self.shared().case.structures[i].clone();
+        // Copied only when it will be searched: a job handed out after a cancel finishes at once.
         let outcome = match self.cancelled.load(Ordering::Relaxed) {
             true => Ok(None),
-            false => suggest_structure(&mut s, self.options, &job.starts, &mut |_| {
-                self.evaluations.fetch_add(1, Ordering::Relaxed);
-                self.tell(false)
-            }),
+            false => {
+                let mut s = self.shared().case.structures[i].clone();
+                let found = suggest_structure(&mut s, self.options, &job.starts, &mut |_| {
+                    self.evaluations.fetch_add(1, Ordering::Relaxed);
+                    self.tell(false)
+                });
+                found.map(|f| f.map(|suggestion| (suggestion, s)))
+            }
         };
         if matches!(outcome, Ok(Some(_))) {
             self.tell(true);
         }
         let mut shared = self.shared();
         match outcome {
-            Ok(Some(suggestion)) => {
+            Ok(Some((suggestion, s))) => {
                 shared.plan.finish(i, Some(suggestion.params));
                 shared.case.structures[i] = s;
                 shared.suggestions[i] = Some(suggestion);

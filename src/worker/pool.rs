@@ -266,16 +266,14 @@ impl Pool {
     /// Queues opening `input` as a model named `name`, ahead of every other job. It supersedes
     /// an opening still waiting or under way (whose answer is then dropped).
     pub fn load(&mut self, name: &str, input: Input) -> LoadJob {
-        if let Some((old, _)) = self.load.take() {
-            self.load_stages.remove(&old);
-        }
-        let superseded: Vec<u64> = (self.in_flight.iter())
+        // Every opening waiting or in flight is superseded.
+        let waiting = self.load.as_ref().map(|(job, _)| *job);
+        let in_flight = (self.in_flight.iter())
             .filter(|(_, f)| matches!(f, Flight::Load))
-            .map(|(job, _)| *job)
-            .collect();
+            .map(|(job, _)| *job);
+        let superseded: Vec<u64> = waiting.into_iter().chain(in_flight).collect();
         for job in superseded {
-            self.in_flight.remove(&job);
-            self.load_stages.remove(&job);
+            self.forget_load(LoadJob(job));
         }
         self.loaded.clear();
         let job = self.new_job();
