@@ -3,7 +3,9 @@
 
 use serde_json::{json, Value};
 
-use super::relations::{marks, relations, PairRelation, RelationChanges, Surface};
+use super::relations::{
+    marks, relations, relations_refitting, PairRelation, RelationChanges, Surface, TreeShapes,
+};
 use super::Case;
 
 /// The relations of every pair of structures that come near each other: of the originals, or
@@ -11,6 +13,13 @@ use super::Case;
 /// segmentation cannot place its boundary closer than that), a surface mesh none.
 pub fn check(case: &Case, shown: bool) -> Vec<PairRelation> {
     relations(&surfaces(case, shown), &tolerances(case))
+}
+
+/// [`check`], refitting the trees of the check before it (kept in `trees`) where the
+/// structures have the same triangles, and keeping this check's: the checks as opened and as
+/// shown differ in positions only.
+pub fn check_refitting(case: &Case, shown: bool, trees: &mut TreeShapes) -> Vec<PairRelation> {
+    relations_refitting(&surfaces(case, shown), &tolerances(case), trees)
 }
 
 /// The vertices of each structure's surface as shown that make the warnings of `changed`

@@ -22,7 +22,7 @@ mod suggest_all;
 mod voxel_grid;
 pub mod xapi;
 
-pub use checks::{check, check_marks, checks_json, checks_text};
+pub use checks::{check, check_marks, check_refitting, checks_json, checks_text};
 pub use clip::{Clip, ClipAxis, Planes};
 pub use folder::{
     folder_order, read_in_folder, EntryKind, FolderListing, FOLDER_DEPTH, FOLDER_ENTRIES,

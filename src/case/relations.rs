@@ -22,7 +22,7 @@ use rayon::prelude::*;
 
 use crate::mesh::{to_f64, Mesh};
 use cells::Cells;
-use rays::{Location, RayBvh};
+use rays::{Location, RayBvh, RayShape};
 
 /// What one pair of structures does, in one state (original or smoothed).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +72,25 @@ pub fn relations<'a, S: Into<Surface<'a>> + Copy>(
     meshes: &[S],
     tolerance: &[f64],
 ) -> Vec<PairRelation> {
+    relations_refitting(meshes, tolerance, &mut TreeShapes::default())
+}
+
+/// The splits of the trees [`relations_refitting`] built over each structure's triangles.
+/// Smoothing moves a structure's vertices, not its triangles: the next check of the same
+/// triangles refits these trees to the new positions instead of building them anew.
+#[derive(Clone, Debug, Default)]
+pub struct TreeShapes(Vec<Option<RayShape>>);
+
+/// [`relations`], refitting the trees of `shapes` where a structure has the triangles they
+/// were built over (building the others), and leaving this check's in `shapes`.
+///
+/// # Panics
+/// When `tolerance` and `meshes` differ in length.
+pub fn relations_refitting<'a, S: Into<Surface<'a>> + Copy>(
+    meshes: &[S],
+    tolerance: &[f64],
+    shapes: &mut TreeShapes,
+) -> Vec<PairRelation> {
     assert_eq!(meshes.len(), tolerance.len(), "one tolerance per structure");
     let meshes: Vec<Surface> = meshes.iter().map(|&m| m.into()).collect();
     let boxes: Vec<Option<Box3>> = meshes.iter().map(|m| Box3::of(m.positions)).collect();
@@ -95,14 +114,21 @@ pub fn relations<'a, S: Into<Surface<'a>> + Copy>(
         used[a] = true;
         used[b] = true;
     }
-    let solids: Vec<Option<Solid>> = meshes
-        .par_iter()
+    let before = std::mem::take(&mut shapes.0);
+    let solids: Vec<Option<Solid>> = (meshes.par_iter().enumerate())
         .zip(&boxes)
         .zip(&used)
-        .map(|((mesh, bounds), &used)| match bounds {
-            Some(bounds) if used => Some(Solid::new(mesh, *bounds)),
+        .map(|(((i, mesh), bounds), &used)| match bounds {
+            Some(bounds) if used => {
+                let shape = before.get(i).and_then(Option::as_ref);
+                Some(Solid::new(mesh, *bounds, shape))
+            }
             _ => None,
         })
+        .collect();
+    drop(before);
+    shapes.0 = (solids.iter())
+        .map(|s| s.as_ref().map(|s| s.rays.shape()))
         .collect();
     pairs
         .par_iter()
@@ -204,7 +230,7 @@ pub fn marks<'a, S: Into<Surface<'a>> + Copy>(
     let mut solids: HashMap<usize, Solid> = HashMap::new();
     for &(_, other, _) in &asks {
         if let (None, Some(bounds)) = (solids.get(&other), Box3::of(meshes[other].positions)) {
-            solids.insert(other, Solid::new(&meshes[other], bounds));
+            solids.insert(other, Solid::new(&meshes[other], bounds, None));
         }
     }
     let mut out = vec![Vec::new(); meshes.len()];
@@ -317,9 +343,11 @@ struct Solid {
 }
 
 impl Solid {
-    fn new(mesh: &Surface, bounds: Box3) -> Self {
+    /// The structure's solid, its rays' tree refitted from `shape` where it fits.
+    fn new(mesh: &Surface, bounds: Box3, shape: Option<&RayShape>) -> Self {
         let (p, t) = (mesh.positions, mesh.triangles);
-        let rays = RayBvh::new(p, t);
+        let refitted = shape.and_then(|s| RayBvh::refitted(s, p, t));
+        let rays = refitted.unwrap_or_else(|| RayBvh::new(p, t));
         Self {
             bounds,
             cells: Cells::new(p, t, bounds.min, bounds.max, &rays),

@@ -232,7 +232,9 @@ pub(super) fn build_case(
     author(&mut case, options)?;
     let opened = started.elapsed().as_secs_f64();
     let checks_started = Instant::now();
-    let before = case::check(&case, false);
+    // The trees of the checks as opened, refitted by the checks as shown.
+    let mut trees = case::relations::TreeShapes::default();
+    let before = case::check_refitting(&case, false, &mut trees);
     let mut checks_seconds = checks_started.elapsed().as_secs_f64();
 
     let suggest_options = SuggestAllOptions {
@@ -245,7 +247,8 @@ pub(super) fn build_case(
     let suggestions = suggest_all_shown(&mut case, &suggest_options)?;
     let suggest_seconds = suggest_started.elapsed().as_secs_f64();
     let checks_started = Instant::now();
-    let after = case::check(&case, true);
+    let after = case::check_refitting(&case, true, &mut trees);
+    drop(trees);
     checks_seconds += checks_started.elapsed().as_secs_f64();
     let changes = case::relations::changes(&before, &after);
 

@@ -60,6 +60,14 @@ fn build_tree(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> (Vec<Node>, Vec
     (nodes, items.iter().map(|item| item.id).collect())
 }
 
+/// A tree's node links (first, count) and leaf order, without its boxes: what a tree over the
+/// same triangles at other positions keeps ([`TriangleBvh::refitted`]).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct TreeShape {
+    links: Vec<[u32; 2]>,
+    ids: Vec<u32>,
+}
+
 /// A triangle while the tree is built.
 struct Item {
     id: u32,
@@ -89,6 +97,71 @@ impl TriangleBvh {
     pub fn new(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Self {
         let (nodes, ids) = build_tree(positions, triangles);
         Self::from_tree(positions, triangles, nodes, ids)
+    }
+
+    /// The node links and leaf order of this tree, to be refitted later ([`Self::refitted`]).
+    pub(crate) fn shape(&self) -> TreeShape {
+        TreeShape {
+            links: self.nodes.iter().map(|n| [n.first, n.count]).collect(),
+            ids: self.ids.clone(),
+        }
+    }
+
+    /// The tree of `shape` over the same `triangles` at new `positions`: the splits kept, every
+    /// box worked out again from its corners. As exact as a tree built anew and cheaper to
+    /// make; its boxes overlap more the farther the vertices moved. `None` when `shape` is not
+    /// of `triangles.len()` triangles.
+    pub(crate) fn refitted(
+        shape: &TreeShape,
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Option<Self> {
+        if shape.ids.len() != triangles.len() {
+            return None;
+        }
+        let corners: Vec<[[f32; 3]; 3]> = (shape.ids.iter())
+            .map(|&t| triangles[t as usize].map(|v| positions[v as usize]))
+            .collect();
+        let mut nodes: Vec<Node> = (shape.links.iter())
+            .map(|&[first, count]| Node {
+                min: [f32::INFINITY; 3],
+                max: [f32::NEG_INFINITY; 3],
+                first,
+                count,
+            })
+            .collect();
+        // Children come after their parent: from the last node back, a node's children have
+        // their boxes when it takes the union.
+        for i in (0..nodes.len()).rev() {
+            let Node { first, count, .. } = nodes[i];
+            let (first, count) = (first as usize, count as usize);
+            let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+            let mut grow = |p: [f32; 3]| {
+                for k in 0..3 {
+                    min[k] = min[k].min(p[k]);
+                    max[k] = max[k].max(p[k]);
+                }
+            };
+            if count > 0 {
+                corners
+                    .get(first..first + count)?
+                    .iter()
+                    .flatten()
+                    .for_each(|&p| grow(p));
+            } else {
+                for child in nodes.get(first..first + 2)? {
+                    grow(child.min);
+                    grow(child.max);
+                }
+            }
+            nodes[i].min = min;
+            nodes[i].max = max;
+        }
+        Some(Self {
+            nodes,
+            corners,
+            ids: shape.ids.clone(),
+        })
     }
 
     fn from_tree(
@@ -368,6 +441,12 @@ mod tests {
             triangles.push([b, c, d]);
         }
         let bvh = TriangleBvh::new(&positions, &triangles);
+        // The same triangles with their vertices moved, on the first tree's splits.
+        let moved: Vec<[f32; 3]> = (positions.iter().enumerate())
+            .map(|(i, p)| [p[0], p[1] + 0.3 * (i as f32).sin(), p[2] - 0.2 * p[0].cos()])
+            .collect();
+        let refitted = TriangleBvh::refitted(&bvh.shape(), &moved, &triangles).expect("fits");
+        assert!(TriangleBvh::refitted(&bvh.shape(), &moved, &triangles[1..]).is_none());
         for k in 0..200 {
             let f = k as f64;
             let p = [
@@ -385,6 +464,15 @@ mod tests {
                 .sqrt();
             let got = bvh.closest(p).expect("non-empty");
             assert_eq!(got.distance, brute, "point {p:?}");
+            let moved_brute = triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| to_f64(moved[v as usize]));
+                    point_triangle_distance2(p, a, b, c)
+                })
+                .fold(f64::INFINITY, f64::min)
+                .sqrt();
+            assert_eq!(refitted.distance(p), Some(moved_brute), "point {p:?}");
             let [a, b, c] = triangles[got.triangle as usize].map(|v| to_f64(positions[v as usize]));
             assert_eq!(point_triangle_distance2(p, a, b, c).sqrt(), brute);
         }

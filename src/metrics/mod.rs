@@ -22,8 +22,8 @@ mod wide;
 
 pub use curvature::{vertex_curvatures, VertexCurvature};
 pub use drift::{identity, smooth_drifting, DriftState, DriftingReference};
-pub(crate) use exact_distance::Node as TreeNode;
 pub use exact_distance::{point_segment_distance2, point_triangle_distance2, Closest, TriangleBvh};
+pub(crate) use exact_distance::{Node as TreeNode, TreeShape};
 pub use original::Original;
 pub use report::{
     as_json_text, exact_distances, exact_error, measure, measure_shape, measure_vertices,

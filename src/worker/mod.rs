@@ -415,8 +415,9 @@ fn suggest_structure(
 /// The checks between a case's structures, as the CLI's `case build` reports them.
 fn check_case(job: u64, case: &Case, clock: &dyn Fn() -> f64) -> Reply {
     let start = clock();
-    let before = case::check(case, false);
-    let after = case::check(case, true);
+    let mut trees = case::relations::TreeShapes::default();
+    let before = case::check_refitting(case, false, &mut trees);
+    let after = case::check_refitting(case, true, &mut trees);
     let changes = case::relations::changes(&before, &after);
     let mut report = case::checks_json(case, &after, &changes);
     report["text"] = case::checks_text(case, &before, &after, &changes).into();

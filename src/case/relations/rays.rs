@@ -9,7 +9,7 @@
 //! edge signs are too close to call (it grazes an edge or a vertex) is thrown away and another
 //! one cast; a ray that meets the surface at its start means the point is on the surface.
 
-use crate::metrics::{TreeNode, TriangleBvh};
+use crate::metrics::{TreeNode, TreeShape, TriangleBvh};
 
 /// Deeper than any median-split tree over `u32` triangle counts can grow.
 const STACK_DEPTH: usize = 64;
@@ -59,6 +59,15 @@ pub(super) struct RayBvh {
     shell_count: usize,
 }
 
+/// A [`RayBvh`] without its positions: its tree's splits and each entry's shell, which depend
+/// on the triangles only.
+#[derive(Clone, Debug, Default)]
+pub(super) struct RayShape {
+    tree: TreeShape,
+    shells: Vec<u32>,
+    shell_count: usize,
+}
+
 /// What one ray saw.
 #[derive(Debug, PartialEq, Eq)]
 pub(super) enum Cast {
@@ -86,6 +95,35 @@ impl RayBvh {
         let shell_of = triangle_shells(positions.len(), triangles);
         let shell_count = shell_of.iter().max().map_or(0, |&s| s as usize + 1);
         let shells = tree.ids().iter().map(|&t| shell_of[t as usize]).collect();
+        Self::with_boxes(tree, shells, shell_count)
+    }
+
+    /// The tree of `shape` ([`Self::shape`] of a tree over the same triangles) at new
+    /// `positions`, refitted ([`TriangleBvh::refitted`]); `None` when `shape` is not of
+    /// `triangles.len()` triangles.
+    pub(super) fn refitted(
+        shape: &RayShape,
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Option<Self> {
+        let tree = TriangleBvh::refitted(&shape.tree, positions, triangles)?;
+        Some(Self::with_boxes(
+            tree,
+            shape.shells.clone(),
+            shape.shell_count,
+        ))
+    }
+
+    /// What a tree over the same triangles at other positions keeps of this one.
+    pub(super) fn shape(&self) -> RayShape {
+        RayShape {
+            tree: self.tree.shape(),
+            shells: self.shells.clone(),
+            shell_count: self.shell_count,
+        }
+    }
+
+    fn with_boxes(tree: TriangleBvh, shells: Vec<u32>, shell_count: usize) -> Self {
         let boxes = (tree.nodes().iter())
             .map(|node| {
                 let (min, max) = padded(node);

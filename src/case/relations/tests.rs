@@ -532,3 +532,34 @@ fn a_short_ray_to_a_placed_cell_tells_what_the_rays_out_of_the_box_tell() {
         "{told:?}, {left} left"
     );
 }
+
+#[test]
+fn trees_refitted_to_moved_vertices_tell_what_trees_built_anew_tell() {
+    // Two neighbouring voxel blocks sharing faces, a hollow one around a third, as opened;
+    // then each pushed out from its centre, as smoothing moves vertices and keeps triangles.
+    let voxels = grid(16, |x, y, z| {
+        let inner = [x, y, z].iter().all(|&c| (6..10).contains(&c));
+        let shell = [x, y, z].iter().all(|&c| (3..13).contains(&c));
+        match (inner, shell, x < 8) {
+            (true, _, _) => 3,
+            (false, true, true) => 1,
+            (false, true, false) => 2,
+            _ => 0,
+        }
+    });
+    let opened: Vec<Mesh> = (1..=3).map(|l| voxel_surface(&voxels, l)).collect();
+    let moved: Vec<Mesh> = opened.iter().map(|m| push_out(m, 0.3)).collect();
+    let tol = [0.5; 3];
+    let mut shapes = TreeShapes::default();
+    let before = relations_refitting(&opened.iter().collect::<Vec<_>>(), &tol, &mut shapes);
+    assert_eq!(before, relations(&opened.iter().collect::<Vec<_>>(), &tol));
+    let after = relations_refitting(&moved.iter().collect::<Vec<_>>(), &tol, &mut shapes);
+    assert_eq!(after, relations(&moved.iter().collect::<Vec<_>>(), &tol));
+    assert!(after.iter().any(|r| r.crosses), "{after:?}");
+    // Shapes of other triangles are not refitted: the trees are built anew.
+    let swapped = [&moved[2], &moved[0], &moved[1]];
+    assert_eq!(
+        relations_refitting(&swapped, &tol, &mut shapes),
+        relations(&swapped, &tol)
+    );
+}
