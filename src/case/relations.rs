@@ -114,23 +114,19 @@ pub fn relations_refitting<'a, S: Into<Surface<'a>> + Copy>(
         used[a] = true;
         used[b] = true;
     }
-    let before = std::mem::take(&mut shapes.0);
-    let solids: Vec<Option<Solid>> = (meshes.par_iter().enumerate())
+    // Each kept shape is moved into its refitted tree, and each tree's back into `shapes`
+    // once the pairs are measured: no copy of either is held beside the trees.
+    let mut before = std::mem::take(&mut shapes.0);
+    before.resize_with(meshes.len(), || None);
+    let solids: Vec<Option<Solid>> = (meshes.par_iter().zip(before))
         .zip(&boxes)
         .zip(&used)
-        .map(|(((i, mesh), bounds), &used)| match bounds {
-            Some(bounds) if used => {
-                let shape = before.get(i).and_then(Option::as_ref);
-                Some(Solid::new(mesh, *bounds, shape))
-            }
+        .map(|(((mesh, shape), bounds), &used)| match bounds {
+            Some(bounds) if used => Some(Solid::new(mesh, *bounds, shape)),
             _ => None,
         })
         .collect();
-    drop(before);
-    shapes.0 = (solids.iter())
-        .map(|s| s.as_ref().map(|s| s.rays.shape()))
-        .collect();
-    pairs
+    let relations = pairs
         .par_iter()
         .filter_map(|&(a, b, tol)| {
             let (sa, sb) = (solids[a].as_ref()?, solids[b].as_ref()?);
@@ -152,7 +148,11 @@ pub fn relations_refitting<'a, S: Into<Surface<'a>> + Copy>(
                 crosses: overlap_depth > tol.crossing,
             })
         })
-        .collect()
+        .collect();
+    shapes.0 = (solids.into_iter())
+        .map(|s| s.map(|s| s.rays.into_shape()))
+        .collect();
+    relations
 }
 
 /// What changed from `before` to `after` (both from [`relations`] over the same structures).
@@ -344,7 +344,7 @@ struct Solid {
 
 impl Solid {
     /// The structure's solid, its rays' tree refitted from `shape` where it fits.
-    fn new(mesh: &Surface, bounds: Box3, shape: Option<&RayShape>) -> Self {
+    fn new(mesh: &Surface, bounds: Box3, shape: Option<RayShape>) -> Self {
         let (p, t) = (mesh.positions, mesh.triangles);
         let refitted = shape.and_then(|s| RayBvh::refitted(s, p, t));
         let rays = refitted.unwrap_or_else(|| RayBvh::new(p, t));

@@ -99,11 +99,12 @@ impl TriangleBvh {
         Self::from_tree(positions, triangles, nodes, ids)
     }
 
-    /// The node links and leaf order of this tree, to be refitted later ([`Self::refitted`]).
-    pub(crate) fn shape(&self) -> TreeShape {
+    /// The node links and leaf order of this tree, to be refitted later ([`Self::refitted`]);
+    /// the rest is dropped.
+    pub(crate) fn into_shape(self) -> TreeShape {
         TreeShape {
             links: self.nodes.iter().map(|n| [n.first, n.count]).collect(),
-            ids: self.ids.clone(),
+            ids: self.ids,
         }
     }
 
@@ -112,7 +113,7 @@ impl TriangleBvh {
     /// make; its boxes overlap more the farther the vertices moved. `None` when `shape` is not
     /// of `triangles.len()` triangles.
     pub(crate) fn refitted(
-        shape: &TreeShape,
+        shape: TreeShape,
         positions: &[[f32; 3]],
         triangles: &[[u32; 3]],
     ) -> Option<Self> {
@@ -160,7 +161,7 @@ impl TriangleBvh {
         Some(Self {
             nodes,
             corners,
-            ids: shape.ids.clone(),
+            ids: shape.ids,
         })
     }
 
@@ -395,6 +396,17 @@ pub fn point_triangle_distance2(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 
 mod tests {
     use super::*;
 
+    /// The distance from `p` to the nearest of `triangles`, each measured.
+    fn brute_distance(p: [f64; 3], positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> f64 {
+        (triangles.iter())
+            .map(|t| {
+                let [a, b, c] = t.map(|v| to_f64(positions[v as usize]));
+                point_triangle_distance2(p, a, b, c)
+            })
+            .fold(f64::INFINITY, f64::min)
+            .sqrt()
+    }
+
     #[test]
     fn triangle_regions() {
         let (a, b, c) = ([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
@@ -445,8 +457,9 @@ mod tests {
         let moved: Vec<[f32; 3]> = (positions.iter().enumerate())
             .map(|(i, p)| [p[0], p[1] + 0.3 * (i as f32).sin(), p[2] - 0.2 * p[0].cos()])
             .collect();
-        let refitted = TriangleBvh::refitted(&bvh.shape(), &moved, &triangles).expect("fits");
-        assert!(TriangleBvh::refitted(&bvh.shape(), &moved, &triangles[1..]).is_none());
+        let shape = || bvh.clone().into_shape();
+        let refitted = TriangleBvh::refitted(shape(), &moved, &triangles).expect("fits");
+        assert!(TriangleBvh::refitted(shape(), &moved, &triangles[1..]).is_none());
         for k in 0..200 {
             let f = k as f64;
             let p = [
@@ -454,24 +467,10 @@ mod tests {
                 (f * 0.61) % 3.0 - 1.0,
                 (f * 0.23) % 4.0 - 2.0,
             ];
-            let brute = triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|v| to_f64(positions[v as usize]));
-                    point_triangle_distance2(p, a, b, c)
-                })
-                .fold(f64::INFINITY, f64::min)
-                .sqrt();
+            let brute = brute_distance(p, &positions, &triangles);
             let got = bvh.closest(p).expect("non-empty");
             assert_eq!(got.distance, brute, "point {p:?}");
-            let moved_brute = triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|v| to_f64(moved[v as usize]));
-                    point_triangle_distance2(p, a, b, c)
-                })
-                .fold(f64::INFINITY, f64::min)
-                .sqrt();
+            let moved_brute = brute_distance(p, &moved, &triangles);
             assert_eq!(refitted.distance(p), Some(moved_brute), "point {p:?}");
             let [a, b, c] = triangles[got.triangle as usize].map(|v| to_f64(positions[v as usize]));
             assert_eq!(point_triangle_distance2(p, a, b, c).sqrt(), brute);

@@ -102,23 +102,20 @@ impl RayBvh {
     /// `positions`, refitted ([`TriangleBvh::refitted`]); `None` when `shape` is not of
     /// `triangles.len()` triangles.
     pub(super) fn refitted(
-        shape: &RayShape,
+        shape: RayShape,
         positions: &[[f32; 3]],
         triangles: &[[u32; 3]],
     ) -> Option<Self> {
-        let tree = TriangleBvh::refitted(&shape.tree, positions, triangles)?;
-        Some(Self::with_boxes(
-            tree,
-            shape.shells.clone(),
-            shape.shell_count,
-        ))
+        let tree = TriangleBvh::refitted(shape.tree, positions, triangles)?;
+        Some(Self::with_boxes(tree, shape.shells, shape.shell_count))
     }
 
-    /// What a tree over the same triangles at other positions keeps of this one.
-    pub(super) fn shape(&self) -> RayShape {
+    /// What a tree over the same triangles at other positions keeps of this one; the rest
+    /// is dropped.
+    pub(super) fn into_shape(self) -> RayShape {
         RayShape {
-            tree: self.tree.shape(),
-            shells: self.shells.clone(),
+            tree: self.tree.into_shape(),
+            shells: self.shells,
             shell_count: self.shell_count,
         }
     }
