@@ -436,9 +436,9 @@ fn marks_are_the_vertices_that_left_or_reach_too_deep() {
     assert_eq!(marked, vec![Vec::<u32>::new(); 2]);
 }
 
-#[test]
-fn cells_place_points_as_the_rays_do_in_material_cavity_and_a_notch() {
-    // A block with a cavity and a notch down one edge: the notch is outside but in the box.
+/// A block with a cavity and a notch down one edge (outside, but in its box): the rays and
+/// cells of its surface.
+fn notched_block() -> (RayBvh, super::cells::Cells) {
     let voxels = grid(30, |x, y, z| {
         let block = [x, y, z].iter().all(|&c| (2..28).contains(&c));
         let cavity = [x, y, z].iter().all(|&c| (9..21).contains(&c));
@@ -455,6 +455,12 @@ fn cells_place_points_as_the_rays_do_in_material_cavity_and_a_notch() {
         bounds.max,
         &rays,
     );
+    (rays, cells)
+}
+
+#[test]
+fn cells_place_points_as_the_rays_do_in_material_cavity_and_a_notch() {
+    let (rays, cells) = notched_block();
     // Every half voxel: on faces, edges and corners of the staircase as well as between.
     let mut placed = [0usize; 3];
     let steps = (-2..=62).map(|i| f64::from(i) * 0.5);
@@ -482,23 +488,8 @@ fn cells_place_points_as_the_rays_do_in_material_cavity_and_a_notch() {
 fn a_short_ray_to_a_placed_cell_tells_what_the_rays_out_of_the_box_tell() {
     // The block with a cavity and a notch, and points near its faces but off the voxel grid,
     // where the cells leave them to rays: in the material, the cavity and outside.
-    let voxels = grid(30, |x, y, z| {
-        let block = [x, y, z].iter().all(|&c| (2..28).contains(&c));
-        let cavity = [x, y, z].iter().all(|&c| (9..21).contains(&c));
-        let notch = x >= 22 && y >= 22;
-        u8::from(block && !cavity && !notch)
-    });
-    let mesh = voxel_surface(&voxels, 1);
-    let rays = RayBvh::new(&mesh.positions, &mesh.triangles);
+    let (rays, cells) = notched_block();
     assert_eq!(rays.shell_count(), 2);
-    let bounds = Box3::of(&mesh.positions).unwrap();
-    let cells = super::cells::Cells::new(
-        &mesh.positions,
-        &mesh.triangles,
-        bounds.min,
-        bounds.max,
-        &rays,
-    );
     let mut told = [0usize; 3];
     let mut left = 0;
     let steps = (0..=120).map(|i| f64::from(i) * 0.25 + 0.0173);
