@@ -271,7 +271,10 @@ fn fixed_angle(radians: f32) -> i32 {
 fn angle(x: f32, y: f32) -> f32 {
     use std::f32::consts::FRAC_PI_2;
     let ax = x.abs();
-    let (lo, hi) = (ax.min(y), ax.max(y));
+    // `ax.min(y)` and `ax.max(y)` as selects, NaNs included: wasm has no instruction for
+    // Rust's `f32::min` and calls a function, which keeps this loop from running as vectors.
+    let lo = if y < ax || ax.is_nan() { y } else { ax };
+    let hi = if y > ax || ax.is_nan() { y } else { ax };
     let t = if hi > 0.0 { lo / hi } else { 0.0 };
     let a = t * atan_polynomial(t * t);
     let a = if y > ax { FRAC_PI_2 - a } else { a };

@@ -221,7 +221,13 @@ fn drift_step(original: &Original, q: [f32; 3], r: u32) -> (u32, [f32; 4]) {
         let closer = dj < best_d2;
         best = if closer { j } else { best };
         best_d2 = if closer { dj } else { best_d2 };
-        nearest_other = nearest_other.min(dj);
+        // `nearest_other.min(dj)` as a select (never NaN, so a NaN `dj` is passed over as
+        // `min` does): wasm has no instruction for Rust's `f32::min` and calls a function.
+        nearest_other = if dj < nearest_other {
+            dj
+        } else {
+            nearest_other
+        };
     }
     if best != r {
         return (best, home_anchor(original, best as usize));

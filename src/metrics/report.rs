@@ -376,7 +376,9 @@ impl Pass<'_> {
                         return;
                     }
                     s.error_sum += e;
-                    s.error_max = s.error_max.max(e);
+                    // A select, not `f64::max`, which wasm calls a function for (`error_max`
+                    // is never NaN, so a NaN `e` is passed over as `max` does).
+                    s.error_max = if e > s.error_max { e } else { s.error_max };
                     s.error_count += 1;
                     if let Some((error, _)) = out.as_mut() {
                         error[i - start] = e as f32;

@@ -58,7 +58,14 @@ impl Constrain for Limits<'_> {
         let mut p = proposed;
         if let Some(w) = self.weights {
             // Written so that a NaN weight counts as 0 (locked) instead of spreading NaN.
-            let w = if w[i] > 0.0 { w[i].min(1.0) } else { 0.0 };
+            // Selects, not `f32::min`, which wasm calls a function for.
+            let w = if w[i] > 1.0 {
+                1.0
+            } else if w[i] > 0.0 {
+                w[i]
+            } else {
+                0.0
+            };
             p = [
                 current[0] + w * (p[0] - current[0]),
                 current[1] + w * (p[1] - current[1]),
