@@ -98,7 +98,7 @@ impl RayBvh {
         Self::with_boxes(tree, shells, shell_count)
     }
 
-    /// The tree of `shape` ([`Self::shape`] of a tree over the same triangles) at new
+    /// The tree of `shape` ([`Self::into_shape`] of a tree over the same triangles) at new
     /// `positions`, refitted ([`TriangleBvh::refitted`]); `None` when `shape` is not of
     /// `triangles.len()` triangles.
     pub(super) fn refitted(
