@@ -102,9 +102,11 @@ fn advance_planned<C: Constrain>(
         Plan::TwoPass => 1,
         Plan::Sweep { runs, .. } => runs.len(),
     });
+    // The originals as the kernel reads them: one aligned four-lane load per vertex.
+    let original: Vec<[f32; 4]> = original.iter().map(|&o| xyz0(o)).collect();
     let kernel = Kernel {
         rings,
-        original,
+        original: &original,
         alpha_beta,
     };
     let mut written = false;
@@ -135,7 +137,7 @@ fn advance_planned<C: Constrain>(
 /// `(alpha, beta)`.
 struct Kernel<'a> {
     rings: KernelRings<'a>,
-    original: &'a [[f32; 3]],
+    original: &'a [[f32; 4]],
     alpha_beta: (f32, f32),
 }
 
@@ -143,14 +145,13 @@ impl Kernel<'_> {
     /// Pass 1 for one vertex: `mean_{N(i)} q - (alpha o_i + (1 - alpha) q_i)`; 0 for an
     /// isolated vertex (no ring reads it).
     #[inline(always)]
-    fn difference(&self, ring: Ring, q: &Field, qi: [f32; 4], oi: [f32; 3]) -> [f32; 4] {
+    fn difference(&self, ring: Ring, q: &Field, qi: [f32; 4], oi: [f32; 4]) -> [f32; 4] {
         if ring.is_empty() {
             return [0.0; 4];
         }
         let alpha = self.alpha_beta.0;
         let keep = 1.0 - alpha;
         let p = self.rings.mean(ring, q);
-        let oi = xyz0(oi);
         std::array::from_fn(|k| p[k] - (alpha * oi[k] + keep * qi[k]))
     }
 
@@ -162,7 +163,7 @@ impl Kernel<'_> {
         ring: Ring,
         b: &Field,
         bi: [f32; 4],
-        oi: [f32; 3],
+        oi: [f32; 4],
         qi: [f32; 4],
     ) -> Option<[f32; 4]> {
         if ring.is_empty() {
@@ -171,7 +172,6 @@ impl Kernel<'_> {
         let (alpha, beta) = self.alpha_beta;
         let (keep, spread) = (1.0 - alpha, 1.0 - beta);
         let mb = self.rings.mean(ring, b);
-        let oi = xyz0(oi);
         Some(std::array::from_fn(|k| {
             let p = bi[k] + alpha * oi[k] + keep * qi[k];
             p - (beta * bi[k] + spread * mb[k])
@@ -179,7 +179,7 @@ impl Kernel<'_> {
     }
 
     /// The original positions of chunk `c`.
-    fn originals(&self, c: usize) -> &[[f32; 3]] {
+    fn originals(&self, c: usize) -> &[[f32; 4]] {
         let n = self.original.len();
         &self.original[(c * CHUNK).min(n)..((c + 1) * CHUNK).min(n)]
     }
