@@ -4,12 +4,22 @@
 //! The kernels are generic over [`Constrain`], so the common unconstrained run compiles to a loop
 //! that reads neither weights nor original positions.
 
+use super::rings::{xyz, xyz0};
+
 /// Maps a filter's proposed position of vertex `i` to the position it takes.
 pub(crate) trait Constrain: Sync {
     /// True when `apply` always returns `proposed` (lets a filter skip a constrained copy).
     const IS_FREE: bool = false;
+    /// [`Self::apply`] on the kernels' four-lane entries (the fourth lane 0, and kept 0). The
+    /// kernels keep all four lanes: were the fourth dropped, the compiler would gather three
+    /// lanes of each neighbour (WebAssembly: a two-lane load, a one-lane load and scalar adds).
+    fn apply4(&self, i: usize, current: [f32; 4], proposed: [f32; 4]) -> [f32; 4];
+
     /// `current` is where the vertex is, `proposed` where the filter would put it.
-    fn apply(&self, i: usize, current: [f32; 3], proposed: [f32; 3]) -> [f32; 3];
+    #[inline(always)]
+    fn apply(&self, i: usize, current: [f32; 3], proposed: [f32; 3]) -> [f32; 3] {
+        xyz(self.apply4(i, xyz0(current), xyz0(proposed)))
+    }
 }
 
 /// No weights, no bound: the filter's position as proposed.
@@ -18,7 +28,7 @@ pub(crate) struct Free;
 impl Constrain for Free {
     const IS_FREE: bool = true;
     #[inline(always)]
-    fn apply(&self, _i: usize, _current: [f32; 3], proposed: [f32; 3]) -> [f32; 3] {
+    fn apply4(&self, _i: usize, _current: [f32; 4], proposed: [f32; 4]) -> [f32; 4] {
         proposed
     }
 }
@@ -54,7 +64,7 @@ impl<'a> Limits<'a> {
 
 impl Constrain for Limits<'_> {
     #[inline(always)]
-    fn apply(&self, i: usize, current: [f32; 3], proposed: [f32; 3]) -> [f32; 3] {
+    fn apply4(&self, i: usize, current: [f32; 4], proposed: [f32; 4]) -> [f32; 4] {
         let mut p = proposed;
         if let Some(w) = self.weights {
             // Written so that a NaN weight counts as 0 (locked) instead of spreading NaN.
@@ -66,19 +76,15 @@ impl Constrain for Limits<'_> {
             } else {
                 0.0
             };
-            p = [
-                current[0] + w * (p[0] - current[0]),
-                current[1] + w * (p[1] - current[1]),
-                current[2] + w * (p[2] - current[2]),
-            ];
+            p = std::array::from_fn(|k| current[k] + w * (p[k] - current[k]));
         }
         if let Some((d_max, original)) = self.bound {
-            let o = original[i];
-            let d = [p[0] - o[0], p[1] - o[1], p[2] - o[2]];
+            let o = xyz0(original[i]);
+            let d: [f32; 4] = std::array::from_fn(|k| p[k] - o[k]);
             let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             if len2 > d_max * d_max {
                 let s = d_max / len2.sqrt();
-                p = [o[0] + d[0] * s, o[1] + d[1] * s, o[2] + d[2] * s];
+                p = std::array::from_fn(|k| o[k] + d[k] * s);
             }
         }
         p

@@ -22,7 +22,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz, xyz0, Field, Fields, KernelRings, Ring, CHUNK};
+use super::rings::{xyz0, Field, Fields, KernelRings, Ring, CHUNK};
 use super::{follow_parts, FollowPart, StepObserver};
 
 /// How an iteration runs (see the module's documentation).
@@ -219,7 +219,7 @@ impl Kernel<'_> {
                 for (k, (((qi, &bi), &oi), ring)) in rows.zip(self.rings.chunk(c)).enumerate() {
                     if let Some(proposed) = self.corrected(ring, b, bi, oi, *qi) {
                         let i = c * CHUNK + k;
-                        *qi = xyz0(constraint.apply(i, xyz(*qi), xyz(proposed)));
+                        *qi = constraint.apply4(i, *qi, proposed);
                     }
                 }
                 if let Some(follow) = part {
@@ -246,7 +246,7 @@ impl Kernel<'_> {
             .zip(self.originals(c));
         for (k, (((o, (&qi, &bi)), &oi), ring)) in rows.zip(self.rings.chunk(c)).enumerate() {
             *o = match self.corrected(ring, b, bi, oi, qi) {
-                Some(proposed) => xyz0(constraint.apply(c * CHUNK + k, xyz(qi), xyz(proposed))),
+                Some(proposed) => constraint.apply4(c * CHUNK + k, qi, proposed),
                 None => qi,
             };
         }

@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::constraint::Constrain;
-use super::rings::{xyz, xyz0, Field, Fields, KernelRings, CHUNK};
+use super::rings::{Field, Fields, KernelRings, CHUNK};
 use super::{follow_parts, FollowPart, StepObserver};
 
 /// Runs iterations `done + 1 ..= done + more` of the umbrella steps `factors` (Laplace:
@@ -66,7 +66,7 @@ fn step<C: Constrain>(
                 } else {
                     let m = rings.mean(ring, src);
                     let proposed = std::array::from_fn(|k| q[k] + factor * (m[k] - q[k]));
-                    xyz0(constraint.apply(c * CHUNK + k, xyz(q), xyz(proposed)))
+                    constraint.apply4(c * CHUNK + k, q, proposed)
                 };
             }
             if let Some(follow) = part {
