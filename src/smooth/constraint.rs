@@ -12,7 +12,7 @@ pub(crate) trait Constrain: Sync {
     const IS_FREE: bool = false;
     /// [`Self::apply`] on the kernels' four-lane entries (the fourth lane 0, and kept 0). The
     /// kernels keep all four lanes: were the fourth dropped, the compiler would gather three
-    /// lanes of each neighbour (WebAssembly: a two-lane load, a one-lane load and scalar adds).
+    /// lanes of each neighbour, as a two-lane and a one-lane load with scalar adds.
     fn apply4(&self, i: usize, current: [f32; 4], proposed: [f32; 4]) -> [f32; 4];
 
     /// `current` is where the vertex is, `proposed` where the filter would put it.
