@@ -118,9 +118,9 @@ pub struct SuggestJob {
 #[derive(Clone, Debug)]
 pub struct SuggestAllPlan {
     options: SuggestAllOptions,
-    /// Structure indices in the order they are handed out.
+    /// Structure indices in the plan's order: learning, the smallest first.
     order: Vec<usize>,
-    /// How many of `order` have been handed out.
+    /// How many structures have been handed out ([`Self::position`] gives which).
     handed_out: usize,
     /// Per position in `order`: finished, with its suggestion's parameters if it got one.
     finished: Vec<Option<Option<Params>>>,
@@ -160,16 +160,37 @@ impl SuggestAllPlan {
         &self.options
     }
 
-    /// The structures in the order they are handed out.
+    /// The structures in the plan's order.
     pub fn order(&self) -> &[usize] {
         &self.order
+    }
+
+    /// The position in [`Self::order`] of the `k`-th structure handed out; as the order only
+    /// turns within a batch, also the reverse. Learning, a batch goes out its largest first: its starts come from the batches before
+    /// it whatever the order within it, and a large structure started last would leave the
+    /// other threads idle at the batch's end.
+    fn position(&self, k: usize) -> usize {
+        if !self.options.search.learns() {
+            return k;
+        }
+        let batch_start = k - k % LEARNING_BATCH;
+        let batch_len = LEARNING_BATCH.min(self.order.len() - batch_start);
+        batch_start + (batch_len - 1 - (k - batch_start))
+    }
+
+    /// Whether the structure at `position` in [`Self::order`] has been handed out.
+    fn handed(&self, position: usize) -> bool {
+        self.position(position) < self.handed_out
     }
 
     /// The next structure's part if it may start now: `None` when all are handed out, or
     /// learning, while the batch before it runs. `case` gives each structure's filter.
     pub fn next_job(&mut self, case: &Case) -> Option<SuggestJob> {
-        let position = self.handed_out;
-        let &structure = self.order.get(position)?;
+        if self.handed_out >= self.order.len() {
+            return None;
+        }
+        let position = self.position(self.handed_out);
+        let structure = self.order[position];
         if self.cancelled {
             return None;
         }
@@ -195,8 +216,8 @@ impl SuggestAllPlan {
     /// Structure `structure` finished, with its suggestion's parameters (`None`: none, as when
     /// it failed or had nothing to smooth).
     pub fn finish(&mut self, structure: usize, suggested: Option<Params>) {
-        let handed = &self.order[..self.handed_out];
-        if let Some(p) = handed.iter().position(|&i| i == structure) {
+        let position = self.order.iter().position(|&i| i == structure);
+        if let Some(p) = position.filter(|&p| self.handed(p)) {
             self.finished[p] = Some(suggested);
         }
     }
@@ -212,9 +233,8 @@ impl SuggestAllPlan {
 
     /// Handed out and not finished.
     pub fn running(&self) -> usize {
-        self.finished[..self.handed_out]
-            .iter()
-            .filter(|f| f.is_none())
+        (0..self.order.len())
+            .filter(|&p| self.handed(p) && self.finished[p].is_none())
             .count()
     }
 
@@ -514,9 +534,14 @@ mod tests {
         // The first batch and those it does not wait for, from the corners.
         let first: Vec<SuggestJob> = std::iter::from_fn(|| plan.next_job(&case)).collect();
         assert_eq!(first.len(), ahead);
+        // The smallest batch first, each batch its largest first.
         let smallest_first: Vec<usize> = (0..sizes.len()).rev().collect();
+        let by_batch: Vec<usize> = (smallest_first[..ahead].chunks(LEARNING_BATCH))
+            .flat_map(|batch| batch.iter().rev().copied())
+            .collect();
         let order: Vec<usize> = first.iter().map(|j| j.structure).collect();
-        assert_eq!(order, smallest_first[..ahead]);
+        assert_eq!(order, by_batch);
+        assert_eq!(plan.order(), smallest_first);
         assert!(first.iter().all(|j| j.starts.is_empty()), "the corners");
         let found = Params {
             iterations: 17,
