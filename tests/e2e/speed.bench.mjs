@@ -509,7 +509,9 @@ testIn(EVERY_RUN, "B9 Suggest all on the whole-body CT map (114 structures) in t
     // and the view worker, lent to Suggest all: N + 1 threads).
     const build = (threads) => cli.cliWithEnv({ RAYON_NUM_THREADS: String(threads) }, "case", "build", map, "--search", search, "-o", out, "--json").then(JSON.parse);
     const nativeOne = await build(1);
-    const native = await build(cpus().length);
+    // The faster of two runs on every core: on a busy machine one slow CLI run flatters the page.
+    const nativeRuns = [await build(cpus().length), await build(cpus().length)];
+    const native = nativeRuns.reduce((a, b) => (a.suggest_seconds <= b.suggest_seconds ? a : b));
     const same = (page) => page.all.structures.filter((s, i) => JSON.stringify(s.params) === JSON.stringify(native.structures[i].params)).length;
     const mb = (m) => ({ page_mb: m.page / 1e6, workers_mb: m.workers.map((b) => b / 1e6), all_mb: (m.page + m.workers.reduce((a, b) => a + b, 0)) / 1e6 });
     emit({
@@ -517,6 +519,7 @@ testIn(EVERY_RUN, "B9 Suggest all on the whole-body CT map (114 structures) in t
         page_one_worker_s: pages[1].seconds, page_two_workers_s: pages[2].seconds,
         cores: cpus().length, cli_suggest_one_thread_s: nativeOne.suggest_seconds,
         cli_suggest_all_cores_s: native.suggest_seconds, cli_case_build_s: native.seconds,
+        cli_suggest_all_cores_runs_s: nativeRuns.map((r) => r.suggest_seconds),
         one_worker_vs_cli: pages[1].seconds / native.suggest_seconds,
         two_workers_vs_cli: pages[2].seconds / native.suggest_seconds,
         memory_one_worker: mb(pages[1].memory), memory_two_workers: mb(pages[2].memory),
