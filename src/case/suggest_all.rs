@@ -166,9 +166,9 @@ impl SuggestAllPlan {
     }
 
     /// The position in [`Self::order`] of the `k`-th structure handed out; as the order only
-    /// turns within a batch, also the reverse. Learning, a batch goes out its largest first: its starts come from the batches before
-    /// it whatever the order within it, and a large structure started last would leave the
-    /// other threads idle at the batch's end.
+    /// turns within a batch, also the reverse. Learning, a batch goes out its largest first:
+    /// its starts come from the batches before it whatever the order within it, and a large
+    /// structure started last would leave the other threads idle at the batch's end.
     fn position(&self, k: usize) -> usize {
         if !self.options.search.learns() {
             return k;
@@ -233,9 +233,8 @@ impl SuggestAllPlan {
 
     /// Handed out and not finished.
     pub fn running(&self) -> usize {
-        (0..self.order.len())
-            .filter(|&p| self.handed(p) && self.finished[p].is_none())
-            .count()
+        // Only structures handed out finish.
+        self.handed_out - self.done()
     }
 
     /// Structures finished.
