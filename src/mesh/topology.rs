@@ -35,9 +35,23 @@ pub struct Topology {
     boundary_ring: Option<(Vec<u32>, Vec<u32>)>,
     /// The smoothing neighbourhood in fixed rows, as the CPU kernels read it.
     padded_ring: PaddedRing,
-    /// The vertex count `padded_ring` describes ([`PaddedRing::describes`]), checked once here:
-    /// every smoothing run asks, and the web app's runs come in many short pieces.
-    padded_ring_for: Option<usize>,
+    /// The vertex count `padded_ring` describes ([`PaddedRing::describes`]), checked once:
+    /// every smoothing run asks, and the web app's runs come in many short pieces. Not sent
+    /// with the rest: a topology read from a message is checked anew, as the kernels' gathers
+    /// rely on it.
+    #[serde(skip)]
+    padded_ring_for: DescribedCount,
+}
+
+/// The vertex count a padded ring describes, worked out when first asked. Derived from the
+/// rings, so it plays no part in comparing topologies.
+#[derive(Clone, Debug, Default)]
+struct DescribedCount(std::sync::OnceLock<Option<usize>>);
+
+impl PartialEq for DescribedCount {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl Topology {
@@ -86,7 +100,7 @@ impl Topology {
             Some((offsets, ring)) => PaddedRing::new(offsets, ring),
             None => PaddedRing::new(&neighbor_offsets, &neighbors),
         };
-        let padded_ring_for = padded_ring.describes(n).then_some(n);
+        let padded_ring_for = DescribedCount(padded_ring.describes(n).then_some(n).into());
 
         Self {
             neighbor_offsets,
@@ -140,7 +154,12 @@ impl Topology {
     /// Whether [`Self::padded_ring`] describes `vertex_count` vertices, so the kernels may
     /// gather with it from buffers of that many (see [`PaddedRing::describes`]).
     pub fn padded_ring_describes(&self, vertex_count: usize) -> bool {
-        self.padded_ring_for == Some(vertex_count)
+        let rows = self.padded_ring.rows.len();
+        let described = self
+            .padded_ring_for
+            .0
+            .get_or_init(|| self.padded_ring.describes(rows).then_some(rows));
+        *described == Some(vertex_count)
     }
 
     /// Number of distinct undirected edges.
@@ -180,6 +199,29 @@ mod tests {
             ],
             vec![[0, 1, 2], [0, 2, 3]],
         )
+    }
+
+    #[test]
+    fn a_topology_read_from_a_message_checks_its_padded_rows_anew() {
+        let t = Topology::build(&square());
+        assert!(t.padded_ring_describes(4));
+        let wire = postcard::to_allocvec(&t).expect("serializes");
+        let back: Topology = postcard::from_bytes(&wire).expect("reads back");
+        assert_eq!(back, t);
+        assert!(back.padded_ring_describes(4) && !back.padded_ring_describes(5));
+        // A row whose pad names a vertex past the last: the kernels must not gather with it.
+        let row: Vec<u8> = t.padded_ring().rows[1]
+            .iter()
+            .flat_map(|j| j.to_le_bytes())
+            .collect();
+        let at = wire
+            .windows(row.len())
+            .position(|w| w == row)
+            .expect("the row's bytes");
+        let mut lying = wire.clone();
+        lying[at + row.len() - 4..at + row.len()].copy_from_slice(&99u32.to_le_bytes());
+        let lying: Topology = postcard::from_bytes(&lying).expect("reads back");
+        assert!(!lying.padded_ring_describes(4));
     }
 
     #[test]

@@ -142,36 +142,29 @@ struct Kernel<'a> {
 }
 
 impl Kernel<'_> {
-    /// Pass 1 for one vertex: `mean_{N(i)} q - (alpha o_i + (1 - alpha) q_i)`; 0 for an
-    /// isolated vertex (no ring reads it).
+    /// Pass 1 for one vertex, its ring over `q`: `mean_{N(i)} q - (alpha o_i + (1 - alpha) q_i)`;
+    /// 0 for an isolated vertex (no ring reads it).
     #[inline(always)]
-    fn difference(&self, ring: Ring, q: &Field, qi: [f32; 4], oi: [f32; 4]) -> [f32; 4] {
+    fn difference(&self, ring: Ring, qi: [f32; 4], oi: [f32; 4]) -> [f32; 4] {
         if ring.is_empty() {
             return [0.0; 4];
         }
         let alpha = self.alpha_beta.0;
         let keep = 1.0 - alpha;
-        let p = self.rings.mean(ring, q);
+        let p = self.rings.mean(ring);
         std::array::from_fn(|k| p[k] - (alpha * oi[k] + keep * qi[k]))
     }
 
-    /// Pass 2 for one vertex, before the constraint: `p_i - (beta b_i + (1 - beta) mean b)`
-    /// (`None` for an isolated vertex: it keeps its place).
+    /// Pass 2 for one vertex, its ring over `b`, before the constraint: `p_i - (beta b_i + (1 -
+    /// beta) mean b)` (`None` for an isolated vertex: it keeps its place).
     #[inline(always)]
-    fn corrected(
-        &self,
-        ring: Ring,
-        b: &Field,
-        bi: [f32; 4],
-        oi: [f32; 4],
-        qi: [f32; 4],
-    ) -> Option<[f32; 4]> {
+    fn corrected(&self, ring: Ring, bi: [f32; 4], oi: [f32; 4], qi: [f32; 4]) -> Option<[f32; 4]> {
         if ring.is_empty() {
             return None;
         }
         let (alpha, beta) = self.alpha_beta;
         let (keep, spread) = (1.0 - alpha, 1.0 - beta);
-        let mb = self.rings.mean(ring, b);
+        let mb = self.rings.mean(ring);
         Some(std::array::from_fn(|k| {
             let p = bi[k] + alpha * oi[k] + keep * qi[k];
             p - (beta * bi[k] + spread * mb[k])
@@ -188,8 +181,8 @@ impl Kernel<'_> {
     fn differences_of_chunk(&self, c: usize, q: &Field, b: &mut [[f32; 4]]) {
         let own = &q.vertices()[c * CHUNK..];
         let rows = b.iter_mut().zip(own).zip(self.originals(c));
-        for (((bi, &qi), &oi), ring) in rows.zip(self.rings.chunk(c)) {
-            *bi = self.difference(ring, q, qi, oi);
+        for (((bi, &qi), &oi), ring) in rows.zip(self.rings.chunk(c, q)) {
+            *bi = self.difference(ring, qi, oi);
         }
     }
 
@@ -216,8 +209,8 @@ impl Kernel<'_> {
             .for_each(|(c, (q, part))| {
                 let own_b = &b.vertices()[c * CHUNK..];
                 let rows = q.iter_mut().zip(own_b).zip(self.originals(c));
-                for (k, (((qi, &bi), &oi), ring)) in rows.zip(self.rings.chunk(c)).enumerate() {
-                    if let Some(proposed) = self.corrected(ring, b, bi, oi, *qi) {
+                for (k, (((qi, &bi), &oi), ring)) in rows.zip(self.rings.chunk(c, b)).enumerate() {
+                    if let Some(proposed) = self.corrected(ring, bi, oi, *qi) {
                         let i = c * CHUNK + k;
                         *qi = constraint.apply4(i, *qi, proposed);
                     }
@@ -244,8 +237,8 @@ impl Kernel<'_> {
             .iter_mut()
             .zip(own_q.iter().zip(own_b))
             .zip(self.originals(c));
-        for (k, (((o, (&qi, &bi)), &oi), ring)) in rows.zip(self.rings.chunk(c)).enumerate() {
-            *o = match self.corrected(ring, b, bi, oi, qi) {
+        for (k, (((o, (&qi, &bi)), &oi), ring)) in rows.zip(self.rings.chunk(c, b)).enumerate() {
+            *o = match self.corrected(ring, bi, oi, qi) {
                 Some(proposed) => constraint.apply4(c * CHUNK + k, qi, proposed),
                 None => qi,
             };

@@ -11,8 +11,8 @@ use crate::mesh::{PaddedRing, Topology, PADDED_WIDTH};
 pub(crate) const CHUNK: usize = 1024;
 
 /// The smoothing neighbourhood as the kernels read it (`Topology::padded_ring`), checked once
-/// against the vertex count, so every kernel can gather neighbours without further checks
-/// failing.
+/// against the vertex count, so the kernels gather neighbours without a check per slot: eight
+/// checks a row kept all eight indices live at once, and WebAssembly's compilers spilled them.
 #[derive(Clone, Copy)]
 pub(crate) struct KernelRings<'a> {
     padded: &'a PaddedRing,
@@ -42,32 +42,45 @@ impl<'a> KernelRings<'a> {
     }
 
     /// The rings of the vertices of chunk `c` (`c * CHUNK ..`, at most `CHUNK` of them), in
-    /// order.
+    /// order, each over `field`, the values its mean reads.
+    ///
+    /// # Panics
+    /// If `field` is not a field of this many vertices.
     #[inline(always)]
-    pub(crate) fn chunk(&self, c: usize) -> impl Iterator<Item = Ring<'a>> + 'a {
+    pub(crate) fn chunk(&self, c: usize, field: &'a Field) -> impl Iterator<Item = Ring<'a>> + 'a {
+        // What makes the gathers of `mean` safe: every slot of a row that fits names at most
+        // the vertex count (`new`), and `field` holds that many entries and one more.
+        assert_eq!(field.0.len(), self.vertex_count + 1, "a field of this mesh");
+        let field = &field.0[..];
         let start = (c * CHUNK).min(self.vertex_count());
         let end = (start + CHUNK).min(self.vertex_count());
         self.padded.rows[start..end]
             .iter()
             .zip(&self.padded.inverse_sizes[start..end])
-            .map(|(row, &inverse_size)| Ring { row, inverse_size })
+            .map(move |(row, &inverse_size)| Ring {
+                row,
+                inverse_size,
+                field,
+            })
     }
 
-    /// Mean of `q` over `ring` (which must not be empty). `q` holds every vertex and the zero
-    /// entry after them ([`Field`]).
+    /// Mean of the ring's field over `ring` (which must not be empty).
     ///
     /// A row's slots go into four sums of two: a fixed loop without branches, four independent
     /// add chains, and a vertex's four lanes in one vector register.
     #[inline(always)]
-    pub(crate) fn mean(&self, ring: Ring, q: &Field) -> [f32; 4] {
-        let q = &q.0[..];
+    pub(crate) fn mean(&self, ring: Ring) -> [f32; 4] {
+        let q = ring.field;
         if !PaddedRing::fits(ring.inverse_size) {
             return self.large_mean(ring.row, q);
         }
         let r = ring.row;
+        // SAFETY: `ring` comes from `chunk`, whose rows fit only where every slot is at most
+        // the vertex count they were checked against, and whose field has one entry more.
+        let at = |slot: usize| unsafe { *q.get_unchecked(r[slot] as usize) };
         let mut sums = [[0.0f32; 4]; 4];
         for (h, sum) in sums.iter_mut().enumerate() {
-            let (a, b) = (q[r[2 * h] as usize], q[r[2 * h + 1] as usize]);
+            let (a, b) = (at(2 * h), at(2 * h + 1));
             for k in 0..4 {
                 sum[k] = a[k] + b[k];
             }
@@ -102,11 +115,13 @@ impl<'a> KernelRings<'a> {
     }
 }
 
-/// One vertex's smoothing ring.
+/// One vertex's smoothing ring, over the field its mean reads (made only by
+/// [`KernelRings::chunk`]).
 #[derive(Clone, Copy)]
 pub(crate) struct Ring<'a> {
     row: &'a [u32; PADDED_WIDTH],
     inverse_size: f32,
+    field: &'a [[f32; 4]],
 }
 
 impl Ring<'_> {
@@ -227,8 +242,8 @@ mod tests {
             let rings = KernelRings::new(&topology, n).expect("built for this mesh");
             let q = Field::from_points(&mesh.positions);
             let means: Vec<Option<[f32; 4]>> = (0..n.div_ceil(CHUNK))
-                .flat_map(|c| rings.chunk(c).collect::<Vec<_>>())
-                .map(|ring| (!ring.is_empty()).then(|| rings.mean(ring, &q)))
+                .flat_map(|c| rings.chunk(c, &q).collect::<Vec<_>>())
+                .map(|ring| (!ring.is_empty()).then(|| rings.mean(ring)))
                 .collect();
             assert_eq!(means.len(), n);
             for (i, m) in means.iter().enumerate() {
@@ -249,6 +264,18 @@ mod tests {
             }
             assert!(means[n - 1].is_none(), "the isolated vertex");
         }
+    }
+
+    #[test]
+    #[should_panic(expected = "a field of this mesh")]
+    fn rings_refuse_a_field_of_another_size() {
+        let mesh = double_cone(5);
+        let topology = Topology::build(&mesh);
+        let n = mesh.vertex_count();
+        let rings = KernelRings::new(&topology, n).expect("built for this mesh");
+        // Its zero entry would be read as a vertex, and a pad slot past its end.
+        let short = Field::zeros(n - 1);
+        let _ = rings.chunk(0, &short).count();
     }
 
     #[test]

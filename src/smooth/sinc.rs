@@ -181,13 +181,13 @@ fn first_term(
         .enumerate()
         .for_each(|(c, ((t1, e), (own, orig)))| {
             let rows = t1.iter_mut().zip(e.iter_mut()).zip(own.iter().zip(orig));
-            for (((t1, e), (&z, &o)), ring) in rows.zip(rings.chunk(c)) {
+            for (((t1, e), (&z, &o)), ring) in rows.zip(rings.chunk(c, z0)) {
                 if ring.is_empty() {
                     *t1 = z;
                     *e = o;
                     continue;
                 }
-                let m = rings.mean(ring, z0);
+                let m = rings.mean(ring);
                 *t1 = std::array::from_fn(|k| 0.5 * (z[k] + m[k]));
                 *e = std::array::from_fn(|k| centre[k] + c0 * z[k] + c1 * t1[k]);
             }
@@ -209,14 +209,18 @@ fn next_term(
         .zip(current.vertices().par_chunks(CHUNK))
         .enumerate()
         .for_each(|(c, ((t, e), own))| {
-            let rows = t.iter_mut().zip(e.iter_mut()).zip(own).zip(rings.chunk(c));
+            let rows = t
+                .iter_mut()
+                .zip(e.iter_mut())
+                .zip(own)
+                .zip(rings.chunk(c, current));
             for (((t, e), &tk), ring) in rows {
                 if ring.is_empty() {
                     // L = 0 there: every T_k x equals x, and the estimate stays the original.
                     *t = tk;
                     continue;
                 }
-                let m = rings.mean(ring, current);
+                let m = rings.mean(ring);
                 for k in 0..4 {
                     t[k] = tk[k] + m[k] - t[k];
                 }

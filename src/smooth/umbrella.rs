@@ -59,12 +59,12 @@ fn step<C: Constrain>(
         .zip(parts.par_iter_mut())
         .enumerate()
         .for_each(|(c, ((dst, own), part))| {
-            let rows = dst.iter_mut().zip(own).zip(rings.chunk(c)).enumerate();
+            let rows = dst.iter_mut().zip(own).zip(rings.chunk(c, src)).enumerate();
             for (k, ((out, &q), ring)) in rows {
                 *out = if ring.is_empty() {
                     q
                 } else {
-                    let m = rings.mean(ring, src);
+                    let m = rings.mean(ring);
                     let proposed = std::array::from_fn(|k| q[k] + factor * (m[k] - q[k]));
                     constraint.apply4(c * CHUNK + k, q, proposed)
                 };
